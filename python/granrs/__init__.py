@@ -1,0 +1,51 @@
+"""granrs: rods, linkages and feet sinking into sand.
+
+A Rust-accelerated simulator of the granular resistance force of "Bipedal impact with
+granular matter" (dynamic drag plus static depth-dependent terms) acting on planar rigid
+and articulated bodies, integrated with a fixed-step RK4 at 10 kHz and exact events.
+
+Quick start::
+
+    import granrs
+    scene = granrs.cases.free_link(q_deg=45, v0=2.27)   # the thesis's steel rod
+    result = granrs.simulate(scene)
+    print(result.t_s, result.depth, result.summary["dE"])
+"""
+
+from __future__ import annotations
+
+from . import _granrs, cases, coefficients, data
+from .api import simulate
+from .coefficients import Coefficients
+from .errors import (
+    CoefficientTableError,
+    GranrsError,
+    InvalidParameterError,
+    InvalidSceneError,
+    SimulationError,
+    UnknownNameError,
+)
+from .result import ContactResult, Result
+from .scene import EFFECTS, RECORDS, Scene
+
+__version__: str = _granrs.__version__
+
+__all__ = [
+    "EFFECTS",
+    "RECORDS",
+    "CoefficientTableError",
+    "Coefficients",
+    "ContactResult",
+    "GranrsError",
+    "InvalidParameterError",
+    "InvalidSceneError",
+    "Result",
+    "Scene",
+    "SimulationError",
+    "UnknownNameError",
+    "__version__",
+    "cases",
+    "coefficients",
+    "data",
+    "simulate",
+]

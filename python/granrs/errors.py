@@ -1,0 +1,48 @@
+"""The granrs exception tree.
+
+Every error granrs raises on purpose derives from :class:`GranrsError`. Errors caused by
+the caller's input also derive from :class:`ValueError`, so ``except ValueError`` keeps
+working for code that does not know granrs.
+
+The Rust core raises the same classes: its one error enum is converted exhaustively in
+``rust/python/mod.rs``.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "GranrsError",
+    "InvalidSceneError",
+    "InvalidParameterError",
+    "UnknownNameError",
+    "CoefficientTableError",
+    "SimulationError",
+]
+
+
+class GranrsError(Exception):
+    """Base class of every error granrs raises on purpose."""
+
+
+class InvalidSceneError(GranrsError, ValueError):
+    """A scene (or one of its fields) is not valid. ``field`` names the offending field."""
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
+
+
+class InvalidParameterError(InvalidSceneError):
+    """A numeric field is out of its allowed range (negative mass, NaN speed, ...)."""
+
+
+class UnknownNameError(InvalidSceneError):
+    """A name (coefficient table, point of application, effect, ...) is not one granrs knows."""
+
+
+class CoefficientTableError(InvalidSceneError):
+    """A coefficient table could not be read or holds invalid values."""
+
+
+class SimulationError(GranrsError, RuntimeError):
+    """The integration itself failed (a non-finite state); never raised for bad input."""

@@ -1,0 +1,149 @@
+"""What a run returns: :class:`Result` (and :class:`ContactResult` per contact)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .scene import Scene
+
+__all__ = ["ContactResult", "Result", "SUMMARY_UNITS"]
+
+#: Units of the summary fields.
+SUMMARY_UNITS: dict[str, str] = {
+    "t_s": "s",
+    "depth": "m",
+    "dq": "rad",
+    "omega_end": "rad/s",
+    "F_d_max": "N",
+    "F_s_end": "N",
+    "F_r_end": "N",
+    "dKE": "J",
+    "dPE": "J",
+    "dE": "J",
+    "work_sand": "J",
+    "x_tip_end": "m",
+    "t_entry": "s",
+    "steps": "-",
+    "rhs_evals": "-",
+    "root_evals": "-",
+    "events": "-",
+}
+
+# Friendly names of the generalized coordinates of each body.
+_COORDS = {"free_link": ("x", "y", "q")}
+_RATES = {"free_link": ("vx", "vy", "omega")}
+
+
+@dataclass(frozen=True)
+class ContactResult:
+    """The results of one contact.
+
+    Attributes:
+        t_s: stopping time [s]: when the tip's vertical velocity reaches zero from below
+            (NaN if it did not stop).
+        depth: depth of the tip at the stop (or at the end without one) [m].
+        stopped: whether the stop happened.
+        summary: every scalar result of the contact (see ``SUMMARY_UNITS``).
+    """
+
+    t_s: float
+    depth: float
+    stopped: bool
+    summary: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Result:
+    """The outcome of :func:`granrs.simulate`.
+
+    Attributes:
+        scene: the scene that was run.
+        status: ``"stopped"``, ``"end_time"`` (ran to t_end as asked) or ``"not_stopped"``
+            (t_end came before the stop the scene waits for).
+        t_s: stopping time of contact 0 [s] (NaN if it did not stop).
+        depth: depth of contact 0 at its stop [m].
+        summary: contact 0's results plus the run's: t_s, depth, dq, omega_end, F_d_max,
+            F_s_end, F_r_end, dKE, dPE, dE (thesis eqs. 3.22-3.26), steps, rhs_evals, ...
+        contacts: per contact.
+        series: recorded time series (numpy arrays by name), or None.
+    """
+
+    scene: Scene
+    status: str
+    t_s: float
+    depth: float
+    summary: dict[str, Any]
+    contacts: list[ContactResult]
+    series: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    @classmethod
+    def _from_raw(cls, scene: Scene, raw: dict[str, Any]) -> Result:
+        stats = raw["stats"]
+        contacts = []
+        for c in raw["contacts"]:
+            summary = {k: v for k, v in c.items() if k != "stopped"}
+            contacts.append(
+                ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=c["stopped"], summary=summary)
+            )
+        summary = dict(contacts[0].summary)
+        summary.update(stats)
+        summary["status"] = raw["status"]
+        summary["t_final"] = raw["t_final"]
+        summary["energy_start"] = raw["energy_start"]
+        summary["energy_end"] = raw["energy_end"]
+        return cls(
+            scene=scene,
+            status=raw["status"],
+            t_s=contacts[0].t_s,
+            depth=contacts[0].depth,
+            summary=summary,
+            contacts=contacts,
+            series=_rename_series(scene, raw["series"], len(contacts)),
+        )
+
+    @property
+    def stopped(self) -> bool:
+        """Whether the run ended on its stop condition."""
+        return self.status == "stopped"
+
+    def to_frame(self) -> Any:
+        """The recorded series as a pandas DataFrame indexed by time."""
+        import pandas as pd
+
+        if self.series is None:
+            raise ValueError("nothing was recorded: set Scene.record, e.g. record=('state',)")
+        frame = pd.DataFrame(self.series)
+        return frame.set_index("t")
+
+    def __repr__(self) -> str:
+        t_s = "not stopped" if math.isnan(self.t_s) else f"{self.t_s * 1e3:.4f} ms"
+        return (
+            f"Result(status={self.status!r}, t_s={t_s}, depth={self.depth * 1e3:.4f} mm, "
+            f"steps={self.summary['steps']}, rhs_evals={self.summary['rhs_evals']})"
+        )
+
+
+def _rename_series(
+    scene: Scene, raw: dict[str, np.ndarray] | None, n_contacts: int
+) -> dict[str, np.ndarray] | None:
+    if raw is None:
+        return None
+    coords = _COORDS.get(scene.body, ())
+    rates = _RATES.get(scene.body, ())
+    out: dict[str, np.ndarray] = {}
+    for name, values in raw.items():
+        new = name
+        if name.startswith("qd") and name[2:].isdigit() and int(name[2:]) < len(rates):
+            new = rates[int(name[2:])]
+        elif name.startswith("q") and name[1:].isdigit() and int(name[1:]) < len(coords):
+            new = coords[int(name[1:])]
+        elif n_contacts == 1 and name.startswith("c0."):
+            new = name[3:]
+        out[new] = values
+    if "KE" in out and "PE" in out:
+        out["E"] = out["KE"] + out["PE"]
+    return out

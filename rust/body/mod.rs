@@ -1,0 +1,12 @@
+//! Bodies: planar trees of rigid links with a floating base, and the rod contact geometry.
+//!
+//! One formulation serves every body model (free link, two-link chain, leg): generalized
+//! coordinates `[x_root, y_root, q_0, ..., q_{n-1}]` (a root point and the absolute angle
+//! of each link from the vertical), a mass matrix and generalized forces obtained from
+//! each contact's force through the Jacobian of its point of application.
+
+pub mod mechanism;
+pub mod rod;
+
+pub use mechanism::{Link, Mechanism};
+pub use rod::{RodContact, RodGeometry};

@@ -1,0 +1,62 @@
+//! The one error type of the Rust core.
+//!
+//! Every variant names the field at fault, so that the Python layer (see
+//! `rust/python/mod.rs`) can raise a typed exception that says what is wrong before
+//! any simulation runs. An event (a stop, the end time) is an outcome, never an error.
+
+use thiserror::Error;
+
+/// Why a scene was refused or a run failed.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum GranrsError {
+    /// A numeric field is out of its allowed range (negative mass, NaN speed, ...).
+    #[error("invalid value for `{field}`: {value} (allowed: {allowed})")]
+    InvalidParameter {
+        field: String,
+        value: f64,
+        allowed: String,
+    },
+    /// A name (point of application, sign model, end condition, ...) is unknown.
+    #[error("unknown {field} `{value}` (allowed: {allowed})")]
+    UnknownName {
+        field: String,
+        value: String,
+        allowed: String,
+    },
+    /// A scene is inconsistent as a whole (e.g. a contact on a link that does not exist).
+    #[error("invalid scene: `{field}`: {message}")]
+    InvalidScene { field: String, message: String },
+    /// The state became non-finite during integration. Never raised for valid input
+    /// unless the physics itself blows up; the message says when and where.
+    #[error("integration failed at t = {t} s: {message}")]
+    NonFinite { t: f64, message: String },
+}
+
+pub type Result<T> = std::result::Result<T, GranrsError>;
+
+/// Check that `value` is finite and at least `min` (or strictly above it).
+pub fn check_range(field: &str, value: f64, min: f64, strict: bool) -> Result<f64> {
+    let ok = value.is_finite() && if strict { value > min } else { value >= min };
+    if ok {
+        Ok(value)
+    } else {
+        Err(GranrsError::InvalidParameter {
+            field: field.to_string(),
+            value,
+            allowed: format!("finite, {} {}", if strict { ">" } else { ">=" }, min),
+        })
+    }
+}
+
+/// Check that `value` is finite.
+pub fn check_finite(field: &str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(GranrsError::InvalidParameter {
+            field: field.to_string(),
+            value,
+            allowed: "finite".to_string(),
+        })
+    }
+}

@@ -1,0 +1,710 @@
+//! The solve loop: fixed-step RK4 on a fixed time grid, with every discontinuity of the
+//! force law (surface entry and exit, a sign switch, the end of a stick) and every stop
+//! located on the step's Hermite interpolant and restarted from exactly there.
+//!
+//! The loop keeps the grid `t_n = n dt` (computed by multiplication, so round-off never adds
+//! a step past `t_end`): after an event the step to the next grid point is shortened. An
+//! event is an outcome, reported in [`Status`]; only a non-finite state is an error.
+
+use nalgebra::{SVector, Vector2};
+
+use super::dense::{locate, Hermite};
+use super::rk4::{deriv_of, step, Deriv, State};
+use crate::dynamics::{ContactMode, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
+use crate::error::{GranrsError, Result};
+
+/// When a run ends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EndCondition {
+    /// At the first stop of any contact (the thesis's end of the penetration phase).
+    FirstStop,
+    /// When every contact has stopped.
+    AllStops,
+    /// At `t_end`, whatever happens before.
+    Time,
+}
+
+/// What to record as time series. Nothing is stored for a field that is off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Record {
+    /// Generalized coordinates and rates, and the work of the sand.
+    pub state: bool,
+    /// Per contact: tip position and velocity, depth, and the four force components.
+    pub forces: bool,
+    /// Kinetic and potential energy.
+    pub energy: bool,
+    /// Record every `stride`-th grid step (events are always recorded). 0 means 1.
+    pub stride: usize,
+}
+
+impl Record {
+    /// Whether anything is recorded.
+    pub fn any(&self) -> bool {
+        self.state || self.forces || self.energy
+    }
+}
+
+/// Options of one run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveOptions {
+    /// Step size of the fixed grid [s] (thesis: 10 kHz, 1e-4 s).
+    pub dt: f64,
+    /// Latest end time [s].
+    pub t_end: f64,
+    /// When to end.
+    pub end: EndCondition,
+    /// What to record.
+    pub record: Record,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            dt: 1e-4,
+            t_end: 1.0,
+            end: EndCondition::FirstStop,
+            record: Record::default(),
+        }
+    }
+}
+
+/// Why a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// The end condition's stop(s) happened.
+    Stopped,
+    /// `t_end` was reached with the end condition `Time`.
+    EndTime,
+    /// `t_end` was reached before the stop(s) the end condition waits for.
+    NotStopped,
+}
+
+impl Status {
+    /// A short name for reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Status::Stopped => "stopped",
+            Status::EndTime => "end_time",
+            Status::NotStopped => "not_stopped",
+        }
+    }
+}
+
+/// Work counters of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Stats {
+    /// Accepted steps (full and shortened).
+    pub steps: usize,
+    /// Right-hand-side evaluations, root finding included.
+    pub rhs_evals: usize,
+    /// Right-hand-side evaluations spent locating events.
+    pub root_evals: usize,
+    /// Events handled (entries, exits, sign switches, sticks, stops).
+    pub events: usize,
+}
+
+/// The results of one contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSummary {
+    /// Whether the contact's stop happened.
+    pub stopped: bool,
+    /// Time of the stop (NaN without one) [s].
+    pub t_s: f64,
+    /// Depth of the tip at the stop, or at the end without one [m].
+    pub depth: f64,
+    /// Change of the contact link's angle from the start to the stop [rad].
+    pub dq: f64,
+    /// Angular velocity dq/dt of the contact link at the stop [rad/s].
+    pub omega_end: f64,
+    /// Largest |F_d| before the stop, over step ends and events [N] (eq. 3.23).
+    pub f_d_max: f64,
+    /// |F_s| at the stop, as the stop is approached [N] (eq. 3.22).
+    pub f_s_end: f64,
+    /// |F_r| at the stop [N] (eq. 3.24).
+    pub f_r_end: f64,
+    /// Kinetic energy lost from the start to the stop, KE(0) - KE(t_s) [J] (eq. 3.25).
+    pub d_ke: f64,
+    /// Potential energy lost, PE(0) - PE(t_s) [J] (eq. 3.26).
+    pub d_pe: f64,
+    /// Mechanical energy lost, dKE + dPE [J].
+    pub d_e: f64,
+    /// Work done by the sand on the body up to the stop (integrated power) [J].
+    pub work_sand: f64,
+    /// Tip position at the stop (or end) [m].
+    pub tip_end: Vector2<f64>,
+    /// Time the tip entered the sand (NaN if it never did) [s].
+    pub t_entry: f64,
+}
+
+/// Recorded time series, column by column (each the same length as `t`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// Time [s].
+    pub t: Vec<f64>,
+    /// Named columns.
+    pub columns: Vec<(String, Vec<f64>)>,
+}
+
+/// What a run returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// Why it ended.
+    pub status: Status,
+    /// Time it ended [s].
+    pub t_final: f64,
+    /// Work counters.
+    pub stats: Stats,
+    /// Per contact.
+    pub contacts: Vec<ContactSummary>,
+    /// Mechanical energy KE + PE at the start and the end [J].
+    pub energy_start: f64,
+    /// See `energy_start`.
+    pub energy_end: f64,
+    /// Work done by the sand over the whole run [J].
+    pub work_sand: f64,
+    /// Time series, if any were asked for.
+    pub series: Option<Series>,
+}
+
+/// Relative tolerance of event location, in units of the step.
+const ROOT_TOL: f64 = 1e-13;
+/// Events closer than this (in units of the step) to the earliest are handled with it.
+const SIMULTANEOUS: f64 = 1e-9;
+/// At most this many events within one grid step before the step is taken as it is.
+const MAX_EVENTS_PER_STEP: usize = 32;
+
+/// Kind of a switching function.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Entry,
+    Exit,
+    SlipX,
+    SlipY,
+    StickX,
+    StickY,
+    Stop,
+}
+
+/// The value of a switching function: non-negative while the mode holds; the event is
+/// where it turns negative (the stop: where -v_Ty reaches zero).
+fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) -> f64 {
+    let c = &e.contacts[ci];
+    match kind {
+        Kind::Entry => c.tip.y,
+        Kind::Exit => -c.tip.y,
+        Kind::SlipX => modes[ci].sx.sign() * c.v_centroid.x,
+        Kind::SlipY => modes[ci].sy.sign() * c.v_centroid.y,
+        Kind::StickX => c.bound_h - c.force.static_h.abs(),
+        Kind::StickY => c.bound_v - c.force.static_v.abs(),
+        Kind::Stop => -c.v_tip.y,
+    }
+}
+
+/// The switching functions active under `modes`.
+fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, usize)>) {
+    out.clear();
+    let with_modes = model.sign_model == SignModel::Modes;
+    for (ci, m) in modes.iter().enumerate().take(model.contacts.len()) {
+        if !m.in_contact {
+            out.push((Kind::Entry, ci));
+            continue;
+        }
+        out.push((Kind::Exit, ci));
+        if !m.stopped {
+            out.push((Kind::Stop, ci));
+        }
+        if with_modes {
+            if model.effects.static_h {
+                out.push((
+                    if m.sx == Slip::Stick {
+                        Kind::StickX
+                    } else {
+                        Kind::SlipX
+                    },
+                    ci,
+                ));
+            }
+            if model.effects.static_v {
+                out.push((
+                    if m.sy == Slip::Stick {
+                        Kind::StickY
+                    } else {
+                        Kind::SlipY
+                    },
+                    ci,
+                ));
+            }
+        }
+    }
+}
+
+/// Whether the function has crossed (the event happened by the end of the step).
+#[inline]
+fn crossed(kind: Kind, g1: f64) -> bool {
+    if kind == Kind::Stop {
+        g1 <= 0.0
+    } else {
+        g1 < 0.0
+    }
+}
+
+/// Choose the mode of the static term along `axis` of contact `ci` at a state where its
+/// velocity component is (about) zero: stick if the reaction that holds it is within the
+/// static bound, else slip the way the other forces push (Karnopp). `probe` is the state
+/// at which to judge (the event point, or the step's end when the event is at its start).
+fn choose_slip<const N: usize>(
+    model: &Model<N>,
+    modes: &mut Modes,
+    ci: usize,
+    axis: usize,
+    probe: &State<N>,
+    stats: &mut Stats,
+) {
+    let mut trial = *modes;
+    if axis == 0 {
+        trial[ci].sx = Slip::Stick;
+    } else {
+        trial[ci].sy = Slip::Stick;
+    }
+    let e = model.eval(&probe.q, &probe.qd, &trial);
+    stats.rhs_evals += 1;
+    let c = &e.contacts[ci];
+    let (reaction, bound, v) = if axis == 0 {
+        (c.force.static_h, c.bound_h, c.v_centroid.x)
+    } else {
+        (c.force.static_v, c.bound_v, c.v_centroid.y)
+    };
+    // A probe that already moves decidedly keeps its direction.
+    let slip = if reaction.abs() <= bound {
+        Slip::Stick
+    } else if reaction > 0.0 {
+        Slip::Neg
+    } else if reaction < 0.0 {
+        Slip::Pos
+    } else if v < 0.0 {
+        Slip::Neg
+    } else {
+        Slip::Pos
+    };
+    if axis == 0 {
+        modes[ci].sx = slip;
+    } else {
+        modes[ci].sy = slip;
+    }
+}
+
+/// The modes at a state where contact `ci` has just entered the sand (or starts in it).
+fn enter_contact<const N: usize>(
+    model: &Model<N>,
+    modes: &mut Modes,
+    ci: usize,
+    y: &State<N>,
+    probe: &State<N>,
+    stats: &mut Stats,
+) {
+    modes[ci].in_contact = true;
+    if model.sign_model != SignModel::Modes {
+        return;
+    }
+    let e = model.eval(&y.q, &y.qd, modes);
+    stats.rhs_evals += 1;
+    let v = e.contacts[ci].v_centroid;
+    for axis in 0..2 {
+        let vk = if axis == 0 { v.x } else { v.y };
+        let slip = if vk < 0.0 {
+            Some(Slip::Neg)
+        } else if vk > 0.0 {
+            Some(Slip::Pos)
+        } else {
+            None
+        };
+        match slip {
+            Some(s) if axis == 0 => modes[ci].sx = s,
+            Some(s) => modes[ci].sy = s,
+            None => choose_slip(model, modes, ci, axis, probe, stats),
+        }
+    }
+}
+
+/// Recorder of time series.
+struct Recorder {
+    on: Record,
+    n_dof: usize,
+    n_contacts: usize,
+    t: Vec<f64>,
+    cols: Vec<Vec<f64>>,
+    names: Vec<String>,
+}
+
+impl Recorder {
+    fn new(on: Record, n_dof: usize, n_contacts: usize) -> Self {
+        let mut names = Vec::new();
+        if on.state {
+            for i in 0..n_dof {
+                names.push(format!("q{i}"));
+            }
+            for i in 0..n_dof {
+                names.push(format!("qd{i}"));
+            }
+            names.push("work_sand".into());
+        }
+        if on.forces {
+            for c in 0..n_contacts {
+                for f in [
+                    "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "F_dx", "F_dy", "F_sh", "F_sv",
+                ] {
+                    names.push(format!("c{c}.{f}"));
+                }
+            }
+        }
+        if on.energy {
+            names.push("KE".into());
+            names.push("PE".into());
+        }
+        let cols = vec![Vec::new(); names.len()];
+        Recorder {
+            on,
+            n_dof,
+            n_contacts,
+            t: Vec::new(),
+            cols,
+            names,
+        }
+    }
+
+    fn push<const N: usize>(&mut self, model: &Model<N>, t: f64, y: &State<N>, e: &Eval<N>) {
+        if !self.on.any() {
+            return;
+        }
+        self.t.push(t);
+        let mut k = 0;
+        let mut put = |cols: &mut Vec<Vec<f64>>, v: f64| {
+            cols[k].push(v);
+            k += 1;
+        };
+        if self.on.state {
+            for i in 0..self.n_dof {
+                put(&mut self.cols, y.q[i]);
+            }
+            for i in 0..self.n_dof {
+                put(&mut self.cols, y.qd[i]);
+            }
+            put(&mut self.cols, y.work);
+        }
+        if self.on.forces {
+            for c in &e.contacts[..self.n_contacts] {
+                for v in [
+                    c.tip.x,
+                    c.tip.y,
+                    c.v_tip.x,
+                    c.v_tip.y,
+                    (-c.tip.y).max(0.0),
+                    c.force.drag.x,
+                    c.force.drag.y,
+                    c.force.static_h,
+                    c.force.static_v,
+                ] {
+                    put(&mut self.cols, v);
+                }
+            }
+        }
+        if self.on.energy {
+            let (ke, pe) = model.energies(&y.q, &y.qd);
+            put(&mut self.cols, ke);
+            put(&mut self.cols, pe);
+        }
+    }
+
+    fn finish(self) -> Option<Series> {
+        if !self.on.any() {
+            return None;
+        }
+        Some(Series {
+            t: self.t,
+            columns: self.names.into_iter().zip(self.cols).collect(),
+        })
+    }
+}
+
+/// Run `model` from `y0` at `t = 0` with `options`.
+pub fn solve<const N: usize>(
+    model: &Model<N>,
+    q0: SVector<f64, N>,
+    qd0: SVector<f64, N>,
+    options: &SolveOptions,
+) -> Result<Outcome> {
+    let nc = model.contacts.len();
+    let dt = options.dt;
+    let mut stats = Stats::default();
+    let mut y = State {
+        q: q0,
+        qd: qd0,
+        work: 0.0,
+    };
+    let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
+
+    // Initial modes: a tip below the surface, or at it and moving down, is in contact.
+    let e_free = model.eval(&y.q, &y.qd, &modes);
+    stats.rhs_evals += 1;
+    for ci in 0..nc {
+        let c = &e_free.contacts[ci];
+        if c.tip.y < 0.0 || (c.tip.y == 0.0 && c.v_tip.y < 0.0) {
+            // Judge a zero velocity component a little later: take a probe step free of
+            // the static terms' signs (they are zero at the surface).
+            let k1 = deriv_of(&y, &e_free);
+            let probe = y.add(dt, &k1);
+            enter_contact(model, &mut modes, ci, &y, &probe, &mut stats);
+        }
+    }
+
+    let (ke0, pe0) = model.energies(&y.q, &y.qd);
+    let energy_start = ke0 + pe0;
+    let mut summaries: Vec<ContactSummary> = (0..nc)
+        .map(|ci| ContactSummary {
+            stopped: false,
+            t_s: f64::NAN,
+            depth: 0.0,
+            dq: 0.0,
+            omega_end: 0.0,
+            f_d_max: 0.0,
+            f_s_end: f64::NAN,
+            f_r_end: f64::NAN,
+            d_ke: f64::NAN,
+            d_pe: f64::NAN,
+            d_e: f64::NAN,
+            work_sand: f64::NAN,
+            tip_end: Vector2::zeros(),
+            t_entry: if modes[ci].in_contact { 0.0 } else { f64::NAN },
+        })
+        .collect();
+
+    let mut recorder = Recorder::new(options.record, N, nc);
+    let stride = options.record.stride.max(1);
+    let mut t = 0.0f64;
+    let mut e0 = model.eval(&y.q, &y.qd, &modes);
+    stats.rhs_evals += 1;
+    recorder.push(model, t, &y, &e0);
+    let n_grid = (options.t_end / dt).ceil() as u64;
+    let mut n: u64 = 0;
+    let mut events_this_step = 0usize;
+    let mut funcs: Vec<(Kind, usize)> = Vec::with_capacity(4 * MAX_CONTACTS);
+
+    let update_fd_max = |summaries: &mut Vec<ContactSummary>, e: &Eval<N>, modes: &Modes| {
+        for (ci, s) in summaries.iter_mut().enumerate() {
+            if !modes[ci].stopped {
+                s.f_d_max = s.f_d_max.max(e.contacts[ci].force.drag_magnitude());
+            }
+        }
+    };
+
+    let status = loop {
+        if n >= n_grid {
+            break if options.end == EndCondition::Time {
+                Status::EndTime
+            } else {
+                Status::NotStopped
+            };
+        }
+        let t_next = ((n + 1) as f64 * dt).min(options.t_end);
+        let h = t_next - t;
+        if h <= 1e-12 * dt {
+            // An event landed on the grid point.
+            n += 1;
+            events_this_step = 0;
+            continue;
+        }
+        let k1: Deriv<N> = deriv_of(&y, &e0);
+        let y1 = step(model, &modes, &y, &k1, h);
+        stats.rhs_evals += 3;
+        let e1 = model.eval(&y1.q, &y1.qd, &modes);
+        stats.rhs_evals += 1;
+        if !y1.is_finite() || !e1.qdd.iter().all(|v| v.is_finite()) {
+            return Err(GranrsError::NonFinite {
+                t,
+                message: format!("state became non-finite in the step from t = {t} s (h = {h} s)"),
+            });
+        }
+
+        // Which switching functions crossed?
+        active(model, &modes, &mut funcs);
+        let mut earliest = f64::INFINITY;
+        let mut hits: Vec<(Kind, usize, f64)> = Vec::new();
+        if events_this_step < MAX_EVENTS_PER_STEP {
+            let dense = Hermite {
+                y0: y,
+                f0: k1,
+                y1,
+                f1: deriv_of(&y1, &e1),
+                h,
+            };
+            for &(kind, ci) in &funcs {
+                let g1 = switching(kind, ci, &e1, &modes);
+                if !crossed(kind, g1) {
+                    continue;
+                }
+                let g0 = switching(kind, ci, &e0, &modes).max(0.0);
+                let theta = if g1 == 0.0 {
+                    1.0
+                } else if g0 == 0.0 {
+                    0.0
+                } else {
+                    let (theta, evals) = locate(
+                        |th| {
+                            let s = dense.at(th);
+                            let e = model.eval(&s.q, &s.qd, &modes);
+                            switching(kind, ci, &e, &modes)
+                        },
+                        g0,
+                        g1,
+                        ROOT_TOL,
+                    );
+                    stats.root_evals += evals;
+                    stats.rhs_evals += evals;
+                    theta
+                };
+                earliest = earliest.min(theta);
+                hits.push((kind, ci, theta));
+            }
+        }
+
+        if hits.is_empty() {
+            // Accept the whole step.
+            y = y1;
+            let changed = model.project_sticking(&y.q, &mut y.qd, &modes);
+            e0 = if changed {
+                stats.rhs_evals += 1;
+                model.eval(&y.q, &y.qd, &modes)
+            } else {
+                e1
+            };
+            t = t_next;
+            n += 1;
+            events_this_step = 0;
+            stats.steps += 1;
+            update_fd_max(&mut summaries, &e0, &modes);
+            if n % stride as u64 == 0 {
+                recorder.push(model, t, &y, &e0);
+            }
+            continue;
+        }
+
+        // Step to the earliest event, exactly: a real RK4 step of the located length.
+        let h_star = earliest * h;
+        let y_star = if earliest >= 1.0 {
+            y1
+        } else if h_star > 0.0 {
+            stats.rhs_evals += 3;
+            step(model, &modes, &y, &k1, h_star)
+        } else {
+            y
+        };
+        let t_star = if earliest >= 1.0 { t_next } else { t + h_star };
+        let e_star_old = model.eval(&y_star.q, &y_star.qd, &modes);
+        stats.rhs_evals += 1;
+        if h_star > 0.0 {
+            stats.steps += 1;
+            update_fd_max(&mut summaries, &e_star_old, &modes);
+        }
+        // An event at the very start of the step is judged at the step's end.
+        let probe = if earliest * h <= 1e-12 * dt {
+            y1
+        } else {
+            y_star
+        };
+        let mut terminal = false;
+        for &(kind, ci, theta) in &hits {
+            if theta > earliest + SIMULTANEOUS {
+                continue;
+            }
+            stats.events += 1;
+            match kind {
+                Kind::Entry => {
+                    if summaries[ci].t_entry.is_nan() {
+                        summaries[ci].t_entry = t_star;
+                    }
+                    enter_contact(model, &mut modes, ci, &y_star, &probe, &mut stats);
+                }
+                Kind::Exit => {
+                    modes[ci].in_contact = false;
+                    modes[ci].sx = Slip::Stick;
+                    modes[ci].sy = Slip::Stick;
+                }
+                Kind::SlipX | Kind::StickX => {
+                    choose_slip(model, &mut modes, ci, 0, &probe, &mut stats)
+                }
+                Kind::SlipY | Kind::StickY => {
+                    choose_slip(model, &mut modes, ci, 1, &probe, &mut stats)
+                }
+                Kind::Stop => {
+                    modes[ci].stopped = true;
+                    let c = &e_star_old.contacts[ci];
+                    let (ke, pe) = model.energies(&y_star.q, &y_star.qd);
+                    let link = model.contacts[ci].rod.link;
+                    let s = &mut summaries[ci];
+                    s.stopped = true;
+                    s.t_s = t_star;
+                    s.depth = (-c.tip.y).max(0.0);
+                    s.dq = y_star.q[2 + link] - q0[2 + link];
+                    s.omega_end = y_star.qd[2 + link];
+                    s.f_s_end = c.force.static_magnitude();
+                    s.f_r_end = c.force.total_magnitude();
+                    s.d_ke = ke0 - ke;
+                    s.d_pe = pe0 - pe;
+                    s.d_e = s.d_ke + s.d_pe;
+                    s.work_sand = y_star.work;
+                    s.tip_end = c.tip;
+                    terminal |= match options.end {
+                        EndCondition::FirstStop => true,
+                        EndCondition::AllStops => modes[..nc].iter().all(|m| m.stopped),
+                        EndCondition::Time => false,
+                    };
+                }
+            }
+        }
+        y = y_star;
+        t = t_star;
+        events_this_step += 1;
+        if terminal {
+            recorder.push(model, t, &y, &e_star_old);
+            break Status::Stopped;
+        }
+        model.project_sticking(&y.q, &mut y.qd, &modes);
+        e0 = model.eval(&y.q, &y.qd, &modes);
+        stats.rhs_evals += 1;
+        recorder.push(model, t, &y, &e0);
+    };
+
+    // Contacts without a stop report their state at the end.
+    let e_end = model.eval(&y.q, &y.qd, &modes);
+    let (ke, pe) = model.energies(&y.q, &y.qd);
+    for (ci, s) in summaries.iter_mut().enumerate() {
+        if s.stopped {
+            continue;
+        }
+        let c = &e_end.contacts[ci];
+        let link = model.contacts[ci].rod.link;
+        s.depth = (-c.tip.y).max(0.0);
+        s.dq = y.q[2 + link] - q0[2 + link];
+        s.omega_end = y.qd[2 + link];
+        s.f_s_end = c.force.static_magnitude();
+        s.f_r_end = c.force.total_magnitude();
+        s.d_ke = ke0 - ke;
+        s.d_pe = pe0 - pe;
+        s.d_e = s.d_ke + s.d_pe;
+        s.work_sand = y.work;
+        s.tip_end = c.tip;
+    }
+    if status != Status::Stopped && options.record.any() && recorder.t.last() != Some(&t) {
+        recorder.push(model, t, &y, &e_end);
+    }
+    Ok(Outcome {
+        status,
+        t_final: t,
+        stats,
+        contacts: summaries,
+        energy_start,
+        energy_end: ke + pe,
+        work_sand: y.work,
+        series: recorder.finish(),
+    })
+}

@@ -1,0 +1,184 @@
+//! What a run is: the body, its contacts and coefficients, the medium, the effects, the
+//! initial state, the time step, the end condition and the outputs wanted.
+//!
+//! Field names are those of the Python `granrs.Scene`, so that an error names the field the
+//! user wrote. Angles are in degrees here (`*_deg`, the API edge) and radians inside the
+//! engine.
+
+use nalgebra::{SVector, Vector2};
+
+use crate::body::rod::ApplyAt;
+use crate::body::{Link, Mechanism, RodContact};
+use crate::dynamics::{Contact, Effects, Model, SignModel};
+use crate::error::{check_finite, check_range, GranrsError, Result};
+use crate::force::{Coefficients, Medium};
+use crate::integrate::{solve, Outcome, SolveOptions};
+
+/// The thesis's free link (sec. 3.2.1): a steel rod with round ends.
+pub mod free_link_defaults {
+    /// Length L [m] (thesis sec. 3.2.1).
+    pub const LENGTH: f64 = 0.190;
+    /// Diameter d_c [m] (thesis sec. 3.2.1).
+    pub const DIAMETER: f64 = 0.0127;
+    /// Mass m [kg] (thesis sec. 3.2.1).
+    pub const MASS: f64 = 0.184;
+}
+
+/// A free round-ended link dropped onto sand, tip first (MODEL.md, "Bodies").
+#[derive(Debug, Clone, PartialEq)]
+pub struct FreeLinkScene {
+    /// Rod length L [m].
+    pub length: f64,
+    /// Rod diameter d_c [m].
+    pub diameter: f64,
+    /// Mass m [kg].
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass [kg m^2]; `None`: a solid cylinder,
+    /// m (L^2/12 + d_c^2/16).
+    pub inertia: Option<f64>,
+    /// The sand.
+    pub medium: Medium,
+    /// Coefficients of the force law.
+    pub coefficients: Coefficients,
+    /// Initial angle from the vertical q [deg], |q| < 90.
+    pub q_deg: f64,
+    /// Initial downward speed of the rod v0 [m/s] (velocity (vx0, -v0)).
+    pub v0: f64,
+    /// Initial horizontal velocity [m/s].
+    pub vx0: f64,
+    /// Initial angular velocity dq/dt [rad/s].
+    pub omega0: f64,
+    /// Point of application of the force.
+    pub apply_at: ApplyAt,
+    /// Sign model of the static terms.
+    pub sign_model: SignModel,
+    /// Which force terms are on.
+    pub effects: Effects,
+    /// Step, end and recording.
+    pub options: SolveOptions,
+}
+
+impl Default for FreeLinkScene {
+    fn default() -> Self {
+        FreeLinkScene {
+            length: free_link_defaults::LENGTH,
+            diameter: free_link_defaults::DIAMETER,
+            mass: free_link_defaults::MASS,
+            inertia: None,
+            medium: Medium::default(),
+            coefficients: Coefficients::TABLE_3_4_VERTICAL,
+            q_deg: 0.0,
+            v0: 2.214,
+            vx0: 0.0,
+            omega0: 0.0,
+            apply_at: ApplyAt::Tip,
+            sign_model: SignModel::Modes,
+            effects: Effects::default(),
+            options: SolveOptions::default(),
+        }
+    }
+}
+
+/// Validate the medium.
+pub fn validate_medium(m: &Medium) -> Result<()> {
+    check_range("rho_g", m.rho_g, 0.0, true)?;
+    check_range("g", m.g, 0.0, false)?;
+    Ok(())
+}
+
+/// Validate step, end time and sign model.
+pub fn validate_options(o: &SolveOptions, sign_model: &SignModel) -> Result<()> {
+    check_range("dt", o.dt, 0.0, true)?;
+    check_range("t_end", o.t_end, 0.0, true)?;
+    if o.t_end / o.dt > 1e9 {
+        return Err(GranrsError::InvalidParameter {
+            field: "dt".into(),
+            value: o.dt,
+            allowed: format!("at most 1e9 steps to t_end = {} s", o.t_end),
+        });
+    }
+    if let SignModel::Smooth { eps } = sign_model {
+        check_range("smooth_eps", *eps, 0.0, true)?;
+    }
+    Ok(())
+}
+
+impl FreeLinkScene {
+    /// Check every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
+        check_range("length", self.length, 0.0, true)?;
+        check_range("diameter", self.diameter, 0.0, true)?;
+        check_range("mass", self.mass, 0.0, true)?;
+        if let Some(i) = self.inertia {
+            check_range("inertia", i, 0.0, true)?;
+        }
+        validate_medium(&self.medium)?;
+        self.coefficients.validate("coefficients")?;
+        check_finite("q_deg", self.q_deg)?;
+        if self.q_deg.abs() >= 90.0 {
+            return Err(GranrsError::InvalidParameter {
+                field: "q_deg".into(),
+                value: self.q_deg,
+                allowed: "-90 < q_deg < 90 (the tip must meet the sand first)".into(),
+            });
+        }
+        check_range("v0", self.v0, 0.0, false)?;
+        check_finite("vx0", self.vx0)?;
+        check_finite("omega0", self.omega0)?;
+        validate_options(&self.options, &self.sign_model)?;
+        Ok(())
+    }
+
+    /// Moment of inertia about the centre of mass [kg m^2].
+    pub fn inertia(&self) -> f64 {
+        self.inertia.unwrap_or(
+            self.mass * (self.length * self.length / 12.0 + self.diameter * self.diameter / 16.0),
+        )
+    }
+
+    /// The free link as a one-link mechanism whose root is its centre of mass.
+    pub fn model(&self) -> Model<3> {
+        let link = Link {
+            mass: self.mass,
+            inertia: self.inertia(),
+            com: Vector2::zeros(),
+            parent: None,
+            joint_on_parent: Vector2::zeros(),
+        };
+        Model {
+            mechanism: Mechanism { links: vec![link] },
+            contacts: vec![Contact {
+                rod: RodContact {
+                    link: 0,
+                    tip: Vector2::new(-0.5 * self.length, 0.0),
+                    length: self.length,
+                    diameter: self.diameter,
+                },
+                coefficients: self.coefficients,
+            }],
+            medium: self.medium,
+            apply_at: self.apply_at,
+            sign_model: self.sign_model,
+            effects: self.effects,
+        }
+    }
+
+    /// Initial generalized coordinates and rates: tip at the surface at x = 0.
+    pub fn initial_state(&self) -> (SVector<f64, 3>, SVector<f64, 3>) {
+        let q = self.q_deg.to_radians();
+        let half = 0.5 * self.length;
+        let q0 = SVector::<f64, 3>::new(half * q.sin(), half * q.cos(), q);
+        // The tip's velocity is (vx0, -v0); the centre moves with it plus the spin.
+        let normal = Vector2::new(q.cos(), -q.sin());
+        let v_c = Vector2::new(self.vx0, -self.v0) + self.omega0 * half * normal;
+        let qd0 = SVector::<f64, 3>::new(v_c.x, v_c.y, self.omega0);
+        (q0, qd0)
+    }
+
+    /// Validate and run.
+    pub fn run(&self) -> Result<Outcome> {
+        self.validate()?;
+        let (q0, qd0) = self.initial_state();
+        solve(&self.model(), q0, qd0, &self.options)
+    }
+}

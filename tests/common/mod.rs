@@ -1,0 +1,76 @@
+//! Shared helpers of the cargo integration tests.
+#![allow(dead_code)]
+
+use _granrs::force::Coefficients;
+use _granrs::scene::FreeLinkScene;
+
+/// The exact final depth of a vertical drop with the force at the tip (MODEL.md, "Exact
+/// answers"): only F_sv acts, so (1/2) m v0^2 + m g d = eta_v g rho (pi d_c^2/4)
+/// d^(lambda+2) / (L^lambda (lambda+2)). Solved by bisection to round-off.
+pub fn exact_vertical_depth(s: &FreeLinkScene) -> f64 {
+    let c = s.coefficients;
+    let g = s.medium.g;
+    let k = c.eta_v * g * s.medium.rho_g * std::f64::consts::PI * s.diameter.powi(2)
+        / 4.0
+        / (s.length.powf(c.lambda) * (c.lambda + 2.0));
+    let f = |d: f64| k * d.powf(c.lambda + 2.0) - 0.5 * s.mass * s.v0 * s.v0 - s.mass * g * d;
+    let (mut a, mut b) = (0.0f64, 1.0f64);
+    while f(b) < 0.0 {
+        b *= 2.0;
+    }
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if f(m) < 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Table 3.4 at q = 0 (thesis), written out here independently of the package.
+pub fn table_3_4_vertical() -> Coefficients {
+    Coefficients {
+        eta_h: 6.5,
+        eta_d: 15.2,
+        eta_v: 248.0,
+        lambda: 0.106,
+    }
+}
+
+/// Read a CSV shipped in the package data folder as rows of strings.
+pub fn read_csv(name: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    let path = format!(
+        "{}/python/granrs/data/{name}.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| split_csv_line(l))
+        .collect();
+    (header, rows)
+}
+
+fn split_csv_line(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    for ch in line.chars() {
+        match ch {
+            '"' => quoted = !quoted,
+            ',' if !quoted => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(ch),
+        }
+    }
+    out.push(cur);
+    out
+}
