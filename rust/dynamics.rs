@@ -17,6 +17,9 @@ use crate::body::{Mechanism, RodContact};
 use crate::force::resistance::{raw_sign, static_bounds};
 use crate::force::{Coefficients, ForceComponents, Medium, RodContactState};
 
+/// Largest sticking-velocity violation [m/s] that the projection treats as drift.
+pub const PROJECTION_LIMIT: f64 = 1e-6;
+
 /// Most contacts a body may have.
 pub const MAX_CONTACTS: usize = 4;
 
@@ -66,6 +69,9 @@ pub struct ContactMode {
     pub sy: Slip,
     /// Whether this contact's stop event has happened.
     pub stopped: bool,
+    /// Whether the rod is wholly immersed (l = L): the kink of l = min(d / cos q, L) is a
+    /// located event too, so that a step never straddles it.
+    pub full: bool,
 }
 
 impl Default for ContactMode {
@@ -75,6 +81,7 @@ impl Default for ContactMode {
             sx: Slip::Stick,
             sy: Slip::Stick,
             stopped: false,
+            full: false,
         }
     }
 }
@@ -145,6 +152,8 @@ pub struct ContactEval {
     pub v_centroid: Vector2<f64>,
     /// Force components (with any sticking reaction in place of its static term) [N].
     pub force: ForceComponents,
+    /// Margin to full immersion, L cos q - d [m] (negative when wholly immersed).
+    pub immersion_margin: f64,
     /// Magnitudes of the static terms (the bounds of a sticking reaction) [N].
     pub bound_h: f64,
     /// See `bound_h`.
@@ -212,6 +221,8 @@ impl<const N: usize> Model<N> {
             let out = &mut contacts[ci];
             out.tip = tip;
             out.v_tip = v_tip;
+            // With nothing immersed, E is the tip.
+            out.v_centroid = v_tip;
             let mode = &modes[ci];
             if !mode.in_contact {
                 continue;
@@ -219,6 +230,7 @@ impl<const N: usize> Model<N> {
             let axis = pose.axis[link];
             let geom = c.rod.geometry(tip.y, axis);
             out.depth = geom.depth;
+            out.immersion_margin = c.rod.length * axis.y - geom.depth;
             if geom.depth <= 0.0 {
                 continue;
             }
@@ -426,6 +438,14 @@ impl<const N: usize> Model<N> {
         let rows = self.stuck_rows(&pose, qd, modes, &chol);
         let k = rows.len();
         if k == 0 {
+            return false;
+        }
+        // Only drift is removed: a violation larger than this is not drift but a wrong mode,
+        // and is left for the solver's switching functions to see.
+        if rows
+            .iter()
+            .any(|r| r.jac_e.dot(qd).abs() > PROJECTION_LIMIT)
+        {
             return false;
         }
         // M^-1 J^T columns and J M^-1 J^T.

@@ -12,7 +12,7 @@ use crate::body::{Link, Mechanism, RodContact};
 use crate::dynamics::{Contact, Effects, Model, SignModel};
 use crate::error::{check_finite, check_range, GranrsError, Result};
 use crate::force::{Coefficients, Medium};
-use crate::integrate::{solve, Outcome, SolveOptions};
+use crate::integrate::{solve, Method, Outcome, SolveOptions};
 
 /// The thesis's free link (sec. 3.2.1): a steel rod with round ends.
 pub mod free_link_defaults {
@@ -44,6 +44,8 @@ pub struct FreeLinkScene {
     pub q_deg: f64,
     /// Initial downward speed of the rod v0 [m/s] (velocity (vx0, -v0)).
     pub v0: f64,
+    /// Initial depth of the tip [m] (0: the tip starts at the surface, as in the thesis).
+    pub depth0: f64,
     /// Initial horizontal velocity [m/s].
     pub vx0: f64,
     /// Initial angular velocity dq/dt [rad/s].
@@ -69,6 +71,7 @@ impl Default for FreeLinkScene {
             coefficients: Coefficients::TABLE_3_4_VERTICAL,
             q_deg: 0.0,
             v0: 2.214,
+            depth0: 0.0,
             vx0: 0.0,
             omega0: 0.0,
             apply_at: ApplyAt::Tip,
@@ -100,6 +103,10 @@ pub fn validate_options(o: &SolveOptions, sign_model: &SignModel) -> Result<()> 
     if let SignModel::Smooth { eps } = sign_model {
         check_range("smooth_eps", *eps, 0.0, true)?;
     }
+    if let Method::Dopri5 { rtol, atol } = o.method {
+        check_range("rtol", rtol, 0.0, true)?;
+        check_range("atol", atol, 0.0, true)?;
+    }
     Ok(())
 }
 
@@ -123,6 +130,7 @@ impl FreeLinkScene {
             });
         }
         check_range("v0", self.v0, 0.0, false)?;
+        check_range("depth0", self.depth0, 0.0, false)?;
         check_finite("vx0", self.vx0)?;
         check_finite("omega0", self.omega0)?;
         validate_options(&self.options, &self.sign_model)?;
@@ -163,11 +171,11 @@ impl FreeLinkScene {
         }
     }
 
-    /// Initial generalized coordinates and rates: tip at the surface at x = 0.
+    /// Initial generalized coordinates and rates: tip at x = 0, `depth0` below the surface.
     pub fn initial_state(&self) -> (SVector<f64, 3>, SVector<f64, 3>) {
         let q = self.q_deg.to_radians();
         let half = 0.5 * self.length;
-        let q0 = SVector::<f64, 3>::new(half * q.sin(), half * q.cos(), q);
+        let q0 = SVector::<f64, 3>::new(half * q.sin(), half * q.cos() - self.depth0, q);
         // The tip's velocity is (vx0, -v0); the centre moves with it plus the spin.
         let normal = Vector2::new(q.cos(), -q.sin());
         let v_c = Vector2::new(self.vx0, -self.v0) + self.omega0 * half * normal;

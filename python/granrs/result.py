@@ -31,6 +31,7 @@ SUMMARY_UNITS: dict[str, str] = {
     "rhs_evals": "-",
     "root_evals": "-",
     "events": "-",
+    "rejected": "-",
 }
 
 # Friendly names of the generalized coordinates of each body.

@@ -66,7 +66,8 @@ class Scene:
         coefficients: the force law's coefficients (default: Table 3.4 at q = 0).
         coefficients_source: where the coefficients come from (for reports; not used).
         q_deg: initial angle of the rod from the vertical [deg], -90 < q_deg < 90.
-        v0: initial downward speed [m/s], >= 0; the tip starts at the surface.
+        v0: initial downward speed [m/s], >= 0.
+        depth0: initial depth of the tip [m], >= 0 (0: at the surface, as in the thesis).
         vx0: initial horizontal velocity of the tip [m/s].
         omega0: initial angular velocity dq/dt [rad/s].
         apply_at: ``"tip"`` (default; the thesis's CAD runs, sec. 3.3.2) or ``"centroid"``
@@ -77,7 +78,12 @@ class Scene:
         smooth_eps: velocity scale of the ``"smooth"`` sign model [m/s].
         effects: the force terms to evaluate, from ``EFFECTS``; a term not listed is neither
             computed nor stored.
-        dt: step of the fixed-step RK4 [s] (thesis sec. 3.3.2: 10 kHz, 1e-4).
+        dt: step of the fixed-step RK4 [s] (thesis sec. 3.3.2: 10 kHz, 1e-4); the first
+            step of ``"dopri5"``.
+        method: ``"rk4"`` (default: classical RK4 on the grid n dt) or ``"dopri5"``
+            (adaptive Dormand-Prince 5(4) with tolerances ``rtol`` and ``atol``).
+        rtol: relative tolerance of ``"dopri5"``.
+        atol: absolute tolerance of ``"dopri5"`` [SI units of each coordinate].
         t_end: latest end time [s].
         end: ``"first_stop"`` (the thesis's end of the penetration phase), ``"all_stops"``
             or ``"time"``.
@@ -96,6 +102,7 @@ class Scene:
     coefficients_source: str = "Table 3.4, row q = 0 deg"
     q_deg: float = 0.0
     v0: float = 2.214
+    depth0: float = 0.0
     vx0: float = 0.0
     omega0: float = 0.0
     apply_at: str = "tip"
@@ -103,6 +110,9 @@ class Scene:
     smooth_eps: float = 1e-3
     effects: tuple[str, ...] = EFFECTS
     dt: float = 1e-4
+    method: str = "rk4"
+    rtol: float = 1e-8
+    atol: float = 1e-10
     t_end: float = 1.0
     end: str = "first_stop"
     record: tuple[str, ...] = ()

@@ -6,5 +6,6 @@ pub mod rk4;
 pub mod solve;
 
 pub use solve::{
-    solve, ContactSummary, EndCondition, Outcome, Record, Series, SolveOptions, Stats, Status,
+    solve, ContactSummary, EndCondition, Method, Outcome, Record, Series, SolveOptions, Stats,
+    Status,
 };

@@ -82,3 +82,102 @@ pub fn step<const N: usize>(
         work: y.work + (h / 6.0) * (k1.work + 2.0 * k2.work + 2.0 * k3.work + k4.work),
     }
 }
+
+/// The Dormand-Prince 5(4) pair (Dormand & Prince 1980, J. Comput. Appl. Math. 6:19-26;
+/// coefficients as tabulated in Hairer, Norsett & Wanner, Solving ODEs I, table 5.2).
+mod dp {
+    pub const A: [[f64; 6]; 7] = [
+        [0.0; 6],
+        [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+        [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+        [
+            19372.0 / 6561.0,
+            -25360.0 / 2187.0,
+            64448.0 / 6561.0,
+            -212.0 / 729.0,
+            0.0,
+            0.0,
+        ],
+        [
+            9017.0 / 3168.0,
+            -355.0 / 33.0,
+            46732.0 / 5247.0,
+            49.0 / 176.0,
+            -5103.0 / 18656.0,
+            0.0,
+        ],
+        [
+            35.0 / 384.0,
+            0.0,
+            500.0 / 1113.0,
+            125.0 / 192.0,
+            -2187.0 / 6784.0,
+            11.0 / 84.0,
+        ],
+    ];
+    /// b - b*: the 5th-order weights less the embedded 4th-order ones.
+    pub const E: [f64; 7] = [
+        71.0 / 57600.0,
+        0.0,
+        -71.0 / 16695.0,
+        71.0 / 1920.0,
+        -17253.0 / 339200.0,
+        22.0 / 525.0,
+        -1.0 / 40.0,
+    ];
+}
+
+/// One Dormand-Prince 5(4) step of size `h` from `y` with known first stage `k1`.
+/// Returns the 5th-order solution, its derivative there (the FSAL stage, costing the
+/// step's sixth evaluation) and the error estimate's weighted RMS norm with tolerances
+/// `rtol`, `atol` over the coordinates and rates.
+#[allow(clippy::too_many_arguments)]
+pub fn dopri5_step<const N: usize>(
+    model: &Model<N>,
+    modes: &Modes,
+    y: &State<N>,
+    k1: &Deriv<N>,
+    h: f64,
+    rtol: f64,
+    atol: f64,
+) -> (State<N>, Eval<N>, f64) {
+    let mut k: [Deriv<N>; 6] = [*k1; 6];
+    for s in 1..6 {
+        let mut ys = *y;
+        for (j, kj) in k.iter().enumerate().take(s) {
+            let a = dp::A[s][j];
+            if a != 0.0 {
+                ys = ys.add(h * a, kj);
+            }
+        }
+        let e = model.eval(&ys.q, &ys.qd, modes);
+        k[s] = deriv_of(&ys, &e);
+    }
+    // The solution is the seventh stage's argument (FSAL): y1 = y + h sum_j a_7j k_j.
+    let mut y1 = *y;
+    for (j, kj) in k.iter().enumerate() {
+        let a = dp::A[6][j];
+        if a != 0.0 {
+            y1 = y1.add(h * a, kj);
+        }
+    }
+    let e7 = model.eval(&y1.q, &y1.qd, modes);
+    let k7 = deriv_of(&y1, &e7);
+    let mut sum = 0.0;
+    for i in 0..N {
+        let mut eq = 0.0;
+        let mut ev = 0.0;
+        for (s, ks) in k.iter().enumerate() {
+            eq += dp::E[s] * ks.q[i];
+            ev += dp::E[s] * ks.qd[i];
+        }
+        eq += dp::E[6] * k7.q[i];
+        ev += dp::E[6] * k7.qd[i];
+        let sq = atol + rtol * y.q[i].abs().max(y1.q[i].abs());
+        let sv = atol + rtol * y.qd[i].abs().max(y1.qd[i].abs());
+        sum += (h * eq / sq).powi(2) + (h * ev / sv).powi(2);
+    }
+    let err = (sum / (2 * N) as f64).sqrt();
+    (y1, e7, err)
+}

@@ -9,7 +9,7 @@
 use nalgebra::{SVector, Vector2};
 
 use super::dense::{locate, Hermite};
-use super::rk4::{deriv_of, step, Deriv, State};
+use super::rk4::{deriv_of, dopri5_step, step, Deriv, State};
 use crate::dynamics::{ContactMode, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
 use crate::error::{GranrsError, Result};
 
@@ -44,11 +44,27 @@ impl Record {
     }
 }
 
+/// The time stepper.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Classical RK4 on the fixed grid `n dt` (default; the thesis ran at 10 kHz).
+    Rk4,
+    /// Adaptive Dormand-Prince 5(4): tolerances instead of a step; `dt` is the first step.
+    Dopri5 {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance [SI units of each coordinate].
+        atol: f64,
+    },
+}
+
 /// Options of one run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveOptions {
-    /// Step size of the fixed grid [s] (thesis: 10 kHz, 1e-4 s).
+    /// Step size of the fixed grid [s] (thesis: 10 kHz, 1e-4 s); the first step of Dopri5.
     pub dt: f64,
+    /// The time stepper.
+    pub method: Method,
     /// Latest end time [s].
     pub t_end: f64,
     /// When to end.
@@ -61,6 +77,7 @@ impl Default for SolveOptions {
     fn default() -> Self {
         SolveOptions {
             dt: 1e-4,
+            method: Method::Rk4,
             t_end: 1.0,
             end: EndCondition::FirstStop,
             record: Record::default(),
@@ -101,6 +118,8 @@ pub struct Stats {
     pub root_evals: usize,
     /// Events handled (entries, exits, sign switches, sticks, stops).
     pub events: usize,
+    /// Steps rejected by the adaptive method's error control.
+    pub rejected: usize,
 }
 
 /// The results of one contact.
@@ -170,6 +189,8 @@ pub struct Outcome {
 const ROOT_TOL: f64 = 1e-13;
 /// Events closer than this (in units of the step) to the earliest are handled with it.
 const SIMULTANEOUS: f64 = 1e-9;
+/// A velocity component above this [m/s] at a mode decision is moving, not at rest.
+const SLIP_SPEED: f64 = 1e-9;
 /// At most this many events within one grid step before the step is taken as it is.
 const MAX_EVENTS_PER_STEP: usize = 32;
 
@@ -183,6 +204,7 @@ enum Kind {
     StickX,
     StickY,
     Stop,
+    Immersion,
 }
 
 /// The value of a switching function: non-negative while the mode holds; the event is
@@ -197,6 +219,13 @@ fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) 
         Kind::StickX => c.bound_h - c.force.static_h.abs(),
         Kind::StickY => c.bound_v - c.force.static_v.abs(),
         Kind::Stop => -c.v_tip.y,
+        Kind::Immersion => {
+            if modes[ci].full {
+                -c.immersion_margin
+            } else {
+                c.immersion_margin
+            }
+        }
     }
 }
 
@@ -210,6 +239,7 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
             continue;
         }
         out.push((Kind::Exit, ci));
+        out.push((Kind::Immersion, ci));
         if !m.stopped {
             out.push((Kind::Stop, ci));
         }
@@ -275,7 +305,13 @@ fn choose_slip<const N: usize>(
         (c.force.static_v, c.bound_v, c.v_centroid.y)
     };
     // A probe that already moves decidedly keeps its direction.
-    let slip = if reaction.abs() <= bound {
+    let slip = if v.abs() > SLIP_SPEED {
+        if v < 0.0 {
+            Slip::Neg
+        } else {
+            Slip::Pos
+        }
+    } else if reaction.abs() <= bound {
         Slip::Stick
     } else if reaction > 0.0 {
         Slip::Neg
@@ -351,7 +387,8 @@ impl Recorder {
         if on.forces {
             for c in 0..n_contacts {
                 for f in [
-                    "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "F_dx", "F_dy", "F_sh", "F_sv",
+                    "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "v_E_x", "v_E_y", "F_dx",
+                    "F_dy", "F_sh", "F_sv", "mode_x", "mode_y",
                 ] {
                     names.push(format!("c{c}.{f}"));
                 }
@@ -372,7 +409,14 @@ impl Recorder {
         }
     }
 
-    fn push<const N: usize>(&mut self, model: &Model<N>, t: f64, y: &State<N>, e: &Eval<N>) {
+    fn push<const N: usize>(
+        &mut self,
+        model: &Model<N>,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) {
         if !self.on.any() {
             return;
         }
@@ -392,17 +436,29 @@ impl Recorder {
             put(&mut self.cols, y.work);
         }
         if self.on.forces {
-            for c in &e.contacts[..self.n_contacts] {
+            for (c, m) in e.contacts[..self.n_contacts].iter().zip(modes) {
+                // The modes: -1, +1, 0 for stick; NaN out of the sand or without modes.
+                let mode = |s: Slip| {
+                    if m.in_contact && model.sign_model == SignModel::Modes {
+                        s.sign()
+                    } else {
+                        f64::NAN
+                    }
+                };
                 for v in [
                     c.tip.x,
                     c.tip.y,
                     c.v_tip.x,
                     c.v_tip.y,
                     (-c.tip.y).max(0.0),
+                    c.v_centroid.x,
+                    c.v_centroid.y,
                     c.force.drag.x,
                     c.force.drag.y,
                     c.force.static_h,
                     c.force.static_v,
+                    mode(m.sx),
+                    mode(m.sy),
                 ] {
                     put(&mut self.cols, v);
                 }
@@ -483,7 +539,7 @@ pub fn solve<const N: usize>(
     let mut t = 0.0f64;
     let mut e0 = model.eval(&y.q, &y.qd, &modes);
     stats.rhs_evals += 1;
-    recorder.push(model, t, &y, &e0);
+    recorder.push(model, t, &y, &e0, &modes);
     let n_grid = (options.t_end / dt).ceil() as u64;
     let mut n: u64 = 0;
     let mut events_this_step = 0usize;
@@ -497,27 +553,71 @@ pub fn solve<const N: usize>(
         }
     };
 
+    let mut h_adapt = dt;
+    let adaptive = matches!(options.method, Method::Dopri5 { .. });
     let status = loop {
-        if n >= n_grid {
+        let finished = if adaptive {
+            t >= options.t_end
+        } else {
+            n >= n_grid
+        };
+        if finished {
             break if options.end == EndCondition::Time {
                 Status::EndTime
             } else {
                 Status::NotStopped
             };
         }
-        let t_next = ((n + 1) as f64 * dt).min(options.t_end);
+        let t_next = if adaptive {
+            let target = t + h_adapt;
+            // Do not leave a sliver before t_end.
+            if target >= options.t_end || options.t_end - target < 1e-3 * h_adapt {
+                options.t_end
+            } else {
+                target
+            }
+        } else {
+            ((n + 1) as f64 * dt).min(options.t_end)
+        };
         let h = t_next - t;
-        if h <= 1e-12 * dt {
+        if !adaptive && h <= 1e-12 * dt {
             // An event landed on the grid point.
             n += 1;
             events_this_step = 0;
             continue;
         }
         let k1: Deriv<N> = deriv_of(&y, &e0);
-        let y1 = step(model, &modes, &y, &k1, h);
-        stats.rhs_evals += 3;
-        let e1 = model.eval(&y1.q, &y1.qd, &modes);
-        stats.rhs_evals += 1;
+        let (y1, e1) = match options.method {
+            Method::Rk4 => {
+                let y1 = step(model, &modes, &y, &k1, h);
+                let e1 = model.eval(&y1.q, &y1.qd, &modes);
+                stats.rhs_evals += 4;
+                (y1, e1)
+            }
+            Method::Dopri5 { rtol, atol } => {
+                let (y1, e1, err) = dopri5_step(model, &modes, &y, &k1, h, rtol, atol);
+                stats.rhs_evals += 6;
+                let factor = if err == 0.0 {
+                    5.0
+                } else {
+                    (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+                };
+                if !(err <= 1.0) {
+                    stats.rejected += 1;
+                    h_adapt = h * factor.min(0.9);
+                    if !(h_adapt > 1e-14 * options.t_end.max(1.0)) || !err.is_finite() && h < 1e-14
+                    {
+                        return Err(GranrsError::NonFinite {
+                            t,
+                            message: format!("step size underflow at t = {t} s (error norm {err})"),
+                        });
+                    }
+                    continue;
+                }
+                h_adapt = h * factor;
+                (y1, e1)
+            }
+        };
         if !y1.is_finite() || !e1.qdd.iter().all(|v| v.is_finite()) {
             return Err(GranrsError::NonFinite {
                 t,
@@ -582,8 +682,8 @@ pub fn solve<const N: usize>(
             events_this_step = 0;
             stats.steps += 1;
             update_fd_max(&mut summaries, &e0, &modes);
-            if n % stride as u64 == 0 {
-                recorder.push(model, t, &y, &e0);
+            if n.is_multiple_of(stride as u64) {
+                recorder.push(model, t, &y, &e0, &modes);
             }
             continue;
         }
@@ -593,8 +693,16 @@ pub fn solve<const N: usize>(
         let y_star = if earliest >= 1.0 {
             y1
         } else if h_star > 0.0 {
-            stats.rhs_evals += 3;
-            step(model, &modes, &y, &k1, h_star)
+            match options.method {
+                Method::Rk4 => {
+                    stats.rhs_evals += 3;
+                    step(model, &modes, &y, &k1, h_star)
+                }
+                Method::Dopri5 { rtol, atol } => {
+                    stats.rhs_evals += 6;
+                    dopri5_step(model, &modes, &y, &k1, h_star, rtol, atol).0
+                }
+            }
         } else {
             y
         };
@@ -629,6 +737,7 @@ pub fn solve<const N: usize>(
                     modes[ci].sx = Slip::Stick;
                     modes[ci].sy = Slip::Stick;
                 }
+                Kind::Immersion => modes[ci].full = !modes[ci].full,
                 Kind::SlipX | Kind::StickX => {
                     choose_slip(model, &mut modes, ci, 0, &probe, &mut stats)
                 }
@@ -665,13 +774,13 @@ pub fn solve<const N: usize>(
         t = t_star;
         events_this_step += 1;
         if terminal {
-            recorder.push(model, t, &y, &e_star_old);
+            recorder.push(model, t, &y, &e_star_old, &modes);
             break Status::Stopped;
         }
         model.project_sticking(&y.q, &mut y.qd, &modes);
         e0 = model.eval(&y.q, &y.qd, &modes);
         stats.rhs_evals += 1;
-        recorder.push(model, t, &y, &e0);
+        recorder.push(model, t, &y, &e0, &modes);
     };
 
     // Contacts without a stop report their state at the end.
@@ -695,7 +804,7 @@ pub fn solve<const N: usize>(
         s.tip_end = c.tip;
     }
     if status != Status::Stopped && options.record.any() && recorder.t.last() != Some(&t) {
-        recorder.push(model, t, &y, &e_end);
+        recorder.push(model, t, &y, &e_end, &modes);
     }
     Ok(Outcome {
         status,

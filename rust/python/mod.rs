@@ -14,7 +14,7 @@ use crate::body::rod::ApplyAt;
 use crate::dynamics::{Effects, SignModel};
 use crate::error::GranrsError;
 use crate::force::{Coefficients, Medium};
-use crate::integrate::{EndCondition, Outcome, Record, SolveOptions};
+use crate::integrate::{EndCondition, Method, Outcome, Record, SolveOptions};
 use crate::scene::FreeLinkScene;
 
 /// Convert a core error to the matching `granrs.errors` exception.
@@ -215,6 +215,7 @@ fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsErr
         coefficients,
         q_deg: get_f64(d, "q_deg")?,
         v0: get_f64(d, "v0")?,
+        depth0: get_opt_f64(d, "depth0")?.unwrap_or(0.0),
         vx0: get_opt_f64(d, "vx0")?.unwrap_or(0.0),
         omega0: get_opt_f64(d, "omega0")?.unwrap_or(0.0),
         apply_at,
@@ -222,6 +223,14 @@ fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsErr
         effects: parse_effects(get_names(d, "effects")?)?,
         options: SolveOptions {
             dt: get_f64(d, "dt")?,
+            method: match get_str(d, "method")?.as_str() {
+                "rk4" => Method::Rk4,
+                "dopri5" => Method::Dopri5 {
+                    rtol: get_f64(d, "rtol")?,
+                    atol: get_f64(d, "atol")?,
+                },
+                other => return Err(unknown("method", other, &["rk4", "dopri5"])),
+            },
             t_end: get_f64(d, "t_end")?,
             end,
             record: parse_record(get_names(d, "record")?, get_opt_f64(d, "record_stride")?)?,
@@ -249,6 +258,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     stats.set_item("rhs_evals", out.stats.rhs_evals)?;
     stats.set_item("root_evals", out.stats.root_evals)?;
     stats.set_item("events", out.stats.events)?;
+    stats.set_item("rejected", out.stats.rejected)?;
     d.set_item("stats", stats)?;
     d.set_item("energy_start", out.energy_start)?;
     d.set_item("energy_end", out.energy_end)?;

@@ -4,16 +4,29 @@
 use _granrs::force::Coefficients;
 use _granrs::scene::FreeLinkScene;
 
-/// The exact final depth of a vertical drop with the force at the tip (MODEL.md, "Exact
-/// answers"): only F_sv acts, so (1/2) m v0^2 + m g d = eta_v g rho (pi d_c^2/4)
-/// d^(lambda+2) / (L^lambda (lambda+2)). Solved by bisection to round-off.
-pub fn exact_vertical_depth(s: &FreeLinkScene) -> f64 {
+/// Work done against F_sv by a vertical rod sunk to depth d (force at the tip): with
+/// l = min(d, L), int_0^d eta_v (s/L)^lambda g rho (pi d_c^2/4) min(s, L) ds.
+pub fn vertical_static_work(s: &FreeLinkScene, d: f64) -> f64 {
     let c = s.coefficients;
+    let a = c.eta_v * s.medium.g * s.medium.rho_g * std::f64::consts::PI * s.diameter.powi(2) / 4.0;
+    let l = s.length;
+    let lam = c.lambda;
+    // Partly immersed: a d^(lam+2) / (L^lam (lam+2)) (MODEL.md, "Exact answers").
+    let part = |x: f64| a * x.powf(lam + 2.0) / (l.powf(lam) * (lam + 2.0));
+    if d <= l {
+        part(d)
+    } else {
+        // Wholly immersed beyond L: V = pi d_c^2 / 4 * L.
+        part(l) + a * l * (d.powf(lam + 1.0) - l.powf(lam + 1.0)) / (l.powf(lam) * (lam + 1.0))
+    }
+}
+
+/// The exact final depth of a vertical drop with the force at the tip (MODEL.md, "Exact
+/// answers"): only F_sv acts, so (1/2) m v0^2 + m g d = W(d), the work of
+/// [`vertical_static_work`]. Solved by bisection to round-off.
+pub fn exact_vertical_depth(s: &FreeLinkScene) -> f64 {
     let g = s.medium.g;
-    let k = c.eta_v * g * s.medium.rho_g * std::f64::consts::PI * s.diameter.powi(2)
-        / 4.0
-        / (s.length.powf(c.lambda) * (c.lambda + 2.0));
-    let f = |d: f64| k * d.powf(c.lambda + 2.0) - 0.5 * s.mass * s.v0 * s.v0 - s.mass * g * d;
+    let f = |d: f64| vertical_static_work(s, d) - 0.5 * s.mass * s.v0 * s.v0 - s.mass * g * d;
     let (mut a, mut b) = (0.0f64, 1.0f64);
     while f(b) < 0.0 {
         b *= 2.0;
@@ -55,7 +68,7 @@ pub fn read_csv(name: &str) -> (Vec<String>, Vec<Vec<String>>) {
         .collect();
     let rows = lines
         .filter(|l| !l.trim().is_empty())
-        .map(|l| split_csv_line(l))
+        .map(split_csv_line)
         .collect();
     (header, rows)
 }
