@@ -602,11 +602,10 @@ pub fn solve<const N: usize>(
                 } else {
                     (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
                 };
-                if !(err <= 1.0) {
+                if err.is_nan() || err > 1.0 {
                     stats.rejected += 1;
                     h_adapt = h * factor.min(0.9);
-                    if !(h_adapt > 1e-14 * options.t_end.max(1.0)) || !err.is_finite() && h < 1e-14
-                    {
+                    if h_adapt.is_nan() || h_adapt <= 1e-14 * options.t_end.max(1.0) {
                         return Err(GranrsError::NonFinite {
                             t,
                             message: format!("step size underflow at t = {t} s (error norm {err})"),
