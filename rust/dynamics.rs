@@ -69,6 +69,9 @@ pub struct ContactMode {
     pub sy: Slip,
     /// Whether this contact's stop event has happened.
     pub stopped: bool,
+    /// Sign of e x v_E held through a step: the drag's reference area is |e x v_E|, whose
+    /// kink where v_E is parallel to the axis is a located event in the `Modes` model.
+    pub cross: Slip,
     /// Whether the rod is wholly immersed (l = L): the kink of l = min(d / cos q, L) is a
     /// located event too, so that a step never straddles it.
     pub full: bool,
@@ -81,6 +84,7 @@ impl Default for ContactMode {
             sx: Slip::Stick,
             sy: Slip::Stick,
             stopped: false,
+            cross: Slip::Pos,
             full: false,
         }
     }
@@ -152,6 +156,8 @@ pub struct ContactEval {
     pub v_centroid: Vector2<f64>,
     /// Force components (with any sticking reaction in place of its static term) [N].
     pub force: ForceComponents,
+    /// e x v_E, the signed sine of the drag's reference area times |v_E| [m/s].
+    pub cross: f64,
     /// Margin to full immersion, L cos q - d [m] (negative when wholly immersed).
     pub immersion_margin: f64,
     /// Magnitudes of the static terms (the bounds of a sticking reaction) [N].
@@ -258,8 +264,15 @@ impl<const N: usize> Model<N> {
                 &state,
             );
             let mut f = ForceComponents::default();
+            let cross_signed = axis.x * v_e.y - axis.y * v_e.x;
+            out.cross = cross_signed;
             if self.effects.drag {
-                let cross = (axis.x * v_e.y - axis.y * v_e.x).abs();
+                // |e x v_E|; in `Modes` the sign is held (the kink at 0 is a located event).
+                let cross = match self.sign_model {
+                    SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
+                    SignModel::Modes => cross_signed,
+                    _ => cross_signed.abs(),
+                };
                 let k =
                     coef.eta_d * self.medium.rho_g * c.rod.diameter * geom.immersed_length * cross;
                 f.drag = -k * v_e;

@@ -11,12 +11,12 @@ The Rust core raises the same classes: its one error enum is converted exhaustiv
 from __future__ import annotations
 
 __all__ = [
-    "GranrsError",
-    "InvalidSceneError",
-    "InvalidParameterError",
-    "UnknownNameError",
     "CoefficientTableError",
+    "GranrsError",
+    "InvalidParameterError",
+    "InvalidSceneError",
     "SimulationError",
+    "UnknownNameError",
 ]
 
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from .scene import Scene
 
-__all__ = ["ContactResult", "Result", "SUMMARY_UNITS"]
+__all__ = ["SUMMARY_UNITS", "ContactResult", "Result"]
 
 #: Units of the summary fields.
 SUMMARY_UNITS: dict[str, str] = {

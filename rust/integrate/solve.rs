@@ -205,6 +205,7 @@ enum Kind {
     StickY,
     Stop,
     Immersion,
+    Cross,
 }
 
 /// The value of a switching function: non-negative while the mode holds; the event is
@@ -219,6 +220,7 @@ fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) 
         Kind::StickX => c.bound_h - c.force.static_h.abs(),
         Kind::StickY => c.bound_v - c.force.static_v.abs(),
         Kind::Stop => -c.v_tip.y,
+        Kind::Cross => modes[ci].cross.sign() * c.cross,
         Kind::Immersion => {
             if modes[ci].full {
                 -c.immersion_margin
@@ -244,6 +246,9 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
             out.push((Kind::Stop, ci));
         }
         if with_modes {
+            if model.effects.drag {
+                out.push((Kind::Cross, ci));
+            }
             if model.effects.static_h {
                 out.push((
                     if m.sx == Slip::Stick {
@@ -278,16 +283,19 @@ fn crossed(kind: Kind, g1: f64) -> bool {
     }
 }
 
-/// Choose the mode of the static term along `axis` of contact `ci` at a state where its
-/// velocity component is (about) zero: stick if the reaction that holds it is within the
-/// static bound, else slip the way the other forces push (Karnopp). `probe` is the state
-/// at which to judge (the event point, or the step's end when the event is at its start).
+/// Choose the mode of the static term along `axis` of contact `ci` at the state `at`,
+/// where its velocity component is (about) zero. Karnopp: stick if the reaction that holds
+/// the component is within the static bound, else slip the way the other forces push. A
+/// component that already moves decidedly keeps its direction. At the surface the bound and
+/// the reaction are both zero; there the decision is taken at `lookahead` (the end of the
+/// step that found the event), where they have grown.
 fn choose_slip<const N: usize>(
     model: &Model<N>,
     modes: &mut Modes,
     ci: usize,
     axis: usize,
-    probe: &State<N>,
+    at: &State<N>,
+    lookahead: &State<N>,
     stats: &mut Stats,
 ) {
     let mut trial = *modes;
@@ -296,15 +304,20 @@ fn choose_slip<const N: usize>(
     } else {
         trial[ci].sy = Slip::Stick;
     }
-    let e = model.eval(&probe.q, &probe.qd, &trial);
-    stats.rhs_evals += 1;
-    let c = &e.contacts[ci];
-    let (reaction, bound, v) = if axis == 0 {
-        (c.force.static_h, c.bound_h, c.v_centroid.x)
-    } else {
-        (c.force.static_v, c.bound_v, c.v_centroid.y)
+    let judge = |s: &State<N>, stats: &mut Stats| {
+        let e = model.eval(&s.q, &s.qd, &trial);
+        stats.rhs_evals += 1;
+        let c = e.contacts[ci];
+        if axis == 0 {
+            (c.force.static_h, c.bound_h, c.v_centroid.x)
+        } else {
+            (c.force.static_v, c.bound_v, c.v_centroid.y)
+        }
     };
-    // A probe that already moves decidedly keeps its direction.
+    let (mut reaction, mut bound, v) = judge(at, stats);
+    if v.abs() <= SLIP_SPEED && bound == 0.0 {
+        (reaction, bound, _) = judge(lookahead, stats);
+    }
     let slip = if v.abs() > SLIP_SPEED {
         if v < 0.0 {
             Slip::Neg
@@ -314,10 +327,6 @@ fn choose_slip<const N: usize>(
     } else if reaction.abs() <= bound {
         Slip::Stick
     } else if reaction > 0.0 {
-        Slip::Neg
-    } else if reaction < 0.0 {
-        Slip::Pos
-    } else if v < 0.0 {
         Slip::Neg
     } else {
         Slip::Pos
@@ -345,6 +354,13 @@ fn enter_contact<const N: usize>(
     let e = model.eval(&y.q, &y.qd, modes);
     stats.rhs_evals += 1;
     let v = e.contacts[ci].v_centroid;
+    // The drag's kink: the sign of e x v_E now, or where it is going.
+    let mut cross = e.contacts[ci].cross;
+    if cross == 0.0 {
+        cross = model.eval(&probe.q, &probe.qd, modes).contacts[ci].cross;
+        stats.rhs_evals += 1;
+    }
+    modes[ci].cross = if cross < 0.0 { Slip::Neg } else { Slip::Pos };
     for axis in 0..2 {
         let vk = if axis == 0 { v.x } else { v.y };
         let slip = if vk < 0.0 {
@@ -357,7 +373,7 @@ fn enter_contact<const N: usize>(
         match slip {
             Some(s) if axis == 0 => modes[ci].sx = s,
             Some(s) => modes[ci].sy = s,
-            None => choose_slip(model, modes, ci, axis, probe, stats),
+            None => choose_slip(model, modes, ci, axis, y, probe, stats),
         }
     }
 }
@@ -737,11 +753,18 @@ pub fn solve<const N: usize>(
                     modes[ci].sy = Slip::Stick;
                 }
                 Kind::Immersion => modes[ci].full = !modes[ci].full,
+                Kind::Cross => {
+                    modes[ci].cross = if modes[ci].cross == Slip::Pos {
+                        Slip::Neg
+                    } else {
+                        Slip::Pos
+                    }
+                }
                 Kind::SlipX | Kind::StickX => {
-                    choose_slip(model, &mut modes, ci, 0, &probe, &mut stats)
+                    choose_slip(model, &mut modes, ci, 0, &y_star, &y1, &mut stats)
                 }
                 Kind::SlipY | Kind::StickY => {
-                    choose_slip(model, &mut modes, ci, 1, &probe, &mut stats)
+                    choose_slip(model, &mut modes, ci, 1, &y_star, &y1, &mut stats)
                 }
                 Kind::Stop => {
                     modes[ci].stopped = true;
