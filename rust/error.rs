@@ -16,6 +16,13 @@ pub enum GranrsError {
         value: f64,
         allowed: String,
     },
+    /// A field holds a value of the wrong type (a bool or a string where a number is expected).
+    #[error("invalid value for `{field}`: expected {expected}, got {got}")]
+    WrongType {
+        field: String,
+        expected: String,
+        got: String,
+    },
     /// A name (point of application, sign model, end condition, ...) is unknown.
     #[error("unknown {field} `{value}` (allowed: {allowed})")]
     UnknownName {

@@ -4,6 +4,7 @@ Usage::
 
     granrs --version
     granrs reproduce [--out DIR] [--dt DT] [--chapter KEY ...] [--quiet]
+    granrs bench accuracy [--out DIR] [--quick] [--repeats N] [--quiet]
 
 Each subcommand is one ``_add_<name>`` function that declares its arguments and one
 ``_cmd_<name>`` function that runs it and returns the exit code; :data:`_COMMANDS` lists
@@ -83,9 +84,48 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_bench(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Declare ``granrs bench``."""
+    parser = sub.add_parser(
+        "bench",
+        help="run a benchmark (accuracy: error against time of each integrator setting)",
+        description=(
+            "Run a benchmark. 'accuracy' compares RK4 (each sign model, a sweep of dt) and "
+            "dopri5 (a sweep of rtol) with a fine reference on three free-link scenes and "
+            "writes DIR/accuracy.csv, DIR/accuracy.png and DIR/accuracy.md."
+        ),
+    )
+    parser.add_argument("name", choices=["accuracy"], help="benchmark to run")
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        default="granrs-bench",
+        help="output directory (default: ./granrs-bench)",
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="shorter sweeps and a coarser reference"
+    )
+    parser.add_argument(
+        "--repeats", type=int, default=3, metavar="N", help="timing repeats (default: 3)"
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.set_defaults(handler=_cmd_bench)
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    """Run ``granrs bench``."""
+    from .bench import work_precision
+
+    work_precision(args.out, quick=args.quick, repeats=args.repeats, progress=not args.quiet)
+    if not args.quiet:
+        print(f"benchmark written to {args.out}")
+    return 0
+
+
 #: The subcommands, in help order: each adds its parser and sets ``handler``.
 _COMMANDS: tuple[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None], ...] = (
     _add_reproduce,
+    _add_bench,
 )
 
 

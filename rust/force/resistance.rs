@@ -47,7 +47,7 @@ impl Coefficients {
         check_range(&format!("{prefix}.eta_h"), self.eta_h, 0.0, false)?;
         check_range(&format!("{prefix}.eta_d"), self.eta_d, 0.0, false)?;
         check_range(&format!("{prefix}.eta_v"), self.eta_v, 0.0, false)?;
-        check_range(&format!("{prefix}.lambda"), self.lambda, 0.0, false)?;
+        check_range(&format!("{prefix}.lam"), self.lambda, 0.0, false)?;
         Ok(())
     }
 }

@@ -23,6 +23,7 @@ fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
         GranrsError::InvalidParameter { field, .. } => {
             ("InvalidParameterError", Some(field.clone()))
         }
+        GranrsError::WrongType { field, .. } => ("InvalidParameterError", Some(field.clone())),
         GranrsError::UnknownName { field, .. } => ("UnknownNameError", Some(field.clone())),
         GranrsError::InvalidScene { field, .. } => ("InvalidSceneError", Some(field.clone())),
         GranrsError::NonFinite { .. } => ("SimulationError", None),
@@ -56,10 +57,16 @@ fn get_f64(d: &Bound<'_, PyDict>, field: &str) -> Result<f64, GranrsError> {
             field: field.to_string(),
             message: "missing".into(),
         })?;
+    let wrong = |got: String| GranrsError::WrongType {
+        field: field.to_string(),
+        expected: "a real number".into(),
+        got,
+    };
     if v.is_instance_of::<pyo3::types::PyBool>() {
-        return Err(bad_type(field, "a number, not a bool"));
+        return Err(wrong("a bool".into()));
     }
-    v.extract::<f64>().map_err(|_| bad_type(field, "a number"))
+    v.extract::<f64>()
+        .map_err(|_| wrong(v.get_type().to_string()))
 }
 
 /// An optional float field (absent or None gives `None`).
@@ -173,6 +180,11 @@ fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsErr
                 GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
                     field: format!("coefficients.{k}"),
                     message,
+                },
+                GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
+                    field: format!("coefficients.{k}"),
+                    expected,
+                    got,
                 },
                 other => other,
             })
