@@ -306,8 +306,7 @@ impl<const N: usize> Model<N> {
         }
         // Power of the sand's forces at their points of application.
         let mut power = 0.0;
-        for (ci, c) in self.contacts.iter().enumerate() {
-            let ce = &contacts[ci];
+        for (ci, ce) in contacts.iter().enumerate().take(self.contacts.len()) {
             if ce.depth <= 0.0 || !modes[ci].in_contact {
                 continue;
             }
@@ -315,7 +314,6 @@ impl<const N: usize> Model<N> {
                 ApplyAt::Tip => ce.v_tip,
                 ApplyAt::Centroid => ce.v_centroid,
             };
-            let _ = c;
             power += ce.force.total().dot(&p);
         }
         Eval {
