@@ -240,7 +240,12 @@ fn rhs(c: &mut Criterion) {
     });
     g.finish();
 
-    let y = State { q, qd, work: 0.0 };
+    let y = State {
+        q,
+        qd,
+        work: 0.0,
+        dissipated: 0.0,
+    };
     let k1 = deriv_of(&y, &model.eval(&q, &qd, &modes));
     let dt = scene.options.dt;
     let mut g = c.benchmark_group("step");

@@ -1,27 +1,37 @@
-//! The equations of motion of a body in sand: a [`Mechanism`], its rod contacts, the
-//! medium and the force terms a scene asks for, evaluated for a given set of discrete
-//! modes (in contact or not; the sign of each static term, or sticking).
+//! The equations of motion of a body in sand: a [`Mechanism`], its contacts (rods or
+//! soles), the medium and the force terms a scene asks for, evaluated for a given set of
+//! discrete modes (in contact or not; the sign of each static term, or sticking).
 //!
-//! `M(q) qddot = bias(q, qdot) + sum_c J_Pc^T F_c`, with `F_c` the resistance force of
-//! contact `c` (see `force::resistance`) applied at its point `P_c` (tip or centroid).
+//! `M(q) qddot = bias(q, qdot) + Q_joints + sum_c J_Pc^T F_c`, with `F_c` the resistance
+//! force of contact `c` (see `force::resistance`) applied at its point `P_c` (reference
+//! point or centroid), and `Q_joints` the joints' spring-damper torques.
 //!
-//! Sticking (MODEL.md, "sgn"): where a static term holds a velocity component of the
-//! centroid E at zero, that term becomes a reaction `R` (along x or y, at `P_c`) chosen so
-//! that the component's rate of change is zero, as in stick-slip friction (Karnopp). The
-//! solver keeps the stick while `|R|` stays below the static term's magnitude.
+//! Constraints, solved together for their multipliers without allocating:
+//! - a locked joint, `qdot_i - qdot_parent = 0`, with an unbounded torque;
+//! - sticking (MODEL.md, "sgn"): where a static term holds a velocity component of the
+//!   centroid E at zero, that term becomes a reaction `R` (along x or y, at `P_c`) chosen so
+//!   that the component's rate of change is zero, as in stick-slip friction (Karnopp). The
+//!   solver keeps the stick while `|R|` stays below the static term's magnitude.
 
-use nalgebra::{DMatrix, DVector, SMatrix, SVector, Vector2};
+use nalgebra::{SMatrix, SVector, Vector2};
 
+use crate::body::mechanism::Pose;
 use crate::body::rod::ApplyAt;
-use crate::body::{Mechanism, RodContact};
-use crate::force::resistance::{raw_sign, static_bounds};
-use crate::force::{Coefficients, ForceComponents, Medium, RodContactState};
+use crate::body::{Mechanism, RodContact, SoleContact, SoleModel};
+use crate::force::resistance::{raw_sign, static_terms};
+use crate::force::{Coefficients, ForceComponents, Medium};
 
 /// Largest sticking-velocity violation [m/s] that the projection treats as drift.
 pub const PROJECTION_LIMIT: f64 = 1e-6;
 
 /// Most contacts a body may have.
 pub const MAX_CONTACTS: usize = 4;
+
+/// Most locked joints a body may have.
+pub const MAX_LOCKED: usize = 8;
+
+/// Most constraint rows at once: two sticking components per contact and the locked joints.
+const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED;
 
 /// How the signs of the static terms are evaluated.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,11 +79,12 @@ pub struct ContactMode {
     pub sy: Slip,
     /// Whether this contact's stop event has happened.
     pub stopped: bool,
-    /// Sign of e x v_E held through a step: the drag's reference area is |e x v_E|, whose
+    /// Sign of e x v_E held through a step: a rod's drag reference area is |e x v_E|, whose
     /// kink where v_E is parallel to the axis is a located event in the `Modes` model.
     pub cross: Slip,
-    /// Whether the rod is wholly immersed (l = L): the kink of l = min(d / cos q, L) is a
-    /// located event too, so that a step never straddles it.
+    /// Whether the contact is wholly immersed (a rod's l = L; a sole box under the surface):
+    /// the kink of l = min(d / cos q, L) is a located event too, so that a step never
+    /// straddles it.
     pub full: bool,
 }
 
@@ -117,19 +128,49 @@ impl Default for Effects {
     }
 }
 
+/// The shape of a contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// A round rod meeting the sand with its tip (free link, chain links).
+    Rod(RodContact),
+    /// A foot's sole box (leg).
+    Sole(SoleContact),
+}
+
 /// One contact of a body with its coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
-    /// Geometry: which link, where the tip is, rod length and diameter.
-    pub rod: RodContact,
+    /// Geometry: which link, where, what shape.
+    pub shape: Shape,
     /// Coefficients of the force law for this contact.
     pub coefficients: Coefficients,
+}
+
+impl Contact {
+    /// The link the contact belongs to.
+    #[inline]
+    pub fn link(&self) -> usize {
+        match &self.shape {
+            Shape::Rod(r) => r.link,
+            Shape::Sole(s) => s.link,
+        }
+    }
+
+    /// The reference point T (local coordinates): a rod's tip, the middle of a sole. Its
+    /// depth and vertical velocity give the contact's depth and stop.
+    #[inline]
+    pub fn reference_point(&self) -> Vector2<f64> {
+        match &self.shape {
+            Shape::Rod(r) => r.tip,
+            Shape::Sole(s) => s.reference_point(),
+        }
+    }
 }
 
 /// A body in sand: everything the right-hand side needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model<const N: usize> {
-    /// The rigid links.
+    /// The rigid links and their joints.
     pub mechanism: Mechanism<N>,
     /// The contacts (at most [`MAX_CONTACTS`]).
     pub contacts: Vec<Contact>,
@@ -146,19 +187,21 @@ pub struct Model<const N: usize> {
 /// What one evaluation finds at one contact.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ContactEval {
-    /// Tip position [m].
+    /// Reference point T (a rod's tip, a sole's middle) [m].
     pub tip: Vector2<f64>,
-    /// Tip velocity [m/s].
+    /// Velocity of T [m/s].
     pub v_tip: Vector2<f64>,
-    /// Depth of the tip [m].
+    /// Depth of the force law [m] (a rod's tip depth; a sole's immersed area / f_s).
     pub depth: f64,
+    /// Lowest point of the contact's shape [m] (the entry and exit function).
+    pub lowest: f64,
     /// Velocity of the material point at the immersed centroid E [m/s].
     pub v_centroid: Vector2<f64>,
     /// Force components (with any sticking reaction in place of its static term) [N].
     pub force: ForceComponents,
-    /// e x v_E, the signed sine of the drag's reference area times |v_E| [m/s].
+    /// e x v_E, the signed sine of a rod's drag reference area times |v_E| [m/s].
     pub cross: f64,
-    /// Margin to full immersion, L cos q - d [m] (negative when wholly immersed).
+    /// Margin to full immersion [m] (negative when wholly immersed).
     pub immersion_margin: f64,
     /// Magnitudes of the static terms (the bounds of a sticking reaction) [N].
     pub bound_h: f64,
@@ -173,6 +216,11 @@ pub struct Eval<const N: usize> {
     pub qdd: SVector<f64, N>,
     /// Power of the sand's forces on the body, sum_c F_c . v_Pc [W] (non-positive at E).
     pub power: f64,
+    /// Power dissipated by the joints' dampers [W] (non-negative).
+    pub joint_power: f64,
+    /// Torque on each link at its joint, from its parent [N m]: a spring-damper's torque,
+    /// or a locked joint's reaction (0 at a free joint and for a root link).
+    pub joint_torque: [f64; N],
     /// Per-contact findings.
     pub contacts: [ContactEval; MAX_CONTACTS],
 }
@@ -187,26 +235,249 @@ fn unit(k: usize) -> Vector2<f64> {
     }
 }
 
-/// A sticking component: contact, axis, and what the solve needs of it.
-struct StuckRow<const N: usize> {
-    contact: usize,
-    axis: usize,
-    /// Row of the constraint `u . v_E = jac_e . qdot`.
-    jac_e: SVector<f64, N>,
-    /// `u . (velocity-product acceleration of E + sliding of E along the link)`.
+/// What a constraint row holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RowKind {
+    /// A sticking component: contact and axis (0 = x, 1 = y).
+    Stick { contact: usize, axis: usize },
+    /// A locked joint of this link.
+    Lock { link: usize },
+}
+
+/// One constraint `jac . qdot = 0`, with what its multiplier does.
+#[derive(Debug, Clone, Copy)]
+struct Row<const N: usize> {
+    kind: RowKind,
+    /// The constrained velocity is `jac . qdot`.
+    jac: SVector<f64, N>,
+    /// `d(jac)/dt . qdot`: the constraint's acceleration at `qddot = 0` beyond `jac . qddot`.
     bias: f64,
-    /// `M^-1 J_P^T u`: the accelerations caused by a unit reaction.
+    /// `M^-1 Q_u`: the accelerations caused by a unit multiplier.
     response: SVector<f64, N>,
 }
 
+/// A fixed-capacity set of constraint rows (no allocation in the right-hand side).
+struct Rows<const N: usize> {
+    rows: [Option<Row<N>>; MAX_ROWS],
+    len: usize,
+}
+
+impl<const N: usize> Rows<N> {
+    fn new() -> Self {
+        Rows {
+            rows: [None; MAX_ROWS],
+            len: 0,
+        }
+    }
+    fn push(&mut self, r: Row<N>) {
+        self.rows[self.len] = Some(r);
+        self.len += 1;
+    }
+    fn get(&self, i: usize) -> &Row<N> {
+        self.rows[i].as_ref().expect("row within len")
+    }
+}
+
+/// Solve the `k x k` system `a x = b` in place (`b` becomes `x`) by Gaussian elimination
+/// with partial pivoting. A (near-)singular system, from redundant constraints, is
+/// regularized by a tiny diagonal shift. Returns false if it still fails.
+fn solve_small(a: &mut [[f64; MAX_ROWS]; MAX_ROWS], b: &mut [f64; MAX_ROWS], k: usize) -> bool {
+    let scale = (0..k).fold(0.0f64, |m, i| m.max(a[i][i].abs()));
+    let tiny = 1e-13 * scale.max(f64::MIN_POSITIVE);
+    let (a0, b0) = (*a, *b);
+    for attempt in 0..2 {
+        if attempt == 1 {
+            *a = a0;
+            *b = b0;
+            for (i, row) in a.iter_mut().enumerate().take(k) {
+                row[i] += 1e-10 * scale.max(f64::MIN_POSITIVE);
+            }
+        }
+        let mut ok = true;
+        for col in 0..k {
+            let piv = (col..k)
+                .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
+                .unwrap_or(col);
+            if a[piv][col].abs() <= tiny {
+                ok = false;
+                break;
+            }
+            a.swap(col, piv);
+            b.swap(col, piv);
+            for r in col + 1..k {
+                let f = a[r][col] / a[col][col];
+                if f != 0.0 {
+                    let pivot_row = a[col];
+                    for (x, p) in a[r][col..k].iter_mut().zip(&pivot_row[col..k]) {
+                        *x -= f * p;
+                    }
+                    b[r] -= f * b[col];
+                }
+            }
+        }
+        if ok {
+            for col in (0..k).rev() {
+                let mut v = b[col];
+                for c in col + 1..k {
+                    v -= a[col][c] * b[c];
+                }
+                b[col] = v / a[col][col];
+            }
+            return true;
+        }
+    }
+    false
+}
+
+/// The immersed geometry of one contact, as the force law needs it.
+#[derive(Debug, Clone, Copy)]
+struct Geometry {
+    /// Depth of the force law [m].
+    depth: f64,
+    /// Local coordinates of the immersed centroid E.
+    centroid: Vector2<f64>,
+    /// Immersed volume [m^3].
+    volume: f64,
+    /// Width w of the horizontal static term [m].
+    width: f64,
+    /// Reference length of the depth factor [m].
+    l_ref: f64,
+    /// Margin to full immersion [m].
+    margin: f64,
+    /// Lowest point of the shape [m].
+    lowest: f64,
+    /// The axis whose cross product with v_E sets a rod's (or the thesis sole's) drag area.
+    cross_axis: Vector2<f64>,
+    /// Drag factor along `cross_axis`: `A_r |v_E| = factor * |cross_axis x v_E|`, or for the
+    /// box `A_r |v_E|` comes from the polygon (`sole`).
+    factor: f64,
+    /// The sole's polygon, for the box drag.
+    sole: Option<crate::body::SoleGeometry>,
+}
+
 impl<const N: usize> Model<N> {
+    /// The geometry of contact `c` at `pose` (depth zero when out of the sand).
+    fn geometry(&self, c: &Contact, pose: &Pose<N>) -> Geometry {
+        let link = c.link();
+        let axis = pose.axis[link];
+        match &c.shape {
+            Shape::Rod(rod) => {
+                let tip = self.mechanism.point(pose, link, rod.tip);
+                let g = rod.geometry(tip.y, axis);
+                Geometry {
+                    depth: g.depth,
+                    centroid: Vector2::new(g.centroid_s, rod.tip.y),
+                    volume: rod.immersed_volume(&g),
+                    width: rod.diameter,
+                    l_ref: rod.length,
+                    margin: rod.length * axis.y - g.depth,
+                    lowest: tip.y,
+                    cross_axis: axis,
+                    factor: rod.diameter * g.immersed_length,
+                    sole: None,
+                }
+            }
+            Shape::Sole(sole) => {
+                let joint = pose.joint[link];
+                let normal = pose.normal[link];
+                let g = sole.geometry(joint, axis, normal);
+                let rel = g.centroid - joint;
+                let centroid = Vector2::new(rel.dot(&axis), rel.dot(&normal));
+                let (volume, factor, cross_axis) = match sole.model {
+                    SoleModel::Box => (sole.volume(&g), 0.0, axis),
+                    SoleModel::Thesis => {
+                        // Eqs. 5.5-5.7 with q the shank's angle from the vertical: infinite
+                        // at q = 0 (V) and |q| = 90 deg (A_r); NaN there stops the run.
+                        let e = pose.axis[sole.angle_link];
+                        let (sin_q, cos_q) = (e.x.abs(), e.y);
+                        let ok = sin_q > 1e-9 && cos_q > 1e-9;
+                        let nan = f64::NAN;
+                        (
+                            if ok {
+                                sole.length * sole.width * g.depth / sin_q
+                            } else {
+                                nan
+                            },
+                            if ok {
+                                sole.length * g.depth / cos_q
+                            } else {
+                                nan
+                            },
+                            e,
+                        )
+                    }
+                };
+                Geometry {
+                    depth: g.depth,
+                    centroid,
+                    volume,
+                    width: sole.length,
+                    l_ref: sole.l_ref,
+                    margin: g.highest,
+                    lowest: g.lowest,
+                    cross_axis,
+                    factor,
+                    sole: if sole.model == SoleModel::Box {
+                        Some(g)
+                    } else {
+                        None
+                    },
+                }
+            }
+        }
+    }
+
+    /// Rate of change of E's local coordinates on its link (E moves over the body as the
+    /// immersed part grows).
+    fn centroid_local_rate(
+        &self,
+        c: &Contact,
+        pose: &Pose<N>,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        geom: &Geometry,
+    ) -> Vector2<f64> {
+        let link = c.link();
+        match &c.shape {
+            Shape::Rod(rod) => {
+                let axis = pose.axis[link];
+                let v_tip = self.mechanism.point_velocity(pose, link, rod.tip, qd);
+                let omega = qd[2 + link];
+                let g = rod.geometry(-geom.depth, axis);
+                let l_rate = rod.immersed_length_rate(&g, axis, -v_tip.y, -axis.x * omega);
+                Vector2::new(0.5 * l_rate, 0.0)
+            }
+            Shape::Sole(_) => {
+                // Central difference along the motion (the polygon's centroid has no simple
+                // closed-form rate).
+                let h = 1e-7;
+                let at = |sign: f64| {
+                    let qh = q + (sign * h) * qd;
+                    self.geometry(c, &self.mechanism.pose(&qh)).centroid
+                };
+                (at(1.0) - at(-1.0)) / (2.0 * h)
+            }
+        }
+    }
+
     /// The local (s, n) coordinates of the point where contact `c`'s force acts.
     #[inline]
-    fn application_point(&self, c: &Contact, centroid_s: f64) -> Vector2<f64> {
+    fn application_point(&self, c: &Contact, centroid: Vector2<f64>) -> Vector2<f64> {
         match self.apply_at {
-            ApplyAt::Tip => c.rod.tip,
-            ApplyAt::Centroid => Vector2::new(centroid_s, c.rod.tip.y),
+            ApplyAt::Tip => c.reference_point(),
+            ApplyAt::Centroid => centroid,
         }
+    }
+
+    /// Whether any sticking component is in force under `modes`.
+    fn any_stuck(&self, modes: &Modes) -> bool {
+        self.sign_model == SignModel::Modes
+            && self.contacts.iter().enumerate().any(|(ci, _)| {
+                let m = &modes[ci];
+                m.in_contact
+                    && ((self.effects.static_h && m.sx == Slip::Stick)
+                        || (self.effects.static_v && m.sy == Slip::Stick))
+            })
     }
 
     /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
@@ -218,64 +489,76 @@ impl<const N: usize> Model<N> {
             0.0
         };
         let mut rhs = self.mechanism.bias_forces(&pose, qd, g);
+        let mut joint_torque = [0.0; N];
+        let joint_power = self
+            .mechanism
+            .add_joint_torques(q, qd, &mut rhs, &mut joint_torque);
         let mut contacts = [ContactEval::default(); MAX_CONTACTS];
-        let mut any_stuck = false;
         for (ci, c) in self.contacts.iter().enumerate() {
-            let link = c.rod.link;
-            let tip = self.mechanism.point(&pose, link, c.rod.tip);
-            let v_tip = self.mechanism.point_velocity(&pose, link, c.rod.tip, qd);
+            let link = c.link();
+            let t_local = c.reference_point();
+            let tip = self.mechanism.point(&pose, link, t_local);
+            let v_tip = self.mechanism.point_velocity(&pose, link, t_local, qd);
             let out = &mut contacts[ci];
             out.tip = tip;
             out.v_tip = v_tip;
-            // With nothing immersed, E is the tip.
+            // With nothing immersed, E is the reference point.
             out.v_centroid = v_tip;
+            let geom = self.geometry(c, &pose);
+            out.lowest = geom.lowest;
             let mode = &modes[ci];
             if !mode.in_contact {
                 continue;
             }
-            let axis = pose.axis[link];
-            let geom = c.rod.geometry(tip.y, axis);
             out.depth = geom.depth;
-            out.immersion_margin = c.rod.length * axis.y - geom.depth;
+            out.immersion_margin = geom.margin;
             if geom.depth <= 0.0 {
                 continue;
             }
-            let e_local = Vector2::new(geom.centroid_s, c.rod.tip.y);
-            let v_e = self.mechanism.point_velocity(&pose, link, e_local, qd);
+            let v_e = self
+                .mechanism
+                .point_velocity(&pose, link, geom.centroid, qd);
             out.v_centroid = v_e;
-            let state = RodContactState {
-                depth: geom.depth,
-                immersed_length: geom.immersed_length,
-                axis,
-                v_centroid: v_e,
-            };
             let (sx, sy) = match self.sign_model {
                 SignModel::Modes => (mode.sx.sign(), mode.sy.sign()),
                 SignModel::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
                 SignModel::Smooth { eps } => ((v_e.x / eps).tanh(), (v_e.y / eps).tanh()),
             };
             let coef = &c.coefficients;
-            let (bh, bv) = static_bounds(
+            let (bh, bv) = static_terms(
                 coef,
                 &self.medium,
-                c.rod.diameter,
-                c.rod.diameter,
-                c.rod.length,
-                &state,
+                geom.width,
+                geom.l_ref,
+                geom.depth,
+                geom.volume,
             );
             let mut f = ForceComponents::default();
-            let cross_signed = axis.x * v_e.y - axis.y * v_e.x;
-            out.cross = cross_signed;
+            let e = geom.cross_axis;
+            let cross_signed = e.x * v_e.y - e.y * v_e.x;
+            out.cross = if geom.sole.is_some() {
+                1.0
+            } else {
+                cross_signed
+            };
             if self.effects.drag {
-                // |e x v_E|; in `Modes` the sign is held (the kink at 0 is a located event).
-                let cross = match self.sign_model {
-                    SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
-                    SignModel::Modes => cross_signed,
-                    _ => cross_signed.abs(),
+                // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held
+                // (the kink at 0 is a located event).
+                let area_speed = match &geom.sole {
+                    Some(sg) => match &c.shape {
+                        Shape::Sole(sole) => sole.drag_area_speed(sg, v_e),
+                        Shape::Rod(_) => unreachable!("a rod has no polygon"),
+                    },
+                    None => {
+                        let cross = match self.sign_model {
+                            SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
+                            SignModel::Modes => cross_signed,
+                            _ => cross_signed.abs(),
+                        };
+                        geom.factor * cross
+                    }
                 };
-                let k =
-                    coef.eta_d * self.medium.rho_g * c.rod.diameter * geom.immersed_length * cross;
-                f.drag = -k * v_e;
+                f.drag = -(coef.eta_d * self.medium.rho_g * area_speed) * v_e;
             }
             if self.effects.static_h {
                 out.bound_h = bh;
@@ -286,13 +569,7 @@ impl<const N: usize> Model<N> {
                 f.static_v = -sy * bv;
             }
             out.force = f;
-            if self.sign_model == SignModel::Modes
-                && ((self.effects.static_h && mode.sx == Slip::Stick)
-                    || (self.effects.static_v && mode.sy == Slip::Stick))
-            {
-                any_stuck = true;
-            }
-            let p = self.application_point(c, geom.centroid_s);
+            let p = self.application_point(c, geom.centroid);
             self.mechanism
                 .add_point_force(&pose, link, p, f.total(), &mut rhs);
         }
@@ -301,8 +578,18 @@ impl<const N: usize> Model<N> {
             .cholesky()
             .expect("mass matrix of positive masses is positive definite");
         let mut qdd = chol.solve(&rhs);
-        if any_stuck {
-            self.solve_sticking(&pose, q, qd, modes, &chol, &mut qdd, &mut contacts);
+        let has_locks = self.mechanism.locked_rows().next().is_some();
+        if has_locks || self.any_stuck(modes) {
+            self.solve_constraints(
+                &pose,
+                q,
+                qd,
+                modes,
+                &chol,
+                &mut qdd,
+                &mut contacts,
+                &mut joint_torque,
+            );
         }
         // Power of the sand's forces at their points of application.
         let mut power = 0.0;
@@ -319,58 +606,75 @@ impl<const N: usize> Model<N> {
         Eval {
             qdd,
             power,
+            joint_power,
+            joint_torque,
             contacts,
         }
     }
 
-    /// Rows of the sticking constraints in force under `modes` at this configuration.
-    fn stuck_rows(
+    /// The constraint rows in force under `modes` at this configuration: the locked joints
+    /// and the sticking components.
+    fn constraint_rows(
         &self,
-        pose: &crate::body::mechanism::Pose<N>,
+        pose: &Pose<N>,
+        q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
         modes: &Modes,
         chol: &nalgebra::Cholesky<f64, nalgebra::Const<N>>,
-    ) -> Vec<StuckRow<N>> {
-        let mut rows = Vec::new();
+    ) -> Rows<N> {
+        let mut rows = Rows::new();
+        for (link, parent) in self.mechanism.locked_rows() {
+            let mut jac = SVector::<f64, N>::zeros();
+            jac[2 + link] = 1.0;
+            jac[2 + parent] = -1.0;
+            rows.push(Row {
+                kind: RowKind::Lock { link },
+                jac,
+                bias: 0.0,
+                response: chol.solve(&jac),
+            });
+        }
+        if self.sign_model != SignModel::Modes {
+            return rows;
+        }
         for (ci, c) in self.contacts.iter().enumerate() {
             let mode = &modes[ci];
             if !mode.in_contact {
                 continue;
             }
-            let link = c.rod.link;
-            let axis = pose.axis[link];
-            let tip = self.mechanism.point(pose, link, c.rod.tip);
-            let geom = c.rod.geometry(tip.y, axis);
+            let stuck_x = self.effects.static_h && mode.sx == Slip::Stick;
+            let stuck_y = self.effects.static_v && mode.sy == Slip::Stick;
+            if !(stuck_x || stuck_y) {
+                continue;
+            }
+            let link = c.link();
+            let geom = self.geometry(c, pose);
             if geom.depth <= 0.0 {
                 continue;
             }
-            let e_local = Vector2::new(geom.centroid_s, c.rod.tip.y);
-            let jac_e: SMatrix<f64, 2, N> = self.mechanism.jacobian(pose, link, e_local);
-            let v_tip = self.mechanism.point_velocity(pose, link, c.rod.tip, qd);
+            let jac_e: SMatrix<f64, 2, N> = self.mechanism.jacobian(pose, link, geom.centroid);
             let omega = qd[2 + link];
-            // E slides along the link as l changes: d(s_E)/dt = l'/2.
-            let l_rate = c
-                .rod
-                .immersed_length_rate(&geom, axis, -v_tip.y, -axis.x * omega);
+            // E moves over the link: d/dt v_E = J qddot + bias + omega dR/dq r_E'.
+            let r_rate = self.centroid_local_rate(c, pose, q, qd, &geom);
+            let slide = r_rate.x * pose.normal[link] - r_rate.y * pose.axis[link];
             let a_bias = self
                 .mechanism
-                .point_bias_acceleration(pose, link, e_local, qd)
-                + omega * pose.normal[link] * (0.5 * l_rate);
-            let p = self.application_point(c, geom.centroid_s);
-            for (k, slip, on) in [
-                (0usize, mode.sx, self.effects.static_h),
-                (1usize, mode.sy, self.effects.static_v),
-            ] {
-                if !on || slip != Slip::Stick {
+                .point_bias_acceleration(pose, link, geom.centroid, qd)
+                + omega * slide;
+            let p = self.application_point(c, geom.centroid);
+            for (k, on) in [(0usize, stuck_x), (1usize, stuck_y)] {
+                if !on {
                     continue;
                 }
                 let u = unit(k);
                 let mut gen = SVector::<f64, N>::zeros();
                 self.mechanism.add_point_force(pose, link, p, u, &mut gen);
-                rows.push(StuckRow {
-                    contact: ci,
-                    axis: k,
-                    jac_e: (u.transpose() * jac_e).transpose(),
+                rows.push(Row {
+                    kind: RowKind::Stick {
+                        contact: ci,
+                        axis: k,
+                    },
+                    jac: (u.transpose() * jac_e).transpose(),
                     bias: u.dot(&a_bias),
                     response: chol.solve(&gen),
                 });
@@ -379,65 +683,65 @@ impl<const N: usize> Model<N> {
         rows
     }
 
-    /// Replace the static term of each sticking component by the reaction that holds its
-    /// velocity component at zero (d/dt (u . v_E) = 0), and correct the accelerations.
+    /// Solve for the multipliers of the locked joints and the sticking components (each
+    /// sticking component's static term becomes the reaction that holds its velocity at
+    /// zero) and correct the accelerations.
     #[allow(clippy::too_many_arguments)]
-    fn solve_sticking(
+    fn solve_constraints(
         &self,
-        pose: &crate::body::mechanism::Pose<N>,
-        _q: &SVector<f64, N>,
+        pose: &Pose<N>,
+        q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
         modes: &Modes,
         chol: &nalgebra::Cholesky<f64, nalgebra::Const<N>>,
         qdd: &mut SVector<f64, N>,
         contacts: &mut [ContactEval; MAX_CONTACTS],
+        joint_torque: &mut [f64; N],
     ) {
-        let rows = self.stuck_rows(pose, qd, modes, chol);
-        let k = rows.len();
+        let rows = self.constraint_rows(pose, q, qd, modes, chol);
+        let k = rows.len;
         if k == 0 {
             return;
         }
-        let mut a = DMatrix::<f64>::zeros(k, k);
-        let mut b = DVector::<f64>::zeros(k);
-        for (i, ri) in rows.iter().enumerate() {
-            b[i] = -(ri.bias + ri.jac_e.dot(qdd));
-            for (j, rj) in rows.iter().enumerate() {
-                a[(i, j)] = ri.jac_e.dot(&rj.response);
+        let mut a = [[0.0; MAX_ROWS]; MAX_ROWS];
+        let mut b = [0.0; MAX_ROWS];
+        for i in 0..k {
+            let ri = rows.get(i);
+            b[i] = -(ri.bias + ri.jac.dot(qdd));
+            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                *aij = ri.jac.dot(&rows.get(j).response);
             }
         }
-        let reactions = match a.clone().lu().solve(&b) {
-            Some(r) => r,
-            None => a.pseudo_inverse(1e-14).map(|p| p * &b).unwrap_or(b * 0.0),
-        };
-        for (i, r) in rows.iter().enumerate() {
-            *qdd += reactions[i] * r.response;
-            let ce = &mut contacts[r.contact];
-            if r.axis == 0 {
-                ce.force.static_h = reactions[i];
-            } else {
-                ce.force.static_v = reactions[i];
+        if !solve_small(&mut a, &mut b, k) {
+            b = [0.0; MAX_ROWS];
+        }
+        for (i, &mult) in b.iter().enumerate().take(k) {
+            let r = rows.get(i);
+            *qdd += mult * r.response;
+            match r.kind {
+                RowKind::Stick { contact, axis } => {
+                    let ce = &mut contacts[contact];
+                    if axis == 0 {
+                        ce.force.static_h = mult;
+                    } else {
+                        ce.force.static_v = mult;
+                    }
+                }
+                RowKind::Lock { link } => joint_torque[link] = mult,
             }
         }
     }
 
-    /// Project `qd` so that every sticking component's velocity is zero, with the smallest
-    /// change in kinetic energy (an M-orthogonal projection). Returns whether it changed.
+    /// Project `qd` so that every sticking component's velocity (and every locked joint's
+    /// rate) is zero, with the smallest change in kinetic energy (an M-orthogonal
+    /// projection). Returns whether it changed.
     pub fn project_sticking(
         &self,
         q: &SVector<f64, N>,
         qd: &mut SVector<f64, N>,
         modes: &Modes,
     ) -> bool {
-        if self.sign_model != SignModel::Modes {
-            return false;
-        }
-        let any = self.contacts.iter().enumerate().any(|(ci, _)| {
-            let m = &modes[ci];
-            m.in_contact
-                && ((self.effects.static_h && m.sx == Slip::Stick)
-                    || (self.effects.static_v && m.sy == Slip::Stick))
-        });
-        if !any {
+        if !self.any_stuck(modes) {
             return false;
         }
         let pose = self.mechanism.pose(q);
@@ -446,46 +750,70 @@ impl<const N: usize> Model<N> {
             Some(c) => c,
             None => return false,
         };
-        let rows = self.stuck_rows(&pose, qd, modes, &chol);
-        let k = rows.len();
+        let rows = self.constraint_rows(&pose, q, qd, modes, &chol);
+        let k = rows.len;
         if k == 0 {
             return false;
         }
         // Only drift is removed: a violation larger than this is not drift but a wrong mode,
         // and is left for the solver's switching functions to see.
-        if rows
-            .iter()
-            .any(|r| r.jac_e.dot(qd).abs() > PROJECTION_LIMIT)
-        {
+        if (0..k).any(|i| rows.get(i).jac.dot(qd).abs() > PROJECTION_LIMIT) {
             return false;
         }
         // M^-1 J^T columns and J M^-1 J^T.
-        let minv_jt: Vec<SVector<f64, N>> = rows.iter().map(|r| chol.solve(&r.jac_e)).collect();
-        let mut a = DMatrix::<f64>::zeros(k, k);
-        let mut b = DVector::<f64>::zeros(k);
+        let mut minv_jt = [SVector::<f64, N>::zeros(); MAX_ROWS];
+        for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
+            *m = chol.solve(&rows.get(i).jac);
+        }
+        let mut a = [[0.0; MAX_ROWS]; MAX_ROWS];
+        let mut b = [0.0; MAX_ROWS];
         for i in 0..k {
-            b[i] = rows[i].jac_e.dot(qd);
+            let ji = &rows.get(i).jac;
+            b[i] = ji.dot(qd);
             for j in 0..k {
-                a[(i, j)] = rows[i].jac_e.dot(&minv_jt[j]);
+                a[i][j] = ji.dot(&minv_jt[j]);
             }
         }
-        match a.lu().solve(&b) {
-            Some(lam) if lam.iter().any(|&l| l != 0.0) => {
-                for i in 0..k {
-                    *qd -= lam[i] * minv_jt[i];
-                }
-                true
-            }
-            _ => false,
+        if !solve_small(&mut a, &mut b, k) || b[..k].iter().all(|&l| l == 0.0) {
+            return false;
         }
+        for i in 0..k {
+            *qd -= b[i] * minv_jt[i];
+        }
+        true
     }
 
-    /// Kinetic and potential energy at `(q, qd)` [J].
+    /// Force each link receives at its joint from its parent (or the root) [N], from the
+    /// accelerations of an evaluation (see [`Mechanism::joint_forces`]).
+    pub fn joint_forces(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) -> [Vector2<f64>; N] {
+        let pose = self.mechanism.pose(q);
+        let mut external = [Vector2::zeros(); N];
+        for (ci, c) in self.contacts.iter().enumerate() {
+            if modes[ci].in_contact {
+                external[c.link()] += e.contacts[ci].force.total();
+            }
+        }
+        let g = if self.effects.gravity {
+            self.medium.g
+        } else {
+            0.0
+        };
+        self.mechanism.joint_forces(&pose, qd, &e.qdd, g, &external)
+    }
+
+    /// Kinetic and potential energy at `(q, qd)` [J]; the potential energy is gravity's
+    /// plus the joints' springs'.
     pub fn energies(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> (f64, f64) {
         let pose = self.mechanism.pose(q);
         (
             self.mechanism.kinetic_energy(&pose, qd),
-            self.mechanism.potential_energy(&pose, self.medium.g),
+            self.mechanism.potential_energy(&pose, self.medium.g) + self.mechanism.spring_energy(q),
         )
     }
 }

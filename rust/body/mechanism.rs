@@ -7,9 +7,35 @@
 //!
 //! With absolute angles the Jacobian of a point is `[I_2 | ... d(R(q_a) r_a)/dq_a ...]` over the
 //! chain of ancestors `a`, and its velocity-product acceleration is `-sum_a qdot_a^2 R(q_a) r_a`.
-//! The mass matrix is `sum_i m_i J_ci^T J_ci + I_i u_i u_i^T` (u_i picks link i's angle).
+//! The mass matrix is `sum_i m_i J_ci^T J_ci + I_i u_i u_i^T` (u_i picks link i's angle),
+//! plus a point mass at the root (the chain's pin).
+//!
+//! A joint between a link and its parent is free, locked, or a rotational spring-damper on
+//! the relative angle `q_i - q_parent`. A locked joint is the linear constraint
+//! `qdot_i - qdot_parent = 0` ([`Mechanism::locked_rows`]), enforced with the contacts'
+//! sticking constraints by `dynamics`; since it is linear in `q`, RK4 keeps it exactly (to
+//! round-off).
 
 use nalgebra::{SMatrix, SVector, Vector2};
+
+/// The joint between a link and its parent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Joint {
+    /// A frictionless revolute joint.
+    Free,
+    /// No relative rotation: the link moves rigidly with its parent.
+    Locked,
+    /// A rotational spring-damper: torque `-k (theta - rest) - c thetadot` on the relative
+    /// angle `theta = q_i - q_parent`.
+    Spring {
+        /// Stiffness [N m/rad].
+        k: f64,
+        /// Damping [N m s/rad].
+        c: f64,
+        /// Relative angle at which the spring is relaxed [rad].
+        rest: f64,
+    },
+}
 
 /// One rigid link.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,6 +50,8 @@ pub struct Link {
     pub parent: Option<usize>,
     /// This link's joint in the parent's local (s, n) coordinates [m] (ignored without parent).
     pub joint_on_parent: Vector2<f64>,
+    /// The joint to the parent (ignored without parent: a root link's angle is free).
+    pub joint: Joint,
 }
 
 /// A planar tree of `N - 2` links with a floating root: `N` generalized coordinates.
@@ -31,11 +59,15 @@ pub struct Link {
 pub struct Mechanism<const N: usize> {
     /// The links; a parent always comes before its children.
     pub links: Vec<Link>,
+    /// A point mass at the root [kg] (the chain's pin; 0 for none).
+    pub root_mass: f64,
 }
 
 /// Positions and axes of every link for one configuration.
 #[derive(Debug, Clone, Copy)]
 pub struct Pose<const N: usize> {
+    /// The root point [m].
+    pub root: Vector2<f64>,
     /// Joint position of each link [m].
     pub joint: [Vector2<f64>; N],
     /// Axis e_i of each link.
@@ -65,18 +97,96 @@ impl<const N: usize> Mechanism<N> {
 
     /// Total mass [kg].
     pub fn total_mass(&self) -> f64 {
-        self.links.iter().map(|l| l.mass).sum()
+        self.root_mass + self.links.iter().map(|l| l.mass).sum::<f64>()
+    }
+
+    /// The (link, parent) pairs of the locked joints; each is the constraint
+    /// `qdot_link - qdot_parent = 0`.
+    pub fn locked_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.links
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| match (l.parent, l.joint) {
+                (Some(p), Joint::Locked) => Some((i, p)),
+                _ => None,
+            })
+    }
+
+    /// Add the spring-damper torques of the joints to the generalized forces `out`; return
+    /// the power they dissipate, `sum c thetadot^2` [W] (non-negative).
+    pub fn add_joint_torques(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        out: &mut SVector<f64, N>,
+        torques: &mut [f64; N],
+    ) -> f64 {
+        let mut dissipated = 0.0;
+        for (i, l) in self.links.iter().enumerate() {
+            if let (Some(p), Joint::Spring { k, c, rest }) = (l.parent, l.joint) {
+                let theta = q[2 + i] - q[2 + p];
+                let rate = qd[2 + i] - qd[2 + p];
+                let tau = -k * (theta - rest) - c * rate;
+                out[2 + i] += tau;
+                out[2 + p] -= tau;
+                torques[i] = tau;
+                dissipated += c * rate * rate;
+            }
+        }
+        dissipated
+    }
+
+    /// Elastic energy stored in the joints' springs [J].
+    pub fn spring_energy(&self, q: &SVector<f64, N>) -> f64 {
+        self.links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| match (l.parent, l.joint) {
+                (Some(p), Joint::Spring { k, rest, .. }) => {
+                    let x = q[2 + i] - q[2 + p] - rest;
+                    0.5 * k * x * x
+                }
+                _ => 0.0,
+            })
+            .sum()
+    }
+
+    /// Force the parent (or the root) exerts on each link at its joint [N], from Newton's
+    /// law on the subtree the joint carries: `sum_subtree m (a_c - g) - F_external`.
+    /// `external[i]` is the external force (the sand's) on link `i`.
+    pub fn joint_forces(
+        &self,
+        pose: &Pose<N>,
+        qd: &SVector<f64, N>,
+        qdd: &SVector<f64, N>,
+        g: f64,
+        external: &[Vector2<f64>; N],
+    ) -> [Vector2<f64>; N] {
+        let mut f = [Vector2::zeros(); N];
+        for (i, link) in self.links.iter().enumerate() {
+            let a = self.jacobian(pose, i, link.com) * qdd
+                + self.point_bias_acceleration(pose, i, link.com, qd);
+            f[i] = link.mass * (a - Vector2::new(0.0, -g)) - external[i];
+        }
+        for i in (0..self.links.len()).rev() {
+            if let Some(p) = self.links[i].parent {
+                let fi = f[i];
+                f[p] += fi;
+            }
+        }
+        f
     }
 
     /// Positions and axes of every link at configuration `q`.
     #[inline]
     pub fn pose(&self, q: &SVector<f64, N>) -> Pose<N> {
+        let root = Vector2::new(q[0], q[1]);
         let mut pose = Pose {
+            root,
             joint: [Vector2::zeros(); N],
             axis: [Vector2::zeros(); N],
             normal: [Vector2::zeros(); N],
         };
-        let root = Vector2::new(q[0], q[1]);
         for (i, link) in self.links.iter().enumerate() {
             let (s, c) = q[2 + i].sin_cos();
             pose.axis[i] = Vector2::new(s, c);
@@ -187,6 +297,8 @@ impl<const N: usize> Mechanism<N> {
             m += link.mass * j.transpose() * j;
             m[(2 + i, 2 + i)] += link.inertia;
         }
+        m[(0, 0)] += self.root_mass;
+        m[(1, 1)] += self.root_mass;
         m
     }
 
@@ -199,12 +311,13 @@ impl<const N: usize> Mechanism<N> {
             let f = link.mass * (Vector2::new(0.0, -g) - a);
             self.add_point_force(pose, i, link.com, f, &mut out);
         }
+        out[1] -= self.root_mass * g;
         out
     }
 
     /// Kinetic energy 1/2 qdot^T M qdot [J].
     pub fn kinetic_energy(&self, pose: &Pose<N>, qd: &SVector<f64, N>) -> f64 {
-        let mut ke = 0.0;
+        let mut ke = 0.5 * self.root_mass * (qd[0] * qd[0] + qd[1] * qd[1]);
         for (i, link) in self.links.iter().enumerate() {
             let v = self.point_velocity(pose, i, link.com, qd);
             ke += 0.5 * link.mass * v.norm_squared() + 0.5 * link.inertia * qd[2 + i] * qd[2 + i];
@@ -212,13 +325,32 @@ impl<const N: usize> Mechanism<N> {
         ke
     }
 
+    /// Kinetic and gravitational potential energy of link `i` alone [J] (thesis eqs.
+    /// 4.9-4.10: 1/2 m v_c^2 + 1/2 I omega^2 and m g y_c).
+    pub fn link_energy(
+        &self,
+        pose: &Pose<N>,
+        qd: &SVector<f64, N>,
+        g: f64,
+        i: usize,
+    ) -> (f64, f64) {
+        let l = &self.links[i];
+        let v = self.point_velocity(pose, i, l.com, qd);
+        (
+            0.5 * l.mass * v.norm_squared() + 0.5 * l.inertia * qd[2 + i] * qd[2 + i],
+            l.mass * g * self.point(pose, i, l.com).y,
+        )
+    }
+
     /// Gravitational potential energy sum m_i g y_ci [J] (zero at the sand surface).
     pub fn potential_energy(&self, pose: &Pose<N>, g: f64) -> f64 {
-        self.links
-            .iter()
-            .enumerate()
-            .map(|(i, l)| l.mass * g * self.point(pose, i, l.com).y)
-            .sum()
+        self.root_mass * g * pose.root.y
+            + self
+                .links
+                .iter()
+                .enumerate()
+                .map(|(i, l)| l.mass * g * self.point(pose, i, l.com).y)
+                .sum::<f64>()
     }
 }
 
@@ -234,9 +366,11 @@ mod tests {
             com: Vector2::new(-0.0675, 0.0),
             parent: None,
             joint_on_parent: Vector2::zeros(),
+            joint: Joint::Free,
         };
         Mechanism {
             links: vec![link.clone(), link],
+            root_mass: 0.01,
         }
     }
 

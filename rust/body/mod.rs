@@ -1,4 +1,5 @@
-//! Bodies: planar trees of rigid links with a floating base, and the rod contact geometry.
+//! Bodies: planar trees of rigid links with a floating base, and the contact geometry of
+//! rods and soles.
 //!
 //! One formulation serves every body model (free link, two-link chain, leg): generalized
 //! coordinates `[x_root, y_root, q_0, ..., q_{n-1}]` (a root point and the absolute angle
@@ -7,6 +8,8 @@
 
 pub mod mechanism;
 pub mod rod;
+pub mod sole;
 
-pub use mechanism::{Link, Mechanism};
+pub use mechanism::{Joint, Link, Mechanism};
 pub use rod::{RodContact, RodGeometry};
+pub use sole::{SoleContact, SoleGeometry, SoleModel};

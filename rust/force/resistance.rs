@@ -117,8 +117,33 @@ impl ForceComponents {
     }
 }
 
-/// Magnitudes of the two static terms before their signs are applied [N]:
-/// (eta_h g rho_g w d^2, eta_v (d/L_ref)^lambda g rho_g V).
+/// Magnitudes of the two static terms for any contact shape [N]:
+/// (eta_h g rho_g w d^2, eta_v (d/L_ref)^lambda g rho_g V), zero at or above the surface.
+#[inline]
+pub fn static_terms(
+    c: &Coefficients,
+    medium: &Medium,
+    width: f64,
+    l_ref: f64,
+    depth: f64,
+    volume: f64,
+) -> (f64, f64) {
+    let d = depth;
+    if d <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let rg = medium.g * medium.rho_g;
+    let h = c.eta_h * rg * width * d * d;
+    let depth_factor = if c.lambda == 0.0 {
+        1.0
+    } else {
+        (d / l_ref).powf(c.lambda)
+    };
+    (h, c.eta_v * depth_factor * rg * volume)
+}
+
+/// Magnitudes of the two static terms of a rod before their signs are applied [N]:
+/// (eta_h g rho_g w d^2, eta_v (d/L_ref)^lambda g rho_g V) with V = pi d_c^2 / 4 * l.
 #[inline]
 pub fn static_bounds(
     c: &Coefficients,
@@ -128,20 +153,8 @@ pub fn static_bounds(
     l_ref: f64,
     state: &RodContactState,
 ) -> (f64, f64) {
-    let d = state.depth;
-    if d <= 0.0 {
-        return (0.0, 0.0);
-    }
-    let rg = medium.g * medium.rho_g;
-    let h = c.eta_h * rg * width * d * d;
     let volume = std::f64::consts::FRAC_PI_4 * diameter * diameter * state.immersed_length;
-    let depth_factor = if c.lambda == 0.0 {
-        1.0
-    } else {
-        (d / l_ref).powf(c.lambda)
-    };
-    let v = c.eta_v * depth_factor * rg * volume;
-    (h, v)
+    static_terms(c, medium, width, l_ref, state.depth, volume)
 }
 
 /// Evaluate the rod resistance force with given signs `sx`, `sy` of the static terms

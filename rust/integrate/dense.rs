@@ -41,6 +41,10 @@ impl<const N: usize> Hermite<N> {
                 + h10 * h * self.f0.work
                 + h01 * self.y1.work
                 + h11 * h * self.f1.work,
+            dissipated: h00 * self.y0.dissipated
+                + h10 * h * self.f0.dissipated
+                + h01 * self.y1.dissipated
+                + h11 * h * self.f1.dissipated,
         }
     }
 }

@@ -6,6 +6,6 @@ pub mod rk4;
 pub mod solve;
 
 pub use solve::{
-    solve, ContactSummary, EndCondition, Method, Outcome, Record, Series, SolveOptions, Stats,
-    Status,
+    solve, ContactSummary, EndCondition, JointSummary, Method, Outcome, Record, Series,
+    SolveOptions, Stats, Status,
 };

@@ -17,6 +17,8 @@ pub struct State<const N: usize> {
     pub qd: SVector<f64, N>,
     /// Work done by the sand on the body since the start [J] (non-positive at E).
     pub work: f64,
+    /// Energy dissipated by the joints' dampers since the start [J] (non-negative).
+    pub dissipated: f64,
 }
 
 /// The time derivative of a [`State`].
@@ -28,6 +30,8 @@ pub struct Deriv<const N: usize> {
     pub qd: SVector<f64, N>,
     /// Power of the sand's forces [W].
     pub work: f64,
+    /// Power dissipated by the joints [W].
+    pub dissipated: f64,
 }
 
 impl<const N: usize> State<N> {
@@ -38,6 +42,7 @@ impl<const N: usize> State<N> {
             q: self.q + h * d.q,
             qd: self.qd + h * d.qd,
             work: self.work + h * d.work,
+            dissipated: self.dissipated + h * d.dissipated,
         }
     }
 
@@ -46,6 +51,7 @@ impl<const N: usize> State<N> {
         self.q.iter().all(|v| v.is_finite())
             && self.qd.iter().all(|v| v.is_finite())
             && self.work.is_finite()
+            && self.dissipated.is_finite()
     }
 }
 
@@ -56,6 +62,7 @@ pub fn deriv_of<const N: usize>(y: &State<N>, e: &Eval<N>) -> Deriv<N> {
         q: y.qd,
         qd: e.qdd,
         work: e.power,
+        dissipated: e.joint_power,
     }
 }
 
@@ -80,6 +87,9 @@ pub fn step<const N: usize>(
         q: y.q + (h / 6.0) * (k1.q + 2.0 * k2.q + 2.0 * k3.q + k4.q),
         qd: y.qd + (h / 6.0) * (k1.qd + 2.0 * k2.qd + 2.0 * k3.qd + k4.qd),
         work: y.work + (h / 6.0) * (k1.work + 2.0 * k2.work + 2.0 * k3.work + k4.work),
+        dissipated: y.dissipated
+            + (h / 6.0)
+                * (k1.dissipated + 2.0 * k2.dissipated + 2.0 * k3.dissipated + k4.dissipated),
     }
 }
 

@@ -153,6 +153,20 @@ pub struct ContactSummary {
     pub tip_end: Vector2<f64>,
     /// Time the tip entered the sand (NaN if it never did) [s].
     pub t_entry: f64,
+    /// Kinetic energy lost by the contact's own link, start to stop [J] (thesis eq. 4.9).
+    pub link_d_ke: f64,
+    /// Potential energy lost by the contact's own link, start to stop [J] (eq. 4.10).
+    pub link_d_pe: f64,
+}
+
+/// The results of one joint (the force and torque a link receives from its parent, or
+/// from the root for a root link).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct JointSummary {
+    /// Largest |F| over the run [N].
+    pub f_max: f64,
+    /// Largest |torque| over the run [N m].
+    pub torque_max: f64,
 }
 
 /// Recorded time series, column by column (each the same length as `t`).
@@ -175,12 +189,16 @@ pub struct Outcome {
     pub stats: Stats,
     /// Per contact.
     pub contacts: Vec<ContactSummary>,
-    /// Mechanical energy KE + PE at the start and the end [J].
+    /// Mechanical energy KE + PE (gravity and springs) at the start and the end [J].
     pub energy_start: f64,
     /// See `energy_start`.
     pub energy_end: f64,
     /// Work done by the sand over the whole run [J].
     pub work_sand: f64,
+    /// Energy dissipated by the joints' dampers over the whole run [J].
+    pub dissipated: f64,
+    /// Per link: the joint that carries it.
+    pub joints: Vec<JointSummary>,
     /// Time series, if any were asked for.
     pub series: Option<Series>,
 }
@@ -213,8 +231,8 @@ enum Kind {
 fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) -> f64 {
     let c = &e.contacts[ci];
     match kind {
-        Kind::Entry => c.tip.y,
-        Kind::Exit => -c.tip.y,
+        Kind::Entry => c.lowest,
+        Kind::Exit => -c.lowest,
         Kind::SlipX => modes[ci].sx.sign() * c.v_centroid.x,
         Kind::SlipY => modes[ci].sy.sign() * c.v_centroid.y,
         Kind::StickX => c.bound_h - c.force.static_h.abs(),
@@ -383,13 +401,14 @@ struct Recorder {
     on: Record,
     n_dof: usize,
     n_contacts: usize,
+    n_links: usize,
     t: Vec<f64>,
     cols: Vec<Vec<f64>>,
     names: Vec<String>,
 }
 
 impl Recorder {
-    fn new(on: Record, n_dof: usize, n_contacts: usize) -> Self {
+    fn new(on: Record, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
         let mut names = Vec::new();
         if on.state {
             for i in 0..n_dof {
@@ -409,16 +428,31 @@ impl Recorder {
                     names.push(format!("c{c}.{f}"));
                 }
             }
+            if n_links > 1 {
+                for i in 0..n_links {
+                    for f in ["Fx", "Fy", "torque"] {
+                        names.push(format!("joint{i}.{f}"));
+                    }
+                }
+            }
         }
         if on.energy {
             names.push("KE".into());
             names.push("PE".into());
+            names.push("joint_loss".into());
+            if n_links > 1 {
+                for i in 0..n_links {
+                    names.push(format!("link{i}.KE"));
+                    names.push(format!("link{i}.PE"));
+                }
+            }
         }
         let cols = vec![Vec::new(); names.len()];
         Recorder {
             on,
             n_dof,
             n_contacts,
+            n_links,
             t: Vec::new(),
             cols,
             names,
@@ -479,11 +513,28 @@ impl Recorder {
                     put(&mut self.cols, v);
                 }
             }
+            if self.n_links > 1 {
+                let f = model.joint_forces(&y.q, &y.qd, e, modes);
+                for (fi, ti) in f.iter().zip(&e.joint_torque).take(self.n_links) {
+                    put(&mut self.cols, fi.x);
+                    put(&mut self.cols, fi.y);
+                    put(&mut self.cols, *ti);
+                }
+            }
         }
         if self.on.energy {
             let (ke, pe) = model.energies(&y.q, &y.qd);
             put(&mut self.cols, ke);
             put(&mut self.cols, pe);
+            put(&mut self.cols, y.dissipated);
+            if self.n_links > 1 {
+                let pose = model.mechanism.pose(&y.q);
+                for i in 0..self.n_links {
+                    let (k, p) = model.mechanism.link_energy(&pose, &y.qd, model.medium.g, i);
+                    put(&mut self.cols, k);
+                    put(&mut self.cols, p);
+                }
+            }
         }
     }
 
@@ -512,6 +563,7 @@ pub fn solve<const N: usize>(
         q: q0,
         qd: qd0,
         work: 0.0,
+        dissipated: 0.0,
     };
     let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
 
@@ -520,7 +572,7 @@ pub fn solve<const N: usize>(
     stats.rhs_evals += 1;
     for ci in 0..nc {
         let c = &e_free.contacts[ci];
-        if c.tip.y < 0.0 || (c.tip.y == 0.0 && c.v_tip.y < 0.0) {
+        if c.lowest < 0.0 || (c.lowest == 0.0 && c.v_tip.y < 0.0) {
             // Judge a zero velocity component a little later: take a probe step free of
             // the static terms' signs (they are zero at the surface).
             let k1 = deriv_of(&y, &e_free);
@@ -547,10 +599,30 @@ pub fn solve<const N: usize>(
             work_sand: f64::NAN,
             tip_end: Vector2::zeros(),
             t_entry: if modes[ci].in_contact { 0.0 } else { f64::NAN },
+            link_d_ke: f64::NAN,
+            link_d_pe: f64::NAN,
         })
         .collect();
+    let n_links = model.mechanism.n_links();
+    let link_energy = |y: &State<N>, i: usize| {
+        let pose = model.mechanism.pose(&y.q);
+        model.mechanism.link_energy(&pose, &y.qd, model.medium.g, i)
+    };
+    let link_e0: Vec<(f64, f64)> = (0..n_links).map(|i| link_energy(&y, i)).collect();
+    let mut joints = vec![JointSummary::default(); n_links];
+    let update_joints =
+        |joints: &mut Vec<JointSummary>, y: &State<N>, e: &Eval<N>, modes: &Modes| {
+            if n_links < 2 {
+                return;
+            }
+            let f = model.joint_forces(&y.q, &y.qd, e, modes);
+            for (i, j) in joints.iter_mut().enumerate() {
+                j.f_max = j.f_max.max(f[i].norm());
+                j.torque_max = j.torque_max.max(e.joint_torque[i].abs());
+            }
+        };
 
-    let mut recorder = Recorder::new(options.record, N, nc);
+    let mut recorder = Recorder::new(options.record, N, nc, n_links);
     let stride = options.record.stride.max(1);
     let mut t = 0.0f64;
     let mut e0 = model.eval(&y.q, &y.qd, &modes);
@@ -697,6 +769,7 @@ pub fn solve<const N: usize>(
             events_this_step = 0;
             stats.steps += 1;
             update_fd_max(&mut summaries, &e0, &modes);
+            update_joints(&mut joints, &y, &e0, &modes);
             if n.is_multiple_of(stride as u64) {
                 recorder.push(model, t, &y, &e0, &modes);
             }
@@ -727,6 +800,7 @@ pub fn solve<const N: usize>(
         if h_star > 0.0 {
             stats.steps += 1;
             update_fd_max(&mut summaries, &e_star_old, &modes);
+            update_joints(&mut joints, &y_star, &e_star_old, &modes);
         }
         // An event at the very start of the step is judged at the step's end.
         let probe = if earliest * h <= 1e-12 * dt {
@@ -770,7 +844,7 @@ pub fn solve<const N: usize>(
                     modes[ci].stopped = true;
                     let c = &e_star_old.contacts[ci];
                     let (ke, pe) = model.energies(&y_star.q, &y_star.qd);
-                    let link = model.contacts[ci].rod.link;
+                    let link = model.contacts[ci].link();
                     let s = &mut summaries[ci];
                     s.stopped = true;
                     s.t_s = t_star;
@@ -784,6 +858,9 @@ pub fn solve<const N: usize>(
                     s.d_e = s.d_ke + s.d_pe;
                     s.work_sand = y_star.work;
                     s.tip_end = c.tip;
+                    let (lk, lp) = link_energy(&y_star, link);
+                    s.link_d_ke = link_e0[link].0 - lk;
+                    s.link_d_pe = link_e0[link].1 - lp;
                     terminal |= match options.end {
                         EndCondition::FirstStop => true,
                         EndCondition::AllStops => modes[..nc].iter().all(|m| m.stopped),
@@ -813,7 +890,7 @@ pub fn solve<const N: usize>(
             continue;
         }
         let c = &e_end.contacts[ci];
-        let link = model.contacts[ci].rod.link;
+        let link = model.contacts[ci].link();
         s.depth = (-c.tip.y).max(0.0);
         s.dq = y.q[2 + link] - q0[2 + link];
         s.omega_end = y.qd[2 + link];
@@ -824,6 +901,9 @@ pub fn solve<const N: usize>(
         s.d_e = s.d_ke + s.d_pe;
         s.work_sand = y.work;
         s.tip_end = c.tip;
+        let (lk, lp) = link_energy(&y, link);
+        s.link_d_ke = link_e0[link].0 - lk;
+        s.link_d_pe = link_e0[link].1 - lp;
     }
     if status != Status::Stopped && options.record.any() && recorder.t.last() != Some(&t) {
         recorder.push(model, t, &y, &e_end, &modes);
@@ -836,6 +916,8 @@ pub fn solve<const N: usize>(
         energy_start,
         energy_end: ke + pe,
         work_sand: y.work,
+        dissipated: y.dissipated,
+        joints,
         series: recorder.finish(),
     })
 }

@@ -11,11 +11,12 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::body::rod::ApplyAt;
+use crate::body::{Joint, SoleModel};
 use crate::dynamics::{Effects, SignModel};
 use crate::error::GranrsError;
 use crate::force::{Coefficients, Medium};
 use crate::integrate::{EndCondition, Method, Outcome, Record, SolveOptions};
-use crate::scene::FreeLinkScene;
+use crate::scene::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -162,40 +163,122 @@ fn parse_record(names: Option<Vec<String>>, stride: Option<f64>) -> Result<Recor
     Ok(r)
 }
 
-/// Build a free-link scene from the dict of `granrs.Scene.to_dict()`.
-fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsError> {
-    let coefficients = {
-        let c = d
-            .get_item("coefficients")
-            .map_err(|_| bad_type("coefficients", "a mapping"))?
-            .ok_or_else(|| GranrsError::InvalidScene {
-                field: "coefficients".into(),
-                message: "missing".into(),
-            })?;
-        let c = c
-            .cast_into::<PyDict>()
-            .map_err(|_| bad_type("coefficients", "a mapping with eta_h, eta_d, eta_v, lam"))?;
-        let get = |k: &str| {
-            get_f64(&c, k).map_err(|e| match e {
-                GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
-                    field: format!("coefficients.{k}"),
-                    message,
-                },
-                GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
-                    field: format!("coefficients.{k}"),
-                    expected,
-                    got,
-                },
-                other => other,
-            })
-        };
-        Coefficients {
-            eta_h: get("eta_h")?,
-            eta_d: get("eta_d")?,
-            eta_v: get("eta_v")?,
-            lambda: get("lam")?,
-        }
+/// A coefficients mapping (`eta_h`, `eta_d`, `eta_v`, `lam`) under `field`; absent or None
+/// gives `None`.
+fn get_coefficients(
+    d: &Bound<'_, PyDict>,
+    field: &str,
+) -> Result<Option<Coefficients>, GranrsError> {
+    let Some(c) = d
+        .get_item(field)
+        .map_err(|_| bad_type(field, "a mapping"))?
+    else {
+        return Ok(None);
     };
+    if c.is_none() {
+        return Ok(None);
+    }
+    let c = c
+        .cast_into::<PyDict>()
+        .map_err(|_| bad_type(field, "a mapping with eta_h, eta_d, eta_v, lam"))?;
+    let get = |k: &str| {
+        get_f64(&c, k).map_err(|e| match e {
+            GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
+                field: format!("{field}.{k}"),
+                message,
+            },
+            GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
+                field: format!("{field}.{k}"),
+                expected,
+                got,
+            },
+            other => other,
+        })
+    };
+    Ok(Some(Coefficients {
+        eta_h: get("eta_h")?,
+        eta_d: get("eta_d")?,
+        eta_v: get("eta_v")?,
+        lambda: get("lam")?,
+    }))
+}
+
+/// A required coefficients mapping.
+fn get_required_coefficients(
+    d: &Bound<'_, PyDict>,
+    field: &str,
+) -> Result<Coefficients, GranrsError> {
+    get_coefficients(d, field)?.ok_or_else(|| GranrsError::InvalidScene {
+        field: field.into(),
+        message: "missing".into(),
+    })
+}
+
+/// A joint: `"free"`, `"locked"`, or a spring-damper `{"k": .., "c": ..}` (absent: free).
+fn get_joint(d: &Bound<'_, PyDict>, field: &str) -> Result<Joint, GranrsError> {
+    let Some(v) = d.get_item(field).map_err(|_| bad_type(field, "a joint"))? else {
+        return Ok(Joint::Free);
+    };
+    if v.is_none() {
+        return Ok(Joint::Free);
+    }
+    if let Ok(name) = v.extract::<String>() {
+        return match name.as_str() {
+            "free" => Ok(Joint::Free),
+            "locked" => Ok(Joint::Locked),
+            other => Err(unknown(
+                field,
+                other,
+                &["free", "locked", "{k, c} spring-damper"],
+            )),
+        };
+    }
+    let spec = v.cast_into::<PyDict>().map_err(|_| {
+        bad_type(
+            field,
+            "\"free\", \"locked\" or a spring-damper mapping {\"k\": N m/rad, \"c\": N m s/rad}",
+        )
+    })?;
+    for key in spec.keys() {
+        let key: String = key.extract().unwrap_or_default();
+        if key != "k" && key != "c" {
+            return Err(unknown(&format!("{field}.{key}"), &key, &["k", "c"]));
+        }
+    }
+    let get = |k: &str| {
+        get_f64(&spec, k).map_err(|e| match e {
+            GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
+                field: format!("{field}.{k}"),
+                message,
+            },
+            GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
+                field: format!("{field}.{k}"),
+                expected,
+                got,
+            },
+            other => other,
+        })
+    };
+    Ok(Joint::Spring {
+        k: get("k")?,
+        c: get("c")?,
+        rest: 0.0,
+    })
+}
+
+/// The fields every body shares.
+struct Common {
+    medium: Medium,
+    apply_at: ApplyAt,
+    sign_model: SignModel,
+    effects: Effects,
+    options: SolveOptions,
+    v0: f64,
+    depth0: f64,
+    vx0: f64,
+}
+
+fn common_from_dict(d: &Bound<'_, PyDict>) -> Result<Common, GranrsError> {
     let apply_at = match get_str(d, "apply_at")?.as_str() {
         "tip" => ApplyAt::Tip,
         "centroid" => ApplyAt::Centroid,
@@ -215,21 +298,11 @@ fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsErr
         "time" => EndCondition::Time,
         other => return Err(unknown("end", other, &["first_stop", "all_stops", "time"])),
     };
-    let scene = FreeLinkScene {
-        length: get_f64(d, "length")?,
-        diameter: get_f64(d, "diameter")?,
-        mass: get_f64(d, "mass")?,
-        inertia: get_opt_f64(d, "inertia")?,
+    Ok(Common {
         medium: Medium {
             rho_g: get_f64(d, "rho_g")?,
             g: get_f64(d, "g")?,
         },
-        coefficients,
-        q_deg: get_f64(d, "q_deg")?,
-        v0: get_f64(d, "v0")?,
-        depth0: get_opt_f64(d, "depth0")?.unwrap_or(0.0),
-        vx0: get_opt_f64(d, "vx0")?.unwrap_or(0.0),
-        omega0: get_opt_f64(d, "omega0")?.unwrap_or(0.0),
         apply_at,
         sign_model,
         effects: parse_effects(get_names(d, "effects")?)?,
@@ -247,17 +320,127 @@ fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsErr
             end,
             record: parse_record(get_names(d, "record")?, get_opt_f64(d, "record_stride")?)?,
         },
+        v0: get_f64(d, "v0")?,
+        depth0: get_opt_f64(d, "depth0")?.unwrap_or(0.0),
+        vx0: get_opt_f64(d, "vx0")?.unwrap_or(0.0),
+    })
+}
+
+/// Build a free-link scene from the dict of `granrs.Scene.to_dict()`.
+fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsError> {
+    let c = common_from_dict(d)?;
+    Ok(FreeLinkScene {
+        length: get_f64(d, "length")?,
+        diameter: get_f64(d, "diameter")?,
+        mass: get_f64(d, "mass")?,
+        inertia: get_opt_f64(d, "inertia")?,
+        medium: c.medium,
+        coefficients: get_required_coefficients(d, "coefficients")?,
+        q_deg: get_f64(d, "q_deg")?,
+        v0: c.v0,
+        depth0: c.depth0,
+        vx0: c.vx0,
+        omega0: get_opt_f64(d, "omega0")?.unwrap_or(0.0),
+        apply_at: c.apply_at,
+        sign_model: c.sign_model,
+        effects: c.effects,
+        options: c.options,
+    })
+}
+
+/// Build a chain scene: link 2's angle defaults to the mirror of link 1's, its
+/// coefficients to link 1's.
+fn chain_from_dict(d: &Bound<'_, PyDict>) -> Result<ChainScene, GranrsError> {
+    let c = common_from_dict(d)?;
+    let coefficients = get_required_coefficients(d, "coefficients")?;
+    let q1 = get_f64(d, "q_deg")?;
+    Ok(ChainScene {
+        length: get_f64(d, "length")?,
+        diameter: get_f64(d, "diameter")?,
+        mass: get_f64(d, "mass")?,
+        inertia: get_opt_f64(d, "inertia")?,
+        pin_mass: get_opt_f64(d, "pin_mass")?.unwrap_or(0.0),
+        joint: get_joint(d, "pin_joint")?,
+        medium: c.medium,
+        coefficients: [
+            coefficients,
+            get_coefficients(d, "coefficients2")?.unwrap_or(coefficients),
+        ],
+        q_deg: [q1, get_opt_f64(d, "q2_deg")?.unwrap_or(-q1)],
+        v0: c.v0,
+        depth0: c.depth0,
+        vx0: c.vx0,
+        omega0: get_opt_f64(d, "omega0")?.unwrap_or(0.0),
+        apply_at: c.apply_at,
+        sign_model: c.sign_model,
+        effects: c.effects,
+        options: c.options,
+    })
+}
+
+/// Build a leg scene.
+fn leg_from_dict(d: &Bound<'_, PyDict>) -> Result<LegScene, GranrsError> {
+    let c = common_from_dict(d)?;
+    let defaults = LegScene::default();
+    let or = |field: &str, default: f64| -> Result<f64, GranrsError> {
+        Ok(get_opt_f64(d, field)?.unwrap_or(default))
     };
-    scene.validate()?;
-    Ok(scene)
+    let sole_model = match d
+        .get_item("sole_model")
+        .map_err(|_| bad_type("sole_model", "a string"))?
+    {
+        Some(v) if !v.is_none() => match get_str(d, "sole_model")?.as_str() {
+            "box" => SoleModel::Box,
+            "thesis" => SoleModel::Thesis,
+            other => return Err(unknown("sole_model", other, &["box", "thesis"])),
+        },
+        _ => SoleModel::Box,
+    };
+    let mut joints = [Joint::Locked; 3];
+    for (j, name) in joints.iter_mut().zip(LEG_JOINTS) {
+        if d.get_item(name)
+            .ok()
+            .flatten()
+            .is_some_and(|v| !v.is_none())
+        {
+            *j = get_joint(d, name)?;
+        }
+    }
+    Ok(LegScene {
+        body_mass: or("body_mass", defaults.body_mass)?,
+        height: or("height", defaults.height)?,
+        foot_length: or("foot_length", defaults.foot_length)?,
+        shoe_width: or("shoe_width", defaults.shoe_width)?,
+        tibia_length: or("tibia_length", defaults.tibia_length)?,
+        sole_height: get_opt_f64(d, "sole_height")?,
+        joints,
+        knee_deg: or("knee_deg", defaults.knee_deg)?,
+        hip_deg: or("hip_deg", defaults.hip_deg)?,
+        trunk_deg: or("trunk_deg", defaults.trunk_deg)?,
+        foot_deg: or("foot_deg", defaults.foot_deg)?,
+        sole_model,
+        medium: c.medium,
+        coefficients: get_required_coefficients(d, "coefficients")?,
+        v0: c.v0,
+        depth0: c.depth0,
+        vx0: c.vx0,
+        apply_at: c.apply_at,
+        sign_model: c.sign_model,
+        effects: c.effects,
+        options: c.options,
+    })
 }
 
 /// Convert a scene dict to an owned, validated scene (GIL held).
-fn scene_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsError> {
-    match get_str(d, "body")?.as_str() {
-        "free_link" => free_link_from_dict(d),
-        other => Err(unknown("body", other, &["free_link"])),
-    }
+fn scene_from_dict(d: &Bound<'_, PyDict>) -> Result<AnyScene, GranrsError> {
+    let scene = match get_str(d, "body")?.as_str() {
+        "free_link" => AnyScene::FreeLink(free_link_from_dict(d)?),
+        "chain" => AnyScene::Chain(chain_from_dict(d)?),
+        "leg" => AnyScene::Leg(leg_from_dict(d)?),
+        other => return Err(unknown("body", other, &["free_link", "chain", "leg"])),
+    };
+    scene.validate()?;
+    Ok(scene)
 }
 
 /// Convert an outcome to a dict of Python values; series move into numpy without copying.
@@ -292,9 +475,21 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
         cd.set_item("work_sand", c.work_sand)?;
         cd.set_item("x_tip_end", c.tip_end.x)?;
         cd.set_item("t_entry", c.t_entry)?;
+        cd.set_item("link_dKE", c.link_d_ke)?;
+        cd.set_item("link_dPE", c.link_d_pe)?;
+        cd.set_item("link_dE", c.link_d_ke + c.link_d_pe)?;
         contacts.append(cd)?;
     }
     d.set_item("contacts", contacts)?;
+    d.set_item("dissipated", out.dissipated)?;
+    let joints = PyList::empty(py);
+    for j in &out.joints {
+        let jd = PyDict::new(py);
+        jd.set_item("F_max", j.f_max)?;
+        jd.set_item("torque_max", j.torque_max)?;
+        joints.append(jd)?;
+    }
+    d.set_item("joints", joints)?;
     match out.series {
         None => d.set_item("series", py.None())?,
         Some(series) => {
@@ -325,12 +520,35 @@ fn validate(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<()> {
         .map_err(|e| to_pyerr(py, e))
 }
 
+/// The leg's segments for a scene dict (body "leg"): a list of dicts with name, mass [kg],
+/// length [m], com (from the lower joint) [m] and inertia about the centre of mass [kg m^2].
+#[pyfunction]
+fn leg_segments<'py>(py: Python<'py>, scene: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyList>> {
+    let leg = leg_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
+    leg.validate().map_err(|e| to_pyerr(py, e))?;
+    let out = PyList::empty(py);
+    for (name, s) in ["foot", "shank", "thigh", "half_trunk"]
+        .iter()
+        .zip(leg.segments())
+    {
+        let d = PyDict::new(py);
+        d.set_item("name", name)?;
+        d.set_item("mass", s.mass)?;
+        d.set_item("length", s.length)?;
+        d.set_item("com", s.com)?;
+        d.set_item("inertia", s.inertia)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add("EFFECTS", EFFECTS.to_vec())?;
     m.add("RECORDS", RECORDS.to_vec())?;
+    m.add_function(wrap_pyfunction!(leg_segments, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
