@@ -1,6 +1,8 @@
 """The thesis's cases as ready-made scenes.
 
 * :func:`free_link`: the steel rod of chapter 3 (sec. 3.2.1) dropped tip first.
+* :func:`chain`: the two-link chain of chapter 4 (sec. 4.1), cases 1-3 of Table 4.1.
+* :func:`leg`: one leg of a person landing on both feet (chapter 5), v0 = 3.28 or 2.35 m/s.
 """
 
 from __future__ import annotations
@@ -9,11 +11,14 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
+from . import data
 from .coefficients import Coefficients, resolve
 from .errors import InvalidParameterError
 from .scene import Scene
 
-__all__ = ["FREE_LINK", "free_link"]
+__all__ = ["CHAIN", "FREE_LINK", "LEG", "chain", "chain_case", "free_link", "leg"]
 
 #: The thesis's free link (sec. 3.2.1 and 3.3.1): SI units.
 FREE_LINK: dict[str, float] = {
@@ -72,6 +77,187 @@ def free_link(
         dt=_number(dt, "dt"),
         apply_at=apply_at,
         **{k: v for k, v in FREE_LINK.items() if k not in overrides},
+    )
+    scene = base.replace(**overrides) if overrides else base
+    return scene.validate()
+
+
+#: The thesis's chain (sec. 4.1): SI units. The link mass is not in the thesis: a solid
+#: steel cylinder (7850 kg/m^3) of the stated size (``bodies.csv``); the thesis's play sand
+#: of chapter 3 (1650 kg/m^3) is assumed.
+CHAIN: dict[str, float] = {
+    "length": 0.135,
+    "diameter": 0.0064,
+    "mass": 0.0341,
+    "rho_g": 1650.0,
+}
+
+#: The thesis's person and sand (secs. 5.2.1 and 5.3.2): SI units.
+LEG: dict[str, float] = {
+    "body_mass": 75.35,
+    "height": 1.78,
+    "foot_length": 0.254,
+    "shoe_width": 0.086,
+    "tibia_length": 0.432,
+    "rho_g": 1600.0,
+}
+
+
+def _coefficients_arg(value: Any, field: str) -> Coefficients:
+    if isinstance(value, Coefficients):
+        return value
+    if isinstance(value, Mapping):
+        return Coefficients(**dict(value))
+    raise InvalidParameterError(
+        f"{field} must be a granrs.Coefficients or a mapping of eta_h, eta_d, eta_v, lam; "
+        f"got {value!r}",
+        field=field,
+    )
+
+
+def chain_case(case: int) -> dict[str, Any]:
+    """The thesis's chain case ``case`` (1, 2 or 3): per link the measured angle and speed
+    (Table 4.1 / 4.2) and the coefficients of Table 4.4, with the chain's v0 (the mean of the
+    two links' measured speeds: the chain falls as one body).
+
+    Returns a dict with ``q_deg`` (two angles), ``v0_links``, ``v0``, ``coefficients`` (two
+    :class:`~granrs.Coefficients`) and ``sources`` (two strings).
+    """
+    if isinstance(case, bool) or case not in (1, 2, 3):
+        raise InvalidParameterError(f"case must be 1, 2 or 3; got {case!r}", field="case")
+    exp = data.load("chain_experiments", as_="numpy")
+    coef = data.load("chain_coefficients", as_="numpy")
+    q, v, cs, sources = [], [], [], []
+    for link in (1, 2):
+        row = int(np.flatnonzero((exp["link"] == link) & (exp["v0_case"] == case))[0])
+        q.append(float(exp["q0_deg"][row]))
+        v.append(float(exp["v0_mean"][row]))
+        crow = int(np.flatnonzero((coef["link"] == link) & (coef["v0_case"] == case))[0])
+        cs.append(
+            Coefficients(
+                eta_h=float(coef["eta_h"][crow]),
+                eta_d=float(coef["eta_d"][crow]),
+                eta_v=float(coef["eta_v"][crow]),
+                lam=float(coef["lambda"][crow]),
+            )
+        )
+        note = str(coef["note"][crow])
+        sources.append(
+            f"Table 4.4, link {link}, case {case}"
+            + (
+                " (row missing in the thesis: Table 4.3 expressions at alpha = 74 deg)"
+                if note
+                else ""
+            )
+        )
+    return {
+        "q_deg": tuple(q),
+        "v0_links": tuple(v),
+        "v0": 0.5 * (v[0] + v[1]),
+        "coefficients": tuple(cs),
+        "sources": tuple(sources),
+    }
+
+
+def chain(
+    case: int = 1,
+    q1_deg: float | None = None,
+    q2_deg: float | None = None,
+    coefficients: Coefficients | Mapping[str, float] | tuple[Any, Any] | None = None,
+    dt: float = 1e-4,
+    apply_at: str = "tip",
+    **overrides: Any,
+) -> Scene:
+    """The thesis's two-link chain (sec. 4.1: L = 0.135 m, d = 0.0064 m per link, pinned at
+    the top ends) falling onto sand, case ``case`` of Table 4.1 (1: v0 ~ 2.58, 2: ~2.29,
+    3: ~1.60 m/s).
+
+    The angles default to the case's measured ones (Table 4.1) and v0 to the mean of the two
+    links' measured speeds. ``coefficients``: ``None`` for Table 4.4's row of each link, one
+    :class:`~granrs.Coefficients` (or mapping) for both links, or a pair (link 1, link 2).
+    The link mass is not in the thesis: the default 0.0341 kg is a solid steel link; pass
+    ``mass=0.017`` (or any) to change it, and ``pin_mass`` for the pin. ``overrides`` set any
+    other :class:`~granrs.Scene` field.
+    """
+    spec = chain_case(case)
+    q1 = spec["q_deg"][0] if q1_deg is None else _number(q1_deg, "q1_deg")
+    q2 = spec["q_deg"][1] if q2_deg is None else _number(q2_deg, "q2_deg")
+    if coefficients is None:
+        c1, c2 = spec["coefficients"]
+        source = f"{spec['sources'][0]}; {spec['sources'][1]}"
+    elif isinstance(coefficients, tuple):
+        if len(coefficients) != 2:
+            raise InvalidParameterError(
+                "coefficients as a tuple must be (link 1, link 2)", field="coefficients"
+            )
+        c1 = _coefficients_arg(coefficients[0], "coefficients")
+        c2 = _coefficients_arg(coefficients[1], "coefficients2")
+        source = "user (per link)"
+    else:
+        c1 = c2 = _coefficients_arg(coefficients, "coefficients")
+        source = "user (both links)"
+    base = Scene(
+        body="chain",
+        q_deg=q1,
+        q2_deg=q2,
+        v0=spec["v0"],
+        coefficients=c1,
+        coefficients2=c2,
+        coefficients_source=source,
+        dt=_number(dt, "dt"),
+        apply_at=apply_at,
+        **{k: v for k, v in CHAIN.items() if k not in overrides},
+    )
+    scene = base.replace(**overrides) if overrides else base
+    return scene.validate()
+
+
+def leg(
+    v0: float = 3.28,
+    coefficients: Coefficients | Mapping[str, float] | None = None,
+    joints: Any = None,
+    dt: float = 1e-4,
+    apply_at: str = "tip",
+    **overrides: Any,
+) -> Scene:
+    """One leg of the thesis's average subject (75.35 kg, 1.78 m; foot 0.254 m, shoe 0.086 m,
+    tibia 0.432 m; sec. 5.2.1 and 5.3.2) landing flat on fine sand (1600 kg/m^3) at ``v0``.
+
+    ``coefficients``: ``None`` for the thesis's row (sec. 5.3.2) at the nearest of its two
+    speeds, 3.28 and 2.35 m/s (the scene's ``coefficients_source`` says which). ``joints``
+    sets ankle, knee and hip at once (``"locked"``, the default; ``"free"``; or a
+    spring-damper ``{"k": N m/rad, "c": N m s/rad}``); ``ankle=``, ``knee=``, ``hip=``
+    set one. Segment masses, lengths, centres of mass and inertias: Dempster's data as
+    tabulated by Winter (2009, Table 4.1, Fig. 4.1), scaled to body mass and height; see
+    :meth:`granrs.Scene.leg_segments`. ``overrides`` set any other :class:`~granrs.Scene`
+    field (posture: ``knee_deg``, ``hip_deg``, ``trunk_deg``, ``foot_deg``).
+    """
+    v = _number(v0, "v0")
+    if coefficients is None:
+        table = data.load("human_coefficients", as_="numpy")
+        row = int(np.argmin(np.abs(table["v0"] - v)))
+        coef = Coefficients(
+            eta_h=float(table["eta_h"][row]),
+            eta_d=float(table["eta_d"][row]),
+            eta_v=float(table["eta_v"][row]),
+            lam=float(table["lambda"][row]),
+        )
+        source = f"thesis sec. 5.3.2, row v0 = {float(table['v0'][row])} m/s"
+    else:
+        coef = _coefficients_arg(coefficients, "coefficients")
+        source = "user"
+    joint_fields = {}
+    if joints is not None:
+        joint_fields = {name: joints for name in ("ankle", "knee", "hip")}
+    fields = {**LEG, **joint_fields}
+    base = Scene(
+        body="leg",
+        v0=v,
+        coefficients=coef,
+        coefficients_source=source,
+        dt=_number(dt, "dt"),
+        apply_at=apply_at,
+        **{k: val for k, val in fields.items() if k not in overrides},
     )
     scene = base.replace(**overrides) if overrides else base
     return scene.validate()

@@ -10,7 +10,7 @@ import numpy as np
 
 from .scene import Scene
 
-__all__ = ["SUMMARY_UNITS", "ContactResult", "Result"]
+__all__ = ["JOINT_NAMES", "LINK_NAMES", "SUMMARY_UNITS", "ContactResult", "Result"]
 
 #: Units of the summary fields.
 SUMMARY_UNITS: dict[str, str] = {
@@ -27,6 +27,10 @@ SUMMARY_UNITS: dict[str, str] = {
     "work_sand": "J",
     "x_tip_end": "m",
     "t_entry": "s",
+    "link_dKE": "J",
+    "link_dPE": "J",
+    "link_dE": "J",
+    "dissipated": "J",
     "steps": "-",
     "rhs_evals": "-",
     "root_evals": "-",
@@ -35,8 +39,28 @@ SUMMARY_UNITS: dict[str, str] = {
 }
 
 # Friendly names of the generalized coordinates of each body.
-_COORDS = {"free_link": ("x", "y", "q")}
-_RATES = {"free_link": ("vx", "vy", "omega")}
+_COORDS = {
+    "free_link": ("x", "y", "q"),
+    "chain": ("x_pin", "y_pin", "q1", "q2"),
+    "leg": ("x_ankle", "y_ankle", "q_foot", "q_shank", "q_thigh", "q_trunk"),
+}
+_RATES = {
+    "free_link": ("vx", "vy", "omega"),
+    "chain": ("vx_pin", "vy_pin", "omega1", "omega2"),
+    "leg": ("vx_ankle", "vy_ankle", "omega_foot", "omega_shank", "omega_thigh", "omega_trunk"),
+}
+#: Names of each body's links (series ``link{i}.*``) and of the joint that carries each
+#: link (series ``joint{i}.*``: the force and torque the link receives there).
+LINK_NAMES = {
+    "free_link": ("rod",),
+    "chain": ("link1", "link2"),
+    "leg": ("foot", "shank", "thigh", "trunk"),
+}
+JOINT_NAMES = {
+    "free_link": ("root",),
+    "chain": ("pin_on_link1", "pin"),
+    "leg": ("root", "ankle", "knee", "hip"),
+}
 
 
 @dataclass(frozen=True)
@@ -69,8 +93,13 @@ class Result:
         depth: depth of contact 0 at its stop [m].
         summary: contact 0's results plus the run's: t_s, depth, dq, omega_end, F_d_max,
             F_s_end, F_r_end, dKE, dPE, dE (thesis eqs. 3.22-3.26), steps, rhs_evals, ...
-        contacts: per contact.
-        series: recorded time series (numpy arrays by name), or None.
+        contacts: per contact (the chain's link 1 and link 2; the leg's foot).
+        joints: per joint, by name (see ``JOINT_NAMES``): ``F_max`` [N], the largest force
+            the joint passes to the link it carries, and ``torque_max`` [N m] (a spring's or
+            a locked joint's). The chain's ``"pin"`` is the force link 1 exerts on link 2.
+        series: recorded time series (numpy arrays by name), or None. Multi-contact bodies
+            keep the ``c0.``/``c1.`` prefixes; joint and link series are named
+            ``<joint>.Fx/Fy/torque`` and ``<link>.KE/PE``.
     """
 
     scene: Scene
@@ -80,6 +109,7 @@ class Result:
     summary: dict[str, Any]
     contacts: list[ContactResult]
     series: dict[str, np.ndarray] | None = field(default=None, repr=False)
+    joints: dict[str, dict[str, float]] = field(default_factory=dict, repr=False)
 
     @classmethod
     def _from_raw(cls, scene: Scene, raw: dict[str, Any]) -> Result:
@@ -96,6 +126,13 @@ class Result:
         summary["t_final"] = raw["t_final"]
         summary["energy_start"] = raw["energy_start"]
         summary["energy_end"] = raw["energy_end"]
+        summary["dissipated"] = raw["dissipated"]
+        names = JOINT_NAMES.get(scene.body, ())
+        joints = {
+            names[i] if i < len(names) else f"joint{i}": dict(j)
+            for i, j in enumerate(raw["joints"])
+            if scene.body != "free_link"
+        }
         return cls(
             scene=scene,
             status=raw["status"],
@@ -104,6 +141,7 @@ class Result:
             summary=summary,
             contacts=contacts,
             series=_rename_series(scene, raw["series"], len(contacts)),
+            joints=joints,
         )
 
     @property
@@ -144,6 +182,16 @@ def _rename_series(
             new = coords[int(name[1:])]
         elif n_contacts == 1 and name.startswith("c0."):
             new = name[3:]
+        elif name.startswith("joint") and "." in name:
+            idx, _, rest = name[5:].partition(".")
+            joints = JOINT_NAMES.get(scene.body, ())
+            if idx.isdigit() and int(idx) < len(joints):
+                new = f"{joints[int(idx)]}.{rest}"
+        elif name.startswith("link") and "." in name:
+            idx, _, rest = name[4:].partition(".")
+            links = LINK_NAMES.get(scene.body, ())
+            if idx.isdigit() and int(idx) < len(links):
+                new = f"{links[int(idx)]}.{rest}"
         out[new] = values
     if "KE" in out and "PE" in out:
         out["E"] = out["KE"] + out["PE"]

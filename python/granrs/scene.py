@@ -1,5 +1,12 @@
 """What a run is: :class:`Scene`, a frozen description of one impact.
 
+Three bodies share one scene type (``body``): ``"free_link"`` (a round rod), ``"chain"``
+(two rods pinned at their top ends, chapter 4) and ``"leg"`` (foot, shank, thigh and half
+of head-arms-trunk for one leg of a person landing on both feet, chapter 5). Fields that
+belong to one body only are listed in :data:`BODY_FIELDS`; setting one for another body
+raises :class:`~granrs.errors.InvalidSceneError`. :mod:`granrs.cases` builds the thesis's
+scenes with every default set.
+
 A scene is plain data: the body and its size, the sand, the coefficients of the force law,
 the initial state, the step, the end condition, the force terms (effects) to evaluate and
 the time series to record. :func:`granrs.simulate` runs it. Every field is checked by the
@@ -21,9 +28,16 @@ from typing import Any
 
 from . import _granrs
 from .coefficients import Coefficients
-from .errors import InvalidParameterError, UnknownNameError
+from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 
-__all__ = ["EFFECTS", "RECORDS", "Scene"]
+__all__ = ["BODIES", "BODY_FIELDS", "EFFECTS", "JOINTS", "RECORDS", "JointSpec", "Scene"]
+
+#: The body models.
+BODIES: tuple[str, ...] = ("free_link", "chain", "leg")
+#: Named joint settings; a spring-damper is a mapping ``{"k": N m/rad, "c": N m s/rad}``.
+JOINTS: tuple[str, ...] = ("free", "locked")
+#: A joint: ``"free"``, ``"locked"`` or ``{"k": stiffness, "c": damping}``.
+JointSpec = str | Mapping[str, float]
 
 #: Force terms a scene may list in ``effects``.
 EFFECTS: tuple[str, ...] = ("gravity", "drag", "static_h", "static_v")
@@ -50,22 +64,80 @@ def _names(value: Any, field_name: str, allowed: tuple[str, ...]) -> tuple[str, 
     return names
 
 
+def _joint(value: Any, field_name: str) -> str | dict[str, float]:
+    if isinstance(value, str):
+        if value not in JOINTS:
+            raise UnknownNameError(
+                f"unknown {field_name} {value!r}; allowed: 'free', 'locked' or "
+                "{'k': N m/rad, 'c': N m s/rad}",
+                field=field_name,
+            )
+        return value
+    if isinstance(value, Mapping):
+        spec = dict(value)
+        extra = set(spec) - {"k", "c"}
+        if extra or not {"k", "c"} <= set(spec):
+            raise InvalidParameterError(
+                f"{field_name} as a spring-damper needs exactly the keys 'k' [N m/rad] and "
+                f"'c' [N m s/rad]; got {sorted(spec)}",
+                field=field_name,
+            )
+        return {"k": spec["k"], "c": spec["c"]}
+    raise InvalidParameterError(
+        f"{field_name} must be 'free', 'locked' or {{'k': .., 'c': ..}}; got {value!r}",
+        field=field_name,
+    )
+
+
+#: Fields that only one or two bodies use (any other field applies to every body).
+BODY_FIELDS: dict[str, tuple[str, ...]] = {
+    "length": ("free_link", "chain"),
+    "diameter": ("free_link", "chain"),
+    "mass": ("free_link", "chain"),
+    "inertia": ("free_link", "chain"),
+    "q_deg": ("free_link", "chain"),
+    "omega0": ("free_link", "chain"),
+    "q2_deg": ("chain",),
+    "coefficients2": ("chain",),
+    "pin_mass": ("chain",),
+    "pin_joint": ("chain",),
+    "body_mass": ("leg",),
+    "height": ("leg",),
+    "foot_length": ("leg",),
+    "shoe_width": ("leg",),
+    "tibia_length": ("leg",),
+    "sole_height": ("leg",),
+    "ankle": ("leg",),
+    "knee": ("leg",),
+    "hip": ("leg",),
+    "knee_deg": ("leg",),
+    "hip_deg": ("leg",),
+    "trunk_deg": ("leg",),
+    "foot_deg": ("leg",),
+    "sole_model": ("leg",),
+}
+
+
 @dataclass(frozen=True)
 class Scene:
     """One impact of a body with sand.
 
     Attributes:
-        body: the body model: ``"free_link"`` (a round rod, 3 degrees of freedom).
-        length: rod length L [m] (thesis sec. 3.2.1: 0.190).
-        diameter: rod diameter d_c [m] (thesis sec. 3.2.1: 0.0127).
-        mass: body mass m [kg] (thesis sec. 3.2.1: 0.184).
+        body: the body model: ``"free_link"`` (a round rod, 3 degrees of freedom),
+            ``"chain"`` (two rods pinned at their top ends, 4) or ``"leg"`` (foot, shank,
+            thigh, half trunk, 6).
+        length: rod length L [m] (thesis sec. 3.2.1: 0.190); each chain link's.
+        diameter: rod diameter d_c [m] (thesis sec. 3.2.1: 0.0127); each chain link's.
+        mass: body mass m [kg] (thesis sec. 3.2.1: 0.184); each chain link's.
         inertia: moment of inertia about the centre of mass [kg m^2]; ``None`` for a solid
             cylinder, m (L^2/12 + d_c^2/16).
         rho_g: bulk density of the sand, packing included [kg/m^3] (thesis sec. 3.3.1: 1650).
         g: gravitational acceleration [m/s^2] (9.81).
-        coefficients: the force law's coefficients (default: Table 3.4 at q = 0).
+        coefficients: the force law's coefficients (default: Table 3.4 at q = 0); the
+            chain's link 1, the leg's foot.
         coefficients_source: where the coefficients come from (for reports; not used).
-        q_deg: initial angle of the rod from the vertical [deg], -90 < q_deg < 90.
+        q_deg: initial angle of the rod (chain: link 1) from the vertical [deg],
+            -90 < q_deg < 90.
         v0: initial downward speed [m/s], >= 0.
         depth0: initial depth of the tip [m], >= 0 (0: at the surface, as in the thesis).
         vx0: initial horizontal velocity of the tip [m/s].
@@ -89,6 +161,31 @@ class Scene:
             or ``"time"``.
         record: time series to record, from ``RECORDS`` (none by default).
         record_stride: record every n-th step (events are always recorded).
+
+    Chain only (thesis chapter 4):
+        q2_deg: link 2's angle from the vertical [deg]; ``None``: -q_deg (mirror image).
+        coefficients2: link 2's coefficients; ``None``: the same as link 1's.
+        pin_mass: mass of the pin, a point mass at the joint [kg] (0).
+        pin_joint: the pin: ``"free"`` (the thesis's frictionless joint, sec. 4.1),
+            ``"locked"`` or ``{"k": .., "c": ..}`` (rest angle: the initial one).
+
+    Leg only (thesis chapter 5; segment data from Winter 2009, Table 4.1 and Fig. 4.1,
+    after Dempster 1955; see :func:`granrs.cases.leg`):
+        body_mass: body mass [kg] (sec. 5.2.1: 75.35); the leg carries half of it.
+        height: body height H [m] (sec. 5.2.1: 1.78).
+        foot_length: foot size f_s [m] (sec. 5.3.2: 0.254).
+        shoe_width: shoe width w_s [m] (sec. 5.3.2: 0.086).
+        tibia_length: tibia l_l [m] (sec. 5.3.2: 0.432): the shank and L_ref of eq. 5.4.
+        sole_height: height of the contact box above the sole [m]; ``None``: the tibia
+            length (the sole's footprint carried up the leg, so V keeps growing as
+            f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count.
+        ankle, knee, hip: each ``"locked"`` (default), ``"free"`` or a spring-damper
+            ``{"k": N m/rad, "c": N m s/rad}`` relaxed at the touchdown posture.
+        knee_deg, hip_deg: flexion at touchdown [deg] (granrs assumption: 20, 20).
+        trunk_deg: trunk lean forward [deg] (granrs assumption: 10).
+        foot_deg: sole pitch, toe up [deg] (0: flat landing).
+        sole_model: ``"box"`` (the geometric box of MODEL.md) or ``"thesis"`` (eqs.
+            5.5-5.7 with the shank's angle; finite only for 1 <= |shank angle| <= 89 deg).
     """
 
     body: str = "free_link"
@@ -117,17 +214,52 @@ class Scene:
     end: str = "first_stop"
     record: tuple[str, ...] = ()
     record_stride: int = 1
+    q2_deg: float | None = None
+    coefficients2: Coefficients | None = None
+    pin_mass: float = 0.0
+    pin_joint: JointSpec = "free"
+    body_mass: float = 75.35
+    height: float = 1.78
+    foot_length: float = 0.254
+    shoe_width: float = 0.086
+    tibia_length: float = 0.432
+    sole_height: float | None = None
+    ankle: JointSpec = "locked"
+    knee: JointSpec = "locked"
+    hip: JointSpec = "locked"
+    knee_deg: float = 20.0
+    hip_deg: float = 20.0
+    trunk_deg: float = 10.0
+    foot_deg: float = 0.0
+    sole_model: str = "box"
 
     def __post_init__(self) -> None:
-        coefficients = self.coefficients
-        if isinstance(coefficients, Mapping):
-            coefficients = Coefficients(**dict(coefficients))
-        if not isinstance(coefficients, Coefficients):
-            raise InvalidParameterError(
-                f"coefficients must be a granrs.Coefficients, got {type(coefficients).__name__}",
-                field="coefficients",
+        if self.body not in BODIES:
+            raise UnknownNameError(
+                f"unknown body {self.body!r}; allowed: {', '.join(BODIES)}", field="body"
             )
-        object.__setattr__(self, "coefficients", coefficients)
+        for name in ("coefficients", "coefficients2"):
+            coefficients = getattr(self, name)
+            if coefficients is None and name == "coefficients2":
+                continue
+            if isinstance(coefficients, Mapping):
+                coefficients = Coefficients(**dict(coefficients))
+            if not isinstance(coefficients, Coefficients):
+                raise InvalidParameterError(
+                    f"{name} must be a granrs.Coefficients, got {type(coefficients).__name__}",
+                    field=name,
+                )
+            object.__setattr__(self, name, coefficients)
+        for name in ("pin_joint", "ankle", "knee", "hip"):
+            object.__setattr__(self, name, _joint(getattr(self, name), name))
+        defaults = _DEFAULTS
+        for name, bodies in BODY_FIELDS.items():
+            if self.body not in bodies and getattr(self, name) != defaults[name]:
+                raise InvalidSceneError(
+                    f"{name} applies to body {' or '.join(repr(b) for b in bodies)} only, "
+                    f"not {self.body!r}",
+                    field=name,
+                )
         object.__setattr__(self, "effects", _names(self.effects, "effects", EFFECTS))
         object.__setattr__(self, "record", _names(self.record, "record", RECORDS))
 
@@ -146,6 +278,7 @@ class Scene:
         """The scene as plain Python values (the form the Rust core reads)."""
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         d["coefficients"] = self.coefficients.as_dict()
+        d["coefficients2"] = None if self.coefficients2 is None else self.coefficients2.as_dict()
         d["effects"] = list(self.effects)
         d["record"] = list(self.record)
         return d
@@ -155,7 +288,19 @@ class Scene:
         _granrs.validate(self.to_dict())
         return self
 
+    def leg_segments(self) -> list[dict[str, Any]]:
+        """The leg's segments scaled to this scene's body: name, mass [kg], length [m], com
+        (from the segment's lower joint) [m], inertia about the centre of mass [kg m^2]."""
+        if self.body != "leg":
+            raise InvalidSceneError("leg_segments() needs body='leg'", field="body")
+        return list(_granrs.leg_segments(self.to_dict()))
+
     @property
     def q_rad(self) -> float:
         """Initial angle from the vertical [rad]."""
         return math.radians(self.q_deg)
+
+
+_DEFAULTS: dict[str, Any] = {
+    f.name: f.default for f in dataclasses.fields(Scene) if f.default is not dataclasses.MISSING
+}
