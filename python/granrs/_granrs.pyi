@@ -11,3 +11,6 @@ def simulate(scene: dict[str, Any]) -> dict[str, Any]:
 
 def validate(scene: dict[str, Any]) -> None:
     """Validate a scene dict; raise the typed granrs error naming the first bad field."""
+
+def leg_segments(scene: dict[str, Any]) -> list[dict[str, Any]]:
+    """The leg's segments (name, mass, length, com, inertia) for a leg scene dict."""
