@@ -1,4 +1,4 @@
-"""Time ``granrs.simulate`` over the scenes of thesis Table 3.5, from Python.
+"""Time ``granrs.simulate`` over the scenes of thesis Table 3.5 and over every body, from Python.
 
 Each row of Table 3.5 (``granrs.data.load("table_3_5")``) becomes a free-link scene with its
 Table 3.4 coefficients (``granrs.cases.free_link(q_deg, v0)``); the scenes are built once.
@@ -16,9 +16,25 @@ are in ``cargo bench --bench free_link``; to compare with them, build the extens
 ``maturin develop --release`` (a plain ``maturin develop`` builds the dev profile, about 1.5x
 slower per evaluation).
 
+The bodies part times one scene per body model, the scenes of ``cargo bench --bench bodies``
+(same names, same work counters):
+
+* ``free_link_q45``: ``granrs.cases.free_link(45, 2.27)``, the Table 3.5 row;
+* ``chain_case1``: ``granrs.cases.chain(1, end="all_stops")``, the thesis's chain case 1 until
+  both links stop;
+* ``leg_locked``, ``leg_spring``, ``leg_free``: ``granrs.cases.leg(3.28)`` with ankle, knee
+  and hip locked (the default), spring-dampers (``joints={"k": 300, "c": 5}``) or free.
+
+It reports the same columns per body (simulate time, work counters, time per evaluation, the
+to_dict + validate overhead) and the ratios to the free link's simulate time and time per
+evaluation. The bodies are timed in turn within each repeat, so a ratio's two times come from
+the same stretch of the run. Compare the ratios with those of ``cargo bench --bench bodies``
+(``python benches/criterion_ratios.py``), not the times: the two are separate runs.
+
 Usage::
 
-    python benches/bench_simulate.py [--repeats 7] [--csv PATH]
+    python benches/bench_simulate.py [--repeats 7] [--part all|table|bodies] [--csv PATH]
+        [--bodies-csv PATH]
 """
 
 from __future__ import annotations
@@ -49,6 +65,34 @@ class Row:
     ns_per_rhs: float
     overhead_us: float
     overhead_frac: float
+
+
+@dataclass
+class BodyRow:
+    """One body's timings (seconds are minima over the repeats; ratios to the free link)."""
+
+    name: str
+    body: str
+    status: str
+    simulate_us: float
+    rhs_evals: int
+    steps: int
+    ns_per_rhs: float
+    overhead_us: float
+    overhead_frac: float
+    sim_ratio: float
+    rhs_ratio: float
+
+
+def build_bodies() -> dict[str, granrs.Scene]:
+    """One scene per body, named as in ``benches/bodies.rs``; the free link first."""
+    return {
+        "free_link_q45": granrs.cases.free_link(45.0, 2.27),
+        "chain_case1": granrs.cases.chain(1, end="all_stops"),
+        "leg_locked": granrs.cases.leg(3.28),
+        "leg_spring": granrs.cases.leg(3.28, joints={"k": 300.0, "c": 5.0}),
+        "leg_free": granrs.cases.leg(3.28, joints="free"),
+    }
 
 
 def build_scenes() -> list[granrs.Scene]:
@@ -109,6 +153,63 @@ def measure(scenes: list[granrs.Scene], repeats: int) -> tuple[list[Row], float]
     return rows, best_batch
 
 
+def measure_bodies(scenes: dict[str, granrs.Scene], repeats: int) -> list[BodyRow]:
+    """Per-body rows; ratios to the first scene (the free link)."""
+    results = {name: granrs.simulate(s) for name, s in scenes.items()}  # warm-up, counters
+    for name, r in results.items():
+        if r.status != "stopped":
+            raise RuntimeError(f"{name}: {r.status}")
+    best_sim = dict.fromkeys(scenes, float("inf"))
+    best_over = dict.fromkeys(scenes, float("inf"))
+    for _ in range(repeats):
+        for name, s in scenes.items():
+            best_sim[name] = min(best_sim[name], time_simulate(s))
+        for name, s in scenes.items():
+            best_over[name] = min(best_over[name], time_overhead(s))
+    base = next(iter(scenes))
+    base_evals = int(results[base].summary["rhs_evals"])
+    base_ns_per_rhs = best_sim[base] * 1e9 / base_evals
+    rows = []
+    for name, s in scenes.items():
+        r, t_sim, t_over = results[name], best_sim[name], best_over[name]
+        evals = int(r.summary["rhs_evals"])
+        ns_per_rhs = t_sim * 1e9 / evals
+        rows.append(
+            BodyRow(
+                name=name,
+                body=s.body,
+                status=r.status,
+                simulate_us=t_sim * 1e6,
+                rhs_evals=evals,
+                steps=int(r.summary["steps"]),
+                ns_per_rhs=ns_per_rhs,
+                overhead_us=t_over * 1e6,
+                overhead_frac=t_over / t_sim,
+                sim_ratio=t_sim / best_sim[base],
+                rhs_ratio=ns_per_rhs / base_ns_per_rhs,
+            )
+        )
+    return rows
+
+
+def report_bodies(rows: list[BodyRow], repeats: int) -> str:
+    """The per-body table as text."""
+    base = rows[0].name
+    lines = [
+        f"granrs {granrs.__version__}: simulate() per body, min of {repeats} repeats; "
+        f"x_sim, x_rhs: ratios to {base}",
+        f"{'name':<14} {'sim_us':>9} {'x_sim':>6} {'steps':>6} {'rhs':>6} {'rhs/step':>8} "
+        f"{'ns/rhs':>8} {'x_rhs':>6} {'ovh_us':>7} {'ovh_%':>6}",
+    ]
+    for r in rows:
+        lines.append(
+            f"{r.name:<14} {r.simulate_us:>9.1f} {r.sim_ratio:>6.2f} {r.steps:>6d} "
+            f"{r.rhs_evals:>6d} {r.rhs_evals / r.steps:>8.2f} {r.ns_per_rhs:>8.1f} "
+            f"{r.rhs_ratio:>6.2f} {r.overhead_us:>7.1f} {100 * r.overhead_frac:>6.2f}"
+        )
+    return "\n".join(lines)
+
+
 def report(rows: list[Row], batch_s: float, repeats: int) -> str:
     """The table and the summary as text."""
     med_ns = statistics.median(r.ns_per_rhs for r in rows)
@@ -156,8 +257,8 @@ def report(rows: list[Row], batch_s: float, repeats: int) -> str:
     return "\n".join(lines)
 
 
-def write_csv(rows: list[Row], path: str) -> None:
-    """One line per scene, the columns of :class:`Row`."""
+def write_csv(rows: list[Row] | list[BodyRow], path: str) -> None:
+    """One line per scene, the columns of :class:`Row` (or :class:`BodyRow`)."""
     with open(path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(asdict(rows[0])))
         writer.writeheader()
@@ -168,16 +269,32 @@ def write_csv(rows: list[Row], path: str) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeats", type=int, default=7, help="repeats (minimum taken)")
-    parser.add_argument("--csv", metavar="PATH", help="write the per-scene table as CSV")
+    parser.add_argument(
+        "--part",
+        choices=("all", "table", "bodies"),
+        default="all",
+        help="Table 3.5 scenes, one scene per body, or both (default: all)",
+    )
+    parser.add_argument("--csv", metavar="PATH", help="write the Table 3.5 table as CSV")
+    parser.add_argument("--bodies-csv", metavar="PATH", help="write the per-body table as CSV")
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error("--repeats must be at least 1")
-    scenes = build_scenes()
-    rows, batch_s = measure(scenes, args.repeats)
-    print(report(rows, batch_s, args.repeats))
-    if args.csv:
-        write_csv(rows, args.csv)
-        print(f"wrote {args.csv}")
+    if args.part in ("all", "table"):
+        scenes = build_scenes()
+        rows, batch_s = measure(scenes, args.repeats)
+        print(report(rows, batch_s, args.repeats))
+        if args.csv:
+            write_csv(rows, args.csv)
+            print(f"wrote {args.csv}")
+    if args.part in ("all", "bodies"):
+        if args.part == "all":
+            print()
+        body_rows = measure_bodies(build_bodies(), args.repeats)
+        print(report_bodies(body_rows, args.repeats))
+        if args.bodies_csv:
+            write_csv(body_rows, args.bodies_csv)
+            print(f"wrote {args.bodies_csv}")
     return 0
 
 
