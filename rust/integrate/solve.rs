@@ -264,7 +264,13 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
             out.push((Kind::Stop, ci));
         }
         if with_modes {
-            if model.effects.drag {
+            // A contact held in both directions has v_E = 0: no drag, and e x v_E is
+            // round-off whose sign would flip back and forth (Zeno events).
+            let held = model.effects.static_h
+                && model.effects.static_v
+                && m.sx == Slip::Stick
+                && m.sy == Slip::Stick;
+            if model.effects.drag && !held {
                 out.push((Kind::Cross, ci));
             }
             if model.effects.static_h {
