@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 import granrs
-from granrs import report
+from granrs import Coefficients, report
 from granrs.cli import main
 from granrs.errors import InvalidParameterError, UnknownNameError
 
@@ -57,7 +57,8 @@ def _float(cell: str) -> float:
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """The chapter 3 report, built once into a fresh directory: (README path, text)."""
+    """The whole report (every chapter, the default), built once into a fresh directory:
+    (README path, text)."""
     out = tmp_path_factory.mktemp("report") / "out"
     path = report.reproduce(out, progress=False)
     return path, path.read_text(encoding="utf-8")
@@ -326,3 +327,312 @@ def test_relative_error_is_eq_3_21() -> None:
     assert report.relative_error(0.050, 0.055) == pytest.approx(0.1)
     assert math.isnan(report.relative_error(0.0, 1.0))
     assert math.isnan(report.relative_error(1.0, math.nan))
+
+
+# --------------------------------------------------------------------------------------
+# Chapter 4: the two-link chain
+# --------------------------------------------------------------------------------------
+
+SOLID_STEEL = granrs.cases.CHAIN["mass"]
+HALF_MASS = 0.017
+
+
+def _chain_link(result: granrs.Result, link: int) -> tuple[float, float]:
+    """A link's t_s counted from its own entry (as Table 4.2) and its depth at its stop."""
+    contact = result.contacts[link - 1]
+    return contact.t_s - contact.summary["t_entry"], contact.depth
+
+
+def _chain_rms_depth_error(mass: float) -> float:
+    """RMS of eq. 4.8 over every Table 4.2 link-case, from fresh runs at ``mass``."""
+    runs = {
+        case: granrs.simulate(granrs.cases.chain(case, mass=mass, end="all_stops"))
+        for case in (1, 2, 3)
+    }
+    errors = []
+    for row in _csv("table_4_chain_experiments"):
+        _, depth = _chain_link(runs[int(float(row["v0_case"]))], int(float(row["link"])))
+        exp = float(row["depth_mean"])
+        errors.append(abs(exp - depth) / exp)
+    return math.sqrt(sum(e * e for e in errors) / len(errors))
+
+
+def _link_case_rows(rows: list[list[str]]) -> dict[tuple[int, int], list[str]]:
+    """Rows keyed by their (link, case) cells; fails on a repeated key."""
+    keyed: dict[tuple[int, int], list[str]] = {}
+    for r in rows:
+        key = (int(_float(r[0])), int(_float(r[1])))
+        assert key not in keyed, f"link-case {key} repeated"
+        keyed[key] = r
+    return keyed
+
+
+def test_chapters_4_and_5_are_registered() -> None:
+    """The chain and the leg are chapters of the report, offered by the command line."""
+    assert {"3", "4", "5"} <= set(report.CHAPTERS)
+    assert "chain" in report.CHAPTERS["4"].title
+    assert "leg" in report.CHAPTERS["5"].title
+    assert main(["reproduce", "--chapter", "6", "--quiet"]) == 2  # argparse choices
+
+
+@pytest.mark.parametrize("mass", [SOLID_STEEL, HALF_MASS])
+def test_table_4_2_one_row_per_link_case(built: tuple[Path, str], mass: float) -> None:
+    """At each link mass, every Table 4.2 link-case is one row with the measured values."""
+    _, text = built
+    header, rows = _table(_section(text, f"#### Link mass {mass:g} kg"))
+    expected = _csv("table_4_chain_experiments")
+    assert len(rows) == len(expected)
+    keyed = _link_case_rows(rows)
+    for row in expected:
+        cells = keyed[(int(float(row["link"])), int(float(row["v0_case"])))]
+        assert _float(cells[header.index("depth exp. [mm]")]) == pytest.approx(
+            float(row["depth_mean"]) * 1e3, abs=0.051
+        )
+        assert _float(cells[header.index("t_s exp. [ms]")]) == pytest.approx(
+            float(row["t_s_mean"]) * 1e3, abs=0.51
+        )
+
+
+@pytest.mark.parametrize(("mass", "case"), [(SOLID_STEEL, 1), (HALF_MASS, 2), (HALF_MASS, 3)])
+def test_table_4_2_granrs_columns_are_simulate(
+    built: tuple[Path, str], mass: float, case: int
+) -> None:
+    """The granrs columns are a fresh simulate() of the case at that mass, per link, with
+    t_s from the link's own entry and ε from eq. 4.8."""
+    _, text = built
+    header, rows = _table(_section(text, f"#### Link mass {mass:g} kg"))
+    keyed = _link_case_rows(rows)
+    result = granrs.simulate(granrs.cases.chain(case, mass=mass, end="all_stops"))
+    experiments = {
+        (int(float(r["link"])), int(float(r["v0_case"]))): r
+        for r in _csv("table_4_chain_experiments")
+    }
+    for link in (1, 2):
+        cells = keyed[(link, case)]
+        t_s, depth = _chain_link(result, link)
+        assert _float(cells[header.index("t_s granrs [ms]")]) == pytest.approx(t_s * 1e3, abs=0.051)
+        assert _float(cells[header.index("depth granrs [mm]")]) == pytest.approx(
+            depth * 1e3, abs=0.051
+        )
+        exp = float(experiments[(link, case)]["depth_mean"])
+        assert _float(cells[header.index("ε depth (eq. 4.8) [%]")]) == pytest.approx(
+            abs(exp - depth) / exp * 100, abs=0.051
+        )
+
+
+def test_table_4_5_shows_the_thesis_and_the_missing_row(built: tuple[Path, str]) -> None:
+    """Tables 4.5-4.6 as shipped; the row missing in the source says so."""
+    _, text = built
+    header, rows = _table(_section(text, "### Tables 4.5-4.6"))
+    keyed = _link_case_rows(rows)
+    i_depth = header.index("depth thesis sim. (Table 4.5) [mm]")
+    i_eps = header.index("ε depth as printed (Table 4.6) [%]")
+    for row in _csv("table_4_chain_coefficients_and_simulation"):
+        cells = keyed[(int(float(row["link"])), int(float(row["v0_case"])))]
+        if row["depth_sim"].strip():
+            assert _float(cells[i_depth]) == pytest.approx(float(row["depth_sim"]) * 1e3)
+            assert _float(cells[i_eps]) == pytest.approx(float(row["depth_rel_err_pct"]))
+        else:
+            assert cells[i_depth] == "n/a (missing in thesis)"
+            assert cells[i_eps] == "n/a (missing in thesis)"
+
+
+def test_best_fit_mass(built: tuple[Path, str]) -> None:
+    """The best-fit mass lies in the swept range, its RMS is what fresh runs give, and no
+    neighbouring mass on the fine grid (0.5 g apart) fits the depths better."""
+    _, text = built
+    section = _section(text, "### Link mass")
+    match = re.search(
+        r"Best-fit link mass: ([\d.]+) g per link .*?RMS relative depth\s+error ([\d.]+) %",
+        section,
+        re.S,
+    )
+    assert match, "best-fit sentence missing"
+    best, rms = float(match.group(1)) * 1e-3, float(match.group(2))
+    low, high = min(report._MASS_SWEEP), max(report._MASS_SWEEP)
+    assert low <= best <= high
+    assert _chain_rms_depth_error(best) * 100 == pytest.approx(rms, abs=0.051)
+    # Every coarse row of the table fits no better than the best.
+    header, rows = _table(section)
+    i_rms = header.index("RMS ε depth vs Table 4.2 [%]")
+    assert all(_float(r[i_rms]) >= rms - 0.051 for r in rows)
+    for neighbour in (best - 0.0005, best + 0.0005):
+        if low <= neighbour <= high:
+            assert _chain_rms_depth_error(neighbour) >= _chain_rms_depth_error(best) - 1e-12
+
+
+def test_links_stop_times_are_compared(built: tuple[Path, str]) -> None:
+    """The stop-time table gives each link's stop (from its own entry) at the solid-steel
+    mass, and their difference, as fresh runs do."""
+    _, text = built
+    header, rows = _table(_section(text, "### Do the two links stop at the same time?"))
+    assert [int(_float(r[0])) for r in rows] == [1, 2, 3]
+    i_pair = header.index(f"granrs {SOLID_STEEL * 1e3:.1f} g: t_s link 1 / 2 [ms]")
+    for r in rows:
+        result = granrs.simulate(granrs.cases.chain(int(_float(r[0])), end="all_stops"))
+        t1, _ = _chain_link(result, 1)
+        t2, _ = _chain_link(result, 2)
+        first, second = (float(x) for x in r[i_pair].split(" / "))
+        assert first == pytest.approx(t1 * 1e3, abs=0.051)
+        assert second == pytest.approx(t2 * 1e3, abs=0.051)
+        assert _float(r[i_pair + 1]) == pytest.approx((t2 - t1) * 1e3, abs=0.11)
+
+
+def test_chapter_4_figures_are_cited(built: tuple[Path, str]) -> None:
+    """Figs. 4.7-4.16 analogues, the pin force and the link-mass figure are in the report."""
+    path, text = built
+    section = text[text.index("## Chapter 4") : text.index("## Chapter 5")]
+    links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", section)
+    assert len(links) >= 5
+    assert all((path.parent / link).read_bytes().startswith(PNG_MAGIC) for link in links)
+    for number in ("4.7", "4.8", "4.9", "4.12", "4.13", "4.16"):
+        assert f"Fig. {number}" in section or f"Figs. {number}" in section
+
+
+# --------------------------------------------------------------------------------------
+# Chapter 5: the leg
+# --------------------------------------------------------------------------------------
+
+
+def _human_coefficients(v0: float) -> Coefficients:
+    """The thesis's leg coefficients at speed v0, from the shipped CSV."""
+    row = next(r for r in _csv("table_5_human_coefficients_and_simulation") if float(r["v0"]) == v0)
+    return Coefficients(
+        eta_h=float(row["eta_h"]),
+        eta_d=float(row["eta_d"]),
+        eta_v=float(row["eta_v"]),
+        lam=float(row["lambda"]),
+    )
+
+
+def test_table_5_1_rows(built: tuple[Path, str]) -> None:
+    """Every subject and height, the mean across subjects and the thesis's row are shown."""
+    _, text = built
+    header, rows = _table(_section(text, "### Table 5.1"))
+    expected = _csv("table_5_1_human_experiments")
+    assert len(rows) == len(expected) + 4  # + a mean and a thesis row per height
+    i_depth = header.index("depth exp. / thesis [mm]")
+    for row in expected:
+        name = f"subject {int(float(row['subject']))}"
+        found = [r for r in rows if r[0] == row["height_case"] and r[1] == name]
+        assert len(found) == 1
+        assert _float(found[0][i_depth]) == pytest.approx(float(row["depth_mean"]) * 1e3, abs=0.51)
+    for height in ("h1", "h2"):
+        subjects = [float(r["depth_mean"]) for r in expected if r["height_case"] == height]
+        mean = next(r for r in rows if r[0] == height and "mean of" in r[1])
+        assert _float(mean[i_depth]) == pytest.approx(statistics.fmean(subjects) * 1e3, abs=0.051)
+        assert any(r[0] == height and r[1].startswith("thesis simulation") for r in rows)
+
+
+def test_table_5_1_granrs_is_simulate(built: tuple[Path, str]) -> None:
+    """A subject's granrs columns: the locked leg at the subject's speed with the thesis's
+    coefficients of that height."""
+    _, text = built
+    header, rows = _table(_section(text, "### Table 5.1"))
+    exp = next(
+        r
+        for r in _csv("table_5_1_human_experiments")
+        if r["height_case"] == "h2" and float(r["subject"]) == 4
+    )
+    cells = next(r for r in rows if r[0] == "h2" and r[1] == "subject 4")
+    result = granrs.simulate(
+        granrs.cases.leg(float(exp["v0_mean"]), coefficients=_human_coefficients(2.35))
+    )
+    assert _float(cells[header.index("t_s granrs [ms]")]) == pytest.approx(
+        result.t_s * 1e3, abs=0.051
+    )
+    assert _float(cells[header.index("depth granrs [mm]")]) == pytest.approx(
+        result.depth * 1e3, abs=0.051
+    )
+
+
+def _joint_table(text: str) -> tuple[list[str], dict[str, list[str]]]:
+    """The joint study's header and its rows by setting name."""
+    header, rows = _table(_section(text, "### The joints"))
+    keyed = {r[0]: r for r in rows}
+    assert len(keyed) == len(rows), "a setting is listed twice"
+    return header, keyed
+
+
+def test_joint_study_lists_every_setting(built: tuple[Path, str]) -> None:
+    """Locked, free, the thesis sole and one spring-damper per stiffness, with the damping
+    rule c = 2 zeta sqrt(k I_ref) of the text, plus the two references."""
+    _, text = built
+    section = _section(text, "### The joints")
+    _, keyed = _joint_table(text)
+    names = list(keyed)
+    assert any(n.startswith("locked (default)") for n in names)
+    assert "free" in names
+    assert any("thesis sole" in n for n in names)
+    assert any(n.startswith("**thesis simulation**") for n in names)
+    assert any(n.startswith("**experiments**") for n in names)
+    springs = {n: r for n, r in keyed.items() if n.startswith("spring-damper")}
+    assert sorted(_float(r[1]) for r in springs.values()) == pytest.approx(
+        sorted(report._LEG_STIFFNESS), rel=1e-3
+    )
+    assert len(keyed) == 2 + 3 + len(report._LEG_STIFFNESS)
+    match = re.search(r"ζ =\s+([\d.]+) and I_ref = ([\d.]+) kg m²", section)
+    assert match, "damping rule missing"
+    zeta, i_ref = float(match.group(1)), float(match.group(2))
+    segments = {s["name"]: s for s in granrs.cases.leg().leg_segments()}
+    trunk = segments["half_trunk"]
+    assert i_ref == pytest.approx(trunk["inertia"] + trunk["mass"] * trunk["com"] ** 2, abs=0.006)
+    for r in springs.values():
+        k = _float(r[1])
+        assert _float(r[2]) == pytest.approx(2 * zeta * math.sqrt(k * i_ref), rel=2e-3)
+
+
+@pytest.mark.parametrize(
+    ("name", "fields"),
+    [
+        ("locked (default)", {}),
+        ("free", {"joints": "free"}),
+        ("locked, thesis sole (eqs. 5.5-5.7)", {"sole_model": "thesis"}),
+    ],
+)
+def test_joint_study_rows_are_simulate(
+    built: tuple[Path, str], name: str, fields: dict[str, object]
+) -> None:
+    """A setting's depth and t_s at both speeds are fresh simulate() runs of cases.leg."""
+    _, text = built
+    header, keyed = _joint_table(text)
+    cells = keyed[name]
+    for height, v0 in (("h1", 3.28), ("h2", 2.35)):
+        result = granrs.simulate(granrs.cases.leg(v0, **fields))
+        assert _float(cells[header.index(f"t_s {height}, {v0} m/s [ms]")]) == pytest.approx(
+            result.t_s * 1e3, abs=0.051
+        )
+        assert _float(cells[header.index(f"depth {height}, {v0} m/s [mm]")]) == pytest.approx(
+            result.depth * 1e3, abs=0.051
+        )
+
+
+def test_joint_study_closest_settings(built: tuple[Path, str]) -> None:
+    """The settings marked closest have the smallest RMS error, and that error is the RMS of
+    the four relative errors recomputed from the table's own numbers."""
+    _, text = built
+    header, keyed = _joint_table(text)
+    references = {n: r for n, r in keyed.items() if n.startswith("**")}
+    settings = {n: r for n, r in keyed.items() if not n.startswith("**")}
+    columns = [h for h in header if h.startswith(("t_s h", "depth h"))]
+    for label, column in (
+        ("thesis", "RMS ε vs thesis [%]"),
+        ("experiments", "RMS ε vs experiments [%]"),
+    ):
+        i = header.index(column)
+        marked = [n for n, r in settings.items() if "(closest)" in r[i]]
+        assert len(marked) == 1
+        assert _float(settings[marked[0]][i]) == pytest.approx(
+            min(_float(r[i]) for r in settings.values())
+        )
+        reference = next(r for n, r in references.items() if label in n)
+        for row in settings.values():
+            errors = [
+                (_float(row[header.index(c)]) - _float(reference[header.index(c)]))
+                / _float(reference[header.index(c)])
+                for c in columns
+            ]
+            rms = math.sqrt(sum(e * e for e in errors) / len(errors)) * 100
+            assert _float(row[i]) == pytest.approx(rms, rel=0.02, abs=0.3)
+    assert "Closest to the thesis's simulation" in _section(text, "### The joints")
+    assert "Leg (chapter 5)" in _section(text, "## Summary")

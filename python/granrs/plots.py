@@ -11,6 +11,9 @@ the Agg renderer.
   (Table 3.5).
 * :func:`alpha_figure`: the thesis's Figs. 3.22-3.23: a stopping result (depth or t_s)
   against the impact angle alpha = 90 deg - q for the three simulated speeds.
+* :func:`panel_grid`: a grid of panels, each a few curves (:class:`Curve`), reference end
+  points (:class:`Point`) and horizontal reference lines (:class:`RefLine`) against time or
+  any other variable: the chain's and the leg's figures (chapters 4 and 5).
 
 Units on the axes are ms and mm for readability; the inputs are SI (s, m, m/s).
 """
@@ -21,19 +24,27 @@ import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 __all__ = [
+    "POINT_KINDS",
     "AlphaPoint",
     "AlphaSeries",
+    "Curve",
     "EndPoint",
+    "Panel",
+    "Point",
+    "RefLine",
     "SpeedCurve",
     "alpha_figure",
     "impact_figure",
+    "panel_grid",
     "png_bytes",
 ]
 
@@ -298,4 +309,228 @@ def alpha_figure(
     ax.set_xticks(np.arange(0.0, 91.0, 15.0))
     ax.grid(True, alpha=0.3)
     ax.legend(handles=handles, fontsize=8, loc="best")
+    return fig
+
+
+# --------------------------------------------------------------------------------------
+# Panel grids (chapters 4 and 5)
+# --------------------------------------------------------------------------------------
+
+#: How each kind of :class:`Point` is drawn: matplotlib marker keywords (the colour is the
+#: point's own; a hollow marker takes it as its edge). ``experiment``: a measured end point
+#: with sd bars; ``thesis``: the thesis's simulated end point; ``stop``: a granrs stop;
+#: ``chosen``: a selected setting; ``other``: any other marked value.
+POINT_KINDS: dict[str, dict[str, Any]] = {
+    "experiment": {"marker": "o", "ms": 7, "mec": "black"},
+    "thesis": {"marker": "s", "ms": 8, "mfc": "none", "mew": 2},
+    "stop": {"marker": "x", "ms": 8, "mew": 2},
+    "chosen": {"marker": "*", "ms": 14, "mec": "black"},
+    "other": {"marker": "D", "ms": 8, "mfc": "none", "mew": 2},
+}
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One line of a panel.
+
+    Attributes:
+        x: abscissa, SI (e.g. time [s]); scaled by the panel's ``x_scale``.
+        y: ordinate, SI; scaled by the panel's ``y_scale``.
+        colour: index into :data:`SPEED_COLOURS`.
+        label: legend text (None: not in the legend).
+        style: line style (``"-"``, ``"--"``, ``":"``).
+        marker: point marker (``""``: none).
+        width: line width.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    colour: int = 0
+    label: str | None = None
+    style: str = "-"
+    marker: str = ""
+    width: float = 1.8
+
+
+@dataclass(frozen=True)
+class Point:
+    """A reference point of a panel (an end point, a stop, a chosen setting).
+
+    Attributes:
+        x: abscissa, SI.
+        y: ordinate, SI.
+        colour: index into :data:`SPEED_COLOURS`, or None for grey.
+        kind: one of :data:`POINT_KINDS`.
+        x_sd: standard deviation of x, SI (NaN: no error bar).
+        y_sd: standard deviation of y, SI (NaN: no error bar).
+    """
+
+    x: float
+    y: float
+    colour: int | None = 0
+    kind: str = "experiment"
+    x_sd: float = math.nan
+    y_sd: float = math.nan
+
+
+@dataclass(frozen=True)
+class RefLine:
+    """A horizontal reference line (a target value) with its legend text.
+
+    Attributes:
+        y: the value, SI.
+        label: legend text.
+        colour: index into :data:`SPEED_COLOURS`, or None for black.
+        style: line style.
+    """
+
+    y: float
+    label: str
+    colour: int | None = None
+    style: str = "--"
+
+
+@dataclass(frozen=True)
+class Panel:
+    """One panel of :func:`panel_grid`.
+
+    Attributes:
+        title: the panel title (cite the thesis figure number).
+        ylabel: y-axis label, in the plotted unit.
+        curves: the lines.
+        points: the reference points.
+        lines: horizontal reference lines.
+        xlabel: x-axis label, in the plotted unit.
+        x_scale: factor from SI to the plotted x unit (1e3: s -> ms).
+        y_scale: factor from SI to the plotted y unit.
+        xlog: logarithmic x axis.
+        y_from_zero: start the y axis at zero.
+        ylim: the y-axis range in the plotted unit (None: automatic).
+        zero_line: draw y = 0.
+        legend: draw the legend in this panel (curves with a label, point kinds and
+            reference lines of this panel).
+    """
+
+    title: str
+    ylabel: str
+    curves: Sequence[Curve] = ()
+    points: Sequence[Point] = ()
+    lines: Sequence[RefLine] = ()
+    xlabel: str = "time t [ms]"
+    x_scale: float = _MS
+    y_scale: float = 1.0
+    xlog: bool = False
+    y_from_zero: bool = True
+    ylim: tuple[float, float] | None = None
+    zero_line: bool = False
+    legend: bool = False
+
+
+def _maybe_colour(i: int | None, default: str) -> str:
+    """The colour of index ``i``, or ``default`` when it is None."""
+    return default if i is None else _colour(i)
+
+
+def _draw_panel(ax: Axes, panel: Panel, point_labels: dict[str, str]) -> None:
+    """Draw ``panel`` on the axes ``ax``."""
+    handles: list[Line2D] = []
+    labels_seen: set[str] = set()
+    for c in panel.curves:
+        colour = _colour(c.colour)
+        ax.plot(
+            np.asarray(c.x) * panel.x_scale,
+            np.asarray(c.y) * panel.y_scale,
+            color=colour,
+            ls=c.style,
+            lw=c.width,
+            marker=c.marker or None,
+            ms=6,
+        )
+        if c.label and c.label not in labels_seen:
+            labels_seen.add(c.label)
+            handles.append(
+                Line2D(
+                    [],
+                    [],
+                    color=colour,
+                    ls=c.style,
+                    lw=c.width,
+                    marker=c.marker or None,
+                    label=c.label,
+                )
+            )
+    for line in panel.lines:
+        colour = _maybe_colour(line.colour, "black")
+        ax.axhline(line.y * panel.y_scale, color=colour, ls=line.style, lw=1.2)
+        handles.append(Line2D([], [], color=colour, ls=line.style, lw=1.2, label=line.label))
+    kinds: list[str] = []
+    for p in panel.points:
+        if p.kind not in POINT_KINDS:
+            raise ValueError(f"unknown point kind {p.kind!r}; known: {', '.join(POINT_KINDS)}")
+        colour = _maybe_colour(p.colour, "grey")
+        style = dict(POINT_KINDS[p.kind])
+        if style.get("mfc") == "none":
+            style["mec"] = colour
+        x, y = p.x * panel.x_scale, p.y * panel.y_scale
+        xerr = p.x_sd * panel.x_scale if _finite(p.x_sd) else None
+        yerr = p.y_sd * panel.y_scale if _finite(p.y_sd) else None
+        if xerr is not None or yerr is not None:
+            ax.errorbar(x, y, xerr=xerr, yerr=yerr, fmt="none", ecolor=colour, capsize=3)
+        ax.plot(x, y, ls="", color=colour, **style)
+        if p.kind not in kinds:
+            kinds.append(p.kind)
+    for kind in kinds:
+        style = dict(POINT_KINDS[kind])
+        if style.get("mfc") == "none":
+            style["mec"] = "grey"
+        handles.append(
+            Line2D([], [], color="grey", ls="", label=point_labels.get(kind, kind), **style)
+        )
+    if panel.zero_line:
+        ax.axhline(0.0, color="black", lw=0.6)
+    if panel.xlog:
+        ax.set_xscale("log")
+    ax.set_xlabel(panel.xlabel)
+    ax.set_ylabel(panel.ylabel)
+    ax.set_title(panel.title, fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if not panel.xlog:
+        ax.set_xlim(left=0.0)
+    if panel.ylim is not None:
+        ax.set_ylim(*panel.ylim)
+    elif panel.y_from_zero:
+        ax.set_ylim(bottom=0.0)
+    if panel.legend and handles:
+        ax.legend(handles=handles, fontsize=7, loc="best")
+
+
+def panel_grid(
+    rows: Sequence[Sequence[Panel]],
+    *,
+    title: str | None = None,
+    point_labels: dict[str, str] | None = None,
+    width: float = 11.0,
+    row_height: float = 3.8,
+) -> Figure:
+    """A grid of panels, one row per entry of ``rows`` (every row the same length).
+
+    Args:
+        rows: the panels, row by row.
+        title: the figure's title (cite the thesis figure numbers), or None.
+        point_labels: legend text of each point kind used (default: the kind's name).
+        width: figure width [inch].
+        row_height: height of one row [inch].
+    """
+    if not rows or not rows[0]:
+        raise ValueError("panel_grid needs at least one panel")
+    n_cols = len(rows[0])
+    if any(len(row) != n_cols for row in rows):
+        raise ValueError("every row of panel_grid must have the same number of panels")
+    fig = Figure(figsize=(width, row_height * len(rows)), layout="constrained")
+    axes = fig.subplots(len(rows), n_cols, squeeze=False)
+    for i, row in enumerate(rows):
+        for j, panel in enumerate(row):
+            _draw_panel(axes[i][j], panel, point_labels or {})
+    if title:
+        fig.suptitle(title)
     return fig
