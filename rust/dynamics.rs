@@ -574,9 +574,17 @@ impl<const N: usize> Model<N> {
                 .add_point_force(&pose, link, p, f.total(), &mut rhs);
         }
         let mass = self.mechanism.mass_matrix(&pose);
-        let chol = mass
-            .cholesky()
-            .expect("mass matrix of positive masses is positive definite");
+        // Positive masses give a positive definite M for any finite state; a state that has
+        // already blown up (NaN) does not: return NaN and let the solver report it.
+        let Some(chol) = mass.cholesky() else {
+            return Eval {
+                qdd: SVector::repeat(f64::NAN),
+                power: f64::NAN,
+                joint_power: f64::NAN,
+                joint_torque,
+                contacts,
+            };
+        };
         let mut qdd = chol.solve(&rhs);
         let has_locks = self.mechanism.locked_rows().next().is_some();
         if has_locks || self.any_stuck(modes) {

@@ -200,6 +200,68 @@ fn validate_joint(field: &str, j: &Joint) -> Result<()> {
     Ok(())
 }
 
+/// Largest `h lambda` the fixed-step RK4 is given for a joint's fastest mode (its stability
+/// limit is 2.78 on the negative real axis and 2.83 on the imaginary one).
+const RK4_STABLE: f64 = 2.5;
+
+/// Check that the fixed-step RK4 resolves every spring-damper joint at the initial posture:
+/// for the joint's relative rate `a . qdot` (a = e_child - e_parent) the damper's rate is
+/// `c a^T M^-1 a` and the spring's angular frequency `sqrt(k a^T M^-1 a)`; each times `dt`
+/// must stay below [`RK4_STABLE`]. A stiffer joint is refused before any work starts, with the
+/// largest value that would run (or use a smaller `dt`, or `method="dopri5"`).
+fn validate_joint_stiffness<const N: usize>(
+    model: &Model<N>,
+    q0: &SVector<f64, N>,
+    options: &SolveOptions,
+    names: &[&str],
+) -> Result<()> {
+    if options.method != Method::Rk4 {
+        return Ok(());
+    }
+    let pose = model.mechanism.pose(q0);
+    let Some(chol) = model.mechanism.mass_matrix(&pose).cholesky() else {
+        return Ok(());
+    };
+    for (i, link) in model.mechanism.links.iter().enumerate() {
+        let (Some(p), Joint::Spring { k, c, .. }) = (link.parent, link.joint) else {
+            continue;
+        };
+        let mut a = SVector::<f64, N>::zeros();
+        a[2 + i] = 1.0;
+        a[2 + p] = -1.0;
+        let inv_inertia = a.dot(&chol.solve(&a));
+        let name = names.get(i).copied().unwrap_or("joint");
+        let dt = options.dt;
+        if c * inv_inertia * dt > RK4_STABLE {
+            return Err(GranrsError::InvalidParameter {
+                field: format!("{name}.c"),
+                value: c,
+                allowed: format!(
+                    "c <= {:.4e} N m s/rad at dt = {dt} s (the damper's rate c / I_eff, \
+                     I_eff = {:.3e} kg m^2, must stay under {RK4_STABLE} / dt for RK4); use a \
+                     smaller dt or method='dopri5'",
+                    RK4_STABLE / (inv_inertia * dt),
+                    1.0 / inv_inertia
+                ),
+            });
+        }
+        if (k * inv_inertia).sqrt() * dt > RK4_STABLE {
+            return Err(GranrsError::InvalidParameter {
+                field: format!("{name}.k"),
+                value: k,
+                allowed: format!(
+                    "k <= {:.4e} N m/rad at dt = {dt} s (the spring's frequency \
+                     sqrt(k / I_eff), I_eff = {:.3e} kg m^2, must stay under {RK4_STABLE} / dt \
+                     for RK4); use a smaller dt or method='dopri5'",
+                    (RK4_STABLE / dt).powi(2) / inv_inertia,
+                    1.0 / inv_inertia
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Check an angle from the vertical at which a rod's tip meets the sand first.
 fn validate_rod_angle(field: &str, q_deg: f64) -> Result<()> {
     check_finite(field, q_deg)?;
@@ -332,6 +394,12 @@ impl ChainScene {
             self.vx0,
             &self.options,
             &self.sign_model,
+        )?;
+        validate_joint_stiffness(
+            &self.model(),
+            &self.initial_state().0,
+            &self.options,
+            &["", "pin_joint"],
         )
     }
 
@@ -611,6 +679,12 @@ impl LegScene {
             self.vx0,
             &self.options,
             &self.sign_model,
+        )?;
+        validate_joint_stiffness(
+            &self.model(),
+            &self.initial_state().0,
+            &self.options,
+            &["", "ankle", "knee", "hip"],
         )
     }
 

@@ -231,3 +231,20 @@ class TestBodyFields:
         with pytest.raises(InvalidParameterError) as e:
             cases.chain(1, **overrides)
         assert e.value.field == field
+
+
+class TestStiffJoints:
+    def test_a_joint_too_stiff_for_the_step_is_refused_before_running(self) -> None:
+        # c / I_foot * dt ~ 8: RK4 at 10 kHz would blow up (it once panicked in the core).
+        with pytest.raises(InvalidParameterError) as e:
+            cases.leg(3.28, joints={"k": 13925.0, "c": 488.0})
+        assert e.value.field == "ankle.c" and "dt" in str(e.value)
+        with pytest.raises(InvalidParameterError) as e:
+            cases.leg(3.28, knee={"k": 1e9, "c": 0.0})
+        assert e.value.field == "knee.k"
+
+    def test_a_smaller_step_runs_it_and_it_is_nearly_locked(self) -> None:
+        stiff = granrs.simulate(cases.leg(3.28, joints={"k": 13925.0, "c": 488.0}, dt=1e-5))
+        locked = granrs.simulate(cases.leg(3.28, dt=1e-5))
+        assert stiff.stopped
+        assert stiff.depth == pytest.approx(locked.depth, rel=0.05)
