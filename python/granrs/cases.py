@@ -115,6 +115,16 @@ def _coefficients_arg(value: Any, field: str) -> Coefficients:
     )
 
 
+def _row_coefficients(table: Mapping[str, Any], row: int) -> Coefficients:
+    """The coefficients in row ``row`` of a shipped table (columns eta_h, eta_d, eta_v, lambda)."""
+    return Coefficients(
+        eta_h=float(table["eta_h"][row]),
+        eta_d=float(table["eta_d"][row]),
+        eta_v=float(table["eta_v"][row]),
+        lam=float(table["lambda"][row]),
+    )
+
+
 def chain_case(case: int) -> dict[str, Any]:
     """The thesis's chain case ``case`` (1, 2 or 3): per link the measured angle and speed
     (Table 4.1 / 4.2) and the coefficients of Table 4.4, with the chain's v0 (the mean of the
@@ -133,14 +143,7 @@ def chain_case(case: int) -> dict[str, Any]:
         q.append(float(exp["q0_deg"][row]))
         v.append(float(exp["v0_mean"][row]))
         crow = int(np.flatnonzero((coef["link"] == link) & (coef["v0_case"] == case))[0])
-        cs.append(
-            Coefficients(
-                eta_h=float(coef["eta_h"][crow]),
-                eta_d=float(coef["eta_d"][crow]),
-                eta_v=float(coef["eta_v"][crow]),
-                lam=float(coef["lambda"][crow]),
-            )
-        )
+        cs.append(_row_coefficients(coef, crow))
         note = str(coef["note"][crow])
         sources.append(
             f"Table 4.4, link {link}, case {case}"
@@ -236,12 +239,7 @@ def leg(
     if coefficients is None:
         table = data.load("human_coefficients", as_="numpy")
         row = int(np.argmin(np.abs(table["v0"] - v)))
-        coef = Coefficients(
-            eta_h=float(table["eta_h"][row]),
-            eta_d=float(table["eta_d"][row]),
-            eta_v=float(table["eta_v"][row]),
-            lam=float(table["lambda"][row]),
-        )
+        coef = _row_coefficients(table, row)
         source = f"thesis sec. 5.3.2, row v0 = {float(table['v0'][row])} m/s"
     else:
         coef = _coefficients_arg(coefficients, "coefficients")

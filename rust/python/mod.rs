@@ -163,6 +163,22 @@ fn parse_record(names: Option<Vec<String>>, stride: Option<f64>) -> Result<Recor
     Ok(r)
 }
 
+/// An error about key `k` of the mapping `field`, renamed to the field `field.k`.
+fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
+    match e {
+        GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
+            field: format!("{field}.{k}"),
+            message,
+        },
+        GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
+            field: format!("{field}.{k}"),
+            expected,
+            got,
+        },
+        other => other,
+    }
+}
+
 /// A coefficients mapping (`eta_h`, `eta_d`, `eta_v`, `lam`) under `field`; absent or None
 /// gives `None`.
 fn get_coefficients(
@@ -181,20 +197,7 @@ fn get_coefficients(
     let c = c
         .cast_into::<PyDict>()
         .map_err(|_| bad_type(field, "a mapping with eta_h, eta_d, eta_v, lam"))?;
-    let get = |k: &str| {
-        get_f64(&c, k).map_err(|e| match e {
-            GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
-                field: format!("{field}.{k}"),
-                message,
-            },
-            GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
-                field: format!("{field}.{k}"),
-                expected,
-                got,
-            },
-            other => other,
-        })
-    };
+    let get = |k: &str| get_f64(&c, k).map_err(|e| within(e, field, k));
     Ok(Some(Coefficients {
         eta_h: get("eta_h")?,
         eta_d: get("eta_d")?,
@@ -245,20 +248,7 @@ fn get_joint(d: &Bound<'_, PyDict>, field: &str) -> Result<Joint, GranrsError> {
             return Err(unknown(&format!("{field}.{key}"), &key, &["k", "c"]));
         }
     }
-    let get = |k: &str| {
-        get_f64(&spec, k).map_err(|e| match e {
-            GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
-                field: format!("{field}.{k}"),
-                message,
-            },
-            GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
-                field: format!("{field}.{k}"),
-                expected,
-                got,
-            },
-            other => other,
-        })
-    };
+    let get = |k: &str| get_f64(&spec, k).map_err(|e| within(e, field, k));
     Ok(Joint::Spring {
         k: get("k")?,
         c: get("c")?,
