@@ -278,55 +278,58 @@ impl<const N: usize> Rows<N> {
     }
 }
 
-/// Solve the `k x k` system `a x = b` in place (`b` becomes `x`) by Gaussian elimination
-/// with partial pivoting. A (near-)singular system, from redundant constraints, is
-/// regularized by a tiny diagonal shift. Returns false if it still fails.
-fn solve_small(a: &mut [[f64; MAX_ROWS]; MAX_ROWS], b: &mut [f64; MAX_ROWS], k: usize) -> bool {
-    let scale = (0..k).fold(0.0f64, |m, i| m.max(a[i][i].abs()));
-    let tiny = 1e-13 * scale.max(f64::MIN_POSITIVE);
-    let (a0, b0) = (*a, *b);
-    for attempt in 0..2 {
-        if attempt == 1 {
-            *a = a0;
-            *b = b0;
-            for (i, row) in a.iter_mut().enumerate().take(k) {
-                row[i] += 1e-10 * scale.max(f64::MIN_POSITIVE);
-            }
+/// A constraint system `a x = b` of size `k` on the stack.
+type Small = ([[f64; MAX_ROWS]; MAX_ROWS], [f64; MAX_ROWS]);
+
+/// Solve the `k x k` system that `fill` assembles, by Gaussian elimination with partial
+/// pivoting. A (near-)singular system, from redundant constraints, is assembled again with a
+/// tiny diagonal shift (only then: the common case copies nothing). Returns the solution, or
+/// `None` if that fails too.
+fn solve_small(k: usize, fill: impl Fn(&mut Small)) -> Option<[f64; MAX_ROWS]> {
+    let mut sys: Small = ([[0.0; MAX_ROWS]; MAX_ROWS], [0.0; MAX_ROWS]);
+    fill(&mut sys);
+    let scale = (0..k).fold(0.0f64, |m, i| m.max(sys.0[i][i].abs()));
+    if eliminate(&mut sys, k, 1e-13 * scale.max(f64::MIN_POSITIVE)) {
+        return Some(sys.1);
+    }
+    fill(&mut sys);
+    for (i, row) in sys.0.iter_mut().enumerate().take(k) {
+        row[i] += 1e-10 * scale.max(f64::MIN_POSITIVE);
+    }
+    eliminate(&mut sys, k, 1e-13 * scale.max(f64::MIN_POSITIVE)).then_some(sys.1)
+}
+
+/// Gaussian elimination with partial pivoting in place (`b` becomes `x`); false at a pivot
+/// at or below `tiny`.
+fn eliminate((a, b): &mut Small, k: usize, tiny: f64) -> bool {
+    for col in 0..k {
+        let piv = (col..k)
+            .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
+            .unwrap_or(col);
+        if a[piv][col].abs() <= tiny {
+            return false;
         }
-        let mut ok = true;
-        for col in 0..k {
-            let piv = (col..k)
-                .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
-                .unwrap_or(col);
-            if a[piv][col].abs() <= tiny {
-                ok = false;
-                break;
-            }
-            a.swap(col, piv);
-            b.swap(col, piv);
-            for r in col + 1..k {
-                let f = a[r][col] / a[col][col];
-                if f != 0.0 {
-                    let pivot_row = a[col];
-                    for (x, p) in a[r][col..k].iter_mut().zip(&pivot_row[col..k]) {
-                        *x -= f * p;
-                    }
-                    b[r] -= f * b[col];
+        a.swap(col, piv);
+        b.swap(col, piv);
+        for r in col + 1..k {
+            let f = a[r][col] / a[col][col];
+            if f != 0.0 {
+                let pivot_row = a[col];
+                for (x, p) in a[r][col..k].iter_mut().zip(&pivot_row[col..k]) {
+                    *x -= f * p;
                 }
+                b[r] -= f * b[col];
             }
-        }
-        if ok {
-            for col in (0..k).rev() {
-                let mut v = b[col];
-                for c in col + 1..k {
-                    v -= a[col][c] * b[c];
-                }
-                b[col] = v / a[col][col];
-            }
-            return true;
         }
     }
-    false
+    for col in (0..k).rev() {
+        let mut v = b[col];
+        for c in col + 1..k {
+            v -= a[col][c] * b[c];
+        }
+        b[col] = v / a[col][col];
+    }
+    true
 }
 
 /// The immersed geometry of one contact, as the force law needs it.
@@ -711,19 +714,18 @@ impl<const N: usize> Model<N> {
         if k == 0 {
             return;
         }
-        let mut a = [[0.0; MAX_ROWS]; MAX_ROWS];
-        let mut b = [0.0; MAX_ROWS];
-        for i in 0..k {
-            let ri = rows.get(i);
-            b[i] = -(ri.bias + ri.jac.dot(qdd));
-            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
-                *aij = ri.jac.dot(&rows.get(j).response);
+        let free = *qdd;
+        let mults = solve_small(k, |(a, b)| {
+            for i in 0..k {
+                let ri = rows.get(i);
+                b[i] = -(ri.bias + ri.jac.dot(&free));
+                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                    *aij = ri.jac.dot(&rows.get(j).response);
+                }
             }
-        }
-        if !solve_small(&mut a, &mut b, k) {
-            b = [0.0; MAX_ROWS];
-        }
-        for (i, &mult) in b.iter().enumerate().take(k) {
+        })
+        .unwrap_or([0.0; MAX_ROWS]);
+        for (i, &mult) in mults.iter().enumerate().take(k) {
             let r = rows.get(i);
             *qdd += mult * r.response;
             match r.kind {
@@ -773,22 +775,25 @@ impl<const N: usize> Model<N> {
         for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
             *m = chol.solve(&rows.get(i).jac);
         }
-        let mut a = [[0.0; MAX_ROWS]; MAX_ROWS];
-        let mut b = [0.0; MAX_ROWS];
-        for i in 0..k {
-            let ji = &rows.get(i).jac;
-            b[i] = ji.dot(qd);
-            for j in 0..k {
-                a[i][j] = ji.dot(&minv_jt[j]);
+        let v = *qd;
+        let lam = solve_small(k, |(a, b)| {
+            for i in 0..k {
+                let ji = &rows.get(i).jac;
+                b[i] = ji.dot(&v);
+                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                    *aij = ji.dot(&minv_jt[j]);
+                }
             }
+        });
+        match lam {
+            Some(lam) if lam[..k].iter().any(|&l| l != 0.0) => {
+                for (l, m) in lam.iter().zip(&minv_jt).take(k) {
+                    *qd -= *l * m;
+                }
+                true
+            }
+            _ => false,
         }
-        if !solve_small(&mut a, &mut b, k) || b[..k].iter().all(|&l| l == 0.0) {
-            return false;
-        }
-        for i in 0..k {
-            *qd -= b[i] * minv_jt[i];
-        }
-        true
     }
 
     /// Force each link receives at its joint from its parent (or the root) [N], from the
