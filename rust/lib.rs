@@ -9,12 +9,14 @@
 //! The Python bindings live in `python/` behind the `python` cargo feature, so that
 //! `cargo test` needs no Python.
 
+pub mod batch;
 pub mod body;
 pub mod dynamics;
 pub mod error;
 pub mod force;
 pub mod integrate;
 pub mod scene;
+pub mod spec;
 
 #[cfg(feature = "python")]
 mod python;

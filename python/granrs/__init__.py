@@ -16,7 +16,9 @@ from __future__ import annotations
 
 from . import _granrs, cases, coefficients, data
 from .api import simulate
+from .batch import sweep
 from .coefficients import Coefficients
+from .effects import EFFECT_INFO, Effect
 from .errors import (
     CoefficientTableError,
     GranrsError,
@@ -32,10 +34,12 @@ __version__: str = _granrs.__version__
 
 __all__ = [
     "EFFECTS",
+    "EFFECT_INFO",
     "RECORDS",
     "CoefficientTableError",
     "Coefficients",
     "ContactResult",
+    "Effect",
     "GranrsError",
     "InvalidParameterError",
     "InvalidSceneError",
@@ -48,4 +52,5 @@ __all__ = [
     "coefficients",
     "data",
     "simulate",
+    "sweep",
 ]

@@ -1,5 +1,6 @@
 """Type stubs of the compiled core (rust/python/mod.rs). Use the public API in granrs instead."""
 
+from collections.abc import Callable
 from typing import Any
 
 __version__: str
@@ -14,3 +15,24 @@ def validate(scene: dict[str, Any]) -> None:
 
 def leg_segments(scene: dict[str, Any]) -> list[dict[str, Any]]:
     """The leg's segments (name, mass, length, com, inertia) for a leg scene dict."""
+
+def sweep(
+    base: dict[str, Any] | None = None,
+    axes: list[tuple[str, list[Any]]] | None = None,
+    scenes: list[dict[str, Any]] | None = None,
+    start: int = 0,
+    stop: int | None = None,
+    threads: int = 0,
+    progress: Callable[[int], None] | None = None,
+) -> dict[str, Any]:
+    """Run runs start..stop of a batch (the product of axes over base, or a list of scene
+    dicts) on `threads` threads (0: every core); return columns, data (rows x columns),
+    failures [(run, message)] and body."""
+
+def validate_sweep(
+    base: dict[str, Any] | None = None,
+    axes: list[tuple[str, list[Any]]] | None = None,
+    scenes: list[dict[str, Any]] | None = None,
+    threads: int = 0,
+) -> int:
+    """Validate every run of a batch without running it; return the number of runs."""

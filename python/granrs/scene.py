@@ -28,6 +28,7 @@ from typing import Any
 
 from . import _granrs
 from .coefficients import Coefficients
+from .effects import EFFECTS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 
 __all__ = ["BODIES", "BODY_FIELDS", "EFFECTS", "JOINTS", "RECORDS", "JointSpec", "Scene"]
@@ -39,8 +40,6 @@ JOINTS: tuple[str, ...] = ("free", "locked")
 #: A joint: ``"free"``, ``"locked"`` or ``{"k": stiffness, "c": damping}``.
 JointSpec = str | Mapping[str, float]
 
-#: Force terms a scene may list in ``effects``.
-EFFECTS: tuple[str, ...] = ("gravity", "drag", "static_h", "static_v")
 #: Time series a scene may list in ``record``.
 RECORDS: tuple[str, ...] = ("state", "forces", "energy")
 
@@ -148,8 +147,10 @@ class Scene:
             exactly, sticking handled), ``"raw"`` (the thesis's plain sign) or ``"smooth"``
             (tanh(v / smooth_eps)).
         smooth_eps: velocity scale of the ``"smooth"`` sign model [m/s].
-        effects: the force terms to evaluate, from ``EFFECTS``; a term not listed is neither
-            computed nor stored.
+        effects: the force terms to evaluate, from ``EFFECTS`` (all by default; see
+            :data:`granrs.EFFECT_INFO` for each term's parameters and units); a term not
+            listed is neither computed nor stored, and a spring-damper joint is free
+            without ``"joint_springs"``.
         dt: step of the fixed-step RK4 [s] (thesis sec. 3.3.2: 10 kHz, 1e-4); the first
             step of ``"dopri5"``.
         method: ``"rk4"`` (default: classical RK4 on the grid n dt) or ``"dopri5"``
@@ -299,6 +300,25 @@ class Scene:
     def q_rad(self) -> float:
         """Initial angle from the vertical [rad]."""
         return math.radians(self.q_deg)
+
+    @classmethod
+    def from_toml(cls, path_or_text: Any) -> Scene:
+        """A validated scene from a TOML scene file (a ``str`` or ``os.PathLike`` path) or
+        TOML text (a ``str`` holding a newline or an ``=``); see :mod:`granrs.scenefile`.
+        Errors name the key and its line."""
+        from . import scenefile
+
+        if isinstance(path_or_text, str) and ("\n" in path_or_text or "=" in path_or_text):
+            return scenefile.loads(path_or_text)
+        return scenefile.load(path_or_text)
+
+    def to_toml(self, path: Any = None) -> str:
+        """The scene as TOML text (every field of its body, floats exact); also written to
+        ``path`` (a ``str`` or ``os.PathLike``) if given.
+        ``Scene.from_toml(scene.to_toml()) == scene``."""
+        from . import scenefile
+
+        return scenefile.dumps(self) if path is None else scenefile.dump(self, path)
 
 
 _DEFAULTS: dict[str, Any] = {

@@ -5,18 +5,18 @@
 //! [`GranrsError`] becomes an instance of the matching class of `granrs.errors`, so that the
 //! Python and Rust layers share one exception tree.
 
-use numpy::IntoPyArray;
-use pyo3::exceptions::PyRuntimeError;
-use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use crate::body::rod::ApplyAt;
-use crate::body::{Joint, SoleModel};
-use crate::dynamics::{Effects, SignModel};
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyList, PyString, PyTuple};
+
+use crate::batch::{self, Source};
 use crate::error::GranrsError;
-use crate::force::{Coefficients, Medium};
-use crate::integrate::{EndCondition, Method, Outcome, Record, SolveOptions};
-use crate::scene::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
+use crate::integrate::Outcome;
+use crate::scene::AnyScene;
+use crate::spec::{SceneSpec, Value, EFFECTS, RECORDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -42,395 +42,63 @@ fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
     make().unwrap_or_else(|_| PyRuntimeError::new_err(message.clone()))
 }
 
-fn bad_type(field: &str, what: &str) -> GranrsError {
-    GranrsError::InvalidScene {
-        field: field.to_string(),
-        message: format!("expected {what}"),
-    }
-}
-
-/// A required float field of the scene dict.
-fn get_f64(d: &Bound<'_, PyDict>, field: &str) -> Result<f64, GranrsError> {
-    let v = d
-        .get_item(field)
-        .map_err(|_| bad_type(field, "a number"))?
-        .ok_or_else(|| GranrsError::InvalidScene {
-            field: field.to_string(),
-            message: "missing".into(),
-        })?;
-    let wrong = |got: String| GranrsError::WrongType {
-        field: field.to_string(),
-        expected: "a real number".into(),
-        got,
-    };
-    if v.is_instance_of::<pyo3::types::PyBool>() {
-        return Err(wrong("a bool".into()));
-    }
-    v.extract::<f64>()
-        .map_err(|_| wrong(v.get_type().to_string()))
-}
-
-/// An optional float field (absent or None gives `None`).
-fn get_opt_f64(d: &Bound<'_, PyDict>, field: &str) -> Result<Option<f64>, GranrsError> {
-    match d.get_item(field).map_err(|_| bad_type(field, "a number"))? {
-        None => Ok(None),
-        Some(v) if v.is_none() => Ok(None),
-        Some(_) => get_f64(d, field).map(Some),
-    }
-}
-
-/// A required string field.
-fn get_str(d: &Bound<'_, PyDict>, field: &str) -> Result<String, GranrsError> {
-    d.get_item(field)
-        .map_err(|_| bad_type(field, "a string"))?
-        .ok_or_else(|| GranrsError::InvalidScene {
-            field: field.to_string(),
-            message: "missing".into(),
-        })?
-        .extract::<String>()
-        .map_err(|_| bad_type(field, "a string"))
-}
-
-/// A list of strings (absent gives `None`).
-fn get_names(d: &Bound<'_, PyDict>, field: &str) -> Result<Option<Vec<String>>, GranrsError> {
-    match d
-        .get_item(field)
-        .map_err(|_| bad_type(field, "a list of names"))?
-    {
-        None => Ok(None),
-        Some(v) if v.is_none() => Ok(None),
-        Some(v) => v
-            .extract::<Vec<String>>()
-            .map(Some)
-            .map_err(|_| bad_type(field, "a list of names")),
-    }
-}
-
-fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
-    GranrsError::UnknownName {
-        field: field.to_string(),
-        value: value.to_string(),
-        allowed: allowed.join(", "),
-    }
-}
-
-/// Names of the effects a scene may list.
-pub const EFFECTS: [&str; 4] = ["gravity", "drag", "static_h", "static_v"];
-/// Names of the series a scene may record.
-pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
-
-fn parse_effects(names: Option<Vec<String>>) -> Result<Effects, GranrsError> {
-    let Some(names) = names else {
-        return Ok(Effects::default());
-    };
-    let mut e = Effects {
-        gravity: false,
-        drag: false,
-        static_h: false,
-        static_v: false,
-    };
-    for n in &names {
-        match n.as_str() {
-            "gravity" => e.gravity = true,
-            "drag" => e.drag = true,
-            "static_h" => e.static_h = true,
-            "static_v" => e.static_v = true,
-            other => return Err(unknown("effects", other, &EFFECTS)),
-        }
-    }
-    Ok(e)
-}
-
-fn parse_record(names: Option<Vec<String>>, stride: Option<f64>) -> Result<Record, GranrsError> {
-    let mut r = Record::default();
-    for n in names.unwrap_or_default() {
-        match n.as_str() {
-            "state" => r.state = true,
-            "forces" => r.forces = true,
-            "energy" => r.energy = true,
-            other => return Err(unknown("record", other, &RECORDS)),
-        }
-    }
-    let stride = stride.unwrap_or(1.0);
-    if !(stride.is_finite() && stride >= 1.0 && stride.fract() == 0.0 && stride < 1e12) {
-        return Err(GranrsError::InvalidParameter {
-            field: "record_stride".into(),
-            value: stride,
-            allowed: "a whole number >= 1".into(),
-        });
-    }
-    r.stride = stride as usize;
-    Ok(r)
-}
-
-/// An error about key `k` of the mapping `field`, renamed to the field `field.k`.
-fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
-    match e {
-        GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
-            field: format!("{field}.{k}"),
-            message,
-        },
-        GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
-            field: format!("{field}.{k}"),
-            expected,
-            got,
-        },
-        other => other,
-    }
-}
-
-/// A coefficients mapping (`eta_h`, `eta_d`, `eta_v`, `lam`) under `field`; absent or None
-/// gives `None`.
-fn get_coefficients(
-    d: &Bound<'_, PyDict>,
-    field: &str,
-) -> Result<Option<Coefficients>, GranrsError> {
-    let Some(c) = d
-        .get_item(field)
-        .map_err(|_| bad_type(field, "a mapping"))?
-    else {
-        return Ok(None);
-    };
-    if c.is_none() {
-        return Ok(None);
-    }
-    let c = c
-        .cast_into::<PyDict>()
-        .map_err(|_| bad_type(field, "a mapping with eta_h, eta_d, eta_v, lam"))?;
-    let get = |k: &str| get_f64(&c, k).map_err(|e| within(e, field, k));
-    Ok(Some(Coefficients {
-        eta_h: get("eta_h")?,
-        eta_d: get("eta_d")?,
-        eta_v: get("eta_v")?,
-        lambda: get("lam")?,
-    }))
-}
-
-/// A required coefficients mapping.
-fn get_required_coefficients(
-    d: &Bound<'_, PyDict>,
-    field: &str,
-) -> Result<Coefficients, GranrsError> {
-    get_coefficients(d, field)?.ok_or_else(|| GranrsError::InvalidScene {
-        field: field.into(),
-        message: "missing".into(),
-    })
-}
-
-/// A joint: `"free"`, `"locked"`, or a spring-damper `{"k": .., "c": ..}` (absent: free).
-fn get_joint(d: &Bound<'_, PyDict>, field: &str) -> Result<Joint, GranrsError> {
-    let Some(v) = d.get_item(field).map_err(|_| bad_type(field, "a joint"))? else {
-        return Ok(Joint::Free);
-    };
+/// Convert a Python value to a spec value (no checks beyond the type).
+fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
     if v.is_none() {
-        return Ok(Joint::Free);
+        return Value::None;
     }
-    if let Ok(name) = v.extract::<String>() {
-        return match name.as_str() {
-            "free" => Ok(Joint::Free),
-            "locked" => Ok(Joint::Locked),
-            other => Err(unknown(
-                field,
-                other,
-                &["free", "locked", "{k, c} spring-damper"],
-            )),
+    if v.is_instance_of::<PyBool>() {
+        return Value::Bool(v.is_truthy().unwrap_or(false));
+    }
+    if let Ok(s) = v.cast::<PyString>() {
+        return Value::Str(s.to_string());
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        return Value::Map(
+            d.iter()
+                .map(|(k, v)| {
+                    (
+                        k.str().map(|s| s.to_string()).unwrap_or_default(),
+                        value_from_py(&v),
+                    )
+                })
+                .collect(),
+        );
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        return match v.extract::<Vec<String>>() {
+            Ok(names) => Value::Names(names),
+            Err(_) => Value::Other("a list that is not all strings".into()),
         };
     }
-    let spec = v.cast_into::<PyDict>().map_err(|_| {
-        bad_type(
-            field,
-            "\"free\", \"locked\" or a spring-damper mapping {\"k\": N m/rad, \"c\": N m s/rad}",
-        )
-    })?;
-    for key in spec.keys() {
-        let key: String = key.extract().unwrap_or_default();
-        if key != "k" && key != "c" {
-            return Err(unknown(&format!("{field}.{key}"), &key, &["k", "c"]));
+    let type_name = v
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_default();
+    if type_name == "bool_" {
+        return Value::Bool(v.is_truthy().unwrap_or(false));
+    }
+    match v.extract::<f64>() {
+        Ok(x) => Value::Num(x),
+        Err(_) => Value::Other(type_name),
+    }
+}
+
+/// A scene dict (from `granrs.Scene.to_dict()`) as a spec.
+fn spec_from_dict(d: &Bound<'_, PyDict>) -> SceneSpec {
+    let mut spec = SceneSpec::new();
+    for (k, v) in d.iter() {
+        if let Ok(k) = k.cast::<PyString>() {
+            spec.set(&k.to_string(), value_from_py(&v));
         }
     }
-    let get = |k: &str| get_f64(&spec, k).map_err(|e| within(e, field, k));
-    Ok(Joint::Spring {
-        k: get("k")?,
-        c: get("c")?,
-        rest: 0.0,
-    })
-}
-
-/// The fields every body shares.
-struct Common {
-    medium: Medium,
-    apply_at: ApplyAt,
-    sign_model: SignModel,
-    effects: Effects,
-    options: SolveOptions,
-    v0: f64,
-    depth0: f64,
-    vx0: f64,
-}
-
-fn common_from_dict(d: &Bound<'_, PyDict>) -> Result<Common, GranrsError> {
-    let apply_at = match get_str(d, "apply_at")?.as_str() {
-        "tip" => ApplyAt::Tip,
-        "centroid" => ApplyAt::Centroid,
-        other => return Err(unknown("apply_at", other, &["tip", "centroid"])),
-    };
-    let sign_model = match get_str(d, "sign_model")?.as_str() {
-        "modes" => SignModel::Modes,
-        "raw" => SignModel::Raw,
-        "smooth" => SignModel::Smooth {
-            eps: get_f64(d, "smooth_eps")?,
-        },
-        other => return Err(unknown("sign_model", other, &["modes", "raw", "smooth"])),
-    };
-    let end = match get_str(d, "end")?.as_str() {
-        "first_stop" => EndCondition::FirstStop,
-        "all_stops" => EndCondition::AllStops,
-        "time" => EndCondition::Time,
-        other => return Err(unknown("end", other, &["first_stop", "all_stops", "time"])),
-    };
-    Ok(Common {
-        medium: Medium {
-            rho_g: get_f64(d, "rho_g")?,
-            g: get_f64(d, "g")?,
-        },
-        apply_at,
-        sign_model,
-        effects: parse_effects(get_names(d, "effects")?)?,
-        options: SolveOptions {
-            dt: get_f64(d, "dt")?,
-            method: match get_str(d, "method")?.as_str() {
-                "rk4" => Method::Rk4,
-                "dopri5" => Method::Dopri5 {
-                    rtol: get_f64(d, "rtol")?,
-                    atol: get_f64(d, "atol")?,
-                },
-                other => return Err(unknown("method", other, &["rk4", "dopri5"])),
-            },
-            t_end: get_f64(d, "t_end")?,
-            end,
-            record: parse_record(get_names(d, "record")?, get_opt_f64(d, "record_stride")?)?,
-        },
-        v0: get_f64(d, "v0")?,
-        depth0: get_opt_f64(d, "depth0")?.unwrap_or(0.0),
-        vx0: get_opt_f64(d, "vx0")?.unwrap_or(0.0),
-    })
-}
-
-/// Build a free-link scene from the dict of `granrs.Scene.to_dict()`.
-fn free_link_from_dict(d: &Bound<'_, PyDict>) -> Result<FreeLinkScene, GranrsError> {
-    let c = common_from_dict(d)?;
-    Ok(FreeLinkScene {
-        length: get_f64(d, "length")?,
-        diameter: get_f64(d, "diameter")?,
-        mass: get_f64(d, "mass")?,
-        inertia: get_opt_f64(d, "inertia")?,
-        medium: c.medium,
-        coefficients: get_required_coefficients(d, "coefficients")?,
-        q_deg: get_f64(d, "q_deg")?,
-        v0: c.v0,
-        depth0: c.depth0,
-        vx0: c.vx0,
-        omega0: get_opt_f64(d, "omega0")?.unwrap_or(0.0),
-        apply_at: c.apply_at,
-        sign_model: c.sign_model,
-        effects: c.effects,
-        options: c.options,
-    })
-}
-
-/// Build a chain scene: link 2's angle defaults to the mirror of link 1's, its
-/// coefficients to link 1's.
-fn chain_from_dict(d: &Bound<'_, PyDict>) -> Result<ChainScene, GranrsError> {
-    let c = common_from_dict(d)?;
-    let coefficients = get_required_coefficients(d, "coefficients")?;
-    let q1 = get_f64(d, "q_deg")?;
-    Ok(ChainScene {
-        length: get_f64(d, "length")?,
-        diameter: get_f64(d, "diameter")?,
-        mass: get_f64(d, "mass")?,
-        inertia: get_opt_f64(d, "inertia")?,
-        pin_mass: get_opt_f64(d, "pin_mass")?.unwrap_or(0.0),
-        joint: get_joint(d, "pin_joint")?,
-        medium: c.medium,
-        coefficients: [
-            coefficients,
-            get_coefficients(d, "coefficients2")?.unwrap_or(coefficients),
-        ],
-        q_deg: [q1, get_opt_f64(d, "q2_deg")?.unwrap_or(-q1)],
-        v0: c.v0,
-        depth0: c.depth0,
-        vx0: c.vx0,
-        omega0: get_opt_f64(d, "omega0")?.unwrap_or(0.0),
-        apply_at: c.apply_at,
-        sign_model: c.sign_model,
-        effects: c.effects,
-        options: c.options,
-    })
-}
-
-/// Build a leg scene.
-fn leg_from_dict(d: &Bound<'_, PyDict>) -> Result<LegScene, GranrsError> {
-    let c = common_from_dict(d)?;
-    let defaults = LegScene::default();
-    let or = |field: &str, default: f64| -> Result<f64, GranrsError> {
-        Ok(get_opt_f64(d, field)?.unwrap_or(default))
-    };
-    let sole_model = match d
-        .get_item("sole_model")
-        .map_err(|_| bad_type("sole_model", "a string"))?
-    {
-        Some(v) if !v.is_none() => match get_str(d, "sole_model")?.as_str() {
-            "box" => SoleModel::Box,
-            "thesis" => SoleModel::Thesis,
-            other => return Err(unknown("sole_model", other, &["box", "thesis"])),
-        },
-        _ => SoleModel::Box,
-    };
-    let mut joints = [Joint::Locked; 3];
-    for (j, name) in joints.iter_mut().zip(LEG_JOINTS) {
-        if d.get_item(name)
-            .ok()
-            .flatten()
-            .is_some_and(|v| !v.is_none())
-        {
-            *j = get_joint(d, name)?;
-        }
-    }
-    Ok(LegScene {
-        body_mass: or("body_mass", defaults.body_mass)?,
-        height: or("height", defaults.height)?,
-        foot_length: or("foot_length", defaults.foot_length)?,
-        shoe_width: or("shoe_width", defaults.shoe_width)?,
-        tibia_length: or("tibia_length", defaults.tibia_length)?,
-        sole_height: get_opt_f64(d, "sole_height")?,
-        joints,
-        knee_deg: or("knee_deg", defaults.knee_deg)?,
-        hip_deg: or("hip_deg", defaults.hip_deg)?,
-        trunk_deg: or("trunk_deg", defaults.trunk_deg)?,
-        foot_deg: or("foot_deg", defaults.foot_deg)?,
-        sole_model,
-        medium: c.medium,
-        coefficients: get_required_coefficients(d, "coefficients")?,
-        v0: c.v0,
-        depth0: c.depth0,
-        vx0: c.vx0,
-        apply_at: c.apply_at,
-        sign_model: c.sign_model,
-        effects: c.effects,
-        options: c.options,
-    })
+    spec
 }
 
 /// Convert a scene dict to an owned, validated scene (GIL held).
 fn scene_from_dict(d: &Bound<'_, PyDict>) -> Result<AnyScene, GranrsError> {
-    let scene = match get_str(d, "body")?.as_str() {
-        "free_link" => AnyScene::FreeLink(free_link_from_dict(d)?),
-        "chain" => AnyScene::Chain(chain_from_dict(d)?),
-        "leg" => AnyScene::Leg(leg_from_dict(d)?),
-        other => return Err(unknown("body", other, &["free_link", "chain", "leg"])),
-    };
-    scene.validate()?;
-    Ok(scene)
+    spec_from_dict(d).build()
 }
 
 /// Convert an outcome to a dict of Python values; series move into numpy without copying.
@@ -514,7 +182,7 @@ fn validate(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<()> {
 /// length [m], com (from the lower joint) [m] and inertia about the centre of mass [kg m^2].
 #[pyfunction]
 fn leg_segments<'py>(py: Python<'py>, scene: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyList>> {
-    let leg = leg_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
+    let leg = spec_from_dict(scene).leg().map_err(|e| to_pyerr(py, e))?;
     leg.validate().map_err(|e| to_pyerr(py, e))?;
     let out = PyList::empty(py);
     for (name, s) in ["foot", "shank", "thigh", "half_trunk"]
@@ -532,10 +200,146 @@ fn leg_segments<'py>(py: Python<'py>, scene: &Bound<'py, PyDict>) -> PyResult<Bo
     Ok(out)
 }
 
+/// The batch a `sweep` call describes.
+fn source_from_py(
+    base: Option<Bound<'_, PyDict>>,
+    axes: Option<Vec<(String, Bound<'_, PyAny>)>>,
+    scenes: Option<Vec<Bound<'_, PyDict>>>,
+) -> PyResult<Source> {
+    match (base, scenes) {
+        (Some(base), None) => {
+            let mut converted = Vec::new();
+            for (field, values) in axes.unwrap_or_default() {
+                let values: Vec<Value> = values
+                    .try_iter()?
+                    .map(|v| v.map(|v| value_from_py(&v)))
+                    .collect::<PyResult<_>>()?;
+                converted.push((field, values));
+            }
+            Ok(Source::Product {
+                base: spec_from_dict(&base),
+                axes: converted,
+            })
+        }
+        (None, Some(scenes)) => Ok(Source::List(scenes.iter().map(spec_from_dict).collect())),
+        _ => Err(PyValueError::new_err(
+            "sweep() takes either base (with axes) or scenes",
+        )),
+    }
+}
+
+/// Validate every run of a batch (as `sweep` describes it) without running any; raises the
+/// typed error of the first bad run, naming the field and the run.
+#[pyfunction]
+#[pyo3(signature = (base=None, axes=None, scenes=None, threads=0))]
+fn validate_sweep<'py>(
+    py: Python<'py>,
+    base: Option<Bound<'py, PyDict>>,
+    axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
+    scenes: Option<Vec<Bound<'py, PyDict>>>,
+    threads: usize,
+) -> PyResult<usize> {
+    let err = |e: GranrsError| to_pyerr(py, e);
+    let src = source_from_py(base, axes, scenes)?;
+    src.body().map_err(err)?;
+    let pool = batch::pool(threads).map_err(err)?;
+    let n = src.len();
+    py.detach(|| pool.install(|| batch::validate(&src, 0..n)))
+        .map_err(err)?;
+    Ok(n)
+}
+
+/// Run a batch: the Cartesian product of `axes` (a list of `(field, values)`) over the scene
+/// dict `base`, or a list of scene dicts `scenes`; runs `start..stop` of it (default: all)
+/// on `threads` threads (0: one per core) with the GIL released.
+///
+/// Every run is validated before any starts. `progress(done)` is called about ten times a
+/// second from the calling thread; Ctrl-C (or an exception in `progress`) cancels the batch
+/// after the runs in flight and raises. Returns a dict: `columns` (names), `data` (a
+/// rows x columns float array, input order), `failures` (list of (run, message)), `body`.
+#[pyfunction]
+#[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn sweep<'py>(
+    py: Python<'py>,
+    base: Option<Bound<'py, PyDict>>,
+    axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
+    scenes: Option<Vec<Bound<'py, PyDict>>>,
+    start: usize,
+    stop: Option<usize>,
+    threads: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let err = |e: GranrsError| to_pyerr(py, e);
+    let src = source_from_py(base, axes, scenes)?;
+    let n = src.len();
+    let stop = stop.unwrap_or(n).min(n);
+    let range = start.min(stop)..stop;
+    let body = src.body().map_err(err)?;
+    let pool = batch::pool(threads).map_err(err)?;
+    py.detach(|| pool.install(|| batch::validate(&src, range.clone())))
+        .map_err(err)?;
+    let done = AtomicUsize::new(0);
+    let cancel = AtomicBool::new(false);
+    let finished = AtomicBool::new(false);
+    let caller = std::thread::current();
+    let (out, interrupted) = std::thread::scope(|s| {
+        let worker = s.spawn(|| {
+            let out = pool.install(|| batch::run(&src, range.clone(), &body, &done, &cancel));
+            finished.store(true, Ordering::Release);
+            caller.unpark();
+            out
+        });
+        let mut interrupted: Option<PyErr> = None;
+        let mut reported = usize::MAX;
+        loop {
+            py.detach(|| {
+                if !finished.load(Ordering::Acquire) {
+                    std::thread::park_timeout(std::time::Duration::from_millis(100));
+                }
+            });
+            let now = done.load(Ordering::Relaxed);
+            if let Some(cb) = &progress {
+                if now != reported {
+                    reported = now;
+                    if let Err(e) = cb.call1((now,)) {
+                        interrupted.get_or_insert(e);
+                    }
+                }
+            }
+            if let Err(e) = py.check_signals() {
+                interrupted.get_or_insert(e);
+            }
+            if interrupted.is_some() {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            if finished.load(Ordering::Acquire) || interrupted.is_some() {
+                break;
+            }
+        }
+        let out = py.detach(|| worker.join());
+        (out, interrupted)
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let out = out.map_err(|_| PyRuntimeError::new_err("a sweep worker panicked"))?;
+    let rows = range.len();
+    let width = out.columns.len();
+    let d = PyDict::new(py);
+    d.set_item("columns", out.columns)?;
+    d.set_item("data", out.data.into_pyarray(py).reshape([rows, width])?)?;
+    d.set_item("failures", out.failures)?;
+    d.set_item("body", body)?;
+    Ok(d)
+}
+
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(validate_sweep, m)?)?;
     m.add("EFFECTS", EFFECTS.to_vec())?;
     m.add("RECORDS", RECORDS.to_vec())?;
     m.add_function(wrap_pyfunction!(leg_segments, m)?)?;

@@ -1,0 +1,305 @@
+"""``granrs.sweep`` (module ``granrs.batch``): many runs in parallel, one row of results per run.
+
+:func:`sweep` runs the Cartesian product of field values over a base scene (or a list of
+scenes) in the Rust core, on a rayon pool with the GIL released, and returns a pandas
+DataFrame of summaries in input order. Every run is validated before the first starts; a
+bad value raises the typed error naming the field and the run. A progress bar (tqdm) shows
+on long sweeps; Ctrl-C cancels after the runs in flight and raises ``KeyboardInterrupt``.
+Given a ``dask.distributed`` client, the same sweep is cut into chunks that each run the
+Rust batch on a worker (``pip install 'granrs[dask]'``).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import uuid
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from . import _granrs
+from .coefficients import Coefficients
+from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+from .result import JOINT_NAMES
+from .scene import Scene
+
+__all__ = ["STATUSES", "sweep"]
+
+#: Values of the ``status`` column, by the core's status code.
+STATUSES: tuple[str, ...] = ("stopped", "end_time", "not_stopped", "failed", "cancelled")
+#: Sweeps with at least this many runs show a progress bar by default (on a terminal).
+PROGRESS_MIN_RUNS = 2000
+_INT_COLUMNS = ("steps", "rhs_evals", "root_evals", "events", "rejected")
+
+
+def _plain(name: str, value: Any) -> Any:
+    """A field value in the form ``Scene.to_dict()`` gives it."""
+    if isinstance(value, Coefficients):
+        return value.as_dict()
+    if isinstance(value, np.generic):
+        return value.item()
+    if name in ("effects", "record") and isinstance(value, tuple):
+        return list(value)
+    return value
+
+
+def _axis_values(name: str, values: Any) -> list[Any]:
+    if isinstance(values, (str, bytes, Mapping, Coefficients)) or not isinstance(values, Iterable):
+        values = [values]
+    if name in ("effects", "record") and all(isinstance(v, str) for v in values):
+        # One list of names is one value of the axis, not an axis of names.
+        values = [tuple(values)]
+    out = list(values)
+    if not out:
+        raise InvalidParameterError(f"sweep axis {name!r} has no values", field=name)
+    return out
+
+
+def _check_axes(scene: Scene, axes: dict[str, list[Any]]) -> None:
+    """Python-level checks of every distinct axis value (field names, body fields, types)."""
+    known = [f for f in scene.to_dict() if f != "body"]
+    for name, values in axes.items():
+        if name == "body":
+            raise InvalidSceneError(
+                "a sweep runs one body; sweep each body separately", field="body"
+            )
+        if name not in known:
+            hint = difflib.get_close_matches(name, known, n=1)
+            more = f"; did you mean {hint[0]!r}?" if hint else ""
+            raise UnknownNameError(f"Scene has no field {name!r}{more}", field=name)
+        seen: list[Any] = []
+        for v in values:
+            if any(v is s for s in seen):
+                continue
+            seen.append(v)
+            if isinstance(v, (int, float, np.number)) and not isinstance(v, bool):
+                continue  # ranges are checked in the core, for every run
+            scene.replace(**{name: v})
+
+
+def _frame(raw: dict[str, Any], body: str, axis_frame: pd.DataFrame | None) -> pd.DataFrame:
+    columns: list[str] = list(raw["columns"])
+    data = np.asarray(raw["data"])
+    n_contacts = sum(1 for c in columns if c.endswith(".t_s"))
+    joints = JOINT_NAMES.get(body, ())
+    names = []
+    for c in columns:
+        if n_contacts == 1 and c.startswith("c0."):
+            c = c[3:]
+        elif c.startswith("joint") and "." in c:
+            idx, _, rest = c[5:].partition(".")
+            c = f"{joints[int(idx)]}.{rest}"
+        names.append(c)
+    out: dict[str, Any] = {}
+    for j, name in enumerate(names):
+        col = data[:, j]
+        if name == "status":
+            codes = np.nan_to_num(col, nan=3).astype(np.int64)
+            out[name] = pd.Categorical.from_codes(codes, categories=list(STATUSES))
+        elif name.endswith("stopped"):
+            out[name] = col == 1.0
+        elif name in _INT_COLUMNS:
+            out[name] = np.nan_to_num(col, nan=0).astype(np.int64)
+        else:
+            out[name] = col
+    frame = pd.DataFrame(out)
+    if raw["failures"]:
+        errors = np.full(len(frame), None, dtype=object)
+        for i, message in raw["failures"]:
+            errors[i - raw["start"]] = message
+        frame["error"] = errors
+    if axis_frame is not None:
+        frame = pd.concat([axis_frame.reset_index(drop=True), frame], axis=1)
+    return frame
+
+
+def _axis_frame(axes: dict[str, list[Any]], start: int, stop: int) -> pd.DataFrame:
+    shape = [len(v) for v in axes.values()]
+    idx = np.unravel_index(np.arange(start, stop), shape) if shape else ()
+    cols: dict[str, Any] = {}
+    for (name, values), ix in zip(axes.items(), idx, strict=True):
+        if all(isinstance(v, (int, float, np.number)) and not isinstance(v, bool) for v in values):
+            cols[name] = np.asarray(values, dtype=float)[ix]
+        else:
+            arr = np.empty(len(values), dtype=object)
+            arr[:] = values
+            cols[name] = arr[ix]
+    return pd.DataFrame(cols)
+
+
+def _threads(threads: int | None) -> int:
+    if threads is None:
+        return 0
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise InvalidParameterError(
+            f"threads must be a whole number >= 1 (or None for every core); got {threads!r}",
+            field="threads",
+        )
+    return threads
+
+
+def _progress_bar(total: int, progress: bool | None) -> Any:
+    if progress is False or (progress is None and total < PROGRESS_MIN_RUNS):
+        return None
+    from tqdm.auto import tqdm
+
+    disable = None if progress is None else False  # None: off when not on a terminal
+    return tqdm(total=total, unit="run", desc="granrs sweep", disable=disable)
+
+
+def _run_local(
+    kwargs: dict[str, Any], start: int, stop: int, threads: int, progress: bool | None
+) -> dict[str, Any]:
+    bar = _progress_bar(stop - start, progress)
+    try:
+        callback = None
+        if bar is not None:
+
+            def callback(done: int) -> None:
+                bar.update(done - bar.n)
+
+        raw = _granrs.sweep(**kwargs, start=start, stop=stop, threads=threads, progress=callback)
+    finally:
+        if bar is not None:
+            bar.close()
+    raw["start"] = start
+    return dict(raw)
+
+
+def run_chunk(kwargs: dict[str, Any], start: int, stop: int, threads: int) -> dict[str, Any]:
+    """Run runs ``start..stop`` of a sweep (the task a Dask worker runs)."""
+    raw = dict(_granrs.sweep(**kwargs, start=start, stop=stop, threads=threads))
+    raw["start"] = start
+    return raw
+
+
+def _run_dask(
+    client: Any,
+    kwargs: dict[str, Any],
+    n: int,
+    chunk_size: int | None,
+    progress: bool | None,
+) -> dict[str, Any]:
+    workers = max(1, sum(client.nthreads().values()))
+    size = chunk_size or max(1, math.ceil(n / (4 * workers)))
+    bounds = [(s, min(n, s + size)) for s in range(0, n, size)]
+    tag = uuid.uuid4().hex
+    futures = [
+        client.submit(run_chunk, kwargs, s, e, 1, pure=False, key=f"granrs-sweep-{tag}-{s}")
+        for s, e in bounds
+    ]
+    bar = _progress_bar(n, progress)
+    try:
+        from dask.distributed import as_completed
+
+        for fut in as_completed(futures):
+            if bar is not None:
+                s, e = bounds[futures.index(fut)]
+                bar.update(e - s)
+        parts = client.gather(futures)
+    except BaseException:
+        client.cancel(futures)
+        raise
+    finally:
+        if bar is not None:
+            bar.close()
+    return {
+        "columns": parts[0]["columns"],
+        "data": np.concatenate([p["data"] for p in parts]),
+        "failures": [f for p in parts for f in p["failures"]],
+        "body": parts[0]["body"],
+        "start": 0,
+    }
+
+
+def sweep(
+    scene: Scene | Sequence[Scene],
+    *,
+    threads: int | None = None,
+    progress: bool | None = None,
+    client: Any = None,
+    chunk_size: int | None = None,
+    **axes: Any,
+) -> pd.DataFrame:
+    """Run many scenes in parallel and return one row of summaries per run.
+
+    Args:
+        scene: the base scene, whose fields the ``axes`` vary; or a list of scenes (then no
+            axes), all of one body.
+        threads: worker threads (default: one per core). Results do not depend on it.
+        progress: show a tqdm progress bar: None (default) shows it on a terminal for
+            sweeps of at least 2000 runs; True always; False never.
+        client: a ``dask.distributed.Client``: cut the sweep into chunks of ``chunk_size``
+            runs (default: about four chunks per worker thread), each run by the Rust batch
+            on a worker with one thread. The result is the same DataFrame.
+        chunk_size: runs per Dask task.
+        **axes: field name = values (any Scene field but ``body``; a single value is an
+            axis of one). The sweep runs their Cartesian product, the last axis varying
+            fastest, as ``itertools.product``.
+
+    Returns:
+        A DataFrame with one row per run, in input order: the axis columns (for a list of
+        scenes, none), then ``status`` (see :data:`STATUSES`), the work counters, the
+        energies, and the contact results of :attr:`granrs.Result.summary` (``t_s``,
+        ``depth``, ``dq``, ...; the chain's prefixed ``c0.`` and ``c1.``), and per joint
+        ``<joint>.F_max`` and ``<joint>.torque_max``. A run that failed has status
+        ``"failed"`` and its message in an ``error`` column (present only then).
+
+    Raises:
+        InvalidSceneError: (or a subclass) before anything runs, naming the field, with
+            the index of the first bad run.
+        KeyboardInterrupt: on Ctrl-C, after the runs in flight.
+
+    Example:
+        >>> import granrs
+        >>> base = granrs.cases.free_link(q_deg=0, v0=2.0)
+        >>> df = granrs.sweep(base, q_deg=[0, 30, 60], v0=[1.0, 2.0])
+        >>> len(df), list(df.columns[:3])
+        (6, ['q_deg', 'v0', 'status'])
+    """
+    n_threads = _threads(threads)
+    axis_frame: pd.DataFrame | None
+    if isinstance(scene, Scene):
+        plain_axes = {name: _axis_values(name, values) for name, values in axes.items()}
+        _check_axes(scene, plain_axes)
+        kwargs: dict[str, Any] = {
+            "base": scene.to_dict(),
+            "axes": [(k, [_plain(k, v) for v in vs]) for k, vs in plain_axes.items()],
+        }
+        n = math.prod(len(v) for v in plain_axes.values())
+        keep_axes = plain_axes
+    else:
+        if axes:
+            raise InvalidParameterError(
+                "sweep() over a list of scenes takes no axes; vary the scenes instead",
+                field=next(iter(axes)),
+            )
+        scenes = list(scene)
+        for i, s in enumerate(scenes):
+            if not isinstance(s, Scene):
+                raise InvalidParameterError(
+                    f"sweep() takes a granrs.Scene or a list of them; item {i} is "
+                    f"{type(s).__name__}",
+                    field="scene",
+                )
+        kwargs = {"scenes": [s.to_dict() for s in scenes]}
+        n = len(scenes)
+        keep_axes = {}
+    if client is not None:
+        if chunk_size is not None and (not isinstance(chunk_size, int) or chunk_size < 1):
+            raise InvalidParameterError(
+                f"chunk_size must be a whole number >= 1; got {chunk_size!r}", field="chunk_size"
+            )
+        if n == 0:
+            raw = run_chunk(kwargs, 0, 0, 1)
+        else:
+            # Validate everything here, before any task is sent.
+            _granrs.validate_sweep(**kwargs, threads=n_threads)
+            raw = _run_dask(client, kwargs, n, chunk_size, progress)
+    else:
+        raw = _run_local(kwargs, 0, n, n_threads, progress)
+    axis_frame = _axis_frame(keep_axes, 0, n) if keep_axes else None
+    return _frame(raw, raw["body"], axis_frame)

@@ -1,0 +1,473 @@
+//! Many runs at once: a Cartesian product of field values over a base scene, or a list of
+//! scenes, run on a rayon pool and summarized into one table (one row per run, in input
+//! order).
+//!
+//! Every scene of the batch is built and validated before the first run starts, so a bad
+//! value stops the batch with an error naming the run and the field, and nothing has run. A
+//! run that fails (a non-finite state) does not stop the batch: its row has status
+//! [`STATUS_FAILED`] and its message is kept. Progress is an atomic counter and
+//! cancellation an atomic flag, so a caller (Python's Ctrl-C) can watch and stop the
+//! batch from another thread; a cancelled batch stops after the runs in flight.
+
+use std::borrow::Cow;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+
+use crate::error::{GranrsError, Result};
+use crate::integrate::{Outcome, Status};
+use crate::spec::{SceneSpec, Value};
+
+/// Status codes of the `status` column.
+pub const STATUS_STOPPED: f64 = 0.0;
+/// `t_end` reached with the end condition `time`.
+pub const STATUS_END_TIME: f64 = 1.0;
+/// `t_end` reached before the stop.
+pub const STATUS_NOT_STOPPED: f64 = 2.0;
+/// The run failed (its message is in [`BatchOut::failures`]).
+pub const STATUS_FAILED: f64 = 3.0;
+/// The run was not started (the batch was cancelled).
+pub const STATUS_CANCELLED: f64 = 4.0;
+
+/// Run-level columns.
+const RUN_COLUMNS: [&str; 10] = [
+    "status",
+    "t_final",
+    "steps",
+    "rhs_evals",
+    "root_evals",
+    "events",
+    "rejected",
+    "energy_start",
+    "energy_end",
+    "dissipated",
+];
+/// Per-contact columns (prefixed `c{i}.`).
+const CONTACT_COLUMNS: [&str; 17] = [
+    "stopped",
+    "t_s",
+    "depth",
+    "dq",
+    "omega_end",
+    "F_d_max",
+    "F_s_end",
+    "F_r_end",
+    "dKE",
+    "dPE",
+    "dE",
+    "work_sand",
+    "x_tip_end",
+    "t_entry",
+    "link_dKE",
+    "link_dPE",
+    "link_dE",
+];
+/// Per-joint columns (prefixed `joint{i}.`).
+const JOINT_COLUMNS: [&str; 2] = ["F_max", "torque_max"];
+
+/// Contacts and reported joints of a body.
+pub fn body_shape(body: &str) -> (usize, usize) {
+    match body {
+        "chain" => (2, 2),
+        "leg" => (1, 4),
+        _ => (1, 0),
+    }
+}
+
+/// The summary columns of a body, in row order.
+pub fn columns(body: &str) -> Vec<String> {
+    let (nc, nj) = body_shape(body);
+    let mut out: Vec<String> = RUN_COLUMNS.iter().map(|s| s.to_string()).collect();
+    for i in 0..nc {
+        out.extend(CONTACT_COLUMNS.iter().map(|c| format!("c{i}.{c}")));
+    }
+    for j in 0..nj {
+        out.extend(JOINT_COLUMNS.iter().map(|c| format!("joint{j}.{c}")));
+    }
+    out
+}
+
+/// Write one outcome into its row (`row.len() == columns(body).len()`).
+pub fn summarize(out: &Outcome, row: &mut [f64]) {
+    let status = match out.status {
+        Status::Stopped => STATUS_STOPPED,
+        Status::EndTime => STATUS_END_TIME,
+        Status::NotStopped => STATUS_NOT_STOPPED,
+    };
+    let s = &out.stats;
+    let run = [
+        status,
+        out.t_final,
+        s.steps as f64,
+        s.rhs_evals as f64,
+        s.root_evals as f64,
+        s.events as f64,
+        s.rejected as f64,
+        out.energy_start,
+        out.energy_end,
+        out.dissipated,
+    ];
+    row[..run.len()].copy_from_slice(&run);
+    let mut k = run.len();
+    let nj = (row.len() - k - out.contacts.len() * CONTACT_COLUMNS.len()) / JOINT_COLUMNS.len();
+    for c in &out.contacts {
+        let values = [
+            if c.stopped { 1.0 } else { 0.0 },
+            c.t_s,
+            c.depth,
+            c.dq,
+            c.omega_end,
+            c.f_d_max,
+            c.f_s_end,
+            c.f_r_end,
+            c.d_ke,
+            c.d_pe,
+            c.d_e,
+            c.work_sand,
+            c.tip_end.x,
+            c.t_entry,
+            c.link_d_ke,
+            c.link_d_pe,
+            c.link_d_ke + c.link_d_pe,
+        ];
+        row[k..k + values.len()].copy_from_slice(&values);
+        k += values.len();
+    }
+    for j in out.joints.iter().take(nj) {
+        row[k] = j.f_max;
+        row[k + 1] = j.torque_max;
+        k += 2;
+    }
+}
+
+/// What a batch runs.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// The Cartesian product of `axes` over `base` (the last axis varies fastest, as in
+    /// `itertools.product`).
+    Product {
+        /// The scene every run starts from.
+        base: SceneSpec,
+        /// Field name and its values, per axis.
+        axes: Vec<(String, Vec<Value>)>,
+    },
+    /// One spec per run.
+    List(Vec<SceneSpec>),
+}
+
+impl Source {
+    /// Number of runs.
+    pub fn len(&self) -> usize {
+        match self {
+            Source::Product { axes, .. } => axes.iter().map(|(_, v)| v.len()).product(),
+            Source::List(specs) => specs.len(),
+        }
+    }
+
+    /// Whether there is nothing to run.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The spec of run `i`.
+    pub fn spec(&self, i: usize) -> Cow<'_, SceneSpec> {
+        match self {
+            Source::List(specs) => Cow::Borrowed(&specs[i]),
+            Source::Product { base, axes } => {
+                let mut spec = base.clone();
+                let mut rest = i;
+                for (field, values) in axes.iter().rev() {
+                    let n = values.len();
+                    spec.set(field, values[rest % n].clone());
+                    rest /= n;
+                }
+                Cow::Owned(spec)
+            }
+        }
+    }
+
+    /// The one body of the batch (every run must share it).
+    pub fn body(&self) -> Result<String> {
+        let body_of = |spec: &SceneSpec| spec.body().map(|b| b.to_string());
+        match self {
+            Source::Product { base, axes } => {
+                if axes.iter().any(|(f, _)| f == "body") {
+                    return Err(GranrsError::InvalidScene {
+                        field: "body".into(),
+                        message: "a sweep runs one body; sweep each body separately".into(),
+                    });
+                }
+                body_of(base)
+            }
+            Source::List(specs) => {
+                let Some(first) = specs.first() else {
+                    return Ok("free_link".into());
+                };
+                let body = body_of(first)?;
+                for (i, s) in specs.iter().enumerate() {
+                    let b = body_of(s).map_err(|e| in_run(i, e))?;
+                    if b != body {
+                        return Err(GranrsError::InvalidScene {
+                            field: "body".into(),
+                            message: format!(
+                                "a sweep runs one body: run 0 is {body:?}, run {i} is {b:?}"
+                            ),
+                        });
+                    }
+                }
+                Ok(body)
+            }
+        }
+    }
+}
+
+/// Prefix an error's message with the run it came from (the field stays the same).
+pub fn in_run(i: usize, e: GranrsError) -> GranrsError {
+    match e {
+        GranrsError::InvalidParameter {
+            field,
+            value,
+            allowed,
+        } => GranrsError::InvalidParameter {
+            field,
+            value,
+            allowed: format!("{allowed}; in run {i}"),
+        },
+        GranrsError::WrongType {
+            field,
+            expected,
+            got,
+        } => GranrsError::WrongType {
+            field,
+            expected,
+            got: format!("{got} (run {i})"),
+        },
+        GranrsError::UnknownName {
+            field,
+            value,
+            allowed,
+        } => GranrsError::UnknownName {
+            field,
+            value,
+            allowed: format!("{allowed}; in run {i}"),
+        },
+        GranrsError::InvalidScene { field, message } => GranrsError::InvalidScene {
+            field,
+            message: format!("{message} (run {i})"),
+        },
+        other => other,
+    }
+}
+
+/// A rayon pool of `threads` threads (0: one per core).
+pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| GranrsError::InvalidScene {
+            field: "threads".into(),
+            message: format!("cannot start a thread pool: {e}"),
+        })
+}
+
+/// Build and validate every run in `range` (in parallel); the error of the first bad run,
+/// in input order, names it.
+pub fn validate(src: &Source, range: std::ops::Range<usize>) -> Result<()> {
+    let first = range
+        .into_par_iter()
+        .filter_map(|i| src.spec(i).build().err().map(|e| (i, e)))
+        .min_by_key(|(i, _)| *i);
+    match first {
+        None => Ok(()),
+        Some((i, e)) => Err(in_run(i, e)),
+    }
+}
+
+/// The table of a batch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BatchOut {
+    /// Column names.
+    pub columns: Vec<String>,
+    /// Row-major values, `rows x columns.len()`.
+    pub data: Vec<f64>,
+    /// Runs that failed, by index within the batch, with their messages.
+    pub failures: Vec<(usize, String)>,
+    /// Whether the batch was cancelled before every run finished.
+    pub cancelled: bool,
+}
+
+/// Run every scene in `range` on the current rayon pool (call inside `pool.install`).
+/// `done` counts finished runs; setting `cancel` stops the batch after the runs in flight
+/// (the rest get status [`STATUS_CANCELLED`]). Validate first: a run whose scene does not
+/// build is recorded as failed.
+pub fn run(
+    src: &Source,
+    range: std::ops::Range<usize>,
+    body: &str,
+    done: &AtomicUsize,
+    cancel: &AtomicBool,
+) -> BatchOut {
+    let columns = columns(body);
+    let width = columns.len();
+    let start = range.start;
+    let mut data = vec![f64::NAN; range.len() * width];
+    let failures = Mutex::new(Vec::new());
+    data.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
+        let i = start + k;
+        if cancel.load(Ordering::Relaxed) {
+            row[0] = STATUS_CANCELLED;
+            return;
+        }
+        match src.spec(i).build().and_then(|s| s.run()) {
+            Ok(out) => summarize(&out, row),
+            Err(e) => {
+                row[0] = STATUS_FAILED;
+                failures
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .push((i, e.to_string()));
+            }
+        }
+        done.fetch_add(1, Ordering::Relaxed);
+    });
+    let mut failures = failures.into_inner().unwrap_or_else(|p| p.into_inner());
+    failures.sort_by_key(|(i, _)| *i);
+    BatchOut {
+        columns,
+        data,
+        failures,
+        cancelled: cancel.load(Ordering::Relaxed),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::Value;
+
+    fn base() -> SceneSpec {
+        let mut s = SceneSpec::new();
+        for (k, v) in [
+            ("length", 0.19),
+            ("diameter", 0.0127),
+            ("mass", 0.184),
+            ("rho_g", 1650.0),
+            ("g", 9.81),
+            ("q_deg", 0.0),
+            ("v0", 2.0),
+            ("dt", 1e-4),
+            ("t_end", 1.0),
+        ] {
+            s.set(k, Value::Num(v));
+        }
+        for (k, v) in [
+            ("body", "free_link"),
+            ("apply_at", "tip"),
+            ("sign_model", "modes"),
+            ("method", "rk4"),
+            ("end", "first_stop"),
+        ] {
+            s.set(k, Value::Str(v.into()));
+        }
+        s.set(
+            "coefficients",
+            Value::Map(
+                [
+                    ("eta_h", 6.5),
+                    ("eta_d", 15.2),
+                    ("eta_v", 248.0),
+                    ("lam", 0.106),
+                ]
+                .iter()
+                .map(|(k, v)| (k.to_string(), Value::Num(*v)))
+                .collect(),
+            ),
+        );
+        s
+    }
+
+    fn product() -> Source {
+        Source::Product {
+            base: base(),
+            axes: vec![
+                (
+                    "q_deg".into(),
+                    vec![Value::Num(0.0), Value::Num(30.0), Value::Num(-60.0)],
+                ),
+                ("v0".into(), vec![Value::Num(1.0), Value::Num(3.0)]),
+            ],
+        }
+    }
+
+    #[test]
+    fn product_order_is_last_axis_fastest() {
+        let src = product();
+        assert_eq!(src.len(), 6);
+        let s = src.spec(3);
+        assert_eq!(s.f64("q_deg").unwrap(), 30.0);
+        assert_eq!(s.f64("v0").unwrap(), 3.0);
+        let s = src.spec(4);
+        assert_eq!(s.f64("q_deg").unwrap(), -60.0);
+        assert_eq!(s.f64("v0").unwrap(), 1.0);
+    }
+
+    #[test]
+    fn parallel_rows_equal_single_runs_in_order() {
+        let src = product();
+        let done = AtomicUsize::new(0);
+        let cancel = AtomicBool::new(false);
+        let out = pool(2)
+            .unwrap()
+            .install(|| run(&src, 0..src.len(), "free_link", &done, &cancel));
+        assert_eq!(done.load(Ordering::Relaxed), 6);
+        let width = out.columns.len();
+        let depth = out.columns.iter().position(|c| c == "c0.depth").unwrap();
+        for i in 0..6 {
+            let alone = src.spec(i).build().unwrap().run().unwrap();
+            let mut row = vec![0.0; width];
+            summarize(&alone, &mut row);
+            assert_eq!(
+                out.data[i * width..(i + 1) * width]
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect::<Vec<_>>(),
+                row.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                "run {i}"
+            );
+            assert!(row[depth] > 0.0);
+        }
+    }
+
+    #[test]
+    fn validation_names_the_first_bad_run() {
+        let src = Source::Product {
+            base: base(),
+            axes: vec![(
+                "mass".into(),
+                vec![Value::Num(1.0), Value::Num(-1.0), Value::Num(f64::NAN)],
+            )],
+        };
+        match validate(&src, 0..3) {
+            Err(GranrsError::InvalidParameter { field, allowed, .. }) => {
+                assert_eq!(field, "mass");
+                assert!(allowed.ends_with("in run 1"), "{allowed}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_cancelled_batch_marks_what_it_did_not_run() {
+        let src = product();
+        let done = AtomicUsize::new(0);
+        let cancel = AtomicBool::new(true);
+        let out = run(&src, 0..src.len(), "free_link", &done, &cancel);
+        assert!(out.cancelled);
+        assert_eq!(done.load(Ordering::Relaxed), 0);
+        assert!(out
+            .data
+            .chunks(out.columns.len())
+            .all(|r| r[0] == STATUS_CANCELLED));
+    }
+}

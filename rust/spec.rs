@@ -1,0 +1,612 @@
+//! A scene as data: named fields with plain values ([`SceneSpec`]), and the one set of rules
+//! that turns them into a validated [`AnyScene`].
+//!
+//! Python dicts (`granrs.Scene.to_dict()`), TOML files (through Python) and sweep axes all
+//! arrive as a `SceneSpec`, so that they share every check and every error message. A sweep
+//! keeps one base spec and overrides a few fields per run ([`SceneSpec::set`]), which needs
+//! neither Python nor the GIL.
+
+use crate::body::rod::ApplyAt;
+use crate::body::{Joint, SoleModel};
+use crate::dynamics::{Effects, SignModel};
+use crate::error::{GranrsError, Result};
+use crate::force::{Coefficients, Medium};
+use crate::integrate::{EndCondition, Method, Record, SolveOptions};
+use crate::scene::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
+
+/// A field's value, as plain data.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    /// Absent or `None`.
+    None,
+    /// A boolean (never a valid number: `True` is not 1.0 here).
+    Bool(bool),
+    /// A real number.
+    Num(f64),
+    /// A string.
+    Str(String),
+    /// A list of names.
+    Names(Vec<String>),
+    /// A mapping (coefficients, a spring-damper).
+    Map(Vec<(String, Value)>),
+    /// Anything else, by its type name (for the error message).
+    Other(String),
+}
+
+impl Value {
+    /// What the value is, for error messages.
+    pub fn kind(&self) -> String {
+        match self {
+            Value::None => "None".into(),
+            Value::Bool(_) => "a bool".into(),
+            Value::Num(_) => "a number".into(),
+            Value::Str(s) => format!("the string {s:?}"),
+            Value::Names(_) => "a list".into(),
+            Value::Map(_) => "a mapping".into(),
+            Value::Other(t) => t.clone(),
+        }
+    }
+}
+
+/// Names of the effects (force terms) a scene may list.
+pub const EFFECTS: [&str; 5] = ["gravity", "drag", "static_h", "static_v", "joint_springs"];
+/// Names of the series a scene may record.
+pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
+/// Names of the bodies.
+pub const BODIES: [&str; 3] = ["free_link", "chain", "leg"];
+
+/// A scene as named fields. Fields that a body does not use are ignored.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneSpec {
+    fields: Vec<(String, Value)>,
+}
+
+fn missing(field: &str) -> GranrsError {
+    GranrsError::InvalidScene {
+        field: field.to_string(),
+        message: "missing".into(),
+    }
+}
+
+fn wrong(field: &str, expected: &str, got: &Value) -> GranrsError {
+    GranrsError::WrongType {
+        field: field.to_string(),
+        expected: expected.to_string(),
+        got: got.kind(),
+    }
+}
+
+fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
+    GranrsError::UnknownName {
+        field: field.to_string(),
+        value: value.to_string(),
+        allowed: allowed.join(", "),
+    }
+}
+
+/// An error about key `k` of the mapping `field`, renamed to the field `field.k`.
+fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
+    match e {
+        GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
+            field: format!("{field}.{k}"),
+            message,
+        },
+        GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
+            field: format!("{field}.{k}"),
+            expected,
+            got,
+        },
+        other => other,
+    }
+}
+
+fn num(field: &str, v: Option<&Value>) -> Result<f64> {
+    match v {
+        None | Some(Value::None) => Err(missing(field)),
+        Some(Value::Num(x)) => Ok(*x),
+        Some(other) => Err(wrong(field, "a real number", other)),
+    }
+}
+
+fn map_get<'a>(entries: &'a [(String, Value)], k: &str) -> Option<&'a Value> {
+    entries.iter().find(|(name, _)| name == k).map(|(_, v)| v)
+}
+
+impl SceneSpec {
+    /// An empty spec.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Set (or replace) a field.
+    pub fn set(&mut self, field: &str, value: Value) {
+        match self.fields.iter_mut().find(|(name, _)| name == field) {
+            Some(slot) => slot.1 = value,
+            None => self.fields.push((field.to_string(), value)),
+        }
+    }
+
+    /// A field's value, if present.
+    pub fn get(&self, field: &str) -> Option<&Value> {
+        map_get(&self.fields, field)
+    }
+
+    /// Whether a field is present and not `None`.
+    fn has(&self, field: &str) -> bool {
+        !matches!(self.get(field), None | Some(Value::None))
+    }
+
+    /// A required number.
+    pub fn f64(&self, field: &str) -> Result<f64> {
+        num(field, self.get(field))
+    }
+
+    /// An optional number (absent or `None` gives `None`).
+    pub fn opt_f64(&self, field: &str) -> Result<Option<f64>> {
+        if self.has(field) {
+            self.f64(field).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
+    /// An optional number with a default.
+    fn f64_or(&self, field: &str, default: f64) -> Result<f64> {
+        Ok(self.opt_f64(field)?.unwrap_or(default))
+    }
+
+    /// A required string.
+    pub fn str(&self, field: &str) -> Result<&str> {
+        match self.get(field) {
+            None | Some(Value::None) => Err(missing(field)),
+            Some(Value::Str(s)) => Ok(s),
+            Some(other) => Err(wrong(field, "a string", other)),
+        }
+    }
+
+    /// A list of names (absent or `None` gives `None`).
+    fn names(&self, field: &str) -> Result<Option<&[String]>> {
+        match self.get(field) {
+            None | Some(Value::None) => Ok(None),
+            Some(Value::Names(n)) => Ok(Some(n)),
+            Some(other) => Err(wrong(field, "a list of names", other)),
+        }
+    }
+
+    /// A coefficients mapping (`eta_h`, `eta_d`, `eta_v`, `lam`); absent or `None` gives
+    /// `None`.
+    fn coefficients(&self, field: &str) -> Result<Option<Coefficients>> {
+        let entries = match self.get(field) {
+            None | Some(Value::None) => return Ok(None),
+            Some(Value::Map(m)) => m,
+            Some(other) => {
+                return Err(wrong(
+                    field,
+                    "a mapping with eta_h, eta_d, eta_v, lam",
+                    other,
+                ))
+            }
+        };
+        for (k, _) in entries {
+            if !["eta_h", "eta_d", "eta_v", "lam"].contains(&k.as_str()) {
+                return Err(unknown(
+                    &format!("{field}.{k}"),
+                    k,
+                    &["eta_h", "eta_d", "eta_v", "lam"],
+                ));
+            }
+        }
+        let get = |k: &str| num(k, map_get(entries, k)).map_err(|e| within(e, field, k));
+        Ok(Some(Coefficients {
+            eta_h: get("eta_h")?,
+            eta_d: get("eta_d")?,
+            eta_v: get("eta_v")?,
+            lambda: get("lam")?,
+        }))
+    }
+
+    fn required_coefficients(&self, field: &str) -> Result<Coefficients> {
+        self.coefficients(field)?.ok_or_else(|| missing(field))
+    }
+
+    /// A joint: `"free"`, `"locked"`, or a spring-damper `{"k": .., "c": ..}`; absent or
+    /// `None` gives `default`.
+    fn joint(&self, field: &str, default: Joint) -> Result<Joint> {
+        match self.get(field) {
+            None | Some(Value::None) => Ok(default),
+            Some(Value::Str(name)) => match name.as_str() {
+                "free" => Ok(Joint::Free),
+                "locked" => Ok(Joint::Locked),
+                other => Err(unknown(
+                    field,
+                    other,
+                    &["free", "locked", "{k, c} spring-damper"],
+                )),
+            },
+            Some(Value::Map(entries)) => {
+                for (k, _) in entries {
+                    if k != "k" && k != "c" {
+                        return Err(unknown(&format!("{field}.{k}"), k, &["k", "c"]));
+                    }
+                }
+                let get = |k: &str| num(k, map_get(entries, k)).map_err(|e| within(e, field, k));
+                Ok(Joint::Spring {
+                    k: get("k")?,
+                    c: get("c")?,
+                    rest: 0.0,
+                })
+            }
+            Some(other) => Err(wrong(
+                field,
+                "\"free\", \"locked\" or a spring-damper mapping {\"k\": N m/rad, \"c\": N m s/rad}",
+                other,
+            )),
+        }
+    }
+
+    /// The effects, and whether spring-dampers are on (absent: every effect).
+    fn effects(&self) -> Result<(Effects, bool)> {
+        let Some(names) = self.names("effects")? else {
+            return Ok((Effects::default(), true));
+        };
+        let mut e = Effects {
+            gravity: false,
+            drag: false,
+            static_h: false,
+            static_v: false,
+        };
+        let mut springs = false;
+        for n in names {
+            match n.as_str() {
+                "gravity" => e.gravity = true,
+                "drag" => e.drag = true,
+                "static_h" => e.static_h = true,
+                "static_v" => e.static_v = true,
+                "joint_springs" => springs = true,
+                other => return Err(unknown("effects", other, &EFFECTS)),
+            }
+        }
+        Ok((e, springs))
+    }
+
+    fn record(&self) -> Result<Record> {
+        let mut r = Record::default();
+        for n in self.names("record")?.unwrap_or_default() {
+            match n.as_str() {
+                "state" => r.state = true,
+                "forces" => r.forces = true,
+                "energy" => r.energy = true,
+                other => return Err(unknown("record", other, &RECORDS)),
+            }
+        }
+        let stride = self.f64_or("record_stride", 1.0)?;
+        if !(stride.is_finite() && stride >= 1.0 && stride.fract() == 0.0 && stride < 1e12) {
+            return Err(GranrsError::InvalidParameter {
+                field: "record_stride".into(),
+                value: stride,
+                allowed: "a whole number >= 1".into(),
+            });
+        }
+        r.stride = stride as usize;
+        Ok(r)
+    }
+
+    fn common(&self) -> Result<Common> {
+        let apply_at = match self.str("apply_at")? {
+            "tip" => ApplyAt::Tip,
+            "centroid" => ApplyAt::Centroid,
+            other => return Err(unknown("apply_at", other, &["tip", "centroid"])),
+        };
+        let sign_model = match self.str("sign_model")? {
+            "modes" => SignModel::Modes,
+            "raw" => SignModel::Raw,
+            "smooth" => SignModel::Smooth {
+                eps: self.f64("smooth_eps")?,
+            },
+            other => return Err(unknown("sign_model", other, &["modes", "raw", "smooth"])),
+        };
+        let end = match self.str("end")? {
+            "first_stop" => EndCondition::FirstStop,
+            "all_stops" => EndCondition::AllStops,
+            "time" => EndCondition::Time,
+            other => return Err(unknown("end", other, &["first_stop", "all_stops", "time"])),
+        };
+        let method = match self.str("method")? {
+            "rk4" => Method::Rk4,
+            "dopri5" => Method::Dopri5 {
+                rtol: self.f64("rtol")?,
+                atol: self.f64("atol")?,
+            },
+            other => return Err(unknown("method", other, &["rk4", "dopri5"])),
+        };
+        let (effects, springs) = self.effects()?;
+        Ok(Common {
+            medium: Medium {
+                rho_g: self.f64("rho_g")?,
+                g: self.f64("g")?,
+            },
+            apply_at,
+            sign_model,
+            effects,
+            springs,
+            options: SolveOptions {
+                dt: self.f64("dt")?,
+                method,
+                t_end: self.f64("t_end")?,
+                end,
+                record: self.record()?,
+            },
+            v0: self.f64("v0")?,
+            depth0: self.f64_or("depth0", 0.0)?,
+            vx0: self.f64_or("vx0", 0.0)?,
+        })
+    }
+
+    /// A joint, with a spring-damper made free when the scene leaves out `joint_springs`.
+    fn joint_with(&self, field: &str, default: Joint, springs: bool) -> Result<Joint> {
+        Ok(match self.joint(field, default)? {
+            Joint::Spring { .. } if !springs => Joint::Free,
+            j => j,
+        })
+    }
+
+    fn free_link(&self) -> Result<FreeLinkScene> {
+        let c = self.common()?;
+        Ok(FreeLinkScene {
+            length: self.f64("length")?,
+            diameter: self.f64("diameter")?,
+            mass: self.f64("mass")?,
+            inertia: self.opt_f64("inertia")?,
+            medium: c.medium,
+            coefficients: self.required_coefficients("coefficients")?,
+            q_deg: self.f64("q_deg")?,
+            v0: c.v0,
+            depth0: c.depth0,
+            vx0: c.vx0,
+            omega0: self.f64_or("omega0", 0.0)?,
+            apply_at: c.apply_at,
+            sign_model: c.sign_model,
+            effects: c.effects,
+            options: c.options,
+        })
+    }
+
+    /// Link 2's angle defaults to the mirror of link 1's, its coefficients to link 1's.
+    fn chain(&self) -> Result<ChainScene> {
+        let c = self.common()?;
+        let coefficients = self.required_coefficients("coefficients")?;
+        let q1 = self.f64("q_deg")?;
+        Ok(ChainScene {
+            length: self.f64("length")?,
+            diameter: self.f64("diameter")?,
+            mass: self.f64("mass")?,
+            inertia: self.opt_f64("inertia")?,
+            pin_mass: self.f64_or("pin_mass", 0.0)?,
+            joint: self.joint_with("pin_joint", Joint::Free, c.springs)?,
+            medium: c.medium,
+            coefficients: [
+                coefficients,
+                self.coefficients("coefficients2")?.unwrap_or(coefficients),
+            ],
+            q_deg: [q1, self.f64_or("q2_deg", -q1)?],
+            v0: c.v0,
+            depth0: c.depth0,
+            vx0: c.vx0,
+            omega0: self.f64_or("omega0", 0.0)?,
+            apply_at: c.apply_at,
+            sign_model: c.sign_model,
+            effects: c.effects,
+            options: c.options,
+        })
+    }
+
+    /// The leg (fields left out take the [`LegScene`] defaults).
+    pub fn leg(&self) -> Result<LegScene> {
+        let c = self.common()?;
+        let defaults = LegScene::default();
+        let sole_model = if self.has("sole_model") {
+            match self.str("sole_model")? {
+                "box" => SoleModel::Box,
+                "thesis" => SoleModel::Thesis,
+                other => return Err(unknown("sole_model", other, &["box", "thesis"])),
+            }
+        } else {
+            SoleModel::Box
+        };
+        let mut joints = [Joint::Locked; 3];
+        for (j, name) in joints.iter_mut().zip(LEG_JOINTS) {
+            *j = self.joint_with(name, Joint::Locked, c.springs)?;
+        }
+        Ok(LegScene {
+            body_mass: self.f64_or("body_mass", defaults.body_mass)?,
+            height: self.f64_or("height", defaults.height)?,
+            foot_length: self.f64_or("foot_length", defaults.foot_length)?,
+            shoe_width: self.f64_or("shoe_width", defaults.shoe_width)?,
+            tibia_length: self.f64_or("tibia_length", defaults.tibia_length)?,
+            sole_height: self.opt_f64("sole_height")?,
+            joints,
+            knee_deg: self.f64_or("knee_deg", defaults.knee_deg)?,
+            hip_deg: self.f64_or("hip_deg", defaults.hip_deg)?,
+            trunk_deg: self.f64_or("trunk_deg", defaults.trunk_deg)?,
+            foot_deg: self.f64_or("foot_deg", defaults.foot_deg)?,
+            sole_model,
+            medium: c.medium,
+            coefficients: self.required_coefficients("coefficients")?,
+            v0: c.v0,
+            depth0: c.depth0,
+            vx0: c.vx0,
+            apply_at: c.apply_at,
+            sign_model: c.sign_model,
+            effects: c.effects,
+            options: c.options,
+        })
+    }
+
+    /// The body named by the `body` field.
+    pub fn body(&self) -> Result<&str> {
+        let body = self.str("body")?;
+        if BODIES.contains(&body) {
+            Ok(body)
+        } else {
+            Err(unknown("body", body, &BODIES))
+        }
+    }
+
+    /// Build the scene and validate every field; the error names the first bad one.
+    pub fn build(&self) -> Result<AnyScene> {
+        let scene = match self.body()? {
+            "free_link" => AnyScene::FreeLink(self.free_link()?),
+            "chain" => AnyScene::Chain(self.chain()?),
+            _ => AnyScene::Leg(self.leg()?),
+        };
+        scene.validate()?;
+        Ok(scene)
+    }
+}
+
+/// The fields every body shares.
+struct Common {
+    medium: Medium,
+    apply_at: ApplyAt,
+    sign_model: SignModel,
+    effects: Effects,
+    springs: bool,
+    options: SolveOptions,
+    v0: f64,
+    depth0: f64,
+    vx0: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The free link's defaults as a spec (what `granrs.Scene().to_dict()` sends).
+    pub(crate) fn free_link_spec() -> SceneSpec {
+        let mut s = SceneSpec::new();
+        for (k, v) in [
+            ("length", 0.19),
+            ("diameter", 0.0127),
+            ("mass", 0.184),
+            ("rho_g", 1650.0),
+            ("g", 9.81),
+            ("q_deg", 45.0),
+            ("v0", 2.27),
+            ("dt", 1e-4),
+            ("t_end", 1.0),
+            ("smooth_eps", 1e-3),
+        ] {
+            s.set(k, Value::Num(v));
+        }
+        for (k, v) in [
+            ("body", "free_link"),
+            ("apply_at", "tip"),
+            ("sign_model", "modes"),
+            ("method", "rk4"),
+            ("end", "first_stop"),
+        ] {
+            s.set(k, Value::Str(v.into()));
+        }
+        s.set(
+            "coefficients",
+            Value::Map(
+                [
+                    ("eta_h", 5.5),
+                    ("eta_d", 11.0),
+                    ("eta_v", 53.0),
+                    ("lam", 0.25),
+                ]
+                .iter()
+                .map(|(k, v)| (k.to_string(), Value::Num(*v)))
+                .collect(),
+            ),
+        );
+        s
+    }
+
+    #[test]
+    fn spec_builds_the_same_scene_as_rust_defaults() {
+        let AnyScene::FreeLink(built) = free_link_spec().build().unwrap() else {
+            panic!("not a free link");
+        };
+        let mut by_hand = FreeLinkScene {
+            q_deg: 45.0,
+            v0: 2.27,
+            coefficients: Coefficients {
+                eta_h: 5.5,
+                eta_d: 11.0,
+                eta_v: 53.0,
+                lambda: 0.25,
+            },
+            ..Default::default()
+        };
+        by_hand.options.record.stride = 1; // the spec's record_stride default
+        assert_eq!(built, by_hand);
+    }
+
+    #[test]
+    fn errors_name_the_field() {
+        let mut s = free_link_spec();
+        s.set("mass", Value::Bool(true));
+        match s.build() {
+            Err(GranrsError::WrongType { field, got, .. }) => {
+                assert_eq!(field, "mass");
+                assert_eq!(got, "a bool");
+            }
+            other => panic!("{other:?}"),
+        }
+        let mut s = free_link_spec();
+        s.set("mass", Value::Num(-1.0));
+        assert!(
+            matches!(s.build(), Err(GranrsError::InvalidParameter { field, .. }) if field == "mass")
+        );
+        let mut s = free_link_spec();
+        s.set(
+            "coefficients",
+            Value::Map(vec![("eta_h".into(), Value::Num(1.0))]),
+        );
+        assert!(
+            matches!(s.build(), Err(GranrsError::InvalidScene { field, .. }) if field == "coefficients.eta_d")
+        );
+        let mut s = free_link_spec();
+        s.set(
+            "effects",
+            Value::Names(vec!["gravity".into(), "wind".into()]),
+        );
+        assert!(
+            matches!(s.build(), Err(GranrsError::UnknownName { field, value, .. }) if field == "effects" && value == "wind")
+        );
+        let mut s = free_link_spec();
+        s.set("body", Value::Str("tripod".into()));
+        assert!(
+            matches!(s.build(), Err(GranrsError::UnknownName { field, .. }) if field == "body")
+        );
+    }
+
+    #[test]
+    fn springs_are_free_without_the_effect() {
+        let mut s = free_link_spec();
+        s.set("body", Value::Str("chain".into()));
+        s.set("q_deg", Value::Num(20.0));
+        s.set(
+            "pin_joint",
+            Value::Map(vec![
+                ("k".into(), Value::Num(1.0)),
+                ("c".into(), Value::Num(0.01)),
+            ]),
+        );
+        let AnyScene::Chain(with) = s.build().unwrap() else {
+            panic!()
+        };
+        assert!(matches!(with.joint, Joint::Spring { .. }));
+        s.set(
+            "effects",
+            Value::Names(vec!["gravity".into(), "static_v".into()]),
+        );
+        let AnyScene::Chain(without) = s.build().unwrap() else {
+            panic!()
+        };
+        assert_eq!(without.joint, Joint::Free);
+        assert!(!without.effects.drag && without.effects.static_v);
+    }
+}

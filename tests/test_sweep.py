@@ -1,0 +1,189 @@
+"""granrs.sweep: the parallel batch gives, row by row and in input order, what simulate()
+gives for each scene alone; it validates everything first, reports failures, shows
+progress, stops on Ctrl-C, and gives the same table on Dask."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import granrs
+from granrs import _granrs, cases
+from granrs.errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+
+# Summary keys a sweep row shares with Result.summary.
+SHARED = (
+    "t_s",
+    "depth",
+    "dq",
+    "omega_end",
+    "F_d_max",
+    "F_s_end",
+    "F_r_end",
+    "dKE",
+    "dPE",
+    "dE",
+    "work_sand",
+    "x_tip_end",
+    "t_entry",
+    "steps",
+    "rhs_evals",
+    "events",
+    "t_final",
+    "energy_start",
+    "energy_end",
+    "dissipated",
+)
+
+
+def _same(a: float, b: float) -> bool:
+    return (math.isnan(a) and math.isnan(b)) or a == b
+
+
+def test_product_rows_equal_single_runs_in_input_order() -> None:
+    base = cases.free_link(q_deg=45, v0=2.27)
+    qs, vs = [0.0, -30.0, 60.0], [0.5, 2.0, 4.0]
+    df = granrs.sweep(base, q_deg=qs, v0=vs, threads=2)
+    assert len(df) == 9
+    for row, (q, v) in zip(df.itertuples(index=False), itertools.product(qs, vs), strict=True):
+        assert (row.q_deg, row.v0) == (q, v)
+        alone = granrs.simulate(base.replace(q_deg=q, v0=v))
+        assert row.status == alone.status
+        for key in SHARED:
+            assert _same(getattr(row, key), alone.summary[key]), (q, v, key)
+
+
+def test_list_of_scenes_chain_and_leg_equal_single_runs() -> None:
+    chains = [cases.chain(case) for case in (1, 2, 3)]
+    df = granrs.sweep(chains)
+    for i, scene in enumerate(chains):
+        alone = granrs.simulate(scene)
+        for c, contact in enumerate(alone.contacts):
+            assert _same(df.loc[i, f"c{c}.depth"], contact.depth)
+            assert _same(df.loc[i, f"c{c}.t_s"], contact.t_s)
+        assert df.loc[i, "pin.F_max"] == alone.joints["pin"]["F_max"]
+    legs = granrs.sweep(cases.leg(v0=3.28), knee=["locked", "free"])
+    for i, knee in enumerate(("locked", "free")):
+        alone = granrs.simulate(cases.leg(v0=3.28).replace(knee=knee))
+        assert legs.loc[i, "depth"] == alone.depth
+        assert legs.loc[i, "knee.torque_max"] == alone.joints["knee"]["torque_max"]
+    assert list(legs["knee"]) == ["locked", "free"]
+
+
+def test_thread_count_does_not_change_results() -> None:
+    base = cases.free_link(q_deg=0, v0=2.0)
+    kw = {"q_deg": np.linspace(-80, 80, 17), "v0": [0.3, 3.0]}
+    one = granrs.sweep(base, threads=1, **kw)
+    two = granrs.sweep(base, threads=2, **kw)
+    pd.testing.assert_frame_equal(one, two)
+
+
+def test_coefficient_and_effect_axes() -> None:
+    base = cases.free_link(q_deg=0, v0=2.0)
+    weak = granrs.Coefficients(eta_h=6.5, eta_d=15.2, eta_v=124.0, lam=0.106)
+    df = granrs.sweep(base, coefficients=[base.coefficients, weak])
+    # Half the vertical static force: the vertical rod sinks deeper.
+    assert df.loc[1, "depth"] > df.loc[0, "depth"]
+    df = granrs.sweep(base, effects=[granrs.EFFECTS, ("gravity", "static_v")])
+    # A vertical drop feels only F_sv: pruning the other terms changes nothing.
+    assert df.loc[0, "depth"] == pytest.approx(df.loc[1, "depth"], rel=1e-12)
+
+
+def test_everything_is_validated_before_anything_runs() -> None:
+    base = cases.free_link(q_deg=0, v0=2.0)
+    with pytest.raises(InvalidParameterError) as err:
+        granrs.sweep(base, q_deg=[0, 30], mass=[0.1, -1.0, 0.2])
+    assert err.value.field == "mass"
+    assert "run 1" in str(err.value)
+    with pytest.raises(InvalidParameterError) as err:
+        granrs.sweep(base, v0=[1.0, float("nan")])
+    assert err.value.field == "v0"
+    with pytest.raises(UnknownNameError, match="did you mean 'length'") as err:
+        granrs.sweep(base, lenght=[0.1, 0.2])
+    assert err.value.field == "lenght"
+    with pytest.raises(InvalidSceneError) as err:
+        granrs.sweep(base, body=["chain"])
+    assert err.value.field == "body"
+    with pytest.raises(InvalidSceneError) as err:
+        granrs.sweep([base, cases.chain(1)])
+    assert err.value.field == "body"
+    with pytest.raises(InvalidSceneError) as err:
+        granrs.sweep(base, knee=["free"])  # a leg field on a free link
+    assert err.value.field == "knee"
+    with pytest.raises(InvalidParameterError) as err:
+        granrs.sweep(base, threads=0)
+    assert err.value.field == "threads"
+
+
+def test_progress_reaches_the_total() -> None:
+    seen: list[int] = []
+    raw = _granrs.sweep(
+        base=cases.free_link(q_deg=0, v0=2.0).to_dict(),
+        axes=[("q_deg", list(np.linspace(-60, 60, 40)))],
+        progress=seen.append,
+    )
+    assert raw["data"].shape[0] == 40
+    assert seen and seen[-1] == 40
+    assert seen == sorted(seen)
+
+
+def test_an_exception_in_progress_cancels() -> None:
+    def boom(done: int) -> None:
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        base = cases.free_link(q_deg=0, v0=2.0).to_dict()
+        _granrs.sweep(base=base, axes=[("v0", [1.0] * 5000)], progress=boom)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
+def test_ctrl_c_stops_a_long_sweep_cleanly() -> None:
+    # 200,000 leg impacts would take many minutes; Ctrl-C after 0.3 s must stop it.
+    base = cases.leg(v0=3.28)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        granrs.sweep(base, v0=np.linspace(1, 4, 400), knee_deg=np.linspace(5, 40, 500))
+    elapsed = time.perf_counter() - start
+    timer.cancel()
+    assert elapsed < 60.0
+    # The module still works afterwards.
+    assert granrs.sweep(cases.free_link(q_deg=0, v0=2.0), v0=[1.0]).loc[0, "status"] == "stopped"
+
+
+def test_dask_gives_the_same_frame() -> None:
+    distributed = pytest.importorskip("distributed")
+    base = cases.free_link(q_deg=0, v0=2.0)
+    kw = {"q_deg": [-40.0, 0.0, 40.0, 70.0], "v0": [0.5, 1.5, 2.5]}
+    local = granrs.sweep(base, **kw)
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        remote = granrs.sweep(base, client=client, chunk_size=5, **kw)
+        with pytest.raises(InvalidParameterError) as err:
+            granrs.sweep(base, client=client, mass=[0.1, -2.0])
+        assert err.value.field == "mass"
+    pd.testing.assert_frame_equal(local, remote)
+
+
+def test_docstring_examples() -> None:
+    import doctest
+
+    import granrs.batch
+    import granrs.effects
+
+    for module in (granrs.batch, granrs.effects):
+        failures, tried = doctest.testmod(module, verbose=False, report=True)
+        assert tried > 0 and failures == 0, module.__name__
