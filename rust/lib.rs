@@ -13,6 +13,7 @@ pub mod batch;
 pub mod body;
 pub mod dynamics;
 pub mod error;
+pub mod evaluate;
 pub mod force;
 pub mod integrate;
 pub mod scene;

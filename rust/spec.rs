@@ -245,7 +245,7 @@ impl SceneSpec {
     }
 
     /// The effects, and whether spring-dampers are on (absent: every effect).
-    fn effects(&self) -> Result<(Effects, bool)> {
+    pub fn effects(&self) -> Result<(Effects, bool)> {
         let Some(names) = self.names("effects")? else {
             return Ok((Effects::default(), true));
         };

@@ -27,6 +27,7 @@ from .errors import (
     SimulationError,
     UnknownNameError,
 )
+from .force import ResistanceForce, resistance_force
 from .result import ContactResult, Result
 from .scene import EFFECTS, RECORDS, Scene
 
@@ -43,6 +44,7 @@ __all__ = [
     "GranrsError",
     "InvalidParameterError",
     "InvalidSceneError",
+    "ResistanceForce",
     "Result",
     "Scene",
     "SimulationError",
@@ -51,6 +53,7 @@ __all__ = [
     "cases",
     "coefficients",
     "data",
+    "resistance_force",
     "simulate",
     "sweep",
 ]

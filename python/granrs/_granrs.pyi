@@ -36,3 +36,19 @@ def validate_sweep(
     threads: int = 0,
 ) -> int:
     """Validate every run of a batch without running it; return the number of runs."""
+
+FORCE_INPUTS: list[str]
+FORCE_OUTPUTS: list[str]
+
+def resistance_force(
+    inputs: list[Any],
+    length: float,
+    diameter: float,
+    rho_g: float,
+    g: float,
+    effects: list[str],
+    sign_model: str,
+    smooth_eps: float,
+) -> Any:
+    """The rod force over n states: nine contiguous float64 arrays (FORCE_INPUTS order) in,
+    an n x 10 array (FORCE_OUTPUTS order) out."""

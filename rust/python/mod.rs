@@ -334,12 +334,116 @@ fn sweep<'py>(
     Ok(d)
 }
 
+/// Evaluate the rod resistance force over many states (see `rust/evaluate.rs`): `inputs`
+/// are nine equal-length float arrays in the order of `INPUTS`; returns an `n x 10` array
+/// in the order of `OUTPUTS`. Every value is checked before any is evaluated.
+#[pyfunction]
+#[pyo3(signature = (inputs, length, diameter, rho_g, g, effects, sign_model, smooth_eps))]
+#[allow(clippy::too_many_arguments)]
+fn resistance_force<'py>(
+    py: Python<'py>,
+    inputs: Vec<numpy::PyReadonlyArray1<'py, f64>>,
+    length: f64,
+    diameter: f64,
+    rho_g: f64,
+    g: f64,
+    effects: Vec<String>,
+    sign_model: &str,
+    smooth_eps: f64,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    use crate::error::check_range;
+    use crate::evaluate::{evaluate, RodSetup, Sign, INPUTS, OUTPUTS};
+    let err = |e: GranrsError| to_pyerr(py, e);
+    if inputs.len() != INPUTS.len() {
+        return Err(PyValueError::new_err(format!(
+            "resistance_force takes {} arrays ({})",
+            INPUTS.len(),
+            INPUTS.join(", ")
+        )));
+    }
+    let slices: Vec<&[f64]> = inputs
+        .iter()
+        .map(|a| a.as_slice())
+        .collect::<Result<_, _>>()
+        .map_err(|_| PyValueError::new_err("resistance_force needs contiguous arrays"))?;
+    let n = slices[0].len();
+    if slices.iter().any(|s| s.len() != n) {
+        return Err(PyValueError::new_err(
+            "resistance_force arrays differ in length",
+        ));
+    }
+    check_range("length", length, 0.0, true).map_err(err)?;
+    check_range("diameter", diameter, 0.0, true).map_err(err)?;
+    check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
+    check_range("g", g, 0.0, false).map_err(err)?;
+    let mut spec = SceneSpec::new();
+    spec.set("effects", Value::Names(effects));
+    let effects = spec.effects().map_err(err)?.0;
+    let sign = match sign_model {
+        "raw" => Sign::Raw,
+        "smooth" => Sign::Smooth(check_range("smooth_eps", smooth_eps, 0.0, true).map_err(err)?),
+        other => {
+            return Err(err(GranrsError::UnknownName {
+                field: "sign_model".into(),
+                value: other.into(),
+                allowed: "raw, smooth (the held signs of \"modes\" need a time history)".into(),
+            }))
+        }
+    };
+    // Check every value before evaluating any.
+    let checked = py.detach(|| -> Result<(), GranrsError> {
+        for (k, (name, s)) in INPUTS.iter().zip(&slices).enumerate() {
+            for (i, &x) in s.iter().enumerate() {
+                let ok = match k {
+                    1 => x.is_finite() && x.abs() < 90.0,
+                    5..=8 => x.is_finite() && x >= 0.0,
+                    _ => x.is_finite(),
+                };
+                if !ok {
+                    let allowed = match k {
+                        1 => "finite, -90 < q_deg < 90",
+                        5..=8 => "finite, >= 0",
+                        _ => "finite",
+                    };
+                    return Err(GranrsError::InvalidParameter {
+                        field: name.to_string(),
+                        value: x,
+                        allowed: format!("{allowed}; at index {i}"),
+                    });
+                }
+            }
+        }
+        Ok(())
+    });
+    checked.map_err(err)?;
+    let setup = RodSetup {
+        length,
+        diameter,
+        medium: crate::force::Medium { rho_g, g },
+        effects,
+        sign,
+    };
+    let width = OUTPUTS.len();
+    let out = py.detach(|| {
+        let mut out = vec![0.0; n * width];
+        for (i, row) in out.chunks_exact_mut(width).enumerate() {
+            let input = std::array::from_fn(|k| slices[k][i]);
+            evaluate(&setup, input, row);
+        }
+        out
+    });
+    out.into_pyarray(py).reshape([n, width])
+}
+
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(validate_sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(resistance_force, m)?)?;
+    m.add("FORCE_INPUTS", crate::evaluate::INPUTS.to_vec())?;
+    m.add("FORCE_OUTPUTS", crate::evaluate::OUTPUTS.to_vec())?;
     m.add("EFFECTS", EFFECTS.to_vec())?;
     m.add("RECORDS", RECORDS.to_vec())?;
     m.add_function(wrap_pyfunction!(leg_segments, m)?)?;
