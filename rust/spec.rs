@@ -55,7 +55,8 @@ pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
 /// Names of the bodies.
 pub const BODIES: [&str; 3] = ["free_link", "chain", "leg"];
 
-/// A scene as named fields. Fields that a body does not use are ignored.
+/// A scene as named fields, kept sorted by name. Fields that a body does not use are
+/// ignored.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneSpec {
     fields: Vec<(String, Value)>,
@@ -118,17 +119,37 @@ impl SceneSpec {
         Self::default()
     }
 
+    /// A spec from (field, value) pairs; a later duplicate replaces an earlier one.
+    pub fn from_pairs(mut pairs: Vec<(String, Value)>) -> Self {
+        // Stable: equal names keep their order, so the last of each wins below.
+        pairs.sort_by(|a, b| a.0.cmp(&b.0));
+        let mut fields: Vec<(String, Value)> = Vec::with_capacity(pairs.len());
+        for (name, value) in pairs {
+            match fields.last_mut() {
+                Some(last) if last.0 == name => last.1 = value,
+                _ => fields.push((name, value)),
+            }
+        }
+        SceneSpec { fields }
+    }
+
     /// Set (or replace) a field.
     pub fn set(&mut self, field: &str, value: Value) {
-        match self.fields.iter_mut().find(|(name, _)| name == field) {
-            Some(slot) => slot.1 = value,
-            None => self.fields.push((field.to_string(), value)),
+        match self
+            .fields
+            .binary_search_by(|(name, _)| name.as_str().cmp(field))
+        {
+            Ok(i) => self.fields[i].1 = value,
+            Err(i) => self.fields.insert(i, (field.to_string(), value)),
         }
     }
 
     /// A field's value, if present.
     pub fn get(&self, field: &str) -> Option<&Value> {
-        map_get(&self.fields, field)
+        self.fields
+            .binary_search_by(|(name, _)| name.as_str().cmp(field))
+            .ok()
+            .map(|i| &self.fields[i].1)
     }
 
     /// Whether a field is present and not `None`.

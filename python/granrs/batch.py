@@ -266,7 +266,7 @@ def sweep(
         plain_axes = {name: _axis_values(name, values) for name, values in axes.items()}
         _check_axes(scene, plain_axes)
         kwargs: dict[str, Any] = {
-            "base": scene.to_dict(),
+            "base": scene._plain(),
             "axes": [(k, [_plain(k, v) for v in vs]) for k, vs in plain_axes.items()],
         }
         n = math.prod(len(v) for v in plain_axes.values())
@@ -285,7 +285,7 @@ def sweep(
                     f"{type(s).__name__}",
                     field="scene",
                 )
-        kwargs = {"scenes": [s.to_dict() for s in scenes]}
+        kwargs = {"scenes": [s._plain() for s in scenes]}
         n = len(scenes)
         keep_axes = {}
     if client is not None:

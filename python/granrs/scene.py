@@ -276,13 +276,27 @@ class Scene:
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
-        """The scene as plain Python values (the form the Rust core reads)."""
+        """The scene as plain Python values, every field (a new dict)."""
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         d["coefficients"] = self.coefficients.as_dict()
         d["coefficients2"] = None if self.coefficients2 is None else self.coefficients2.as_dict()
         d["effects"] = list(self.effects)
         d["record"] = list(self.record)
         return d
+
+    def _plain(self) -> dict[str, Any]:
+        """What the Rust core reads: the fields of this scene's body as plain values, built
+        once per scene (it is frozen) and shared. Callers must not change it."""
+        cached: dict[str, Any] | None = self.__dict__.get("_plain_cache")
+        if cached is None:
+            cached = {
+                name: value
+                for name, value in self.to_dict().items()
+                if self.body in BODY_FIELDS.get(name, (self.body,))
+                and name != "coefficients_source"
+            }
+            object.__setattr__(self, "_plain_cache", cached)
+        return cached
 
     def validate(self) -> Scene:
         """Check every field in the Rust core; raise the typed error naming the first bad one."""

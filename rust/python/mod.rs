@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString, PyTuple};
 
 use crate::batch::{self, Source};
 use crate::error::GranrsError;
@@ -42,16 +42,20 @@ fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
     make().unwrap_or_else(|_| PyRuntimeError::new_err(message.clone()))
 }
 
-/// Convert a Python value to a spec value (no checks beyond the type).
+/// Convert a Python value to a spec value (no checks beyond the type). The common types
+/// (float, str, None) are tried first: this runs for every field of every scene.
 fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
+    if let Ok(f) = v.cast_exact::<PyFloat>() {
+        return Value::Num(f.value());
+    }
+    if let Ok(s) = v.cast::<PyString>() {
+        return Value::Str(s.to_str().map(str::to_owned).unwrap_or_default());
+    }
     if v.is_none() {
         return Value::None;
     }
     if v.is_instance_of::<PyBool>() {
         return Value::Bool(v.is_truthy().unwrap_or(false));
-    }
-    if let Ok(s) = v.cast::<PyString>() {
-        return Value::Str(s.to_string());
     }
     if let Ok(d) = v.cast::<PyDict>() {
         return Value::Map(
@@ -87,13 +91,15 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
 
 /// A scene dict (from `granrs.Scene.to_dict()`) as a spec.
 fn spec_from_dict(d: &Bound<'_, PyDict>) -> SceneSpec {
-    let mut spec = SceneSpec::new();
+    let mut pairs = Vec::with_capacity(d.len());
     for (k, v) in d.iter() {
         if let Ok(k) = k.cast::<PyString>() {
-            spec.set(&k.to_string(), value_from_py(&v));
+            if let Ok(k) = k.to_str() {
+                pairs.push((k.to_owned(), value_from_py(&v)));
+            }
         }
     }
-    spec
+    SceneSpec::from_pairs(pairs)
 }
 
 /// Convert a scene dict to an owned, validated scene (GIL held).
