@@ -3,26 +3,36 @@
 Usage::
 
     granrs --version
+    granrs run SCENE.toml [--set FIELD=VALUE ...] [--series OUT.csv|OUT.parquet] [--json]
+    granrs scene new [--body BODY] [--out FILE]
     granrs reproduce [--out DIR] [--dt DT] [--chapter KEY ...] [--quiet]
     granrs bench accuracy [--out DIR] [--quick] [--repeats N] [--quiet]
 
 Each subcommand is one ``_add_<name>`` function that declares its arguments and one
 ``_cmd_<name>`` function that runs it and returns the exit code; :data:`_COMMANDS` lists
-them (``run``, ``bench`` and ``calibrate`` are meant to be added the same way).
+them (``calibrate`` is meant to be added the same way).
 
-Exit codes: 0 on success; 2 for invalid input (a usage error, or any
-:class:`~granrs.errors.GranrsError`: one line on stderr, no traceback); 1 when a file
-cannot be written; 130 on Ctrl-C.
+Exit codes: 0 on success; 2 for invalid input (a usage error, a scene file that cannot be
+read, or any :class:`~granrs.errors.GranrsError` but a simulation failure: one line on
+stderr naming the field and the file and line, no traceback); 1 when the simulation fails
+(:class:`~granrs.errors.SimulationError`) or an output file cannot be written; 130 on Ctrl-C.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import json
+import math
+import numbers
+import os
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
 
 from . import __version__
-from .errors import GranrsError
+from .errors import GranrsError, InvalidSceneError, SimulationError
 
 __all__ = ["main"]
 
@@ -31,6 +41,8 @@ PROG = "granrs"
 EXIT_INVALID = 2
 #: Exit code of an operating-system error (e.g. the output directory is not writable).
 EXIT_OS_ERROR = 1
+#: Exit code of a failed simulation (a non-finite state).
+EXIT_SIMULATION = 1
 #: Exit code after Ctrl-C.
 EXIT_INTERRUPTED = 130
 
@@ -122,8 +134,269 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+#: What ``--series`` records when the scene records nothing.
+SERIES_RECORD: tuple[str, ...] = ("state", "forces", "energy")
+#: The output formats of ``--series``, by file extension.
+SERIES_FORMATS: tuple[str, ...] = (".csv", ".parquet")
+
+
+def _add_run(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Declare ``granrs run``."""
+    parser = sub.add_parser(
+        "run",
+        help="run one scene file and print its summary",
+        description=(
+            "Run the scene in a TOML scene file (see granrs.scenefile; 'granrs scene new' "
+            "writes one) and print its summary: the run's status and statistics, then each "
+            "contact's results with units."
+        ),
+    )
+    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="FIELD=VALUE",
+        help=(
+            "override a field, repeatable; VALUE is TOML (q_deg=30, 'record=[\"state\"]', "
+            "'knee={k=300.0, c=5.0}', coefficients.eta_h=7); a bare word is a string "
+            "(body=chain)"
+        ),
+    )
+    parser.add_argument(
+        "--series",
+        metavar="OUT",
+        help=(
+            "write the recorded time series to OUT.csv or OUT.parquet (parquet needs "
+            "pyarrow); a scene that records nothing records state, forces and energy"
+        ),
+    )
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    parser.set_defaults(handler=_cmd_run)
+
+
+def _series_format(path: str) -> str:
+    """The extension of a ``--series`` file, checked (and pyarrow's presence for parquet)."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in SERIES_FORMATS:
+        raise InvalidSceneError(
+            f"--series {path}: unknown extension {suffix or '(none)'!r}; "
+            f"use {' or '.join(SERIES_FORMATS)}",
+            field="series",
+        )
+    if suffix == ".parquet" and importlib.util.find_spec("pyarrow") is None:
+        raise InvalidSceneError(
+            f"--series {path}: writing parquet needs pyarrow: pip install pyarrow (or write .csv)",
+            field="series",
+        )
+    return suffix
+
+
+def _plain(value: Any) -> Any:
+    """A JSON-ready value: numpy scalars to Python, NaN and infinities to None."""
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        number = float(value)
+        return number if math.isfinite(number) else None
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return str(value)
+
+
+def _contact_names(result: Any) -> list[str]:
+    from .result import LINK_NAMES
+
+    names = LINK_NAMES.get(result.scene.body, ())
+    return [names[i] if i < len(names) else f"c{i}" for i in range(len(result.contacts))]
+
+
+#: The run-level entries of ``Result.summary`` (the rest are contact 0's).
+_RUN_KEYS: tuple[str, ...] = (
+    "status",
+    "t_final",
+    "energy_start",
+    "energy_end",
+    "dissipated",
+    "steps",
+    "rhs_evals",
+    "root_evals",
+    "events",
+    "rejected",
+)
+
+
+def summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
+    """The run's summary as plain data (what ``granrs run --json`` prints): the scene file,
+    body, status, the run's statistics, each contact's results by name, each joint's
+    largest force and torque, and the units. NaN (e.g. ``t_s`` without a stop) is None."""
+    from .result import SUMMARY_UNITS
+
+    run = {key: result.summary[key] for key in _RUN_KEYS if key in result.summary}
+    contacts = {
+        name: {"stopped": c.stopped, **c.summary}
+        for name, c in zip(_contact_names(result), result.contacts, strict=True)
+    }
+    units = dict(SUMMARY_UNITS)
+    units.update({"t_final": "s", "energy_start": "J", "energy_end": "J"})
+    return _plain(
+        {
+            "scene": source,
+            "body": result.scene.body,
+            "status": result.status,
+            "t_s": result.t_s,
+            "depth": result.depth,
+            "run": run,
+            "contacts": contacts,
+            "joints": result.joints,
+            "units": units,
+        }
+    )
+
+
+def _number(value: Any) -> str:
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        number = float(value)
+        return "-" if math.isnan(number) else f"{number:.6g}"
+    return str(value)
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
+    """Rows of text columns, the first left-aligned and the others right-aligned."""
+    widths = [max(len(row[i]) for row in [header, *rows]) for i in range(len(header))]
+
+    def line(row: Sequence[str]) -> str:
+        cells = [row[0].ljust(widths[0])]
+        cells += [cell.rjust(width) for cell, width in zip(row[1:], widths[1:], strict=True)]
+        return "  ".join(cells).rstrip()
+
+    return [line(header), line(["-" * w for w in widths]), *(line(row) for row in rows)]
+
+
+def summary_text(result: Any, source: str | None = None) -> str:
+    """The run's summary as a readable table (what ``granrs run`` prints)."""
+    from .result import SUMMARY_UNITS
+
+    s = result.summary
+    title = f"{source}: " if source else ""
+    lines = [
+        f"{title}{result.scene.body}, status {result.status} at t = {_number(s['t_final'])} s "
+        f"({s['steps']} steps, {s['rhs_evals']} rhs evaluations, {s['events']} events)",
+        f"energy: {_number(s['energy_start'])} J at the start, "
+        f"{_number(s['energy_end'])} J at the end",
+        "",
+    ]
+    names = _contact_names(result)
+    keys = [k for k in result.contacts[0].summary if k in SUMMARY_UNITS]
+    rows = [["stopped", "-", *(_number(c.stopped) for c in result.contacts)]]
+    rows += [
+        [key, SUMMARY_UNITS[key], *(_number(c.summary.get(key, math.nan)) for c in result.contacts)]
+        for key in keys
+    ]
+    lines += _table(["quantity", "unit", *names], rows)
+    if result.joints:
+        lines.append("")
+        joint_rows = [
+            [name, _number(j.get("F_max", math.nan)), _number(j.get("torque_max", math.nan))]
+            for name, j in result.joints.items()
+        ]
+        lines += _table(["joint", "F_max [N]", "torque_max [N m]"], joint_rows)
+    return "\n".join(lines)
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    """Run ``granrs run``."""
+    from . import scenefile
+    from .api import simulate
+
+    overrides = dict(scenefile.parse_override(item) for item in args.overrides)
+    suffix = _series_format(args.series) if args.series else None
+    try:
+        text = Path(args.scene).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise InvalidSceneError(f"cannot read scene file {args.scene}: {reason}") from None
+    scene = scenefile.loads(text, source=args.scene, overrides=overrides)
+    if suffix and not scene.record:
+        scene = scene.replace(record=SERIES_RECORD)
+        print(
+            f"{PROG}: note: the scene records nothing; --series records {', '.join(SERIES_RECORD)}",
+            file=sys.stderr,
+        )
+    result = simulate(scene)
+    if args.series:
+        frame = result.to_frame()
+        if suffix == ".parquet":
+            frame.to_parquet(args.series)
+        else:
+            frame.to_csv(args.series)
+        print(
+            f"{PROG}: series written to {args.series} ({len(frame)} rows, "
+            f"{len(frame.columns) + 1} columns)",
+            file=sys.stderr,
+        )
+    if args.json:
+        print(json.dumps(summary_dict(result, args.scene), indent=2, allow_nan=False))
+    else:
+        print(summary_text(result, args.scene))
+    return 0
+
+
+def _add_scene(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Declare ``granrs scene``."""
+    from .scene import BODIES
+
+    parser = sub.add_parser(
+        "scene",
+        help="write a scene file template ('scene new')",
+        description="Scene files: 'new' writes a commented scene file to start from.",
+    )
+    actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
+    new = actions.add_parser(
+        "new",
+        help="write a commented scene file (the thesis's scene for the body)",
+        description=(
+            "Write a scene file with every field of the body and a note on each: the "
+            "thesis's free link (q = 0, v0 = 2.214 m/s), chain case 1, or the leg at "
+            "3.28 m/s. Prints to stdout unless --out is given."
+        ),
+    )
+    new.add_argument(
+        "--body", choices=list(BODIES), default="free_link", help="the body (default: free_link)"
+    )
+    new.add_argument("--out", metavar="FILE", help="write to FILE instead of stdout")
+    new.add_argument("--force", action="store_true", help="overwrite FILE if it exists")
+    parser.set_defaults(handler=_cmd_scene)
+
+
+def _cmd_scene(args: argparse.Namespace) -> int:
+    """Run ``granrs scene new``."""
+    from . import scenefile
+
+    text = scenefile.template(args.body)
+    if args.out is None:
+        sys.stdout.write(text)
+        return 0
+    if os.path.exists(args.out) and not args.force:
+        raise InvalidSceneError(f"{args.out} exists; pass --force to overwrite it", field="out")
+    Path(args.out).write_text(text, encoding="utf-8")
+    print(f"scene file written to {args.out}", file=sys.stderr)
+    return 0
+
+
 #: The subcommands, in help order: each adds its parser and sets ``handler``.
 _COMMANDS: tuple[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]], None], ...] = (
+    _add_run,
+    _add_scene,
     _add_reproduce,
     _add_bench,
 )
@@ -164,6 +437,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else EXIT_INVALID
     try:
         return int(args.handler(args))
+    except SimulationError as exc:
+        print(f"{PROG}: simulation failed: {_one_line(exc)}", file=sys.stderr)
+        return EXIT_SIMULATION
     except GranrsError as exc:
         print(f"{PROG}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_INVALID
