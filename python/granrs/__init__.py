@@ -14,7 +14,7 @@ Quick start::
 
 from __future__ import annotations
 
-from . import _granrs, cases, coefficients, data
+from . import _granrs, cases, coefficients, data, scenefile
 from .api import simulate
 from .batch import sweep
 from .coefficients import Coefficients
@@ -54,6 +54,7 @@ __all__ = [
     "coefficients",
     "data",
     "resistance_force",
+    "scenefile",
     "simulate",
     "sweep",
 ]

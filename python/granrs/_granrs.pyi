@@ -10,6 +10,15 @@ RECORDS: list[str]
 def simulate(scene: dict[str, Any]) -> dict[str, Any]:
     """Run one scene dict (from Scene.to_dict()); return the raw results dict."""
 
+class Compiled:
+    """A scene dict converted and validated by the core (from compile())."""
+
+def compile(scene: dict[str, Any]) -> Compiled:
+    """Convert and validate a scene dict once."""
+
+def run(compiled: Compiled) -> dict[str, Any]:
+    """Run a compiled scene; return the raw results dict (plus run_seconds)."""
+
 def validate(scene: dict[str, Any]) -> None:
     """Validate a scene dict; raise the typed granrs error naming the first bad field."""
 

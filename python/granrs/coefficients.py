@@ -29,7 +29,6 @@ user's own table from CSV.
 from __future__ import annotations
 
 import csv
-import dataclasses
 import functools
 import math
 import numbers
@@ -111,7 +110,7 @@ class Coefficients:
 
     def as_dict(self) -> dict[str, float]:
         """``{"eta_h": ..., "eta_d": ..., "eta_v": ..., "lam": ...}`` (a new dict)."""
-        return dataclasses.asdict(self)
+        return {"eta_h": self.eta_h, "eta_d": self.eta_d, "eta_v": self.eta_v, "lam": self.lam}
 
 
 def _check_angle(q_deg: object, *, limit_deg: float, inclusive: bool) -> float:

@@ -60,6 +60,8 @@ class ResistanceForce(NamedTuple):
 
 
 def _array(name: str, value: Any) -> np.ndarray:
+    if type(value) is np.ndarray and value.dtype == np.float64:
+        return value
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -152,15 +154,25 @@ def resistance_force(
     names = ("depth", "q_deg", "vx", "vy", "omega", "eta_h", "eta_d", "eta_v", "lam")
     values = (depth, q_deg, vx, vy, omega, c["eta_h"], c["eta_d"], c["eta_v"], c["lam"])
     arrays = [_array(n, v) for n, v in zip(names, values, strict=True)]
-    try:
-        shaped = np.broadcast_arrays(*arrays)
-    except ValueError as exc:
-        shapes = ", ".join(f"{n} {a.shape}" for n, a in zip(names, arrays, strict=True))
-        raise InvalidParameterError(
-            f"the arrays do not broadcast together: {shapes}", field="depth"
-        ) from exc
-    shape = shaped[0].shape
-    flat = [np.ascontiguousarray(a, dtype=np.float64).reshape(-1) for a in shaped]
+    shapes = {a.shape for a in arrays if a.size != 1}
+    if len(shapes) <= 1:
+        # The common cases: scalars, and arrays of one shape. Scalars go to the core as one
+        # value (broadcast there without copying), arrays as flat views.
+        shape = shapes.pop() if shapes else np.broadcast_shapes(*(a.shape for a in arrays))
+        flat = [np.ascontiguousarray(a).reshape(-1) for a in arrays]
+    else:
+        try:
+            shaped = np.broadcast_arrays(*arrays)
+        except ValueError as exc:
+            listed = ", ".join(f"{n} {a.shape}" for n, a in zip(names, arrays, strict=True))
+            raise InvalidParameterError(
+                f"the arrays do not broadcast together: {listed}", field="depth"
+            ) from exc
+        shape = shaped[0].shape
+        flat = [
+            a.reshape(1) if a.size == 1 else np.ascontiguousarray(b).reshape(-1)
+            for a, b in zip(arrays, shaped, strict=True)
+        ]
     out = _granrs.resistance_force(
         flat,
         _scalar("length", length),

@@ -113,26 +113,20 @@ class Result:
 
     @classmethod
     def _from_raw(cls, scene: Scene, raw: dict[str, Any]) -> Result:
-        stats = raw["stats"]
-        contacts = []
-        for c in raw["contacts"]:
-            summary = {k: v for k, v in c.items() if k != "stopped"}
-            contacts.append(
-                ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=c["stopped"], summary=summary)
-            )
-        summary = dict(contacts[0].summary)
-        summary.update(stats)
-        summary["status"] = raw["status"]
-        summary["t_final"] = raw["t_final"]
-        summary["energy_start"] = raw["energy_start"]
-        summary["energy_end"] = raw["energy_end"]
-        summary["dissipated"] = raw["dissipated"]
+        contacts = [
+            ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=stopped, summary=c)
+            for c, stopped in zip(raw["contacts"], raw["stopped"], strict=True)
+        ]
+        summary = dict(raw["contacts"][0])
+        summary.update(raw["run"])
         names = JOINT_NAMES.get(scene.body, ())
-        joints = {
-            names[i] if i < len(names) else f"joint{i}": dict(j)
-            for i, j in enumerate(raw["joints"])
-            if scene.body != "free_link"
-        }
+        joints = (
+            {}
+            if scene.body == "free_link"
+            else {
+                names[i] if i < len(names) else f"joint{i}": j for i, j in enumerate(raw["joints"])
+            }
+        )
         return cls(
             scene=scene,
             status=raw["status"],

@@ -289,14 +289,27 @@ class Scene:
         once per scene (it is frozen) and shared. Callers must not change it."""
         cached: dict[str, Any] | None = self.__dict__.get("_plain_cache")
         if cached is None:
-            cached = {
-                name: value
-                for name, value in self.to_dict().items()
-                if self.body in BODY_FIELDS.get(name, (self.body,))
-                and name != "coefficients_source"
-            }
+            fields = self.__dict__
+            cached = {name: fields[name] for name in _CORE_FIELDS[self.body]}
+            cached["coefficients"] = self.coefficients.as_dict()
+            if "coefficients2" in cached and self.coefficients2 is not None:
+                cached["coefficients2"] = self.coefficients2.as_dict()
+            cached["effects"] = list(self.effects)
+            cached["record"] = list(self.record)
             object.__setattr__(self, "_plain_cache", cached)
         return cached
+
+    def __getstate__(self) -> dict[str, Any]:
+        # Pickle (Dask, multiprocessing) and copy the fields, not the caches of the core.
+        return {k: v for k, v in self.__dict__.items() if not k.endswith("_cache")}
+
+    def _compiled(self) -> Any:
+        """The scene converted and validated by the core, once per scene (it is frozen)."""
+        compiled = self.__dict__.get("_compiled_cache")
+        if compiled is None:
+            compiled = _granrs.compile(self._plain())
+            object.__setattr__(self, "_compiled_cache", compiled)
+        return compiled
 
     def validate(self) -> Scene:
         """Check every field in the Rust core; raise the typed error naming the first bad one."""
@@ -337,4 +350,13 @@ class Scene:
 
 _DEFAULTS: dict[str, Any] = {
     f.name: f.default for f in dataclasses.fields(Scene) if f.default is not dataclasses.MISSING
+}
+#: Per body, the fields the Rust core reads (those of the body; not coefficients_source).
+_CORE_FIELDS: dict[str, tuple[str, ...]] = {
+    body: tuple(
+        f.name
+        for f in dataclasses.fields(Scene)
+        if body in BODY_FIELDS.get(f.name, (body,)) and f.name != "coefficients_source"
+    )
+    for body in BODIES
 }

@@ -118,14 +118,23 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     stats.set_item("root_evals", out.stats.root_evals)?;
     stats.set_item("events", out.stats.events)?;
     stats.set_item("rejected", out.stats.rejected)?;
+    // The run-level entries of Result.summary, merged there with contact 0's in one update.
+    let run = stats.copy()?;
+    run.set_item("status", out.status.name())?;
+    run.set_item("t_final", out.t_final)?;
+    run.set_item("energy_start", out.energy_start)?;
+    run.set_item("energy_end", out.energy_end)?;
+    run.set_item("dissipated", out.dissipated)?;
+    d.set_item("run", run)?;
     d.set_item("stats", stats)?;
     d.set_item("energy_start", out.energy_start)?;
     d.set_item("energy_end", out.energy_end)?;
     d.set_item("work_sand", out.work_sand)?;
     let contacts = PyList::empty(py);
+    let stopped = PyList::empty(py);
     for c in &out.contacts {
+        stopped.append(c.stopped)?;
         let cd = PyDict::new(py);
-        cd.set_item("stopped", c.stopped)?;
         cd.set_item("t_s", c.t_s)?;
         cd.set_item("depth", c.depth)?;
         cd.set_item("dq", c.dq)?;
@@ -145,6 +154,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
         contacts.append(cd)?;
     }
     d.set_item("contacts", contacts)?;
+    d.set_item("stopped", stopped)?;
     d.set_item("dissipated", out.dissipated)?;
     let joints = PyList::empty(py);
     for j in &out.joints {
@@ -168,12 +178,42 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     Ok(d)
 }
 
+/// A scene converted and validated once (`compile`), to run many times without parsing.
+#[pyclass(frozen, module = "granrs._granrs")]
+struct Compiled {
+    scene: AnyScene,
+}
+
+/// Convert and validate a scene dict once; `run` it as often as wanted.
+#[pyfunction]
+fn compile(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Compiled> {
+    let scene = scene_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
+    Ok(Compiled { scene })
+}
+
+/// Run a compiled scene and return its results as a dict.
+#[pyfunction]
+fn run<'py>(py: Python<'py>, compiled: &Bound<'py, Compiled>) -> PyResult<Bound<'py, PyDict>> {
+    run_scene(py, &compiled.get().scene)
+}
+
 /// Run one scene (a dict from `granrs.Scene.to_dict()`) and return its results as a dict.
 #[pyfunction]
 fn simulate<'py>(py: Python<'py>, scene: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
     let scene = scene_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
-    let out = py.detach(|| scene.run()).map_err(|e| to_pyerr(py, e))?;
-    outcome_to_dict(py, out)
+    run_scene(py, &scene)
+}
+
+fn run_scene<'py>(py: Python<'py>, scene: &AnyScene) -> PyResult<Bound<'py, PyDict>> {
+    let (out, seconds) = py.detach(|| {
+        let t0 = std::time::Instant::now();
+        let out = scene.run();
+        (out, t0.elapsed().as_secs_f64())
+    });
+    let d = outcome_to_dict(py, out.map_err(|e| to_pyerr(py, e))?)?;
+    // Wall time of the run alone (for measuring the call's overhead; not a result).
+    d.set_item("run_seconds", seconds)?;
+    Ok(d)
 }
 
 /// Validate a scene dict without running it (raises the typed error, or returns None).
@@ -372,10 +412,11 @@ fn resistance_force<'py>(
         .map(|a| a.as_slice())
         .collect::<Result<_, _>>()
         .map_err(|_| PyValueError::new_err("resistance_force needs contiguous arrays"))?;
-    let n = slices[0].len();
-    if slices.iter().any(|s| s.len() != n) {
+    // Each input has n values or one (a scalar, broadcast here without copying).
+    let n = slices.iter().map(|s| s.len()).max().unwrap_or(0);
+    if slices.iter().any(|s| s.len() != n && s.len() != 1) {
         return Err(PyValueError::new_err(
-            "resistance_force arrays differ in length",
+            "resistance_force arrays must have the same length or length 1",
         ));
     }
     check_range("length", length, 0.0, true).map_err(err)?;
@@ -431,10 +472,32 @@ fn resistance_force<'py>(
     };
     let width = OUTPUTS.len();
     let out = py.detach(|| {
+        use rayon::prelude::*;
+        const CHUNK: usize = 4096;
         let mut out = vec![0.0; n * width];
-        for (i, row) in out.chunks_exact_mut(width).enumerate() {
-            let input = std::array::from_fn(|k| slices[k][i]);
-            evaluate(&setup, input, row);
+        let run = |c: usize, rows: &mut [f64]| {
+            for (j, row) in rows.chunks_exact_mut(width).enumerate() {
+                let i = c * CHUNK + j;
+                let input = std::array::from_fn(|k| {
+                    let s = slices[k];
+                    if s.len() == 1 {
+                        s[0]
+                    } else {
+                        s[i]
+                    }
+                });
+                evaluate(&setup, input, row);
+            }
+        };
+        if n <= 4 * CHUNK {
+            // Small calls (a simulator's contacts at one step): no thread hand-off.
+            out.chunks_mut(CHUNK * width)
+                .enumerate()
+                .for_each(|(c, rows)| run(c, rows));
+        } else {
+            out.par_chunks_mut(CHUNK * width)
+                .enumerate()
+                .for_each(|(c, rows)| run(c, rows));
         }
         out
     });
@@ -444,6 +507,9 @@ fn resistance_force<'py>(
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(compile, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_class::<Compiled>()?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(validate_sweep, m)?)?;

@@ -1,0 +1,291 @@
+"""Benchmarks of issue 5: sweeps, call overhead, pruned scenes, the vectorized force.
+
+One command, every ratio measured in the same run (absolute times on shared machines are
+noisy; the ratios are what to quote)::
+
+    python benches/bench_sweep.py            # 100,000-impact sweep; about two minutes
+    python benches/bench_sweep.py --quick    # 10,000 impacts
+    python benches/bench_sweep.py --part overhead --part prune
+
+Parts:
+
+* ``sweep``: a sweep of free-link impacts (angles x speeds x coefficient scales), summary
+  only, on 1 and 2 threads, each in a fresh child process that reports its own peak
+  resident memory (``ru_maxrss``). Targets: 2 threads >= 1.8x faster than 1; peak < 200 MB.
+* ``overhead``: each ``granrs.simulate(scene)`` call timed whole, against the run inside
+  it as the core times it. Target: overhead < 10 % of the call.
+* ``prune``: the vertical drop with every effect and every series recorded, against the
+  same drop with only ``gravity`` and ``static_v`` (summary only), and against every effect
+  summary only. Both must be measurably faster than the full scene with full recording.
+* ``force``: ``granrs.resistance_force`` on a million states against the same equations in
+  numpy.
+
+Build in release first: ``maturin develop --release``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+import granrs
+from granrs import cases
+
+PARTS = ("sweep", "overhead", "prune", "force")
+
+
+def _median_time(fn: Callable[[], object], repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+# ---------------------------------------------------------------------------------- sweep
+def _sweep_axes(n: int) -> dict[str, list[float]]:
+    """About n free-link impacts: angle x speed x eta_v scale."""
+    n_q = 100
+    n_v = 20
+    n_c = max(1, round(n / (n_q * n_v)))
+    return {
+        "q_deg": list(np.linspace(-85.0, 85.0, n_q)),
+        "v0": list(np.linspace(0.5, 5.0, n_v)),
+        "rho_g": list(np.linspace(1400.0, 1800.0, n_c)),
+    }
+
+
+def _child(n: int, threads: int) -> None:
+    """Run one sweep and print its time and this process's peak memory (JSON)."""
+    base = cases.free_link(q_deg=0.0, v0=2.0)
+    axes = _sweep_axes(n)
+    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    t0 = time.perf_counter()
+    df = granrs.sweep(base, threads=threads, progress=False, **axes)
+    elapsed = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+    ok = bool((df["status"] == "stopped").all() and np.isfinite(df["depth"]).all())
+    print(
+        json.dumps(
+            {
+                "runs": len(df),
+                "threads": threads,
+                "seconds": elapsed,
+                "peak_mb": peak / 1024,
+                "before_mb": rss_before / 1024,
+                "frame_mb": df.memory_usage(deep=True).sum() / 2**20,
+                "all_stopped_finite": ok,
+            }
+        )
+    )
+
+
+def part_sweep(n: int) -> list[str]:
+    rows = {}
+    for threads in (1, 2):
+        out = subprocess.run(
+            [sys.executable, __file__, "--child", str(n), str(threads)],
+            check=True,
+            capture_output=True,
+            text=True,
+        )
+        rows[threads] = json.loads(out.stdout.strip().splitlines()[-1])
+    one, two = rows[1], rows[2]
+    speedup = one["seconds"] / two["seconds"]
+    lines = [
+        f"### Sweep of {one['runs']:,} free-link impacts, summary only",
+        "",
+        "| threads | time [s] | per impact [us] | peak RSS [MB] | RSS after import [MB] "
+        "| DataFrame [MB] | all stopped, finite |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in (one, two):
+        lines.append(
+            f"| {r['threads']} | {r['seconds']:.2f} | {r['seconds'] / r['runs'] * 1e6:.1f} "
+            f"| {r['peak_mb']:.0f} | {r['before_mb']:.0f} | {r['frame_mb']:.1f} "
+            f"| {r['all_stopped_finite']} |"
+        )
+    peak = max(one["peak_mb"], two["peak_mb"])
+    lines += [
+        "",
+        f"2 threads / 1 thread speed-up: **{speedup:.2f}x** (target >= 1.8x: "
+        f"{'met' if speedup >= 1.8 else 'NOT met'}); peak memory **{peak:.0f} MB** "
+        f"(target < 200 MB: {'met' if peak < 200 else 'NOT met'}).",
+        "",
+    ]
+    return lines
+
+
+# ------------------------------------------------------------------------------- overhead
+def part_overhead(repeat: int) -> list[str]:
+    """Each call of simulate() timed whole, and the core's run inside it timed by the core
+    (``run_seconds``): the difference is the call's overhead, measured in the same call."""
+    from granrs import _granrs
+    from granrs.result import Result
+
+    lines = ["### Python call overhead of `simulate`", ""]
+    lines += [
+        "| scene | simulate() [us] | the run in the core [us] | overhead [us] | share "
+        "| a new Scene each call: overhead [us] | share |"
+    ]
+    lines += ["|---|---|---|---|---|---|---|"]
+    worst = 0.0
+    for name, scene in (
+        ("free link q = 45, v0 = 2.27", cases.free_link(q_deg=45.0, v0=2.27)),
+        ("free link q = 85, v0 = 2.257", cases.free_link(q_deg=85.0, v0=2.257)),
+        ("vertical drop v0 = 2.214", cases.free_link(q_deg=0.0, v0=2.214)),
+    ):
+        n = 200 * repeat
+        # Fresh copies (their construction is not timed): each call then converts and
+        # validates its scene in the core, as a loop over scene.replace(...) does.
+        fresh = [dataclasses.replace(scene) for _ in range(n)]
+        stats: dict[str, tuple[float, float]] = {}
+        for label, scenes in (("same", [scene] * n), ("fresh", fresh)):
+            totals, cores = [], []
+            for s in scenes:
+                t0 = time.perf_counter()
+                # The body of granrs.simulate (api.py), with the core's own timing kept.
+                raw = _granrs.run(s._compiled())
+                Result._from_raw(s, raw)
+                totals.append(time.perf_counter() - t0)
+                cores.append(raw["run_seconds"])
+            stats[label] = (statistics.median(totals), statistics.median(cores))
+        total, core = stats["same"]
+        over = total - core
+        f_total, f_core = stats["fresh"]
+        f_over = f_total - f_core
+        worst = max(worst, over / total, f_over / f_total)
+        lines.append(
+            f"| {name} | {total * 1e6:.1f} | {core * 1e6:.1f} | {over * 1e6:.1f} "
+            f"| {over / total * 100:.1f} % | {f_over * 1e6:.1f} | {f_over / f_total * 100:.1f} % |"
+        )
+    lines += [
+        "",
+        f"Largest overhead: **{worst * 100:.1f} %** of a simulate() call (target < 10 %: "
+        f"{'met' if worst < 0.10 else 'NOT met'}).",
+        "",
+    ]
+    return lines
+
+
+# ---------------------------------------------------------------------------------- prune
+def part_prune(repeat: int) -> list[str]:
+    base = cases.free_link(q_deg=0.0, v0=2.214)
+    variants = {
+        "every effect, every series recorded": base.replace(record=("state", "forces", "energy")),
+        "every effect, summary only": base,
+        "gravity + static_v, summary only": base.replace(effects=("gravity", "static_v")),
+        "gravity + static_v, every series": base.replace(
+            effects=("gravity", "static_v"), record=("state", "forces", "energy")
+        ),
+    }
+    n = 200
+    results = {k: [] for k in variants}
+    for _ in range(repeat):
+        for name, scene in variants.items():
+            results[name].append(
+                _median_time(lambda s=scene: [granrs.simulate(s) for _ in range(n)], 1) / n
+            )
+    full = statistics.median(results["every effect, every series recorded"])
+    depth = {k: granrs.simulate(s).depth for k, s in variants.items()}
+    lines = [
+        "### Effects and outputs: the vertical drop (v0 = 2.214 m/s, 10 kHz)",
+        "",
+        "| scene | per impact [us] | full / this | depth [mm] |",
+        "|---|---|---|---|",
+    ]
+    for name in variants:
+        t = statistics.median(results[name])
+        lines.append(f"| {name} | {t * 1e6:.1f} | {full / t:.2f}x | {depth[name] * 1e3:.4f} |")
+    lines.append("")
+    return lines
+
+
+# ---------------------------------------------------------------------------------- force
+def _numpy_force(depth, q_deg, vx, vy, omega, c, length=0.19, dc=0.0127, rho=1650.0, g=9.81):
+    q = np.radians(q_deg)
+    s, co = np.sin(q), np.cos(q)
+    d = np.maximum(depth, 0.0)
+    li = np.minimum(d / co, length)
+    vex = vx + 0.5 * li * omega * co
+    vey = vy - 0.5 * li * omega * s
+    k = c["eta_d"] * rho * dc * li * np.abs(s * vey - co * vex)
+    fsh = -np.sign(vex) * c["eta_h"] * g * rho * dc * d**2
+    fsv = -np.sign(vey) * c["eta_v"] * (d / length) ** c["lam"] * g * rho * math.pi / 4 * dc**2 * li
+    return -k * vex + fsh, -k * vey + fsv
+
+
+def part_force(repeat: int, n: int = 1_000_000) -> list[str]:
+    rng = np.random.default_rng(1)
+    depth = rng.uniform(0, 0.1, n)
+    q = rng.uniform(-80, 80, n)
+    vx, vy, om = rng.normal(0, 1, n), rng.normal(-1, 1, n), rng.normal(0, 5, n)
+    c = {"eta_h": 5.5, "eta_d": 11.0, "eta_v": 53.0, "lam": 0.25}
+    ours = _median_time(
+        lambda: granrs.resistance_force(depth, q, vx, vy, om, coefficients=c), repeat
+    )
+    theirs = _median_time(lambda: _numpy_force(depth, q, vx, vy, om, c), repeat)
+    f = granrs.resistance_force(depth, q, vx, vy, om, coefficients=c)
+    fx, fy = _numpy_force(depth, q, vx, vy, om, c)
+    err = max(np.max(np.abs(f.F_x - fx)), np.max(np.abs(f.F_y - fy)))
+    return [
+        f"### `resistance_force` on {n:,} states",
+        "",
+        "| implementation | time [ms] | per state [ns] |",
+        "|---|---|---|",
+        f"| granrs (Rust, one thread) | {ours * 1e3:.1f} | {ours / n * 1e9:.1f} |",
+        f"| the same equations in numpy | {theirs * 1e3:.1f} | {theirs / n * 1e9:.1f} |",
+        "",
+        f"numpy / granrs: **{theirs / ours:.1f}x**; largest difference {err:.2e} N.",
+        "",
+    ]
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--part", action="append", choices=PARTS, help="parts to run (all)")
+    parser.add_argument("--quick", action="store_true", help="10,000-impact sweep, fewer repeats")
+    parser.add_argument("--runs", type=int, default=None, help="impacts in the sweep")
+    parser.add_argument("--out", help="also write the Markdown report here")
+    parser.add_argument("--child", nargs=2, type=int, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.child:
+        _child(*args.child)
+        return 0
+    parts = args.part or list(PARTS)
+    n = args.runs or (10_000 if args.quick else 100_000)
+    repeat = 3 if args.quick else 7
+    lines = [
+        f"## granrs {granrs.__version__}: sweeps, overhead, effects (cpus: {os.cpu_count()})",
+        "",
+    ]
+    for part in parts:
+        if part == "sweep":
+            lines += part_sweep(n)
+        elif part == "overhead":
+            lines += part_overhead(repeat)
+        elif part == "prune":
+            lines += part_prune(repeat)
+        else:
+            lines += part_force(repeat)
+    print("\n".join(lines), flush=True)
+    if args.out:
+        with open(args.out, "w", encoding="utf-8") as fh:
+            fh.write("\n".join(lines) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
