@@ -22,9 +22,12 @@ def test_readme_has_a_short_python_example() -> None:
 
 
 def test_readme_python_examples_run() -> None:
+    outputs = []
     for block in _python_blocks():
         out = io.StringIO()
         with contextlib.redirect_stdout(out):
             exec(compile(block, str(README), "exec"), {})
-        text = out.getvalue()
-        assert "stopped after" in text and "mm depth" in text
+        outputs.append(out.getvalue())
+    assert "stopped after" in outputs[0] and "mm depth" in outputs[0]
+    # Every later example prints something (a table or an array).
+    assert all(text.strip() for text in outputs[1:])
