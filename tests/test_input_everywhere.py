@@ -588,3 +588,17 @@ def test_fuzz_scene_loaders_short() -> None:
     )
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     assert "failures: 0" in proc.stdout, proc.stdout[-3000:]
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="Coefficients with an int too large for a float (10**400) raises OverflowError "
+    "from float(), not InvalidParameterError (coefficients.Coefficients.__post_init__); "
+    "found by benches/fuzz_scenes.py --n 100000 --seed 0 (inputs #43238, #72758)",
+)
+def test_huge_integer_coefficient() -> None:
+    """Minimal reproducer: Coefficients(eta_h=10**400, eta_d=1, eta_v=1, lam=0)."""
+    big = 10**400
+    expect(
+        lambda: granrs.Coefficients(eta_h=big, eta_d=1.0, eta_v=1.0, lam=0.0), "coefficients.eta_h"
+    )

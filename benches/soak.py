@@ -1,0 +1,178 @@
+"""Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6).
+
+Checks that a long batch never returns NaN or infinity in a run that did not fail, never
+hangs and keeps its memory flat. Scenes are drawn from the valid domain of
+tests/test_properties.py (angle in (-90, 90) deg, v0 in [0, 10] m/s, coefficients 0..10x
+Table 3.4, masses 1 g .. 100 kg, every sign model, both points of application) with the
+thesis's step (dt = 1e-4 s by default; ``--dt-range`` draws dt from 1e-6 .. 1e-3 s) and
+``t_end`` capped so that a run takes at most ``--max-steps`` steps.
+
+They run in chunks (``--chunk``, 50,000 by default), each one ``granrs.sweep`` over a list
+of scenes; after each chunk the script prints the chunk, its seconds, the runs per second,
+its status counts and the resident memory (VmRSS from /proc/self/status). At the end: the
+totals, every failed run (with its scene and message; at most 20 printed), every run with
+a non-finite result, and the RSS growth from the first chunk to the last.
+
+Usage::
+
+    nice -n 10 python benches/soak.py [--n 1000000] [--chunk 50000] [--seed 0]
+
+Exits 1 if any run returned a non-finite number or memory grew by more than ``--max-growth``
+MB after the first chunk.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import math
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+import granrs
+from granrs import Coefficients, Scene
+
+SCALE = {"eta_h": 6.5, "eta_d": 15.2, "eta_v": 248.0, "lam": 0.106}
+SIGN_MODELS = ("modes", "raw", "smooth")
+APPLY_AT = ("tip", "centroid")
+
+
+def rss_mb() -> float:
+    """Resident set size of this process [MB] (Linux /proc)."""
+    with open("/proc/self/status", encoding="ascii") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return math.nan
+
+
+def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: int) -> list[Scene]:
+    """``n`` random valid free-link scenes (vectorized draws, then one Scene each)."""
+    q = rng.uniform(-89.99, 89.99, n)
+    v0 = rng.uniform(0.0, 10.0, n)
+    vx0 = np.where(rng.random(n) < 0.3, rng.uniform(-2.0, 2.0, n), 0.0)
+    omega0 = np.where(rng.random(n) < 0.3, rng.uniform(-20.0, 20.0, n), 0.0)
+    mass = 10.0 ** rng.uniform(-3.0, 2.0, n)
+    factors = rng.uniform(0.0, 10.0, (n, 4))
+    dt = 10.0 ** rng.uniform(-6.0, -3.0, n) if dt_range else np.full(n, 1e-4)
+    t_end = np.minimum(1.0, max_steps * dt)
+    sign = rng.integers(0, 3, n)
+    apply = rng.integers(0, 2, n)
+    out = []
+    for i in range(n):
+        f = factors[i]
+        out.append(
+            Scene(
+                q_deg=float(q[i]),
+                v0=float(v0[i]),
+                vx0=float(vx0[i]),
+                omega0=float(omega0[i]),
+                mass=float(mass[i]),
+                coefficients=Coefficients(
+                    eta_h=SCALE["eta_h"] * f[0],
+                    eta_d=SCALE["eta_d"] * f[1],
+                    eta_v=SCALE["eta_v"] * f[2],
+                    lam=SCALE["lam"] * f[3],
+                ),
+                dt=float(dt[i]),
+                t_end=float(t_end[i]),
+                sign_model=SIGN_MODELS[sign[i]],
+                apply_at=APPLY_AT[apply[i]],
+            )
+        )
+    return out
+
+
+def describe(scene: Scene) -> str:
+    c = scene.coefficients
+    return (
+        f"Scene(q_deg={scene.q_deg!r}, v0={scene.v0!r}, vx0={scene.vx0!r}, "
+        f"omega0={scene.omega0!r}, mass={scene.mass!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, "
+        f"sign_model={scene.sign_model!r}, apply_at={scene.apply_at!r}, coefficients="
+        f"Coefficients(eta_h={c.eta_h!r}, eta_d={c.eta_d!r}, eta_v={c.eta_v!r}, lam={c.lam!r}))"
+    )
+
+
+def soak(args: argparse.Namespace) -> int:
+    rng = np.random.default_rng(args.seed)
+    statuses: collections.Counter[str] = collections.Counter()
+    failed: list[tuple[int, str, str]] = []
+    non_finite: list[tuple[int, str, list[str]]] = []
+    rss: list[float] = []
+    t_all = time.perf_counter()
+    print(
+        f"granrs {granrs.__version__}: {args.n} scenes in chunks of {args.chunk}, seed {args.seed}"
+    )
+    print(f"{'chunk':>5} {'runs':>8} {'seconds':>8} {'runs/s':>8} {'RSS MB':>8}  statuses")
+    done = 0
+    chunk = 0
+    while done < args.n:
+        size = min(args.chunk, args.n - done)
+        scenes = random_scenes(rng, size, args.dt_range, args.max_steps)
+        t0 = time.perf_counter()
+        df = granrs.sweep(scenes, progress=False)
+        seconds = time.perf_counter() - t0
+        counts = df["status"].value_counts()
+        statuses.update({str(k): int(v) for k, v in counts.items() if v})
+        bad = (df["status"] == "failed").to_numpy()
+        for i in np.flatnonzero(bad):
+            failed.append((done + int(i), describe(scenes[i]), str(df["error"].iloc[i])))
+        ok = df[~bad]
+        numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
+        values = numeric.select_dtypes("number").to_numpy()
+        rows = np.flatnonzero(~np.isfinite(values).all(axis=1))
+        stopped = (ok["status"] == "stopped").to_numpy()
+        rows = np.union1d(rows, np.flatnonzero(stopped & ok["t_s"].isna().to_numpy()))
+        index = np.flatnonzero(~bad)
+        for r in rows:
+            cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
+            non_finite.append((done + int(index[r]), describe(scenes[index[r]]), cols))
+        del df, scenes, ok, numeric, values
+        rss.append(rss_mb())
+        short = ", ".join(f"{k} {int(v)}" for k, v in counts.items() if v)
+        print(
+            f"{chunk:>5} {size:>8} {seconds:>8.1f} {size / seconds:>8.0f} {rss[-1]:>8.1f}  {short}",
+            flush=True,
+        )
+        done += size
+        chunk += 1
+    elapsed = time.perf_counter() - t_all
+    growth = rss[-1] - rss[0]
+    print(f"total: {done} runs in {elapsed:.0f} s ({done / elapsed:.0f} runs/s)")
+    print("statuses: " + ", ".join(f"{k} {v}" for k, v in sorted(statuses.items())))
+    print(
+        f"RSS: first chunk {rss[0]:.1f} MB, last {rss[-1]:.1f} MB, max {max(rss):.1f} MB, "
+        f"growth after the first chunk {growth:+.1f} MB"
+    )
+    print(f"failed runs: {len(failed)}")
+    for i, scene, message in failed[:20]:
+        print(f"  run {i}: {message}\n    {scene}")
+    print(f"runs with a non-finite result: {len(non_finite)}")
+    for i, scene, cols in non_finite[:20]:
+        print(f"  run {i}: {', '.join(cols) or 't_s'}\n    {scene}")
+    return 1 if non_finite or growth > args.max_growth else 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--n", type=int, default=1_000_000, help="scenes (1000000)")
+    parser.add_argument("--chunk", type=int, default=50_000, help="scenes per sweep (50000)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    parser.add_argument(
+        "--dt-range", action="store_true", help="draw dt from 1e-6 .. 1e-3 s (default: 1e-4)"
+    )
+    parser.add_argument(
+        "--max-steps", type=int, default=20_000, help="cap on steps per run via t_end (20000)"
+    )
+    parser.add_argument(
+        "--max-growth", type=float, default=50.0, help="allowed RSS growth [MB] (50)"
+    )
+    args: Any = parser.parse_args(argv)
+    return soak(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
