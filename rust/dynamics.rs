@@ -365,7 +365,7 @@ struct Geometry {
 fn apply_rows<const N: usize, const R: usize>(
     rows: &Rows<N, R>,
     qdd: &mut SVector<f64, N>,
-    contacts: &mut [ContactEval; MAX_CONTACTS],
+    contacts: &mut [ContactEval],
     joint_torque: &mut [f64; N],
 ) {
     let k = rows.len;
@@ -617,8 +617,68 @@ impl<const N: usize> Model<N> {
     #[inline]
     pub fn eval(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>, modes: &Modes) -> Eval<N> {
         match self.rigid_rod() {
-            Some(rod) => self.eval_rigid_rod(rod, q, qd, modes),
+            Some(rod) => {
+                let mut contacts = [ContactEval::default(); MAX_CONTACTS];
+                let (qdd, power, joint_torque) =
+                    self.eval_rigid_rod(rod, q, qd, modes, &mut contacts[0]);
+                Eval {
+                    qdd,
+                    power,
+                    joint_power: 0.0,
+                    joint_torque,
+                    contacts,
+                }
+            }
             None => self.eval_general(q, qd, modes),
+        }
+    }
+
+    /// [`Model::eval`] into `out`, in place (an `Eval` holds every contact's findings: the
+    /// solver keeps two and writes each step's end into one). Every field is overwritten
+    /// except the findings past the model's contacts, which stay as they were (the defaults,
+    /// when `out` came from this model).
+    #[inline]
+    pub fn eval_into(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+        out: &mut Eval<N>,
+    ) {
+        match self.rigid_rod() {
+            Some(rod) => {
+                out.contacts[0] = ContactEval::default();
+                let (qdd, power, joint_torque) =
+                    self.eval_rigid_rod(rod, q, qd, modes, &mut out.contacts[0]);
+                out.qdd = qdd;
+                out.power = power;
+                out.joint_power = 0.0;
+                out.joint_torque = joint_torque;
+            }
+            None => *out = self.eval_general(q, qd, modes),
+        }
+    }
+
+    /// What a Runge-Kutta stage needs of [`Model::eval`]: the accelerations, the power of
+    /// the sand's forces and that of the joints' dampers [W] (the free link skips the
+    /// per-contact findings).
+    #[inline]
+    pub fn rates(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> (SVector<f64, N>, f64, f64) {
+        match self.rigid_rod() {
+            Some(rod) => {
+                let mut contact = ContactEval::default();
+                let (qdd, power, _) = self.eval_rigid_rod(rod, q, qd, modes, &mut contact);
+                (qdd, power, 0.0)
+            }
+            None => {
+                let e = self.eval_general(q, qd, modes);
+                (e.qdd, e.power, e.joint_power)
+            }
         }
     }
 
@@ -656,13 +716,18 @@ impl<const N: usize> Model<N> {
     /// form: `M = diag(m + m_root, m + m_root, I)`, gravity the only bias force, a force `F`
     /// applied at `P` giving the torque `F . dP/dq`, and at most two sticking rows. The same
     /// equations as [`Model::eval_general`], equal to round-off (the tests compare the two).
+    ///
+    /// Writes the contact's findings into `out` (which must hold the defaults) and returns
+    /// the accelerations, the power of the sand's force and the joint torques.
+    #[inline]
     fn eval_rigid_rod(
         &self,
         rod: &RodContact,
         q: &SVector<f64, N>,
         qd: &SVector<f64, N>,
         modes: &Modes,
-    ) -> Eval<N> {
+        out: &mut ContactEval,
+    ) -> (SVector<f64, N>, f64, [f64; N]) {
         let link = &self.mechanism.links[0];
         let mass = link.mass + self.mechanism.root_mass;
         let g = if self.effects.gravity {
@@ -673,8 +738,6 @@ impl<const N: usize> Model<N> {
         let fr = RodFrame::new(q, qd);
         let mut gen = SVector::<f64, N>::zeros();
         gen[1] = -mass * g;
-        let mut contacts = [ContactEval::default(); MAX_CONTACTS];
-        let out = &mut contacts[0];
         let tip = fr.at(rod.tip);
         let v_tip = fr.velocity(rod.tip);
         out.tip = tip;
@@ -736,25 +799,23 @@ impl<const N: usize> Model<N> {
         let mut joint_torque = [0.0; N];
         if self.any_stuck(modes) {
             let rows = self.rigid_rod_rows(rod, &fr, modes);
-            apply_rows(&rows, &mut qdd, &mut contacts, &mut joint_torque);
+            apply_rows(
+                &rows,
+                &mut qdd,
+                std::slice::from_mut(out),
+                &mut joint_torque,
+            );
         }
-        let c = &contacts[0];
         let power = if forced {
             let v_p = match self.apply_at {
-                ApplyAt::Tip => c.v_tip,
-                ApplyAt::Centroid => c.v_centroid,
+                ApplyAt::Tip => out.v_tip,
+                ApplyAt::Centroid => out.v_centroid,
             };
-            c.force.total().dot(&v_p)
+            out.force.total().dot(&v_p)
         } else {
             0.0
         };
-        Eval {
-            qdd,
-            power,
-            joint_power: 0.0,
-            joint_torque,
-            contacts,
-        }
+        (qdd, power, joint_torque)
     }
 
     /// The sticking rows of a single rigid rod about its centre of mass under `modes`
@@ -1172,7 +1233,16 @@ mod tests {
             };
             let q = SVector::<f64, 3>::new(x, y, th);
             let qd = SVector::<f64, 3>::new(vx, vy, w);
-            let a = model.eval_rigid_rod(rod.as_ref().unwrap(), &q, &qd, &modes);
+            let a = model.eval(&q, &qd, &modes);
+            prop_assert!(model.rigid_rod().is_some());
+            let mut a_into = model.eval(&q, &qd, &modes);
+            a_into.qdd *= 2.0;
+            a_into.contacts[0].depth = -1.0;
+            model.eval_into(&q, &qd, &modes, &mut a_into);
+            prop_assert_eq!(a.qdd, a_into.qdd);
+            prop_assert_eq!(a.contacts, a_into.contacts);
+            let (qdd, power, joint_power) = model.rates(&q, &qd, &modes);
+            prop_assert_eq!((qdd, power, joint_power), (a.qdd, a.power, a.joint_power));
             let b = model.eval_general(&q, &qd, &modes);
             let scale = b.qdd.amax().max(model.medium.g);
             for i in 0..3 {
