@@ -219,7 +219,7 @@ def impact_scalar(y0, p, dt, t_end):
     x, y, q, vx, vy, w = y0[0], y0[1], y0[2], y0[3], y0[4], y0[5]
     h_prev = y - half * math.cos(q)
     vt_prev = vy + half * w * math.sin(q)
-    n_max = int(math.ceil(t_end / dt))
+    n_max = math.ceil(t_end / dt)
     hdt = 0.5 * dt
     for i in range(n_max):
         a1x, a1y, a1w = _accel(y, q, vx, vy, w, inv_m, inv_i, half, length, length, c_d, c_h,
@@ -544,7 +544,7 @@ def write_out(path: Path, runs: list[SceneRun], lines: list[str]) -> None:
         w.writerow(
             ["q_deg", "v0", "depth_ref", "rtol", "ivp_matched", "err_granrs", "err_granrs_raw"]
             + [f"depth_{k}" for k in sorted(runs[0].depth)]
-            + [f"err_solve_ivp"]
+            + ["err_solve_ivp"]
             + [f"seconds_{k}" for k in names]
         )
         for r in runs:

@@ -599,14 +599,18 @@ impl<const N: usize> Model<N> {
     }
 
     /// Whether any sticking component is in force under `modes`.
+    #[inline]
     fn any_stuck(&self, modes: &Modes) -> bool {
         self.sign_model == SignModel::Modes
-            && self.contacts.iter().enumerate().any(|(ci, _)| {
-                let m = &modes[ci];
-                m.in_contact
-                    && ((self.effects.static_h && m.sx == Slip::Stick)
-                        || (self.effects.static_v && m.sy == Slip::Stick))
-            })
+            && modes[..self.contacts.len()].iter().any(|m| self.stuck(m))
+    }
+
+    /// Whether a static term of a contact in mode `m` sticks (with `SignModel::Modes`).
+    #[inline]
+    fn stuck(&self, m: &ContactMode) -> bool {
+        m.in_contact
+            && ((self.effects.static_h && m.sx == Slip::Stick)
+                || (self.effects.static_v && m.sy == Slip::Stick))
     }
 
     /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
@@ -795,9 +799,12 @@ impl<const N: usize> Model<N> {
             gen[1] += total.y;
             gen[2] += total.dot(&fr.lever(self.application_point(&self.contacts[0], centroid)));
         }
-        let mut qdd = gen.component_mul(&self.rigid_rod_inverse_mass());
+        let mut qdd = SVector::<f64, N>::zeros();
+        qdd[0] = gen[0] / mass;
+        qdd[1] = gen[1] / mass;
+        qdd[2] = gen[2] / link.inertia;
         let mut joint_torque = [0.0; N];
-        if self.any_stuck(modes) {
+        if self.sign_model == SignModel::Modes && self.stuck(mode) {
             let rows = self.rigid_rod_rows(rod, &fr, modes);
             apply_rows(
                 &rows,
