@@ -7,7 +7,9 @@
 //! * `step/rk4`: one RK4 step from that state (three more evaluations);
 //! * `impact/*`: whole impacts: the Table 3.5 row q = 45, v0 = 2.27, the vertical drop at
 //!   v0 = 2.214, and every row of Table 3.5 (31 as shipped) with its Table 3.4 coefficients
-//!   (the row at the tabulated angle nearest |q|, ties to the larger angle).
+//!   (the row at the tabulated angle nearest |q|, ties to the larger angle);
+//!   `impact/table_3_5_all_raw` the same with the plain sign() (`SignModel::Raw`), the
+//!   algorithm of the peers in `benches/peers.py`.
 //!
 //! `cargo bench --bench free_link` (about a minute); `cargo bench --bench free_link -- --test`
 //! runs each once as a check. The machines are shared: compare ratios (an impact against
@@ -19,7 +21,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::{SVector, Vector2};
 
-use _granrs::dynamics::{ContactMode, Modes, Slip, MAX_CONTACTS};
+use _granrs::dynamics::{ContactMode, Modes, SignModel, Slip, MAX_CONTACTS};
 use _granrs::force::resistance::rod_force;
 use _granrs::force::{Coefficients, Medium, RodContactState};
 use _granrs::integrate::rk4::{deriv_of, step, State};
@@ -309,6 +311,23 @@ fn impact(c: &mut Criterion) {
     g.bench_function("table_3_5_all", |b| {
         b.iter(|| {
             black_box(&all)
+                .iter()
+                .map(|s| s.run().unwrap().contacts[0].depth)
+                .sum::<f64>()
+        })
+    });
+    // The same table with the thesis's plain sign() (SignModel::Raw): the algorithm of the
+    // numba and scipy peers of `benches/peers.py`.
+    let all_raw: Vec<FreeLinkScene> = all
+        .iter()
+        .map(|s| FreeLinkScene {
+            sign_model: SignModel::Raw,
+            ..s.clone()
+        })
+        .collect();
+    g.bench_function("table_3_5_all_raw", |b| {
+        b.iter(|| {
+            black_box(&all_raw)
                 .iter()
                 .map(|s| s.run().unwrap().contacts[0].depth)
                 .sum::<f64>()

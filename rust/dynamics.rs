@@ -256,16 +256,17 @@ struct Row<const N: usize> {
     response: SVector<f64, N>,
 }
 
-/// A fixed-capacity set of constraint rows (no allocation in the right-hand side).
-struct Rows<const N: usize> {
-    rows: [Option<Row<N>>; MAX_ROWS],
+/// A set of at most `R` constraint rows (no allocation in the right-hand side): `R` is
+/// [`MAX_ROWS`] for any body, 2 for a single rod (its two sticking components).
+struct Rows<const N: usize, const R: usize> {
+    rows: [Option<Row<N>>; R],
     len: usize,
 }
 
-impl<const N: usize> Rows<N> {
+impl<const N: usize, const R: usize> Rows<N, R> {
     fn new() -> Self {
         Rows {
-            rows: [None; MAX_ROWS],
+            rows: [None; R],
             len: 0,
         }
     }
@@ -278,15 +279,15 @@ impl<const N: usize> Rows<N> {
     }
 }
 
-/// A constraint system `a x = b` of size `k` on the stack.
-type Small = ([[f64; MAX_ROWS]; MAX_ROWS], [f64; MAX_ROWS]);
+/// A constraint system `a x = b` of size `k <= R` on the stack.
+type Small<const R: usize> = ([[f64; R]; R], [f64; R]);
 
 /// Solve the `k x k` system that `fill` assembles, by Gaussian elimination with partial
 /// pivoting. A (near-)singular system, from redundant constraints, is assembled again with a
 /// tiny diagonal shift (only then: the common case copies nothing). Returns the solution, or
 /// `None` if that fails too.
-fn solve_small(k: usize, fill: impl Fn(&mut Small)) -> Option<[f64; MAX_ROWS]> {
-    let mut sys: Small = ([[0.0; MAX_ROWS]; MAX_ROWS], [0.0; MAX_ROWS]);
+fn solve_small<const R: usize>(k: usize, fill: impl Fn(&mut Small<R>)) -> Option<[f64; R]> {
+    let mut sys: Small<R> = ([[0.0; R]; R], [0.0; R]);
     fill(&mut sys);
     let scale = (0..k).fold(0.0f64, |m, i| m.max(sys.0[i][i].abs()));
     if eliminate(&mut sys, k, 1e-13 * scale.max(f64::MIN_POSITIVE)) {
@@ -301,7 +302,7 @@ fn solve_small(k: usize, fill: impl Fn(&mut Small)) -> Option<[f64; MAX_ROWS]> {
 
 /// Gaussian elimination with partial pivoting in place (`b` becomes `x`); false at a pivot
 /// at or below `tiny`.
-fn eliminate((a, b): &mut Small, k: usize, tiny: f64) -> bool {
+fn eliminate<const R: usize>((a, b): &mut Small<R>, k: usize, tiny: f64) -> bool {
     for col in 0..k {
         let piv = (col..k)
             .max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))
@@ -356,6 +357,131 @@ struct Geometry {
     factor: f64,
     /// The sole's polygon, for the box drag.
     sole: Option<crate::body::SoleGeometry>,
+}
+
+/// Solve for the multipliers of `rows` at the unconstrained accelerations `qdd`, correct
+/// `qdd`, and store each multiplier: a sticking component's reaction in place of its static
+/// term, a locked joint's torque.
+fn apply_rows<const N: usize, const R: usize>(
+    rows: &Rows<N, R>,
+    qdd: &mut SVector<f64, N>,
+    contacts: &mut [ContactEval],
+    joint_torque: &mut [f64; N],
+) {
+    let k = rows.len;
+    if k == 0 {
+        return;
+    }
+    let free = *qdd;
+    let mults = solve_small::<R>(k, |(a, b)| {
+        for i in 0..k {
+            let ri = rows.get(i);
+            b[i] = -(ri.bias + ri.jac.dot(&free));
+            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                *aij = ri.jac.dot(&rows.get(j).response);
+            }
+        }
+    })
+    .unwrap_or([0.0; R]);
+    for (i, &mult) in mults.iter().enumerate().take(k) {
+        let r = rows.get(i);
+        *qdd += mult * r.response;
+        match r.kind {
+            RowKind::Stick { contact, axis } => {
+                let ce = &mut contacts[contact];
+                if axis == 0 {
+                    ce.force.static_h = mult;
+                } else {
+                    ce.force.static_v = mult;
+                }
+            }
+            RowKind::Lock { link } => joint_torque[link] = mult,
+        }
+    }
+}
+
+/// Project `qd` onto `rows` (each `jac . qd = 0`) M-orthogonally, `minv` applying M^-1.
+/// Only drift is removed: a violation above [`PROJECTION_LIMIT`] is a wrong mode, left for
+/// the solver's switching functions to see. Returns whether `qd` changed.
+fn project_rows<const N: usize, const R: usize>(
+    rows: &Rows<N, R>,
+    qd: &mut SVector<f64, N>,
+    minv: impl Fn(&SVector<f64, N>) -> SVector<f64, N>,
+) -> bool {
+    let k = rows.len;
+    if k == 0 {
+        return false;
+    }
+    if (0..k).any(|i| rows.get(i).jac.dot(qd).abs() > PROJECTION_LIMIT) {
+        return false;
+    }
+    // M^-1 J^T columns and J M^-1 J^T.
+    let mut minv_jt = [SVector::<f64, N>::zeros(); R];
+    for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
+        *m = minv(&rows.get(i).jac);
+    }
+    let v = *qd;
+    let lam = solve_small::<R>(k, |(a, b)| {
+        for i in 0..k {
+            let ji = &rows.get(i).jac;
+            b[i] = ji.dot(&v);
+            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                *aij = ji.dot(&minv_jt[j]);
+            }
+        }
+    });
+    match lam {
+        Some(lam) if lam[..k].iter().any(|&l| l != 0.0) => {
+            for (l, m) in lam.iter().zip(&minv_jt).take(k) {
+                *qd -= *l * m;
+            }
+            true
+        }
+        _ => false,
+    }
+}
+
+/// Position and velocity of a single rigid rod whose root is its centre of mass: what
+/// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation).
+#[derive(Debug, Clone, Copy)]
+struct RodFrame {
+    root: Vector2<f64>,
+    v_root: Vector2<f64>,
+    omega: f64,
+    axis: Vector2<f64>,
+    normal: Vector2<f64>,
+}
+
+impl RodFrame {
+    #[inline]
+    fn new<const N: usize>(q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Self {
+        let (s, c) = q[2].sin_cos();
+        RodFrame {
+            root: Vector2::new(q[0], q[1]),
+            v_root: Vector2::new(qd[0], qd[1]),
+            omega: qd[2],
+            axis: Vector2::new(s, c),
+            normal: Vector2::new(c, -s),
+        }
+    }
+
+    /// Position of the point with local coordinates `r`: `root + R r`.
+    #[inline]
+    fn at(&self, r: Vector2<f64>) -> Vector2<f64> {
+        self.root + (r.x * self.axis + r.y * self.normal)
+    }
+
+    /// `d(R r)/dq`: the lever of `r` (velocity per unit rate, generalized force per unit force).
+    #[inline]
+    fn lever(&self, r: Vector2<f64>) -> Vector2<f64> {
+        r.x * self.normal - r.y * self.axis
+    }
+
+    /// Velocity of the point with local coordinates `r`.
+    #[inline]
+    fn velocity(&self, r: Vector2<f64>) -> Vector2<f64> {
+        self.v_root + self.omega * self.lever(r)
+    }
 }
 
 impl<const N: usize> Model<N> {
@@ -473,18 +599,291 @@ impl<const N: usize> Model<N> {
     }
 
     /// Whether any sticking component is in force under `modes`.
+    #[inline]
     fn any_stuck(&self, modes: &Modes) -> bool {
         self.sign_model == SignModel::Modes
-            && self.contacts.iter().enumerate().any(|(ci, _)| {
-                let m = &modes[ci];
-                m.in_contact
-                    && ((self.effects.static_h && m.sx == Slip::Stick)
-                        || (self.effects.static_v && m.sy == Slip::Stick))
-            })
+            && modes[..self.contacts.len()].iter().any(|m| self.stuck(m))
+    }
+
+    /// Whether a static term of a contact in mode `m` sticks (with `SignModel::Modes`).
+    #[inline]
+    fn stuck(&self, m: &ContactMode) -> bool {
+        m.in_contact
+            && ((self.effects.static_h && m.sx == Slip::Stick)
+                || (self.effects.static_v && m.sy == Slip::Stick))
     }
 
     /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
+    ///
+    /// A single rigid rod whose root is its centre of mass (the free link) has a constant,
+    /// diagonal mass matrix and no velocity products: it takes [`Model::eval_rigid_rod`],
+    /// the same equations in closed form.
+    #[inline]
     pub fn eval(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>, modes: &Modes) -> Eval<N> {
+        match self.rigid_rod() {
+            Some(rod) => {
+                let mut contacts = [ContactEval::default(); MAX_CONTACTS];
+                let (qdd, power, joint_torque) =
+                    self.eval_rigid_rod(rod, q, qd, modes, &mut contacts[0]);
+                Eval {
+                    qdd,
+                    power,
+                    joint_power: 0.0,
+                    joint_torque,
+                    contacts,
+                }
+            }
+            None => self.eval_general(q, qd, modes),
+        }
+    }
+
+    /// [`Model::eval`] into `out`, in place (an `Eval` holds every contact's findings: the
+    /// solver keeps two and writes each step's end into one). Every field is overwritten
+    /// except the findings past the model's contacts, which stay as they were (the defaults,
+    /// when `out` came from this model).
+    #[inline]
+    pub fn eval_into(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+        out: &mut Eval<N>,
+    ) {
+        match self.rigid_rod() {
+            Some(rod) => {
+                out.contacts[0] = ContactEval::default();
+                let (qdd, power, joint_torque) =
+                    self.eval_rigid_rod(rod, q, qd, modes, &mut out.contacts[0]);
+                out.qdd = qdd;
+                out.power = power;
+                out.joint_power = 0.0;
+                out.joint_torque = joint_torque;
+            }
+            None => *out = self.eval_general(q, qd, modes),
+        }
+    }
+
+    /// What a Runge-Kutta stage needs of [`Model::eval`]: the accelerations, the power of
+    /// the sand's forces and that of the joints' dampers [W] (the free link skips the
+    /// per-contact findings).
+    #[inline]
+    pub fn rates(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> (SVector<f64, N>, f64, f64) {
+        match self.rigid_rod() {
+            Some(rod) => {
+                let mut contact = ContactEval::default();
+                let (qdd, power, _) = self.eval_rigid_rod(rod, q, qd, modes, &mut contact);
+                (qdd, power, 0.0)
+            }
+            None => {
+                let e = self.eval_general(q, qd, modes);
+                (e.qdd, e.power, e.joint_power)
+            }
+        }
+    }
+
+    /// The rod contact of a single free link with its centre of mass at the root (no
+    /// parent, one rod contact on it), or `None` for any other body.
+    #[inline]
+    fn rigid_rod(&self) -> Option<&RodContact> {
+        if N != 3 || self.mechanism.links.len() != 1 || self.contacts.len() != 1 {
+            return None;
+        }
+        let link = &self.mechanism.links[0];
+        if link.parent.is_some() || link.com != Vector2::zeros() {
+            return None;
+        }
+        match &self.contacts[0].shape {
+            Shape::Rod(rod) if rod.link == 0 => Some(rod),
+            _ => None,
+        }
+    }
+
+    /// The diagonal of M^-1 of a single rigid rod about its centre of mass:
+    /// `M = diag(m + m_root, m + m_root, I)`.
+    #[inline]
+    fn rigid_rod_inverse_mass(&self) -> SVector<f64, N> {
+        let link = &self.mechanism.links[0];
+        let mass = link.mass + self.mechanism.root_mass;
+        let mut inv = SVector::<f64, N>::zeros();
+        inv[0] = 1.0 / mass;
+        inv[1] = 1.0 / mass;
+        inv[2] = 1.0 / link.inertia;
+        inv
+    }
+
+    /// [`Model::eval`] of a single rigid rod whose root is its centre of mass, in closed
+    /// form: `M = diag(m + m_root, m + m_root, I)`, gravity the only bias force, a force `F`
+    /// applied at `P` giving the torque `F . dP/dq`, and at most two sticking rows. The same
+    /// equations as [`Model::eval_general`], equal to round-off (the tests compare the two).
+    ///
+    /// Writes the contact's findings into `out` (which must hold the defaults) and returns
+    /// the accelerations, the power of the sand's force and the joint torques.
+    #[inline]
+    fn eval_rigid_rod(
+        &self,
+        rod: &RodContact,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+        out: &mut ContactEval,
+    ) -> (SVector<f64, N>, f64, [f64; N]) {
+        let link = &self.mechanism.links[0];
+        let mass = link.mass + self.mechanism.root_mass;
+        let g = if self.effects.gravity {
+            self.medium.g
+        } else {
+            0.0
+        };
+        let fr = RodFrame::new(q, qd);
+        let mut gen = SVector::<f64, N>::zeros();
+        gen[1] = -mass * g;
+        let tip = fr.at(rod.tip);
+        let v_tip = fr.velocity(rod.tip);
+        out.tip = tip;
+        out.v_tip = v_tip;
+        out.v_centroid = v_tip;
+        out.lowest = tip.y;
+        let mode = &modes[0];
+        let geom = rod.geometry(tip.y, fr.axis);
+        let forced = mode.in_contact && geom.depth > 0.0;
+        if mode.in_contact {
+            out.depth = geom.depth;
+            out.immersion_margin = rod.length * fr.axis.y - geom.depth;
+        }
+        if forced {
+            let centroid = Vector2::new(geom.centroid_s, rod.tip.y);
+            let v_e = fr.velocity(centroid);
+            out.v_centroid = v_e;
+            let (sx, sy) = match self.sign_model {
+                SignModel::Modes => (mode.sx.sign(), mode.sy.sign()),
+                SignModel::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
+                SignModel::Smooth { eps } => ((v_e.x / eps).tanh(), (v_e.y / eps).tanh()),
+            };
+            let coef = &self.contacts[0].coefficients;
+            let (bh, bv) = static_terms(
+                coef,
+                &self.medium,
+                rod.diameter,
+                rod.length,
+                geom.depth,
+                rod.immersed_volume(&geom),
+            );
+            let mut f = ForceComponents::default();
+            let cross_signed = fr.axis.x * v_e.y - fr.axis.y * v_e.x;
+            out.cross = cross_signed;
+            if self.effects.drag {
+                let cross = match self.sign_model {
+                    SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
+                    SignModel::Modes => cross_signed,
+                    _ => cross_signed.abs(),
+                };
+                let area_speed = rod.diameter * geom.immersed_length * cross;
+                f.drag = -(coef.eta_d * self.medium.rho_g * area_speed) * v_e;
+            }
+            if self.effects.static_h {
+                out.bound_h = bh;
+                f.static_h = -sx * bh;
+            }
+            if self.effects.static_v {
+                out.bound_v = bv;
+                f.static_v = -sy * bv;
+            }
+            out.force = f;
+            let total = f.total();
+            gen[0] += total.x;
+            gen[1] += total.y;
+            gen[2] += total.dot(&fr.lever(self.application_point(&self.contacts[0], centroid)));
+        }
+        let mut qdd = SVector::<f64, N>::zeros();
+        qdd[0] = gen[0] / mass;
+        qdd[1] = gen[1] / mass;
+        qdd[2] = gen[2] / link.inertia;
+        let mut joint_torque = [0.0; N];
+        if self.sign_model == SignModel::Modes && self.stuck(mode) {
+            let rows = self.rigid_rod_rows(rod, &fr, modes);
+            apply_rows(
+                &rows,
+                &mut qdd,
+                std::slice::from_mut(out),
+                &mut joint_torque,
+            );
+        }
+        let power = if forced {
+            let v_p = match self.apply_at {
+                ApplyAt::Tip => out.v_tip,
+                ApplyAt::Centroid => out.v_centroid,
+            };
+            out.force.total().dot(&v_p)
+        } else {
+            0.0
+        };
+        (qdd, power, joint_torque)
+    }
+
+    /// The sticking rows of a single rigid rod about its centre of mass under `modes`
+    /// ([`Model::constraint_rows`] for that body): the velocity of the immersed centroid E
+    /// along x and/or y held at zero, E sliding along the rod as the immersed length grows.
+    fn rigid_rod_rows(&self, rod: &RodContact, fr: &RodFrame, modes: &Modes) -> Rows<N, 2> {
+        let mut rows = Rows::new();
+        let mode = &modes[0];
+        let stuck_x = self.effects.static_h && mode.sx == Slip::Stick;
+        let stuck_y = self.effects.static_v && mode.sy == Slip::Stick;
+        if self.sign_model != SignModel::Modes || !mode.in_contact || !(stuck_x || stuck_y) {
+            return rows;
+        }
+        let geom = rod.geometry(fr.at(rod.tip).y, fr.axis);
+        if geom.depth <= 0.0 {
+            return rows;
+        }
+        let centroid = Vector2::new(geom.centroid_s, rod.tip.y);
+        let lever_e = fr.lever(centroid);
+        // E moves over the rod at half the rate of the immersed length.
+        let v_tip = fr.velocity(rod.tip);
+        let l_rate = rod.immersed_length_rate(&geom, fr.axis, -v_tip.y, -fr.axis.x * fr.omega);
+        let slide = (0.5 * l_rate) * fr.normal;
+        let a_bias = -(fr.omega * fr.omega) * (centroid.x * fr.axis + centroid.y * fr.normal)
+            + fr.omega * slide;
+        let lever_p = fr.lever(self.application_point(&self.contacts[0], centroid));
+        let inv = self.rigid_rod_inverse_mass();
+        for (k, on) in [(0usize, stuck_x), (1usize, stuck_y)] {
+            if !on {
+                continue;
+            }
+            let u = unit(k);
+            let mut jac = SVector::<f64, N>::zeros();
+            jac[0] = u.x;
+            jac[1] = u.y;
+            jac[2] = u.dot(&lever_e);
+            let mut gen = SVector::<f64, N>::zeros();
+            gen[0] = u.x;
+            gen[1] = u.y;
+            gen[2] = u.dot(&lever_p);
+            rows.push(Row {
+                kind: RowKind::Stick {
+                    contact: 0,
+                    axis: k,
+                },
+                jac,
+                bias: u.dot(&a_bias),
+                response: gen.component_mul(&inv),
+            });
+        }
+        rows
+    }
+
+    /// [`Model::eval`] for any body: pose, bias forces, contact forces through the
+    /// Jacobians, mass matrix and its Cholesky factor, and the constraints in force.
+    pub fn eval_general(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> Eval<N> {
         let pose = self.mechanism.pose(q);
         let g = if self.effects.gravity {
             self.medium.g
@@ -632,7 +1031,7 @@ impl<const N: usize> Model<N> {
         qd: &SVector<f64, N>,
         modes: &Modes,
         chol: &nalgebra::Cholesky<f64, nalgebra::Const<N>>,
-    ) -> Rows<N> {
+    ) -> Rows<N, MAX_ROWS> {
         let mut rows = Rows::new();
         for (link, parent) in self.mechanism.locked_rows() {
             let mut jac = SVector::<f64, N>::zeros();
@@ -710,36 +1109,7 @@ impl<const N: usize> Model<N> {
         joint_torque: &mut [f64; N],
     ) {
         let rows = self.constraint_rows(pose, q, qd, modes, chol);
-        let k = rows.len;
-        if k == 0 {
-            return;
-        }
-        let free = *qdd;
-        let mults = solve_small(k, |(a, b)| {
-            for i in 0..k {
-                let ri = rows.get(i);
-                b[i] = -(ri.bias + ri.jac.dot(&free));
-                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
-                    *aij = ri.jac.dot(&rows.get(j).response);
-                }
-            }
-        })
-        .unwrap_or([0.0; MAX_ROWS]);
-        for (i, &mult) in mults.iter().enumerate().take(k) {
-            let r = rows.get(i);
-            *qdd += mult * r.response;
-            match r.kind {
-                RowKind::Stick { contact, axis } => {
-                    let ce = &mut contacts[contact];
-                    if axis == 0 {
-                        ce.force.static_h = mult;
-                    } else {
-                        ce.force.static_v = mult;
-                    }
-                }
-                RowKind::Lock { link } => joint_torque[link] = mult,
-            }
-        }
+        apply_rows(&rows, qdd, contacts, joint_torque);
     }
 
     /// Project `qd` so that every sticking component's velocity (and every locked joint's
@@ -754,6 +1124,22 @@ impl<const N: usize> Model<N> {
         if !self.any_stuck(modes) {
             return false;
         }
+        if let Some(rod) = self.rigid_rod() {
+            let frame = RodFrame::new(q, qd);
+            let rows = self.rigid_rod_rows(rod, &frame, modes);
+            let inv = self.rigid_rod_inverse_mass();
+            return project_rows(&rows, qd, |v| v.component_mul(&inv));
+        }
+        self.project_sticking_general(q, qd, modes)
+    }
+
+    /// [`Model::project_sticking`] for any body (after the `any_stuck` check).
+    fn project_sticking_general(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &mut SVector<f64, N>,
+        modes: &Modes,
+    ) -> bool {
         let pose = self.mechanism.pose(q);
         let mass = self.mechanism.mass_matrix(&pose);
         let chol = match mass.cholesky() {
@@ -761,39 +1147,7 @@ impl<const N: usize> Model<N> {
             None => return false,
         };
         let rows = self.constraint_rows(&pose, q, qd, modes, &chol);
-        let k = rows.len;
-        if k == 0 {
-            return false;
-        }
-        // Only drift is removed: a violation larger than this is not drift but a wrong mode,
-        // and is left for the solver's switching functions to see.
-        if (0..k).any(|i| rows.get(i).jac.dot(qd).abs() > PROJECTION_LIMIT) {
-            return false;
-        }
-        // M^-1 J^T columns and J M^-1 J^T.
-        let mut minv_jt = [SVector::<f64, N>::zeros(); MAX_ROWS];
-        for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
-            *m = chol.solve(&rows.get(i).jac);
-        }
-        let v = *qd;
-        let lam = solve_small(k, |(a, b)| {
-            for i in 0..k {
-                let ji = &rows.get(i).jac;
-                b[i] = ji.dot(&v);
-                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
-                    *aij = ji.dot(&minv_jt[j]);
-                }
-            }
-        });
-        match lam {
-            Some(lam) if lam[..k].iter().any(|&l| l != 0.0) => {
-                for (l, m) in lam.iter().zip(&minv_jt).take(k) {
-                    *qd -= *l * m;
-                }
-                true
-            }
-            _ => false,
-        }
+        project_rows(&rows, qd, |v| chol.solve(v))
     }
 
     /// Force each link receives at its joint from its parent (or the root) [N], from the
@@ -828,5 +1182,140 @@ impl<const N: usize> Model<N> {
             self.mechanism.kinetic_energy(&pose, qd),
             self.mechanism.potential_energy(&pose, self.medium.g) + self.mechanism.spring_energy(q),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::FreeLinkScene;
+    use proptest::prelude::*;
+
+    fn slip(i: u8) -> Slip {
+        [Slip::Neg, Slip::Pos, Slip::Stick][i as usize % 3]
+    }
+
+    fn close(a: f64, b: f64, scale: f64) -> bool {
+        (a - b).abs() <= 1e-13 * scale.max(a.abs()).max(b.abs())
+    }
+
+    proptest! {
+        /// The free link's closed-form evaluation (`eval_rigid_rod`) is the general engine's
+        /// (`eval_general`) to round-off, for every sign model, point of application, mode,
+        /// term switched off, and a point mass at the root.
+        #[test]
+        fn rigid_rod_path_is_the_general_engine(
+            x in -0.1f64..0.1, y in -0.12f64..0.12, th in -1.55f64..1.55,
+            vx in -3.0f64..3.0, vy in -3.0f64..3.0, w in -30.0f64..30.0,
+            sign in 0u8..3, centroid in any::<bool>(), in_contact in any::<bool>(),
+            sx in 0u8..3, sy in 0u8..3, cross in 0u8..2, effects in 0u8..16,
+            root_mass in prop_oneof![Just(0.0f64), Just(0.05f64)],
+        ) {
+            let mut model = FreeLinkScene {
+                apply_at: if centroid { ApplyAt::Centroid } else { ApplyAt::Tip },
+                sign_model: [
+                    SignModel::Modes,
+                    SignModel::Raw,
+                    SignModel::Smooth { eps: 1e-3 },
+                ][sign as usize],
+                ..Default::default()
+            }
+            .model();
+            model.mechanism.root_mass = root_mass;
+            model.effects = Effects {
+                gravity: effects & 1 != 0,
+                drag: effects & 2 != 0,
+                static_h: effects & 4 != 0,
+                static_v: effects & 8 != 0,
+            };
+            let rod = model.rigid_rod().copied();
+            prop_assert!(rod.is_some());
+            let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
+            modes[0] = ContactMode {
+                in_contact,
+                sx: slip(sx),
+                sy: slip(sy),
+                cross: slip(cross),
+                ..ContactMode::default()
+            };
+            let q = SVector::<f64, 3>::new(x, y, th);
+            let qd = SVector::<f64, 3>::new(vx, vy, w);
+            let a = model.eval(&q, &qd, &modes);
+            prop_assert!(model.rigid_rod().is_some());
+            let mut a_into = model.eval(&q, &qd, &modes);
+            a_into.qdd *= 2.0;
+            a_into.contacts[0].depth = -1.0;
+            model.eval_into(&q, &qd, &modes, &mut a_into);
+            prop_assert_eq!(a.qdd, a_into.qdd);
+            prop_assert_eq!(a.contacts, a_into.contacts);
+            let (qdd, power, joint_power) = model.rates(&q, &qd, &modes);
+            prop_assert_eq!((qdd, power, joint_power), (a.qdd, a.power, a.joint_power));
+            let b = model.eval_general(&q, &qd, &modes);
+            let scale = b.qdd.amax().max(model.medium.g);
+            for i in 0..3 {
+                prop_assert!(close(a.qdd[i], b.qdd[i], scale), "qdd {:?} vs {:?}", a.qdd, b.qdd);
+            }
+            prop_assert!(close(a.power, b.power, 1e-12), "{} vs {}", a.power, b.power);
+            let (ca, cb) = (&a.contacts[0], &b.contacts[0]);
+            let pairs = [
+                (ca.tip.x, cb.tip.x), (ca.tip.y, cb.tip.y), (ca.v_tip.x, cb.v_tip.x),
+                (ca.v_tip.y, cb.v_tip.y), (ca.depth, cb.depth), (ca.lowest, cb.lowest),
+                (ca.v_centroid.x, cb.v_centroid.x), (ca.v_centroid.y, cb.v_centroid.y),
+                (ca.force.drag.x, cb.force.drag.x), (ca.force.drag.y, cb.force.drag.y),
+                (ca.force.static_h, cb.force.static_h), (ca.force.static_v, cb.force.static_v),
+                (ca.cross, cb.cross), (ca.immersion_margin, cb.immersion_margin),
+                (ca.bound_h, cb.bound_h), (ca.bound_v, cb.bound_v),
+            ];
+            for (i, (u, v)) in pairs.into_iter().enumerate() {
+                prop_assert!(close(u, v, 1e-12), "field {i}: {u} vs {v}");
+            }
+            prop_assert_eq!(&a.contacts[1..], &b.contacts[1..]);
+        }
+    }
+
+    proptest! {
+        /// The rod's closed-form projection onto its sticking rows is the general one.
+        #[test]
+        fn rigid_rod_projection_is_the_general_engine(
+            th in -1.5f64..1.5, depth in 0.001f64..0.1, vy in -3.0f64..3.0,
+            w in -30.0f64..30.0, drift in -5e-7f64..5e-7, sx in 0u8..3, sy in 0u8..3,
+        ) {
+            let model = FreeLinkScene::default().model();
+            let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
+            modes[0] = ContactMode {
+                in_contact: true,
+                sx: slip(sx),
+                sy: slip(sy),
+                ..ContactMode::default()
+            };
+            // The tip `depth` deep; v_E within `drift` of zero along each stuck axis.
+            let half = 0.5 * model.contacts[0].reference_point().x.abs();
+            let q = SVector::<f64, 3>::new(0.0, half * th.cos() - depth, th);
+            let mut qd = SVector::<f64, 3>::new(0.0, vy, w);
+            let v_e = model.eval_general(&q, &qd, &modes).contacts[0].v_centroid;
+            if modes[0].sx == Slip::Stick {
+                qd[0] -= v_e.x - drift;
+            }
+            if modes[0].sy == Slip::Stick {
+                qd[1] -= v_e.y + drift;
+            }
+            let (mut a, mut b) = (qd, qd);
+            let changed_a = model.project_sticking(&q, &mut a, &modes);
+            let changed_b = model.any_stuck(&modes)
+                && model.project_sticking_general(&q, &mut b, &modes);
+            prop_assert_eq!(changed_a, changed_b);
+            for i in 0..3 {
+                prop_assert!(close(a[i], b[i], 1e-9), "{a:?} vs {b:?}");
+            }
+        }
+    }
+
+    /// Any other body keeps the general engine.
+    #[test]
+    fn only_a_rod_about_its_centre_of_mass_is_closed_form() {
+        let mut model = FreeLinkScene::default().model();
+        assert!(model.rigid_rod().is_some());
+        model.mechanism.links[0].com = Vector2::new(0.01, 0.0);
+        assert!(model.rigid_rod().is_none());
     }
 }

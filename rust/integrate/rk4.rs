@@ -76,7 +76,15 @@ pub fn step<const N: usize>(
     k1: &Deriv<N>,
     h: f64,
 ) -> State<N> {
-    let f = |s: &State<N>| deriv_of(s, &model.eval(&s.q, &s.qd, modes));
+    let f = |s: &State<N>| {
+        let (qdd, power, joint_power) = model.rates(&s.q, &s.qd, modes);
+        Deriv {
+            q: s.qd,
+            qd: qdd,
+            work: power,
+            dissipated: joint_power,
+        }
+    };
     let y2 = y.add(0.5 * h, k1);
     let k2 = f(&y2);
     let y3 = y.add(0.5 * h, &k2);
@@ -161,8 +169,13 @@ pub fn dopri5_step<const N: usize>(
                 ys = ys.add(h * a, kj);
             }
         }
-        let e = model.eval(&ys.q, &ys.qd, modes);
-        k[s] = deriv_of(&ys, &e);
+        let (qdd, power, joint_power) = model.rates(&ys.q, &ys.qd, modes);
+        k[s] = Deriv {
+            q: ys.qd,
+            qd: qdd,
+            work: power,
+            dissipated: joint_power,
+        };
     }
     // The solution is the seventh stage's argument (FSAL): y1 = y + h sum_j a_7j k_j.
     let mut y1 = *y;

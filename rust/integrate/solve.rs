@@ -631,9 +631,12 @@ pub fn solve<const N: usize>(
     let mut recorder = Recorder::new(options.record, N, nc, n_links);
     let stride = options.record.stride.max(1);
     let mut t = 0.0f64;
-    let mut e0 = model.eval(&y.q, &y.qd, &modes);
+    // The evaluations at the step's start (`evals[cur]`) and end: an accepted step swaps
+    // their roles instead of copying (an `Eval` holds every contact's findings).
+    let mut evals = [model.eval(&y.q, &y.qd, &modes); 2];
+    let mut cur = 0usize;
     stats.rhs_evals += 1;
-    recorder.push(model, t, &y, &e0, &modes);
+    recorder.push(model, t, &y, &evals[cur], &modes);
     let n_grid = (options.t_end / dt).ceil() as u64;
     let mut n: u64 = 0;
     let mut events_this_step = 0usize;
@@ -680,13 +683,19 @@ pub fn solve<const N: usize>(
             events_this_step = 0;
             continue;
         }
-        let k1: Deriv<N> = deriv_of(&y, &e0);
-        let (y1, e1) = match options.method {
+        let (head, tail) = evals.split_at_mut(1);
+        let (e0, e1_slot) = if cur == 0 {
+            (&head[0], &mut tail[0])
+        } else {
+            (&tail[0], &mut head[0])
+        };
+        let k1: Deriv<N> = deriv_of(&y, e0);
+        let y1 = match options.method {
             Method::Rk4 => {
                 let y1 = step(model, &modes, &y, &k1, h);
-                let e1 = model.eval(&y1.q, &y1.qd, &modes);
+                model.eval_into(&y1.q, &y1.qd, &modes, e1_slot);
                 stats.rhs_evals += 4;
-                (y1, e1)
+                y1
             }
             Method::Dopri5 { rtol, atol } => {
                 let (y1, e1, err) = dopri5_step(model, &modes, &y, &k1, h, rtol, atol);
@@ -708,9 +717,11 @@ pub fn solve<const N: usize>(
                     continue;
                 }
                 h_adapt = h * factor;
-                (y1, e1)
+                *e1_slot = e1;
+                y1
             }
         };
+        let e1: &Eval<N> = e1_slot;
         if !y1.is_finite() || !e1.qdd.iter().all(|v| v.is_finite()) {
             return Err(GranrsError::NonFinite {
                 t,
@@ -727,15 +738,15 @@ pub fn solve<const N: usize>(
                 y0: y,
                 f0: k1,
                 y1,
-                f1: deriv_of(&y1, &e1),
+                f1: deriv_of(&y1, e1),
                 h,
             };
             for &(kind, ci) in &funcs {
-                let g1 = switching(kind, ci, &e1, &modes);
+                let g1 = switching(kind, ci, e1, &modes);
                 if !crossed(kind, g1) {
                     continue;
                 }
-                let g0 = switching(kind, ci, &e0, &modes).max(0.0);
+                let g0 = switching(kind, ci, e0, &modes).max(0.0);
                 let theta = if g1 == 0.0 {
                     1.0
                 } else if g0 == 0.0 {
@@ -763,21 +774,20 @@ pub fn solve<const N: usize>(
         if hits.is_empty() {
             // Accept the whole step.
             y = y1;
-            let changed = model.project_sticking(&y.q, &mut y.qd, &modes);
-            e0 = if changed {
+            cur = 1 - cur;
+            if model.project_sticking(&y.q, &mut y.qd, &modes) {
                 stats.rhs_evals += 1;
-                model.eval(&y.q, &y.qd, &modes)
-            } else {
-                e1
-            };
+                model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
+            }
+            let e0 = &evals[cur];
             t = t_next;
             n += 1;
             events_this_step = 0;
             stats.steps += 1;
-            update_fd_max(&mut summaries, &e0, &modes);
-            update_joints(&mut joints, &y, &e0, &modes);
+            update_fd_max(&mut summaries, e0, &modes);
+            update_joints(&mut joints, &y, e0, &modes);
             if n.is_multiple_of(stride as u64) {
-                recorder.push(model, t, &y, &e0, &modes);
+                recorder.push(model, t, &y, e0, &modes);
             }
             continue;
         }
@@ -883,9 +893,9 @@ pub fn solve<const N: usize>(
             break Status::Stopped;
         }
         model.project_sticking(&y.q, &mut y.qd, &modes);
-        e0 = model.eval(&y.q, &y.qd, &modes);
+        model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
         stats.rhs_evals += 1;
-        recorder.push(model, t, &y, &e0, &modes);
+        recorder.push(model, t, &y, &evals[cur], &modes);
     };
 
     // Contacts without a stop report their state at the end.

@@ -1,0 +1,638 @@
+"""granrs against the same free-link model written without granrs, on the Table 3.5 scenes.
+
+One command times granrs and its peers on the same scenes in one run and prints ratios
+(issue 5, "peers"). The model is the one of ``shared/MODEL.md`` as granrs runs it by default
+for the free link: a rod of L = 0.190 m, d_c = 0.0127 m, m = 0.184 kg, I = m (L^2/12 +
+d_c^2/16), sand of 1650 kg/m^3, g = 9.81, Table 3.4 coefficients (the row at the tabulated
+angle nearest |q|, ties to the larger angle: ``granrs.cases.free_link``), the resistance
+force applied at the tip T, dropped tip first at q with velocity (0, -v0). The peers:
+
+* ``numba_user``: a numba-jitted fixed-step RK4 written the way a user would: the state
+  (x, y, q, vx, vy, omega) as a numpy array, a right-hand side that returns a new array,
+  k1..k4 temporaries, the thesis's plain ``sign()`` (``np.sign``), dt = 1e-4 s, and the stop
+  (the tip's vertical velocity reaching 0 from below) located by linear interpolation
+  between the two step ends. Compiled before timing.
+* ``numba_scalar``: the same algorithm hand-tuned: no arrays, every quantity a scalar,
+  constants folded, sin and cos once per evaluation. A ceiling for what a jitted loop gives.
+* ``solve_ivp``: ``scipy.integrate.solve_ivp`` (RK45) on a plain-Python right-hand side
+  (``math``, a list returned), with a terminal event on the tip's vertical velocity
+  (direction +1); a run past ``IVP_MAX_NFEV`` evaluations is abandoned as failed (the
+  plain sign() can trap RK45 where v_Ey reaches 0). Its tolerance is matched to granrs's
+  depth accuracy per scene: the reference depth is granrs (``"modes"``) at dt = 1e-7 s
+  (1e-6 with ``--quick``), granrs's error is that of its default run at dt = 1e-4, and
+  the matched rtol is the loosest of 1e-3 .. 1e-12 from which on (it and every tighter
+  rtol of the sweep) solve_ivp's depth error is at most granrs's; atol = 1e-3 rtol. A
+  scene where no rtol gets there is timed at its most accurate rtol and flagged; one where
+  every rtol fails is not timed, and the solve_ivp ratio is over the scenes it ran.
+
+granrs itself is timed per impact, single thread, summary only (no time series):
+
+* through ``granrs.simulate(scene)`` per scene from Python, with the default sign model
+  ``"modes"`` (each sign a mode held through a step, switches located exactly) and with
+  ``"raw"`` (the thesis's plain sign: the peers' algorithm, with granrs's exact stop);
+* Rust only: criterion's ``impact/table_3_5_all`` and ``impact/table_3_5_all_raw``
+  (``benches/free_link.rs``), run by this script through ``cargo bench`` unless
+  ``--no-criterion``; and as a Python-free estimate, the simulate time less its
+  ``Scene.to_dict`` + ``_granrs.validate`` overhead.
+
+Every method runs the whole table in turn within each repeat, and each scene's time is the
+minimum over the repeats: the ratios come from the same stretch of a shared, noisy machine.
+Before timing, the peers' depths are checked against granrs ``"raw"``: the same model and the
+same steps, so they must agree to RK4 accuracy (the two differ only where granrs cuts a step
+at a kink of the force law and in how the stop is located); the script fails otherwise.
+
+Usage::
+
+    python benches/peers.py [--quick] [--repeats N] [--out results.csv|results.md]
+        [--no-criterion]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numba import njit
+from scipy.integrate import solve_ivp
+
+import granrs
+from granrs import _granrs
+
+#: RK4 step of granrs's default and of the numba peers [s] (thesis: 10 kHz).
+DT = 1e-4
+#: Latest end time of the peers [s] (every Table 3.5 impact stops within about 40 ms).
+T_END = 0.2
+#: granrs reference steps [s] (``"modes"``): full and ``--quick``.
+REFERENCE_DT = 1e-7
+REFERENCE_DT_QUICK = 1e-6
+#: solve_ivp tolerances swept, loosest first; atol = ATOL_FACTOR * rtol.
+RTOLS = tuple(10.0**-k for k in range(3, 13))
+ATOL_FACTOR = 1e-3
+#: Right-hand-side evaluations after which a solve_ivp run is abandoned as failed: with the
+#: plain sign() the vertical force flips where v_Ey reaches 0 and RK45 can shrink its step
+#: without end there instead of reaching the stop event.
+IVP_MAX_NFEV = 50_000
+#: Largest |depth(numba) - depth(granrs raw)| accepted [m]: RK4 accuracy at 10 kHz. The
+#: steps are the same; the stop differs (linear against Hermite interpolation, an error of
+#: about |a| dt^2 / 8 ~ 1e-7 m) and so do steps that granrs cuts at the full-immersion kink.
+AGREEMENT_TOL = 2e-6
+#: The Table 3.5 rows run in ``--quick`` mode (q_deg, v0).
+QUICK_ROWS = ((0.0, 2.214), (25.0, 1.766), (45.0, 2.27), (65.0, 1.119), (85.0, 2.257))
+#: Targets of issue 5.
+TARGET_NUMBA = 1.0 / 3.0
+TARGET_SOLVE_IVP = 1000.0
+REPO = Path(__file__).resolve().parents[1]
+
+
+# --- the model, as a user writes it -------------------------------------------------------
+
+
+def parameters(scene: granrs.Scene) -> np.ndarray:
+    """The peers' parameter vector: m, I, L, d_c, rho_g, g, eta_h, eta_d, eta_v, lambda."""
+    c = scene.coefficients
+    inertia = scene.inertia
+    if inertia is None:
+        inertia = scene.mass * (scene.length**2 / 12.0 + scene.diameter**2 / 16.0)
+    return np.array(
+        [
+            scene.mass,
+            inertia,
+            scene.length,
+            scene.diameter,
+            scene.rho_g,
+            scene.g,
+            c.eta_h,
+            c.eta_d,
+            c.eta_v,
+            c.lam,
+        ]
+    )
+
+
+def initial_state(scene: granrs.Scene) -> np.ndarray:
+    """(x, y, q, vx, vy, omega) of the centre of mass: tip at the origin, moving (0, -v0)."""
+    q = math.radians(scene.q_deg)
+    half = 0.5 * scene.length
+    return np.array([half * math.sin(q), half * math.cos(q), q, 0.0, -scene.v0, 0.0])
+
+
+@njit
+def rhs_user(y, p):
+    """dy/dt of the free link (user style: arrays in, a new array out)."""
+    m, inertia, length, dc, rho, g = p[0], p[1], p[2], p[3], p[4], p[5]
+    eta_h, eta_d, eta_v, lam = p[6], p[7], p[8], p[9]
+    q, vx, vy, w = y[2], y[3], y[4], y[5]
+    e = np.array([np.sin(q), np.cos(q)])  # axis, tip to top
+    n = np.array([e[1], -e[0]])  # d e / d q
+    tip = y[0:2] - 0.5 * length * e
+    d = max(0.0, -tip[1])
+    force = np.zeros(2)
+    torque = 0.0
+    if d > 0.0:
+        # Immersed length, capped at L; centroid E of the immersed part and its velocity.
+        if d >= length * e[1]:
+            ell = length
+        else:
+            ell = d / e[1]
+        s_e = -0.5 * length + 0.5 * ell
+        v_e = np.array([vx, vy]) + w * s_e * n
+        cross = abs(e[0] * v_e[1] - e[1] * v_e[0])
+        drag = -eta_d * rho * dc * ell * cross * v_e
+        f_h = eta_h * g * rho * dc * d**2
+        f_v = eta_v * (d / length) ** lam * g * rho * (np.pi / 4 * dc**2 * ell)
+        force = drag - np.array([np.sign(v_e[0]) * f_h, np.sign(v_e[1]) * f_v])
+        # Applied at the tip, r = -L/2 e: generalized torque F . dr/dq.
+        torque = np.dot(force, -0.5 * length * n)
+    return np.array([vx, vy, w, force[0] / m, force[1] / m - g, torque / inertia])
+
+
+@njit
+def tip_height_and_vy(y, length):
+    """Height y_T and vertical velocity of the tip."""
+    return y[1] - 0.5 * length * np.cos(y[2]), y[4] + 0.5 * length * y[5] * np.sin(y[2])
+
+
+@njit
+def impact_user(y0, p, dt, t_end):
+    """Fixed-step RK4 to the stop; returns (t_s, depth at t_s, steps). User style."""
+    y = y0.copy()
+    h_prev, vt_prev = tip_height_and_vy(y, p[2])
+    n_max = int(np.ceil(t_end / dt))
+    for i in range(n_max):
+        k1 = rhs_user(y, p)
+        k2 = rhs_user(y + 0.5 * dt * k1, p)
+        k3 = rhs_user(y + 0.5 * dt * k2, p)
+        k4 = rhs_user(y + dt * k3, p)
+        y_new = y + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        h_tip, vt = tip_height_and_vy(y_new, p[2])
+        if vt >= 0.0:
+            theta = -vt_prev / (vt - vt_prev)
+            height = h_prev + theta * (h_tip - h_prev)
+            return (i + theta) * dt, max(0.0, -height), i + 1
+        y = y_new
+        h_prev, vt_prev = h_tip, vt
+    return np.nan, max(0.0, -h_prev), n_max
+
+
+@njit(inline="always")
+def _accel(x_y, q, vx, vy, w, inv_m, inv_i, half, length, lcos_cap, c_d, c_h, c_v, lam, g):
+    """(ax, ay, alpha) with every constant folded (hand-tuned scalar peer)."""
+    s = math.sin(q)
+    c = math.cos(q)
+    d = half * c - x_y  # depth of the tip: -(y - L/2 cos q)
+    if d <= 0.0:
+        return 0.0, -g, 0.0
+    ell = length if d >= lcos_cap * c else d / c
+    s_e = 0.5 * (ell - length)
+    vex = vx + w * s_e * c
+    vey = vy - w * s_e * s
+    k = c_d * ell * abs(s * vey - c * vex)
+    f_h = c_h * d * d
+    f_v = c_v * math.pow(d, lam) * ell
+    fx = -k * vex
+    fy = -k * vey
+    if vex > 0.0:
+        fx -= f_h
+    elif vex < 0.0:
+        fx += f_h
+    if vey > 0.0:
+        fy -= f_v
+    elif vey < 0.0:
+        fy += f_v
+    return fx * inv_m, fy * inv_m - g, -half * (c * fx - s * fy) * inv_i
+
+
+@njit
+def impact_scalar(y0, p, dt, t_end):
+    """The same RK4 and stop as :func:`impact_user`, all in scalars."""
+    m, inertia, length, dc, rho, g = p[0], p[1], p[2], p[3], p[4], p[5]
+    eta_h, eta_d, eta_v, lam = p[6], p[7], p[8], p[9]
+    inv_m, inv_i, half = 1.0 / m, 1.0 / inertia, 0.5 * length
+    c_d = eta_d * rho * dc
+    c_h = eta_h * g * rho * dc
+    c_v = eta_v * g * rho * (math.pi / 4.0) * dc * dc / math.pow(length, lam)
+    x, y, q, vx, vy, w = y0[0], y0[1], y0[2], y0[3], y0[4], y0[5]
+    h_prev = y - half * math.cos(q)
+    vt_prev = vy + half * w * math.sin(q)
+    n_max = math.ceil(t_end / dt)
+    hdt = 0.5 * dt
+    for i in range(n_max):
+        a1x, a1y, a1w = _accel(y, q, vx, vy, w, inv_m, inv_i, half, length, length, c_d, c_h,
+                               c_v, lam, g)  # fmt: skip
+        a2x, a2y, a2w = _accel(y + hdt * vy, q + hdt * w, vx + hdt * a1x, vy + hdt * a1y,
+                               w + hdt * a1w, inv_m, inv_i, half, length, length, c_d, c_h,
+                               c_v, lam, g)  # fmt: skip
+        vx2, vy2, w2 = vx + hdt * a1x, vy + hdt * a1y, w + hdt * a1w
+        a3x, a3y, a3w = _accel(y + hdt * vy2, q + hdt * w2, vx + hdt * a2x, vy + hdt * a2y,
+                               w + hdt * a2w, inv_m, inv_i, half, length, length, c_d, c_h,
+                               c_v, lam, g)  # fmt: skip
+        vx3, vy3, w3 = vx + hdt * a2x, vy + hdt * a2y, w + hdt * a2w
+        vx4, vy4, w4 = vx + dt * a3x, vy + dt * a3y, w + dt * a3w
+        a4x, a4y, a4w = _accel(y + dt * vy3, q + dt * w3, vx4, vy4, w4, inv_m, inv_i, half,
+                               length, length, c_d, c_h, c_v, lam, g)  # fmt: skip
+        s6 = dt / 6.0
+        x += s6 * (vx + 2.0 * vx2 + 2.0 * vx3 + vx4)
+        y += s6 * (vy + 2.0 * vy2 + 2.0 * vy3 + vy4)
+        q += s6 * (w + 2.0 * w2 + 2.0 * w3 + w4)
+        vx += s6 * (a1x + 2.0 * a2x + 2.0 * a3x + a4x)
+        vy += s6 * (a1y + 2.0 * a2y + 2.0 * a3y + a4y)
+        w += s6 * (a1w + 2.0 * a2w + 2.0 * a3w + a4w)
+        h_tip = y - half * math.cos(q)
+        vt = vy + half * w * math.sin(q)
+        if vt >= 0.0:
+            theta = -vt_prev / (vt - vt_prev)
+            height = h_prev + theta * (h_tip - h_prev)
+            return (i + theta) * dt, max(0.0, -height), i + 1
+        h_prev, vt_prev = h_tip, vt
+    return np.nan, max(0.0, -h_prev), n_max
+
+
+class IvpBudgetError(Exception):
+    """A solve_ivp run passed ``IVP_MAX_NFEV`` evaluations."""
+
+
+def make_ivp(
+    p: np.ndarray, budget: bool = True
+) -> tuple[Callable[..., list[float]], Callable[..., float]]:
+    """solve_ivp's right-hand side and stop event (plain Python, ``math``), user style."""
+    m, inertia, length, dc, rho, g, eta_h, eta_d, eta_v, lam = (float(v) for v in p)
+
+    calls = [0]
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        if budget:
+            calls[0] += 1
+            if calls[0] > IVP_MAX_NFEV:
+                raise IvpBudgetError
+        q, vx, vy, w = y[2], y[3], y[4], y[5]
+        s, c = math.sin(q), math.cos(q)
+        d = max(0.0, -(y[1] - 0.5 * length * c))
+        fx = fy = torque = 0.0
+        if d > 0.0:
+            ell = length if d >= length * c else d / c
+            s_e = -0.5 * length + 0.5 * ell
+            vex, vey = vx + w * s_e * c, vy - w * s_e * s
+            k = eta_d * rho * dc * ell * abs(s * vey - c * vex)
+            f_h = eta_h * g * rho * dc * d**2
+            f_v = eta_v * (d / length) ** lam * g * rho * (math.pi / 4 * dc**2 * ell)
+            fx = -k * vex - np.sign(vex) * f_h
+            fy = -k * vey - np.sign(vey) * f_v
+            torque = -0.5 * length * (c * fx - s * fy)
+        return [vx, vy, w, fx / m, fy / m - g, torque / inertia]
+
+    def stop(t: float, y: np.ndarray) -> float:
+        return y[4] + 0.5 * length * y[5] * math.sin(y[2])
+
+    stop.terminal = True  # type: ignore[attr-defined]
+    stop.direction = 1.0  # type: ignore[attr-defined]
+    return rhs, stop
+
+
+def impact_ivp(
+    y0: np.ndarray, p: np.ndarray, rtol: float, budget: bool = True
+) -> tuple[float, float, int]:
+    """solve_ivp (RK45) to the stop: (t_s, depth, rhs evaluations); NaNs when it fails
+    (no stop by ``T_END``, or more than ``IVP_MAX_NFEV`` evaluations)."""
+    rhs, stop = make_ivp(p, budget)
+    try:
+        sol = solve_ivp(
+            rhs, (0.0, T_END), y0, method="RK45", rtol=rtol, atol=ATOL_FACTOR * rtol, events=stop
+        )
+    except IvpBudgetError:
+        return math.nan, math.nan, IVP_MAX_NFEV
+    if sol.status != 1 or len(sol.t_events[0]) == 0:
+        return math.nan, math.nan, int(sol.nfev)
+    ye = sol.y_events[0][0]
+    depth = max(0.0, -(ye[1] - 0.5 * float(p[2]) * math.cos(ye[2])))
+    return float(sol.t_events[0][0]), depth, int(sol.nfev)
+
+
+# --- the run ------------------------------------------------------------------------------
+
+
+@dataclass
+class SceneRun:
+    """One Table 3.5 scene: its inputs and every method's depth and best time."""
+
+    q_deg: float
+    v0: float
+    scene: granrs.Scene
+    p: np.ndarray
+    y0: np.ndarray
+    depth: dict[str, float] = field(default_factory=dict)
+    seconds: dict[str, float] = field(default_factory=dict)
+    depth_ref: float = math.nan
+    err_granrs: float = math.nan
+    err_granrs_raw: float = math.nan
+    rtol: float = math.nan
+    err_ivp: float = math.nan
+    ivp_matched: bool = False
+    ivp_failed: bool = False
+    ivp_nfev: int = 0
+
+
+def build(quick: bool) -> list[SceneRun]:
+    """The Table 3.5 scenes (all 31, or the ``QUICK_ROWS``)."""
+    table = granrs.data.load("table_3_5", as_="numpy")
+    runs = []
+    for q, v0 in zip(table["q_deg"], table["v0"], strict=True):
+        if quick and (float(q), float(v0)) not in QUICK_ROWS:
+            continue
+        scene = granrs.cases.free_link(float(q), float(v0))
+        runs.append(SceneRun(float(q), float(v0), scene, parameters(scene), initial_state(scene)))
+    return runs
+
+
+def granrs_depth(scene: granrs.Scene) -> float:
+    r = granrs.simulate(scene)
+    if r.status != "stopped":
+        raise RuntimeError(f"q = {scene.q_deg}, v0 = {scene.v0}: {r.status}")
+    return float(r.depth)
+
+
+def check_agreement(runs: list[SceneRun]) -> float:
+    """Depths of the peers against granrs ``"raw"``; raises if any is off by more than
+    ``AGREEMENT_TOL``. Returns the largest difference [m]."""
+    worst = 0.0
+    for r in runs:
+        raw = r.depth["granrs_raw"]
+        for name in ("numba_user", "numba_scalar"):
+            diff = abs(r.depth[name] - raw)
+            worst = max(worst, diff)
+            if not diff <= AGREEMENT_TOL:
+                raise AssertionError(
+                    f"{name} computes a different model: q = {r.q_deg}, v0 = {r.v0}: depth "
+                    f"{r.depth[name]!r} against granrs raw {raw!r}"
+                )
+    return worst
+
+
+def match_tolerance(runs: list[SceneRun], ref_dt: float, progress: bool) -> None:
+    """Reference depths, granrs's error, and solve_ivp's matched rtol per scene."""
+    for r in runs:
+        r.depth_ref = granrs_depth(r.scene.replace(dt=ref_dt))
+        r.err_granrs = abs(r.depth["granrs"] - r.depth_ref)
+        r.err_granrs_raw = abs(r.depth["granrs_raw"] - r.depth_ref)
+        errs = []
+        for rtol in RTOLS:
+            _, depth, _ = impact_ivp(r.y0, r.p, rtol)
+            errs.append(abs(depth - r.depth_ref) if math.isfinite(depth) else math.inf)
+        # The loosest rtol from which on every tighter one also meets granrs's error; else
+        # the most accurate one that ran (unmatched); none ran: failed, not timed.
+        ok = [e <= r.err_granrs for e in errs]
+        idx = next((i for i in range(len(RTOLS)) if all(ok[i:])), None)
+        r.ivp_matched = idx is not None
+        if idx is None and any(math.isfinite(e) for e in errs):
+            idx = min(range(len(RTOLS)), key=lambda i: errs[i])
+        r.ivp_failed = idx is None
+        if idx is not None:
+            r.rtol, r.err_ivp = RTOLS[idx], errs[idx]
+        if progress:
+            note = " (FAILED at every rtol)" if r.ivp_failed else ""
+            note = note or ("" if r.ivp_matched else " (NOT matched within the sweep)")
+            print(
+                f"  q = {r.q_deg:4.0f}, v0 = {r.v0:5.3f}: granrs error {r.err_granrs:.2e} m, "
+                f"solve_ivp rtol {r.rtol:.0e} error {r.err_ivp:.2e} m{note}",
+                file=sys.stderr,
+            )
+
+
+def methods(runs: list[SceneRun]) -> dict[str, Callable[[SceneRun], Any]]:
+    """Name -> one impact of a scene (what is timed)."""
+    raw = {id(r): r.scene.replace(sign_model="raw") for r in runs}
+    dicts = {id(r): r.scene.to_dict() for r in runs}
+    return {
+        "granrs": lambda r: granrs.simulate(r.scene),
+        "granrs_raw": lambda r: granrs.simulate(raw[id(r)]),
+        "granrs_overhead": lambda r: _granrs.validate(dicts[id(r)]),
+        "numba_user": lambda r: impact_user(r.y0, r.p, DT, T_END),
+        "numba_scalar": lambda r: impact_scalar(r.y0, r.p, DT, T_END),
+        # Timed without the evaluation budget (the matched rtol is known to run).
+        "solve_ivp": lambda r: impact_ivp(r.y0, r.p, r.rtol, budget=False),
+    }
+
+
+def time_all(runs: list[SceneRun], repeats: int, ivp_repeats: int) -> None:
+    """Best time per scene and method; the methods take turns within each repeat."""
+    todo = methods(runs)
+    for rep in range(repeats):
+        for name, fn in todo.items():
+            if name == "solve_ivp" and rep >= ivp_repeats:
+                continue
+            for r in runs:
+                if name == "solve_ivp" and r.ivp_failed:
+                    r.seconds[name] = math.nan
+                    continue
+                if name == "granrs_overhead":
+                    # The to_dict + validate overhead takes microseconds: a short batch.
+                    t0 = time.perf_counter()
+                    for _ in range(10):
+                        r.scene.to_dict()
+                        fn(r)
+                    dt = (time.perf_counter() - t0) / 10
+                else:
+                    t0 = time.perf_counter()
+                    fn(r)
+                    dt = time.perf_counter() - t0
+                r.seconds[name] = min(r.seconds.get(name, math.inf), dt)
+
+
+def run_criterion(quick: bool) -> dict[str, float]:
+    """Per-impact medians [s] of criterion's ``impact/table_3_5_all`` (``"modes"``) and
+    ``impact/table_3_5_all_raw`` (``"raw"``); empty if cargo is missing or it fails."""
+    if shutil.which("cargo") is None:
+        print("cargo not found: no Rust-only timing", file=sys.stderr)
+        return {}
+    secs = "1" if quick else "3"
+    cmd = [
+        "cargo",
+        "bench",
+        "--bench",
+        "free_link",
+        "--",
+        "impact/table_3_5_all",
+        "--warm-up-time",
+        "1",
+        "--measurement-time",
+        secs,
+    ]
+    print("running: " + " ".join(cmd), file=sys.stderr)
+    proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        print(proc.stderr[-2000:], file=sys.stderr)
+        return {}
+    out = {}
+    n_rows = len(granrs.data.load("table_3_5", as_="numpy")["q_deg"])
+    for bench, key in (("table_3_5_all", "rust"), ("table_3_5_all_raw", "rust_raw")):
+        path = REPO / "target" / "criterion" / "impact" / bench / "new" / "estimates.json"
+        if path.is_file():
+            median = json.loads(path.read_text())["median"]["point_estimate"]
+            out[key] = median * 1e-9 / n_rows
+    return out
+
+
+def per_impact(runs: list[SceneRun], name: str) -> float:
+    """Mean over the scenes of the best time per impact [s]."""
+    return statistics.fmean(r.seconds[name] for r in runs)
+
+
+def summarize(runs: list[SceneRun], crit: dict[str, float], agreement: float) -> list[str]:
+    """The report, as lines of Markdown."""
+    t = {name: per_impact(runs, name) for name in runs[0].seconds}
+    # solve_ivp over the scenes where it ran, against granrs on the same scenes.
+    ran = [r for r in runs if not r.ivp_failed]
+    t["solve_ivp"] = per_impact(ran, "solve_ivp") if ran else math.nan
+    t["granrs_ivp_scenes"] = per_impact(ran, "granrs") if ran else math.nan
+    t["granrs_rust_est"] = statistics.fmean(
+        r.seconds["granrs"] - r.seconds["granrs_overhead"] for r in runs
+    )
+    t.update(crit)
+    us = {k: v * 1e6 for k, v in t.items()}
+    ivp_ratios = [r.seconds["solve_ivp"] / r.seconds["granrs"] for r in ran] or [math.nan]
+    lines = [
+        f"granrs {granrs.__version__}, {len(runs)} Table 3.5 scenes, dt = {DT:g} s; per impact, "
+        "single thread, mean over scenes of the best time per scene.",
+        "",
+        "| method | us / impact | / granrs (modes, simulate) |",
+        "|---|---:|---:|",
+    ]
+    labels = {
+        "granrs": 'granrs.simulate, sign_model="modes" (default)',
+        "granrs_raw": 'granrs.simulate, sign_model="raw"',
+        "granrs_rust_est": "granrs modes, simulate less to_dict + validate",
+        "rust": "granrs modes, Rust only (criterion impact/table_3_5_all)",
+        "rust_raw": "granrs raw, Rust only (criterion impact/table_3_5_all_raw)",
+        "numba_user": "numba RK4, user style (arrays)",
+        "numba_scalar": "numba RK4, hand-tuned scalars",
+        "solve_ivp": "scipy solve_ivp RK45, matched rtol",
+    }
+    for key, label in labels.items():
+        if key in us:
+            lines.append(f"| {label} | {us[key]:.1f} | {t[key] / t['granrs']:.3g} |")
+    lines += ["", "| ratio | value | target | met |", "|---|---:|---:|---|"]
+
+    def ratio(name: str, num: str, den: str, target: float | None, below: bool) -> None:
+        if num not in t or den not in t:
+            return
+        v = t[num] / t[den]
+        if target is None:
+            lines.append(f"| {name} | {v:.3g} | | |")
+        else:
+            met = v <= target if below else v >= target
+            sign = "<=" if below else ">="
+            lines.append(f"| {name} | {v:.3g} | {sign} {target:.3g} | {'yes' if met else 'NO'} |")
+
+    ratio("granrs (simulate) / numba user", "granrs", "numba_user", TARGET_NUMBA, True)
+    ratio("granrs raw (simulate) / numba user", "granrs_raw", "numba_user", TARGET_NUMBA, True)
+    ratio("granrs Rust only / numba user", "rust", "numba_user", TARGET_NUMBA, True)
+    ratio("granrs (simulate) / numba scalar", "granrs", "numba_scalar", None, True)
+    ratio("granrs Rust only / numba scalar", "rust", "numba_scalar", None, True)
+    ratio("granrs raw Rust only / numba scalar", "rust_raw", "numba_scalar", None, True)
+    ratio(
+        "solve_ivp / granrs (simulate), scenes it ran",
+        "solve_ivp",
+        "granrs_ivp_scenes",
+        TARGET_SOLVE_IVP,
+        False,
+    )
+    lines.append(
+        f"| solve_ivp / granrs per scene: min, median | {min(ivp_ratios):.3g}, "
+        f"{statistics.median(ivp_ratios):.3g} | | |"
+    )
+    unmatched = sum(not r.ivp_matched and not r.ivp_failed for r in runs)
+    failed = sum(r.ivp_failed for r in runs)
+    lines += [
+        "",
+        f"Depth agreement (same model): max |depth(numba) - depth(granrs raw)| = "
+        f"{agreement:.2e} m (accepted up to {AGREEMENT_TOL:g} m).",
+        f"Matched rtol: median {statistics.median(r.rtol for r in ran) if ran else math.nan:.0e}; "
+        f"{unmatched} scene(s) not matched within 1e-3..1e-12 (timed at their most accurate "
+        f"rtol, marked *); solve_ivp FAILED on {failed} scene(s) at every rtol (no stop within "
+        f"{IVP_MAX_NFEV} evaluations; not timed, marked !).",
+        "",
+        "| q_deg | v0 | depth_ref [m] | err granrs | err granrs raw | err numba user | "
+        "rtol | err solve_ivp | granrs us | raw us | numba user us | numba scalar us | "
+        "solve_ivp us |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in runs:
+        s = {k: v * 1e6 for k, v in r.seconds.items()}
+        lines.append(
+            f"| {r.q_deg:g} | {r.v0:g} | {r.depth_ref:.6f} | {r.err_granrs:.1e} | "
+            f"{r.err_granrs_raw:.1e} | {abs(r.depth['numba_user'] - r.depth_ref):.1e} | "
+            f"{r.rtol:.0e}{'!' if r.ivp_failed else '' if r.ivp_matched else '*'} | "
+            f"{r.err_ivp:.1e} | "
+            f"{s['granrs']:.0f} | {s['granrs_raw']:.0f} | {s['numba_user']:.0f} | "
+            f"{s['numba_scalar']:.0f} | {s['solve_ivp']:.0f} |"
+        )
+    return lines
+
+
+def write_out(path: Path, runs: list[SceneRun], lines: list[str]) -> None:
+    """Markdown report (``.md``) or one CSV row per scene (anything else)."""
+    if path.suffix == ".md":
+        path.write_text("\n".join(lines) + "\n")
+        return
+    import csv
+
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        names = sorted(runs[0].seconds)
+        w.writerow(
+            ["q_deg", "v0", "depth_ref", "rtol", "ivp_matched", "err_granrs", "err_granrs_raw"]
+            + [f"depth_{k}" for k in sorted(runs[0].depth)]
+            + ["err_solve_ivp"]
+            + [f"seconds_{k}" for k in names]
+        )
+        for r in runs:
+            w.writerow(
+                [r.q_deg, r.v0, r.depth_ref, r.rtol, r.ivp_matched, r.err_granrs]
+                + [r.err_granrs_raw]
+                + [r.depth[k] for k in sorted(r.depth)]
+                + [r.err_ivp]
+                + [r.seconds[k] for k in names]
+            )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="5 scenes, coarser reference")
+    parser.add_argument("--repeats", type=int, default=None, help="timing repeats")
+    parser.add_argument("--out", type=Path, default=None, help="write .md or .csv results")
+    parser.add_argument("--no-criterion", action="store_true", help="skip cargo bench")
+    args = parser.parse_args(argv)
+    repeats = args.repeats or (3 if args.quick else 7)
+    runs = build(args.quick)
+
+    # Depths of every method (and the numba compile: the warm-up call).
+    for r in runs:
+        r.depth["granrs"] = granrs_depth(r.scene)
+        r.depth["granrs_raw"] = granrs_depth(r.scene.replace(sign_model="raw"))
+        r.depth["numba_user"] = impact_user(r.y0, r.p, DT, T_END)[1]
+        r.depth["numba_scalar"] = impact_scalar(r.y0, r.p, DT, T_END)[1]
+    agreement = check_agreement(runs)
+    print("matching solve_ivp's tolerance to granrs's depth error ...", file=sys.stderr)
+    match_tolerance(runs, REFERENCE_DT_QUICK if args.quick else REFERENCE_DT, progress=True)
+    print(f"timing ({repeats} repeats) ...", file=sys.stderr)
+    time_all(runs, repeats, ivp_repeats=min(repeats, 3))
+    crit = {} if args.no_criterion else run_criterion(args.quick)
+    lines = summarize(runs, crit, agreement)
+    print("\n".join(lines))
+    if args.out is not None:
+        write_out(args.out, runs, lines)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
