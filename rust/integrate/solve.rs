@@ -10,7 +10,7 @@ use nalgebra::{SVector, Vector2};
 
 use super::dense::{locate, Hermite};
 use super::rk4::{deriv_of, dopri5_step, step, Deriv, State};
-use crate::dynamics::{ContactMode, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
+use crate::dynamics::{ContactMode, Effects, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
 use crate::error::{GranrsError, Result};
 
 /// When a run ends.
@@ -414,7 +414,7 @@ struct Recorder {
 }
 
 impl Recorder {
-    fn new(on: Record, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
+    fn new(on: Record, effects: Effects, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
         let mut names = Vec::new();
         if on.state {
             for i in 0..n_dof {
@@ -426,11 +426,27 @@ impl Recorder {
             names.push("work_sand".into());
         }
         if on.forces {
+            // A force term that is off is not stored, nor the mode of its sign.
+            let mut fields = vec![
+                "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "v_E_x", "v_E_y",
+            ];
+            if effects.drag {
+                fields.extend(["F_dx", "F_dy"]);
+            }
+            if effects.static_h {
+                fields.push("F_sh");
+            }
+            if effects.static_v {
+                fields.push("F_sv");
+            }
+            if effects.static_h {
+                fields.push("mode_x");
+            }
+            if effects.static_v {
+                fields.push("mode_y");
+            }
             for c in 0..n_contacts {
-                for f in [
-                    "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "v_E_x", "v_E_y", "F_dx",
-                    "F_dy", "F_sh", "F_sv", "mode_x", "mode_y",
-                ] {
+                for f in &fields {
                     names.push(format!("c{c}.{f}"));
                 }
             }
@@ -509,14 +525,21 @@ impl Recorder {
                     (-c.tip.y).max(0.0),
                     c.v_centroid.x,
                     c.v_centroid.y,
-                    c.force.drag.x,
-                    c.force.drag.y,
-                    c.force.static_h,
-                    c.force.static_v,
-                    mode(m.sx),
-                    mode(m.sy),
                 ] {
                     put(&mut self.cols, v);
+                }
+                let fx = model.effects;
+                for (on, v) in [
+                    (fx.drag, c.force.drag.x),
+                    (fx.drag, c.force.drag.y),
+                    (fx.static_h, c.force.static_h),
+                    (fx.static_v, c.force.static_v),
+                    (fx.static_h, mode(m.sx)),
+                    (fx.static_v, mode(m.sy)),
+                ] {
+                    if on {
+                        put(&mut self.cols, v);
+                    }
                 }
             }
             if self.n_links > 1 {
@@ -628,7 +651,7 @@ pub fn solve<const N: usize>(
             }
         };
 
-    let mut recorder = Recorder::new(options.record, N, nc, n_links);
+    let mut recorder = Recorder::new(options.record, model.effects, N, nc, n_links);
     let stride = options.record.stride.max(1);
     let mut t = 0.0f64;
     // The evaluations at the step's start (`evals[cur]`) and end: an accepted step swaps
