@@ -16,8 +16,17 @@ class Compiled:
 def compile(scene: dict[str, Any]) -> Compiled:
     """Convert and validate a scene dict once."""
 
-def run(compiled: Compiled) -> dict[str, Any]:
-    """Run a compiled scene; return the raw results dict (plus run_seconds)."""
+class RunOutcome:
+    """One run's outcome, kept in the core until asked for."""
+
+    status: str
+    t_s: float
+    depth: float
+    run_seconds: float
+    def to_dict(self) -> dict[str, Any]: ...
+
+def run(compiled: Compiled) -> RunOutcome:
+    """Run a compiled scene."""
 
 def validate(scene: dict[str, Any]) -> None:
     """Validate a scene dict; raise the typed granrs error naming the first bad field."""

@@ -28,5 +28,4 @@ def simulate(scene: Scene) -> Result:
         raise InvalidParameterError(
             f"simulate() takes a granrs.Scene, got {type(scene).__name__}", field="scene"
         )
-    raw = _granrs.run(scene._compiled())
-    return Result._from_raw(scene, raw)
+    return Result(scene, _granrs.run(scene._compiled()))

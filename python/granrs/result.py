@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -81,9 +81,12 @@ class ContactResult:
     summary: dict[str, Any]
 
 
-@dataclass(frozen=True)
 class Result:
     """The outcome of :func:`granrs.simulate`.
+
+    The run's numbers stay in the Rust core until they are read: ``status``, ``t_s`` and
+    ``depth`` come straight from it, and the rest is converted on first access (so a loop
+    that reads only the headline numbers pays for nothing else).
 
     Attributes:
         scene: the scene that was run.
@@ -102,41 +105,85 @@ class Result:
             ``<joint>.Fx/Fy/torque`` and ``<link>.KE/PE``.
     """
 
-    scene: Scene
-    status: str
-    t_s: float
-    depth: float
-    summary: dict[str, Any]
-    contacts: list[ContactResult]
-    series: dict[str, np.ndarray] | None = field(default=None, repr=False)
-    joints: dict[str, dict[str, float]] = field(default_factory=dict, repr=False)
+    __slots__ = ("_core", "_d", "_raw", "scene")
+
+    def __init__(self, scene: Scene, core: Any) -> None:
+        self.scene = scene
+        self._core = core  # a granrs._granrs.RunOutcome, or the raw dict
+        self._raw: dict[str, Any] | None = core if isinstance(core, dict) else None
+        self._d: dict[str, Any] | None = None
 
     @classmethod
-    def _from_raw(cls, scene: Scene, raw: dict[str, Any]) -> Result:
-        contacts = [
-            ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=stopped, summary=c)
-            for c, stopped in zip(raw["contacts"], raw["stopped"], strict=True)
-        ]
-        summary = dict(raw["contacts"][0])
-        summary.update(raw["run"])
-        names = JOINT_NAMES.get(scene.body, ())
-        joints = (
-            {}
-            if scene.body == "free_link"
-            else {
-                names[i] if i < len(names) else f"joint{i}": j for i, j in enumerate(raw["joints"])
+    def _from_raw(cls, scene: Scene, raw: Any) -> Result:
+        return cls(scene, raw)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Pickle the plain results, not the core's object.
+        return (Result, (self.scene, self._raw_dict()))
+
+    def _raw_dict(self) -> dict[str, Any]:
+        if self._raw is None:
+            self._raw = self._core.to_dict()
+        return self._raw
+
+    def _parts(self) -> dict[str, Any]:
+        if self._d is None:
+            raw = self._raw_dict()
+            scene = self.scene
+            contacts = [
+                ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=stopped, summary=c)
+                for c, stopped in zip(raw["contacts"], raw["stopped"], strict=True)
+            ]
+            summary = dict(raw["contacts"][0])
+            summary.update(raw["run"])
+            names = JOINT_NAMES.get(scene.body, ())
+            joints = (
+                {}
+                if scene.body == "free_link"
+                else {
+                    names[i] if i < len(names) else f"joint{i}": j
+                    for i, j in enumerate(raw["joints"])
+                }
+            )
+            self._d = {
+                "summary": summary,
+                "contacts": contacts,
+                "joints": joints,
+                "series": _rename_series(scene, raw["series"], len(contacts)),
             }
-        )
-        return cls(
-            scene=scene,
-            status=raw["status"],
-            t_s=contacts[0].t_s,
-            depth=contacts[0].depth,
-            summary=summary,
-            contacts=contacts,
-            series=_rename_series(scene, raw["series"], len(contacts)),
-            joints=joints,
-        )
+        return self._d
+
+    @property
+    def status(self) -> str:
+        return str(self._core["status"] if isinstance(self._core, dict) else self._core.status)
+
+    @property
+    def t_s(self) -> float:
+        if isinstance(self._core, dict):
+            return float(self._core["contacts"][0]["t_s"])
+        return float(self._core.t_s)
+
+    @property
+    def depth(self) -> float:
+        if isinstance(self._core, dict):
+            return float(self._core["contacts"][0]["depth"])
+        return float(self._core.depth)
+
+    @property
+    def summary(self) -> dict[str, Any]:
+        return self._parts()["summary"]  # type: ignore[no-any-return]
+
+    @property
+    def contacts(self) -> list[ContactResult]:
+        return self._parts()["contacts"]  # type: ignore[no-any-return]
+
+    @property
+    def joints(self) -> dict[str, dict[str, float]]:
+        return self._parts()["joints"]  # type: ignore[no-any-return]
+
+    @property
+    def series(self) -> dict[str, np.ndarray] | None:
+        return self._parts()["series"]  # type: ignore[no-any-return]
 
     @property
     def stopped(self) -> bool:

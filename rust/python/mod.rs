@@ -191,10 +191,54 @@ fn compile(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Compiled> {
     Ok(Compiled { scene })
 }
 
-/// Run a compiled scene and return its results as a dict.
+/// The outcome of one run, kept in Rust until Python asks for it: the headline numbers are
+/// getters, the rest comes as a dict from `to_dict` (built on first request by `Result`).
+#[pyclass(frozen, module = "granrs._granrs")]
+struct RunOutcome {
+    out: Outcome,
+    /// Wall time of the run alone [s] (for measuring a call's overhead; not a result).
+    #[pyo3(get)]
+    run_seconds: f64,
+}
+
+#[pymethods]
+impl RunOutcome {
+    /// Why the run ended.
+    #[getter]
+    fn status(&self) -> &'static str {
+        self.out.status.name()
+    }
+    /// Contact 0's stopping time [s] (NaN without a stop).
+    #[getter]
+    fn t_s(&self) -> f64 {
+        self.out.contacts.first().map_or(f64::NAN, |c| c.t_s)
+    }
+    /// Contact 0's depth at its stop [m].
+    #[getter]
+    fn depth(&self) -> f64 {
+        self.out.contacts.first().map_or(f64::NAN, |c| c.depth)
+    }
+    /// Everything, as the dict `simulate` returns.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = outcome_to_dict(py, self.out.clone())?;
+        d.set_item("run_seconds", self.run_seconds)?;
+        Ok(d)
+    }
+}
+
+/// Run a compiled scene; its outcome stays in Rust until asked for.
 #[pyfunction]
-fn run<'py>(py: Python<'py>, compiled: &Bound<'py, Compiled>) -> PyResult<Bound<'py, PyDict>> {
-    run_scene(py, &compiled.get().scene)
+fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
+    let scene = &compiled.get().scene;
+    let (out, seconds) = py.detach(|| {
+        let t0 = std::time::Instant::now();
+        let out = scene.run();
+        (out, t0.elapsed().as_secs_f64())
+    });
+    Ok(RunOutcome {
+        out: out.map_err(|e| to_pyerr(py, e))?,
+        run_seconds: seconds,
+    })
 }
 
 /// Run one scene (a dict from `granrs.Scene.to_dict()`) and return its results as a dict.
@@ -510,6 +554,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Compiled>()?;
+    m.add_class::<RunOutcome>()?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(validate_sweep, m)?)?;
