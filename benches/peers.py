@@ -32,8 +32,8 @@ granrs itself is timed per impact, single thread, summary only (no time series):
   ``"raw"`` (the thesis's plain sign: the peers' algorithm, with granrs's exact stop);
 * Rust only: criterion's ``impact/table_3_5_all`` and ``impact/table_3_5_all_raw``
   (``benches/free_link.rs``), run by this script through ``cargo bench`` unless
-  ``--no-criterion``; and as a Python-free estimate, the simulate time less its
-  ``Scene.to_dict`` + ``_granrs.validate`` overhead.
+  ``--no-criterion``; and, in the same interleaved loop as the peers, the run alone as the
+  core times it (``_granrs.run(...).run_seconds``: no Python around it).
 
 Every method runs the whole table in turn within each repeat, and each scene's time is the
 minimum over the repeats: the ratios come from the same stretch of a shared, noisy machine.
@@ -411,11 +411,11 @@ def match_tolerance(runs: list[SceneRun], ref_dt: float, progress: bool) -> None
 def methods(runs: list[SceneRun]) -> dict[str, Callable[[SceneRun], Any]]:
     """Name -> one impact of a scene (what is timed)."""
     raw = {id(r): r.scene.replace(sign_model="raw") for r in runs}
-    dicts = {id(r): r.scene.to_dict() for r in runs}
     return {
         "granrs": lambda r: granrs.simulate(r.scene),
         "granrs_raw": lambda r: granrs.simulate(raw[id(r)]),
-        "granrs_overhead": lambda r: _granrs.validate(dicts[id(r)]),
+        # The run alone, as the core times it (no Python around it), in the same loop.
+        "granrs_core": lambda r: _granrs.run(r.scene._compiled()).run_seconds,
         "numba_user": lambda r: impact_user(r.y0, r.p, DT, T_END),
         "numba_scalar": lambda r: impact_scalar(r.y0, r.p, DT, T_END),
         # Timed without the evaluation budget (the matched rtol is known to run).
@@ -434,13 +434,8 @@ def time_all(runs: list[SceneRun], repeats: int, ivp_repeats: int) -> None:
                 if name == "solve_ivp" and r.ivp_failed:
                     r.seconds[name] = math.nan
                     continue
-                if name == "granrs_overhead":
-                    # The to_dict + validate overhead takes microseconds: a short batch.
-                    t0 = time.perf_counter()
-                    for _ in range(10):
-                        r.scene.to_dict()
-                        fn(r)
-                    dt = (time.perf_counter() - t0) / 10
+                if name == "granrs_core":
+                    dt = fn(r)
                 else:
                     t0 = time.perf_counter()
                     fn(r)
@@ -494,9 +489,6 @@ def summarize(runs: list[SceneRun], crit: dict[str, float], agreement: float) ->
     ran = [r for r in runs if not r.ivp_failed]
     t["solve_ivp"] = per_impact(ran, "solve_ivp") if ran else math.nan
     t["granrs_ivp_scenes"] = per_impact(ran, "granrs") if ran else math.nan
-    t["granrs_rust_est"] = statistics.fmean(
-        r.seconds["granrs"] - r.seconds["granrs_overhead"] for r in runs
-    )
     t.update(crit)
     us = {k: v * 1e6 for k, v in t.items()}
     ivp_ratios = [r.seconds["solve_ivp"] / r.seconds["granrs"] for r in ran] or [math.nan]
@@ -510,7 +502,7 @@ def summarize(runs: list[SceneRun], crit: dict[str, float], agreement: float) ->
     labels = {
         "granrs": 'granrs.simulate, sign_model="modes" (default)',
         "granrs_raw": 'granrs.simulate, sign_model="raw"',
-        "granrs_rust_est": "granrs modes, simulate less to_dict + validate",
+        "granrs_core": "granrs modes, the run alone (timed in the core, same loop)",
         "rust": "granrs modes, Rust only (criterion impact/table_3_5_all)",
         "rust_raw": "granrs raw, Rust only (criterion impact/table_3_5_all_raw)",
         "numba_user": "numba RK4, user style (arrays)",
@@ -535,7 +527,8 @@ def summarize(runs: list[SceneRun], crit: dict[str, float], agreement: float) ->
 
     ratio("granrs (simulate) / numba user", "granrs", "numba_user", TARGET_NUMBA, True)
     ratio("granrs raw (simulate) / numba user", "granrs_raw", "numba_user", TARGET_NUMBA, True)
-    ratio("granrs Rust only / numba user", "rust", "numba_user", TARGET_NUMBA, True)
+    ratio("granrs run alone / numba user", "granrs_core", "numba_user", TARGET_NUMBA, True)
+    ratio("granrs Rust only (criterion) / numba user", "rust", "numba_user", TARGET_NUMBA, True)
     ratio("granrs (simulate) / numba scalar", "granrs", "numba_scalar", None, True)
     ratio("granrs Rust only / numba scalar", "rust", "numba_scalar", None, True)
     ratio("granrs raw Rust only / numba scalar", "rust_raw", "numba_scalar", None, True)
