@@ -245,7 +245,7 @@ def part_force(repeat: int, n: int = 1_000_000) -> list[str]:
         "",
         "| implementation | time [ms] | per state [ns] |",
         "|---|---|---|",
-        f"| granrs (Rust, one thread) | {ours * 1e3:.1f} | {ours / n * 1e9:.1f} |",
+        f"| granrs (Rust; both cores above 16k states) | {ours * 1e3:.1f} | {ours / n * 1e9:.1f} |",
         f"| the same equations in numpy | {theirs * 1e3:.1f} | {theirs / n * 1e9:.1f} |",
         "",
         f"numpy / granrs: **{theirs / ours:.1f}x**; largest difference {err:.2e} N.",
