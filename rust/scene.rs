@@ -381,7 +381,7 @@ impl ChainScene {
             check_range("inertia", i, 0.0, true)?;
         }
         check_range("pin_mass", self.pin_mass, 0.0, false)?;
-        validate_joint("joint", &self.joint)?;
+        validate_joint("pin_joint", &self.joint)?;
         self.coefficients[0].validate("coefficients")?;
         self.coefficients[1].validate("coefficients2")?;
         validate_rod_angle("q_deg", self.q_deg[0])?;

@@ -65,7 +65,7 @@ pub struct SceneSpec {
 fn missing(field: &str) -> GranrsError {
     GranrsError::InvalidScene {
         field: field.to_string(),
-        message: "missing".into(),
+        message: "missing (a value is needed)".into(),
     }
 }
 
@@ -103,7 +103,7 @@ fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
 
 fn num(field: &str, v: Option<&Value>) -> Result<f64> {
     match v {
-        None | Some(Value::None) => Err(missing(field)),
+        None => Err(missing(field)),
         Some(Value::Num(x)) => Ok(*x),
         Some(other) => Err(wrong(field, "a real number", other)),
     }
@@ -171,15 +171,19 @@ impl SceneSpec {
         }
     }
 
-    /// An optional number with a default.
+    /// A number with a default when the field is absent (a TOML file may leave it out);
+    /// `None` is not a number and is refused, naming the field.
     fn f64_or(&self, field: &str, default: f64) -> Result<f64> {
-        Ok(self.opt_f64(field)?.unwrap_or(default))
+        match self.get(field) {
+            None => Ok(default),
+            v => num(field, v),
+        }
     }
 
     /// A required string.
     pub fn str(&self, field: &str) -> Result<&str> {
         match self.get(field) {
-            None | Some(Value::None) => Err(missing(field)),
+            None => Err(missing(field)),
             Some(Value::Str(s)) => Ok(s),
             Some(other) => Err(wrong(field, "a string", other)),
         }
@@ -409,7 +413,7 @@ impl SceneSpec {
                 coefficients,
                 self.coefficients("coefficients2")?.unwrap_or(coefficients),
             ],
-            q_deg: [q1, self.f64_or("q2_deg", -q1)?],
+            q_deg: [q1, self.opt_f64("q2_deg")?.unwrap_or(-q1)],
             v0: c.v0,
             depth0: c.depth0,
             vx0: c.vx0,

@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
-from .errors import GranrsError, InvalidSceneError, SimulationError
+from .errors import GranrsError, InvalidParameterError, InvalidSceneError, SimulationError
 
 __all__ = ["main"]
 
@@ -128,6 +128,10 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     """Run ``granrs bench``."""
     from .bench import work_precision
 
+    if args.repeats < 1:
+        raise InvalidParameterError(
+            f"--repeats must be a whole number >= 1; got {args.repeats}", field="repeats"
+        )
     work_precision(args.out, quick=args.quick, repeats=args.repeats, progress=not args.quiet)
     if not args.quiet:
         print(f"benchmark written to {args.out}")

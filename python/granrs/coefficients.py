@@ -101,7 +101,10 @@ class Coefficients:
                     f"{field} must be {allowed}, got {value!r} of type {type(value).__name__}",
                     field=field,
                 )
-            number = float(value)
+            try:
+                number = float(value)
+            except OverflowError:  # an int beyond the floats, e.g. 10**400
+                number = math.inf
             if not math.isfinite(number) or number < 0.0:
                 raise InvalidParameterError(
                     f"{field} must be {allowed}, got {value!r}", field=field
@@ -412,7 +415,7 @@ def load_table(path_or_file: str | os.PathLike[str] | IO[str]) -> dict[float, Co
 def _read_table(handle: IO[str], filename: str) -> dict[float, Coefficients]:
     columns = ("q_deg", *_CSV_COLUMNS.values())
     try:
-        reader = csv.DictReader(handle)
+        reader = csv.DictReader(handle, strict=True)
         fieldnames = reader.fieldnames
         if fieldnames is None:
             raise CoefficientTableError(f"{filename}: the file is empty", field=None)

@@ -239,12 +239,28 @@ class Scene:
             raise UnknownNameError(
                 f"unknown body {self.body!r}; allowed: {', '.join(BODIES)}", field="body"
             )
+        for name in _NOT_NONE:
+            if getattr(self, name) is None:
+                raise InvalidParameterError(
+                    f"{name} must be a value, not None (its default: {_DEFAULTS[name]!r})",
+                    field=name,
+                )
         for name in ("coefficients", "coefficients2"):
             coefficients = getattr(self, name)
             if coefficients is None and name == "coefficients2":
                 continue
             if isinstance(coefficients, Mapping):
-                coefficients = Coefficients(**dict(coefficients))
+                try:
+                    coefficients = Coefficients(**dict(coefficients))
+                except InvalidSceneError as exc:
+                    # Name the scene's field (coefficients2.lam), not the class's.
+                    field = getattr(exc, "field", None) or name
+                    renamed = f"{name}.{field.partition('.')[2]}" if "." in field else name
+                    raise type(exc)(str(exc).replace(field, renamed), field=renamed) from exc
+                except TypeError as exc:
+                    raise InvalidParameterError(
+                        f"{name} needs exactly eta_h, eta_d, eta_v, lam: {exc}", field=name
+                    ) from exc
             if not isinstance(coefficients, Coefficients):
                 raise InvalidParameterError(
                     f"{name} must be a granrs.Coefficients, got {type(coefficients).__name__}",
@@ -360,3 +376,7 @@ _CORE_FIELDS: dict[str, tuple[str, ...]] = {
     )
     for body in BODIES
 }
+#: Fields whose default is a value: None is refused for them.
+_NOT_NONE: tuple[str, ...] = tuple(
+    f.name for f in dataclasses.fields(Scene) if f.default is not None and f.name != "body"
+)

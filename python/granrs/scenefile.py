@@ -367,7 +367,9 @@ def _as_field_value(name: str, value: Any) -> Any:
             return float(value)
         except OverflowError:
             raise InvalidParameterError(
-                f"invalid value for `{name}`: {value} is too large for a float", field=name
+                f"invalid value for `{name}`: {value} is too large for a float "
+                "(allowed: a finite real number within the field's range)",
+                field=name,
             ) from None
     if name in _JOINT_FIELDS and isinstance(value, dict):
         return {
