@@ -345,14 +345,6 @@ def test_centroid_energy_with_the_plain_sign_rises_by_chatter() -> None:
     assert worst < 1e-3  # first order in dt: far above the modes' 1e-8, far below 1
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "past RK4's stability limit the centroid run is not dissipative: a 9.3 g rod at "
-        "88.8 deg with 10x-ish coefficients and dt = 4.2e-4 s (dt x rate = 80) ends with "
-        "KE + PE 1e10 times its start, status 'stopped', no error"
-    ),
-)
 def test_centroid_energy_never_rises_unresolved_step() -> None:
     """Minimal reproducer found by the property search: outside step_resolves the run must
     not gain energy (or must raise SimulationError)."""
@@ -564,7 +556,6 @@ WHOLE_DOMAIN_REASON = (
 )
 
 
-@pytest.mark.xfail(strict=True, reason=WHOLE_DOMAIN_REASON)
 def test_sweep_of_random_scenes_whole_domain() -> None:
     """The same 1500 scenes as the domain draws them, unresolved steps included: every run
     must be finite or fail with its message (a 'failed' row), never return inf."""
@@ -572,7 +563,6 @@ def test_sweep_of_random_scenes_whole_domain() -> None:
     check_sweep([random_scene(rng, apply_at=("tip", "centroid")[i % 2]) for i in range(1500)])
 
 
-@pytest.mark.xfail(strict=True, reason=WHOLE_DOMAIN_REASON)
 def test_blow_up_is_reported_not_returned() -> None:
     """Minimal reproducer: simulate(BLOWS_UP_TO_INF) must return finite numbers or raise
     SimulationError."""
