@@ -10,7 +10,9 @@ use nalgebra::{SVector, Vector2};
 
 use super::dense::{locate, Hermite};
 use super::rk4::{deriv_of, dopri5_step, step, Deriv, State};
-use crate::dynamics::{ContactMode, Effects, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
+use crate::dynamics::{
+    ContactMode, Effects, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS,
+};
 use crate::error::{GranrsError, Result};
 
 /// When a run ends.
@@ -1002,10 +1004,20 @@ fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> 
     }
     let links = &model.mechanism.links;
     let mass: f64 = links.iter().map(|l| l.mass).sum::<f64>() + model.mechanism.root_mass;
+    // The body's size: its links' extents and its contacts' lengths (a free link's root is
+    // its centre of mass, so only the rod's length says how tall it is).
     let size: f64 = links
         .iter()
         .map(|l| 2.0 * l.com.norm() + l.joint_on_parent.norm())
-        .sum();
+        .sum::<f64>()
+        + model
+            .contacts
+            .iter()
+            .map(|c| match c.shape {
+                Shape::Rod(r) => r.length,
+                Shape::Sole(s) => s.length + s.height,
+            })
+            .sum::<f64>();
     let scale = out.energy_start.abs() + mass * model.medium.g * size + 1e-12 * mass;
     let gain = out.energy_end - out.energy_start;
     if !out.energy_end.is_finite() || gain > DIVERGENCE_FACTOR * scale {
