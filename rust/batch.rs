@@ -347,44 +347,7 @@ mod tests {
     use crate::spec::Value;
 
     fn base() -> SceneSpec {
-        let mut s = SceneSpec::new();
-        for (k, v) in [
-            ("length", 0.19),
-            ("diameter", 0.0127),
-            ("mass", 0.184),
-            ("rho_g", 1650.0),
-            ("g", 9.81),
-            ("q_deg", 0.0),
-            ("v0", 2.0),
-            ("dt", 1e-4),
-            ("t_end", 1.0),
-        ] {
-            s.set(k, Value::Num(v));
-        }
-        for (k, v) in [
-            ("body", "free_link"),
-            ("apply_at", "tip"),
-            ("sign_model", "modes"),
-            ("method", "rk4"),
-            ("end", "first_stop"),
-        ] {
-            s.set(k, Value::Str(v.into()));
-        }
-        s.set(
-            "coefficients",
-            Value::Map(
-                [
-                    ("eta_h", 6.5),
-                    ("eta_d", 15.2),
-                    ("eta_v", 248.0),
-                    ("lam", 0.106),
-                ]
-                .iter()
-                .map(|(k, v)| (k.to_string(), Value::Num(*v)))
-                .collect(),
-            ),
-        );
-        s
+        crate::spec::free_link_spec()
     }
 
     fn product() -> Source {

@@ -502,52 +502,53 @@ struct Common {
     vx0: f64,
 }
 
+/// (Tests.) The Table 3.5 row q = 45 deg as a spec (what `granrs.Scene().to_dict()` sends).
+#[cfg(test)]
+pub(crate) fn free_link_spec() -> SceneSpec {
+    let mut s = SceneSpec::new();
+    for (k, v) in [
+        ("length", 0.19),
+        ("diameter", 0.0127),
+        ("mass", 0.184),
+        ("rho_g", 1650.0),
+        ("g", 9.81),
+        ("q_deg", 45.0),
+        ("v0", 2.27),
+        ("dt", 1e-4),
+        ("t_end", 1.0),
+        ("smooth_eps", 1e-3),
+    ] {
+        s.set(k, Value::Num(v));
+    }
+    for (k, v) in [
+        ("body", "free_link"),
+        ("apply_at", "tip"),
+        ("sign_model", "modes"),
+        ("method", "rk4"),
+        ("end", "first_stop"),
+    ] {
+        s.set(k, Value::Str(v.into()));
+    }
+    s.set(
+        "coefficients",
+        Value::Map(
+            [
+                ("eta_h", 5.5),
+                ("eta_d", 11.0),
+                ("eta_v", 53.0),
+                ("lam", 0.25),
+            ]
+            .iter()
+            .map(|(k, v)| (k.to_string(), Value::Num(*v)))
+            .collect(),
+        ),
+    );
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The free link's defaults as a spec (what `granrs.Scene().to_dict()` sends).
-    pub(crate) fn free_link_spec() -> SceneSpec {
-        let mut s = SceneSpec::new();
-        for (k, v) in [
-            ("length", 0.19),
-            ("diameter", 0.0127),
-            ("mass", 0.184),
-            ("rho_g", 1650.0),
-            ("g", 9.81),
-            ("q_deg", 45.0),
-            ("v0", 2.27),
-            ("dt", 1e-4),
-            ("t_end", 1.0),
-            ("smooth_eps", 1e-3),
-        ] {
-            s.set(k, Value::Num(v));
-        }
-        for (k, v) in [
-            ("body", "free_link"),
-            ("apply_at", "tip"),
-            ("sign_model", "modes"),
-            ("method", "rk4"),
-            ("end", "first_stop"),
-        ] {
-            s.set(k, Value::Str(v.into()));
-        }
-        s.set(
-            "coefficients",
-            Value::Map(
-                [
-                    ("eta_h", 5.5),
-                    ("eta_d", 11.0),
-                    ("eta_v", 53.0),
-                    ("lam", 0.25),
-                ]
-                .iter()
-                .map(|(k, v)| (k.to_string(), Value::Num(*v)))
-                .collect(),
-            ),
-        );
-        s
-    }
 
     #[test]
     fn spec_builds_the_same_scene_as_rust_defaults() {
