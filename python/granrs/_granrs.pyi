@@ -7,9 +7,6 @@ __version__: str
 EFFECTS: list[str]
 RECORDS: list[str]
 
-def simulate(scene: dict[str, Any]) -> dict[str, Any]:
-    """Run one scene dict (from Scene.to_dict()); return the raw results dict."""
-
 class Compiled:
     """A scene dict converted and validated by the core (from compile())."""
 
@@ -23,7 +20,8 @@ class RunOutcome:
     t_s: float
     depth: float
     run_seconds: float
-    def to_dict(self) -> dict[str, Any]: ...
+    def to_dict(self) -> dict[str, Any]:
+        """Everything, as a dict; once (the outcome moves out)."""
 
 def run(compiled: Compiled) -> RunOutcome:
     """Run a compiled scene."""

@@ -113,10 +113,6 @@ class Result:
         self._raw: dict[str, Any] | None = core if isinstance(core, dict) else None
         self._d: dict[str, Any] | None = None
 
-    @classmethod
-    def _from_raw(cls, scene: Scene, raw: Any) -> Result:
-        return cls(scene, raw)
-
     def __reduce__(self) -> tuple[Any, ...]:
         # Pickle the plain results, not the core's object.
         return (Result, (self.scene, self._raw_dict()))

@@ -6,6 +6,7 @@
 //! Python and Rust layers share one exception tree.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -195,32 +196,33 @@ fn compile(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Compiled> {
 /// getters, the rest comes as a dict from `to_dict` (built on first request by `Result`).
 #[pyclass(frozen, module = "granrs._granrs")]
 struct RunOutcome {
-    out: Outcome,
+    /// Why the run ended.
+    #[pyo3(get)]
+    status: &'static str,
+    /// Contact 0's stopping time [s] (NaN without a stop).
+    #[pyo3(get)]
+    t_s: f64,
+    /// Contact 0's depth at its stop [m].
+    #[pyo3(get)]
+    depth: f64,
     /// Wall time of the run alone [s] (for measuring a call's overhead; not a result).
     #[pyo3(get)]
     run_seconds: f64,
+    /// The rest, moved out (series included, without a copy) by the one `to_dict` call.
+    out: Mutex<Option<Outcome>>,
 }
 
 #[pymethods]
 impl RunOutcome {
-    /// Why the run ended.
-    #[getter]
-    fn status(&self) -> &'static str {
-        self.out.status.name()
-    }
-    /// Contact 0's stopping time [s] (NaN without a stop).
-    #[getter]
-    fn t_s(&self) -> f64 {
-        self.out.contacts.first().map_or(f64::NAN, |c| c.t_s)
-    }
-    /// Contact 0's depth at its stop [m].
-    #[getter]
-    fn depth(&self) -> f64 {
-        self.out.contacts.first().map_or(f64::NAN, |c| c.depth)
-    }
-    /// Everything, as the dict `simulate` returns.
+    /// Everything, as a dict (once: `Result` keeps it).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = outcome_to_dict(py, self.out.clone())?;
+        let out = self
+            .out
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take()
+            .ok_or_else(|| PyRuntimeError::new_err("RunOutcome.to_dict() was already called"))?;
+        let d = outcome_to_dict(py, out)?;
         d.set_item("run_seconds", self.run_seconds)?;
         Ok(d)
     }
@@ -235,29 +237,15 @@ fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
         let out = scene.run();
         (out, t0.elapsed().as_secs_f64())
     });
+    let out = out.map_err(|e| to_pyerr(py, e))?;
+    let first = out.contacts.first();
     Ok(RunOutcome {
-        out: out.map_err(|e| to_pyerr(py, e))?,
+        status: out.status.name(),
+        t_s: first.map_or(f64::NAN, |c| c.t_s),
+        depth: first.map_or(f64::NAN, |c| c.depth),
         run_seconds: seconds,
+        out: Mutex::new(Some(out)),
     })
-}
-
-/// Run one scene (a dict from `granrs.Scene.to_dict()`) and return its results as a dict.
-#[pyfunction]
-fn simulate<'py>(py: Python<'py>, scene: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyDict>> {
-    let scene = scene_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
-    run_scene(py, &scene)
-}
-
-fn run_scene<'py>(py: Python<'py>, scene: &AnyScene) -> PyResult<Bound<'py, PyDict>> {
-    let (out, seconds) = py.detach(|| {
-        let t0 = std::time::Instant::now();
-        let out = scene.run();
-        (out, t0.elapsed().as_secs_f64())
-    });
-    let d = outcome_to_dict(py, out.map_err(|e| to_pyerr(py, e))?)?;
-    // Wall time of the run alone (for measuring the call's overhead; not a result).
-    d.set_item("run_seconds", seconds)?;
-    Ok(d)
 }
 
 /// Validate a scene dict without running it (raises the typed error, or returns None).
@@ -550,7 +538,6 @@ fn resistance_force<'py>(
 
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Compiled>()?;
