@@ -17,6 +17,7 @@ from __future__ import annotations
 from . import _granrs, cases, coefficients, data, scenefile
 from .api import simulate
 from .batch import sweep
+from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
 from .effects import EFFECT_INFO, Effect
 from .errors import (
@@ -24,6 +25,7 @@ from .errors import (
     GranrsError,
     InvalidParameterError,
     InvalidSceneError,
+    MeasurementError,
     SimulationError,
     UnknownNameError,
 )
@@ -37,6 +39,7 @@ __all__ = [
     "EFFECTS",
     "EFFECT_INFO",
     "RECORDS",
+    "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
     "ContactResult",
@@ -44,12 +47,15 @@ __all__ = [
     "GranrsError",
     "InvalidParameterError",
     "InvalidSceneError",
+    "MeasurementError",
+    "Measurements",
     "ResistanceForce",
     "Result",
     "Scene",
     "SimulationError",
     "UnknownNameError",
     "__version__",
+    "calibrate",
     "cases",
     "coefficients",
     "data",

@@ -68,7 +68,8 @@ import math
 import os
 import re
 import time
-from collections.abc import Iterable, Mapping, Sequence
+import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import IO, Any
 
@@ -80,11 +81,22 @@ from . import data
 from .coefficients import Coefficients, table_3_2, table_3_4
 from .errors import (
     InvalidParameterError,
+    InvalidSceneError,
     MeasurementError,
     SimulationError,
     UnknownNameError,
 )
 from .scene import Scene
+
+try:  # the core's step-resolution check (newer builds)
+    from .api import RK4_STABILITY_LIMIT as _RK4_LIMIT
+    from .errors import StepSizeWarning as _StepSizeWarning
+except ImportError:  # pragma: no cover - older builds have neither
+    _RK4_LIMIT = math.inf
+
+    class _StepSizeWarning(UserWarning):  # type: ignore[no-redef]
+        """Stand-in: never raised."""
+
 
 __all__ = [
     "BODIES",
@@ -93,6 +105,7 @@ __all__ = [
     "CalibrationResult",
     "Measurements",
     "calibrate",
+    "evaluate",
     "within",
 ]
 
@@ -136,8 +149,8 @@ _DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     "eta_v": (1e-3, 1e6),
     "lam": (0.0, 3.0),
     "scale": (1e-3, 1e3),
-    "joints.k": (1.0, 1e6),
-    "joints.c": (1e-2, 1e4),
+    "joints.k": (1.0, 1e5),
+    "joints.c": (1e-2, 100.0),
 }
 #: Start of the joint settings when not given [N m/rad], [N m s/rad].
 _JOINT_START: dict[str, float] = {"k": 1000.0, "c": 10.0}
@@ -425,9 +438,7 @@ _NODE = re.compile(r"^(eta_h|eta_d|eta_v|lam|lambda)@([-+]?\d+(\.\d*)?)$")
 
 def _parse_param(name: Any, body: str) -> _Param:
     if not isinstance(name, str):
-        raise InvalidParameterError(
-            f"parameter names are strings; got {name!r}", field="params"
-        )
+        raise InvalidParameterError(f"parameter names are strings; got {name!r}", field="params")
     plain = name.replace("lambda", "lam")
     if plain in _COEFS:
         return _Param(plain, "coef", plain)
@@ -468,6 +479,8 @@ class _Model:
     dt: float
     overrides: dict[str, Any]
     fixed_joints: dict[str, float]
+    #: Per vector and row of the last :meth:`simulate`: the step did not resolve the run.
+    last_unresolved: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
 
     def to_internal(self, values: Sequence[float]) -> np.ndarray:
         return np.array(
@@ -475,9 +488,7 @@ class _Model:
         )
 
     def to_natural(self, x: Sequence[float]) -> np.ndarray:
-        return np.array(
-            [math.exp(u) if p.log else u for p, u in zip(self.params, x, strict=True)]
-        )
+        return np.array([math.exp(u) if p.log else u for p, u in zip(self.params, x, strict=True)])
 
     # base coefficients -------------------------------------------------------------------
     def base_coefficients(self, row: Mapping[str, Any]) -> Coefficients:
@@ -539,7 +550,9 @@ class _Model:
             ]
         if self.body == "leg":
             joints: Any = None
-            named = {p.target: v for p, v in zip(self.params, values, strict=True) if p.kind == "joint"}
+            named = {
+                p.target: v for p, v in zip(self.params, values, strict=True) if p.kind == "joint"
+            }
             if named or self.fixed_joints:
                 joints = {**_JOINT_START, **self.fixed_joints, **named}
             return [
@@ -581,30 +594,54 @@ class _Model:
         from .batch import sweep
 
         scenes: list[Scene] = []
-        for values in vectors:
-            scenes += self.scenes(rows, values)
-        frame = sweep(scenes, threads=threads, progress=False)
-        n_runs = len(scenes) // len(vectors)
-        depth = np.empty((len(vectors), len(rows)))
-        t_s = np.empty_like(depth)
-        ok = np.ones_like(depth, dtype=bool)
+        invalid = np.zeros(len(vectors), dtype=bool)
+        n_runs = len(rows) if self.body != "chain" else len(_chain_pairs(rows))
+        for v, values in enumerate(vectors):
+            try:
+                scenes += self.scenes(rows, values)
+            except InvalidSceneError:
+                # A value the core refuses (e.g. a damper past RK4's stability limit) is a
+                # failed point of the fit, not an error: the optimizer steps back.
+                invalid[v] = True
+        depth = np.full((len(vectors), len(rows)), np.nan)
+        t_s = np.full_like(depth, np.nan)
+        ok = np.zeros_like(depth, dtype=bool)
+        if not scenes:
+            self.last_unresolved = np.zeros_like(depth, dtype=bool)
+            return depth, t_s, ok
+        with warnings.catch_warnings():
+            # Runs the step did not resolve are counted (``unresolved``), not warned about
+            # once per sweep of a fit.
+            warnings.simplefilter("ignore", _StepSizeWarning)
+            frame = sweep(scenes, threads=threads, progress=False)
         failed = (frame["status"] == "failed").to_numpy()
+        run_unresolved = np.zeros(len(frame), dtype=bool)
+        if "unresolved" in frame.columns:
+            run_unresolved |= frame["unresolved"].to_numpy(dtype=float) > 0
+        if "h_lambda" in frame.columns:
+            run_unresolved |= frame["h_lambda"].to_numpy(dtype=float) > _RK4_LIMIT
+        unresolved = np.zeros((len(vectors), len(rows)), dtype=bool)
+        valid = np.flatnonzero(~invalid)
         if self.body == "chain":
             pairs = _chain_pairs(rows)
-            for v in range(len(vectors)):
+            for slot, v in enumerate(valid):
                 for j, (i1, i2) in enumerate(pairs):
-                    k = v * n_runs + j
+                    k = slot * n_runs + j
                     for link, i in ((0, i1), (1, i2)):
                         t = frame[f"c{link}.t_s"].iloc[k]
                         depth[v, i] = frame[f"c{link}.depth"].iloc[k]
                         t_s[v, i] = t if math.isfinite(t) else frame["t_final"].iloc[k]
                         ok[v, i] = not failed[k]
+                        unresolved[v, i] = run_unresolved[k]
         else:
             t = frame["t_s"].to_numpy(dtype=float)
             t = np.where(np.isfinite(t), t, frame["t_final"].to_numpy(dtype=float))
-            depth[:] = frame["depth"].to_numpy(dtype=float).reshape(len(vectors), len(rows))
-            t_s[:] = t.reshape(len(vectors), len(rows))
-            ok[:] = ~failed.reshape(len(vectors), len(rows))
+            shape = (len(valid), len(rows))
+            depth[valid] = frame["depth"].to_numpy(dtype=float).reshape(shape)
+            t_s[valid] = t.reshape(shape)
+            ok[valid] = ~failed.reshape(shape)
+            unresolved[valid] = run_unresolved.reshape(shape)
+        self.last_unresolved = unresolved
         depth[~ok] = np.nan
         t_s[~ok] = np.nan
         return depth, t_s, ok
@@ -665,6 +702,9 @@ class CalibrationResult:
         nfev, njev: residual and Jacobian evaluations.
         success, message: scipy's convergence flag and message.
         failed_runs: simulations that failed (SimulationError) during the fit.
+        unresolved_runs: simulations during the fit whose step did not resolve the contact
+            (the core's :class:`~granrs.StepSizeWarning` check; counted, not warned); the
+            ``unresolved`` column of :attr:`residuals` flags them at the optimum.
     """
 
     body: str
@@ -687,6 +727,7 @@ class CalibrationResult:
     success: bool
     message: str
     failed_runs: int
+    unresolved_runs: int
     _model: _Model = field(repr=False, compare=False)
     _measurements: Measurements = field(repr=False, compare=False)
     _threads: int | None = field(default=None, repr=False, compare=False)
@@ -697,7 +738,9 @@ class CalibrationResult:
         _check_measurements(measurements, self.body)
         values = [self.values[p] for p in self.params]
         depth, t_s, _ = self._model.simulate(measurements.rows, [values], self._threads)
-        return _residual_frame(measurements, depth[0], t_s[0])
+        frame = _residual_frame(measurements, depth[0], t_s[0])
+        frame["unresolved"] = self._model.last_unresolved[0]
+        return frame
 
     def coefficients(self, row: Mapping[str, Any]) -> Coefficients:
         """The fitted coefficients for one measurement row (e.g. ``{"q_deg": 60,
@@ -749,9 +792,8 @@ class CalibrationResult:
             "success": self.success,
             "message": self.message,
             "failed_runs": self.failed_runs,
-            "within": {
-                q: {"1sd": self.within(q, 1), "2sd": self.within(q, 2)} for q in QUANTITIES
-            },
+            "unresolved_runs": self.unresolved_runs,
+            "within": {q: {"1sd": self.within(q, 1), "2sd": self.within(q, 2)} for q in QUANTITIES},
             "residuals": self.residuals.to_dict("records"),
         }
 
@@ -874,8 +916,9 @@ def calibrate(
             ``eta_v``, ``lam``; ``<coef>@<q_deg>`` angle nodes (free link);
             ``scale.<coef>``; ``joints.k``, ``joints.c`` (leg). The rest keep their base value.
         bounds: ``{name: (low, high)}`` in natural units; defaults: etas 1e-3..1e5 (eta_v
-            1e-3..1e6), lambda 0..3, scale factors 1e-3..1e3, joints.k 1..1e6 N m/rad,
-            joints.c 0.01..1e4 N m s/rad.
+            1e-3..1e6), lambda 0..3, scale factors 1e-3..1e3, joints.k 1..1e5 N m/rad,
+            joints.c 0.01..100 N m s/rad (the damper's rate must stay within RK4's stability
+            limit at dt = 1e-4, about 150 N m s/rad for the foot).
         start: ``{name: value}``; default: the base value (at the row nearest the node for
             a node; 1 for a scale factor; k = 1000 N m/rad, c = 10 N m s/rad).
         base: the coefficients of what is not fitted: free link ``"table_3_4"`` (default;
@@ -963,8 +1006,11 @@ def calibrate(
     if base is None:
         base = "table_3_4" if body == "free_link" else "thesis"
     if isinstance(base, str):
-        allowed = {"free_link": ("table_3_4", "table_3_2"), "chain": ("thesis", "table_4_4"),
-                   "leg": ("thesis",)}[body]
+        allowed = {
+            "free_link": ("table_3_4", "table_3_2"),
+            "chain": ("thesis", "table_4_4"),
+            "leg": ("thesis",),
+        }[body]
         if base not in allowed:
             raise UnknownNameError(
                 f"unknown base {base!r} for the {body}; use {', '.join(allowed)} or a "
@@ -979,9 +1025,16 @@ def calibrate(
     for name, value, ok in (
         ("dt", dt, _is_number(dt) and math.isfinite(dt) and dt > 0),
         ("rel_step", rel_step, _is_number(rel_step) and 1e-8 <= rel_step <= 0.1),
-        ("starts", starts, isinstance(starts, int) and not isinstance(starts, bool) and starts >= 1),
-        ("max_nfev", max_nfev, isinstance(max_nfev, int) and not isinstance(max_nfev, bool)
-         and max_nfev >= 1),
+        (
+            "starts",
+            starts,
+            isinstance(starts, int) and not isinstance(starts, bool) and starts >= 1,
+        ),
+        (
+            "max_nfev",
+            max_nfev,
+            isinstance(max_nfev, int) and not isinstance(max_nfev, bool) and max_nfev >= 1,
+        ),
         ("error_scale", error_scale, error_scale in ("auto", "none")),
     ):
         if not ok:
@@ -1042,7 +1095,7 @@ def calibrate(
     x0 = np.clip(x0, lo_x, hi_x)
     sd = {q: m.sd_fit(q) for q in qs}
     means = {q: m.rows[f"{q}_mean"].to_numpy(dtype=float) for q in qs}
-    counters = {"sims": 0, "failed": 0}
+    counters = {"sims": 0, "failed": 0, "unresolved": 0}
     n_runs = len(model.scenes(m.rows, x_start))
 
     def weighted(depth: np.ndarray, t_s: np.ndarray) -> np.ndarray:
@@ -1054,8 +1107,9 @@ def calibrate(
     def evaluate(xs: Sequence[np.ndarray]) -> np.ndarray:
         vectors = [model.to_natural(x) for x in xs]
         depth, t_s, ok = model.simulate(m.rows, vectors, threads)
-        counters["sims"] += n_runs * len(xs)
+        counters["sims"] += n_runs * len(xs)  # refused vectors count as attempted
         counters["failed"] += int(np.sum(~ok))
+        counters["unresolved"] += int(np.sum(model.last_unresolved))
         return weighted(depth, t_s)
 
     cache: dict[bytes, np.ndarray] = {}
@@ -1069,8 +1123,10 @@ def calibrate(
 
     def steps(x: np.ndarray) -> np.ndarray:
         h = np.array(
-            [rel_step if p.log else rel_step * max(abs(u), 0.1) for p, u in zip(parsed, x,
-                                                                                  strict=True)]
+            [
+                rel_step if p.log else rel_step * max(abs(u), 0.1)
+                for p, u in zip(parsed, x, strict=True)
+            ]
         )
         # Step inwards where the forward step would leave the box.
         return np.where(x + h > hi_x, -h, h)
@@ -1156,7 +1212,9 @@ def calibrate(
     # Residual tables at the optimum and at the start (one sweep).
     depth, t_s, _ = model.simulate(m.rows, [natural, model.to_natural(x0)], threads)
     counters["sims"] += 2 * n_runs
+    flags = model.last_unresolved
     frame = _residual_frame(m, depth[0], t_s[0])
+    frame["unresolved"] = flags[0] if flags.size else False
     start_frame = _residual_frame(m, depth[1], t_s[1])
     for q in QUANTITIES:
         frame[f"{q}_z_start"] = start_frame[f"{q}_z"]
@@ -1181,6 +1239,7 @@ def calibrate(
         success=bool(best.success),
         message=str(best.message),
         failed_runs=counters["failed"],
+        unresolved_runs=counters["unresolved"],
         _model=model,
         _measurements=m,
         _threads=threads,
@@ -1193,3 +1252,28 @@ def _exp(u: float) -> float:
     except OverflowError:
         return math.inf
 
+
+def evaluate(
+    cases: str,
+    measurements: Measurements | str | os.PathLike[str],
+    *,
+    base: str | Coefficients | None = None,
+    dt: float = 1e-4,
+    threads: int | None = None,
+    **overrides: Any,
+) -> pd.DataFrame:
+    """The residuals of ``measurements`` with the base coefficients, nothing fitted (e.g.
+    the thesis's Table 3.4 rows): a frame as :attr:`CalibrationResult.residuals` without
+    the start columns. Arguments as in :func:`calibrate`."""
+    if not isinstance(cases, str) or cases not in BODIES:
+        raise UnknownNameError(
+            f"unknown cases {cases!r}; calibrate fits {', '.join(BODIES)}", field="cases"
+        )
+    m = _check_measurements(measurements, cases)
+    if base is None:
+        base = "table_3_4" if cases == "free_link" else "thesis"
+    model = _Model(cases, (), base, float(dt), dict(overrides), {})
+    depth, t_s, _ = model.simulate(m.rows, [[]], threads)
+    frame = _residual_frame(m, depth[0], t_s[0])
+    frame["unresolved"] = model.last_unresolved[0]
+    return frame
