@@ -15,7 +15,7 @@ Quick start::
 from __future__ import annotations
 
 from . import _granrs, cases, coefficients, data, scenefile
-from .api import simulate
+from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
@@ -27,6 +27,7 @@ from .errors import (
     InvalidSceneError,
     MeasurementError,
     SimulationError,
+    StepSizeWarning,
     UnknownNameError,
 )
 from .force import ResistanceForce, resistance_force
@@ -39,6 +40,7 @@ __all__ = [
     "EFFECTS",
     "EFFECT_INFO",
     "RECORDS",
+    "RK4_STABILITY_LIMIT",
     "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
@@ -53,6 +55,7 @@ __all__ = [
     "Result",
     "Scene",
     "SimulationError",
+    "StepSizeWarning",
     "UnknownNameError",
     "__version__",
     "calibrate",
