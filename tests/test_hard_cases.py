@@ -390,8 +390,11 @@ def test_contact_reemerges() -> None:
     reason=(
         "after re-entering, the spinning rod sticks at E (mode_x = mode_y = 0 from ~80 ms) "
         "and its depth at 0.1 s stops converging: against dt = 1e-7 (0.04732100 m) the "
-        "error is 1.6e-6 m at dt = 1e-5 and 1.8e-6 m at dt = 1e-6 (no smaller); at 75 ms, "
-        "before the sticking, it still shrinks (3.2e-6 -> 4.7e-7)"
+        "error is 1.2e-6 m at dt = 1e-5 and 1.8e-6 m at dt = 1e-6 (no smaller). Located on "
+        "2026-11-22: the errors appear at the re-entry (t = 0.068 s), where the rod is past "
+        "horizontal (q = 4.1 rad), T is its upper end and l jumps 0 -> L, so F_sv rises as "
+        "d^0.25 on the full volume: at 70 ms they are already -3.2e-7 (1e-5) and -4.1e-7 "
+        "(1e-6), and before the re-entry below 1e-12"
     ),
 )
 def test_contact_reemerges_then_sticks_converges() -> None:
