@@ -691,18 +691,21 @@ pub fn solve<const N: usize>(
     let mut events_this_step = 0usize;
     let mut funcs: Vec<(Kind, usize)> = Vec::with_capacity(4 * MAX_CONTACTS);
 
-    // The drag's stiffest moment: (|F_d| / |v_E|, the state, the contact, v_E / |v_E|).
+    // The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E). Squared
+    // norms: a square root only when a maximum is beaten.
     let mut stiffest = (0.0f64, y.q, 0usize, Vector2::zeros());
     let mut update_fd_max =
         |summaries: &mut Vec<ContactSummary>, e: &Eval<N>, q: &SVector<f64, N>, modes: &Modes| {
             for (ci, s) in summaries.iter_mut().enumerate() {
                 if !modes[ci].stopped {
                     let c = &e.contacts[ci];
-                    let drag = c.force.drag_magnitude();
-                    s.f_d_max = s.f_d_max.max(drag);
-                    let speed = c.v_centroid.norm();
-                    if speed > 0.0 && drag > stiffest.0 * speed {
-                        stiffest = (drag / speed, *q, ci, c.v_centroid / speed);
+                    let drag2 = c.force.drag.norm_squared();
+                    if drag2 > s.f_d_max * s.f_d_max {
+                        s.f_d_max = drag2.sqrt();
+                    }
+                    let speed2 = c.v_centroid.norm_squared();
+                    if speed2 > 0.0 && drag2 > stiffest.0 * speed2 {
+                        stiffest = (drag2 / speed2, *q, ci, c.v_centroid);
                     }
                 }
             }
@@ -987,8 +990,12 @@ pub fn solve<const N: usize>(
     let h_lambda = if adaptive {
         f64::NAN
     } else if stiffest.0 > 0.0 {
-        let (k, q, ci, dir) = stiffest;
-        dt * drag_rate(&model.centroid_inverse_mass(&q, ci), k, dir)
+        let (k2, q, ci, v) = stiffest;
+        dt * drag_rate(
+            &model.centroid_inverse_mass(&q, ci),
+            k2.sqrt(),
+            v.normalize(),
+        )
     } else {
         0.0
     };
