@@ -6,6 +6,8 @@
 //! keeps one base spec and overrides a few fields per run ([`SceneSpec::set`]), which needs
 //! neither Python nor the GIL.
 
+use std::borrow::Cow;
+
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
 use crate::dynamics::{Effects, SignModel};
@@ -55,11 +57,59 @@ pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
 /// Names of the bodies.
 pub const BODIES: [&str; 3] = ["free_link", "chain", "leg"];
 
+/// Every field a `granrs.Scene` hands the core, sorted: a name found here is kept without
+/// an allocation of its own ([`SceneSpec::from_sorted`]).
+pub const SCENE_FIELDS: [&str; 43] = [
+    "ankle",
+    "apply_at",
+    "atol",
+    "body",
+    "body_mass",
+    "coefficients",
+    "coefficients2",
+    "depth0",
+    "diameter",
+    "dt",
+    "effects",
+    "end",
+    "foot_deg",
+    "foot_length",
+    "g",
+    "height",
+    "hip",
+    "hip_deg",
+    "inertia",
+    "knee",
+    "knee_deg",
+    "length",
+    "mass",
+    "method",
+    "omega0",
+    "pin_joint",
+    "pin_mass",
+    "q2_deg",
+    "q_deg",
+    "record",
+    "record_stride",
+    "rho_g",
+    "rtol",
+    "shoe_width",
+    "sign_model",
+    "smooth_eps",
+    "sole_height",
+    "sole_model",
+    "t_end",
+    "tibia_length",
+    "trunk_deg",
+    "v0",
+    "vx0",
+];
+
 /// A scene as named fields, kept sorted by name. Fields that a body does not use are
 /// ignored.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneSpec {
-    fields: Vec<(String, Value)>,
+    fields: Vec<(Cow<'static, str>, Value)>,
 }
 
 fn missing(field: &str) -> GranrsError {
@@ -109,6 +159,13 @@ fn num(field: &str, v: Option<&Value>) -> Result<f64> {
     }
 }
 
+/// Name order (that of `str`).
+#[inline]
+fn name_cmp(a: &str, b: &str) -> std::cmp::Ordering {
+    // Byte by byte, inline: the names are short, and a call to `memcmp` costs more.
+    a.as_bytes().iter().cmp(b.as_bytes().iter())
+}
+
 fn map_get<'a>(entries: &'a [(String, Value)], k: &str) -> Option<&'a Value> {
     entries.iter().find(|(name, _)| name == k).map(|(_, v)| v)
 }
@@ -120,10 +177,27 @@ impl SceneSpec {
     }
 
     /// A spec from (field, value) pairs; a later duplicate replaces an earlier one.
-    pub fn from_pairs(mut pairs: Vec<(String, Value)>) -> Self {
-        // Stable: equal names keep their order, so the last of each wins below.
-        pairs.sort_by(|a, b| a.0.cmp(&b.0));
-        let mut fields: Vec<(String, Value)> = Vec::with_capacity(pairs.len());
+    pub fn from_pairs(pairs: Vec<(String, Value)>) -> Self {
+        Self::from_sorted(
+            pairs
+                .into_iter()
+                .map(|(name, value)| (Cow::Owned(name), value))
+                .collect(),
+        )
+    }
+
+    /// [`SceneSpec::from_pairs`] for names that may be borrowed (see [`SCENE_FIELDS`]);
+    /// cheapest when they come sorted, as a `granrs.Scene` sends them.
+    pub fn from_sorted(mut pairs: Vec<(Cow<'static, str>, Value)>) -> Self {
+        if pairs.is_sorted_by(|a, b| name_cmp(&a.0, &b.0).is_lt()) {
+            // Sorted without duplicates: the pairs are the fields.
+            return SceneSpec { fields: pairs };
+        }
+        if !pairs.is_sorted_by(|a, b| a.0 <= b.0) {
+            // Stable: equal names keep their order, so the last of each wins below.
+            pairs.sort_by(|a, b| a.0.cmp(&b.0));
+        }
+        let mut fields: Vec<(Cow<'static, str>, Value)> = Vec::with_capacity(pairs.len());
         for (name, value) in pairs {
             match fields.last_mut() {
                 Some(last) if last.0 == name => last.1 = value,
@@ -133,21 +207,39 @@ impl SceneSpec {
         SceneSpec { fields }
     }
 
+    /// The name `name` as a `'static` string if it is one of [`SCENE_FIELDS`] at or after
+    /// position `*from` (advanced past it: a sorted run of names walks the table once).
+    pub fn static_name(name: &str, from: &mut usize) -> Option<&'static str> {
+        while let Some(&known) = SCENE_FIELDS.get(*from) {
+            match name_cmp(known, name) {
+                std::cmp::Ordering::Less => *from += 1,
+                std::cmp::Ordering::Equal => {
+                    *from += 1;
+                    return Some(known);
+                }
+                std::cmp::Ordering::Greater => return None,
+            }
+        }
+        None
+    }
+
     /// Set (or replace) a field.
     pub fn set(&mut self, field: &str, value: Value) {
         match self
             .fields
-            .binary_search_by(|(name, _)| name.as_str().cmp(field))
+            .binary_search_by(|(name, _)| name_cmp(name, field))
         {
             Ok(i) => self.fields[i].1 = value,
-            Err(i) => self.fields.insert(i, (field.to_string(), value)),
+            Err(i) => self
+                .fields
+                .insert(i, (Cow::Owned(field.to_string()), value)),
         }
     }
 
     /// A field's value, if present.
     pub fn get(&self, field: &str) -> Option<&Value> {
         self.fields
-            .binary_search_by(|(name, _)| name.as_str().cmp(field))
+            .binary_search_by(|(name, _)| name_cmp(name, field))
             .ok()
             .map(|i| &self.fields[i].1)
     }
@@ -607,6 +699,19 @@ mod tests {
         assert!(
             matches!(s.build(), Err(GranrsError::UnknownName { field, .. }) if field == "body")
         );
+    }
+
+    #[test]
+    fn scene_fields_are_sorted_and_found() {
+        assert!(SCENE_FIELDS.is_sorted_by(|a, b| a < b));
+        let mut from = 0;
+        for name in SCENE_FIELDS {
+            assert_eq!(SceneSpec::static_name(name, &mut from), Some(name));
+        }
+        let mut from = 0;
+        assert_eq!(SceneSpec::static_name("mass", &mut from), Some("mass"));
+        assert_eq!(SceneSpec::static_name("diameter", &mut from), None);
+        assert_eq!(SceneSpec::static_name("zzz", &mut from), None);
     }
 
     #[test]

@@ -6,12 +6,16 @@ from typing import Any
 __version__: str
 EFFECTS: list[str]
 RECORDS: list[str]
+SCENE_FIELDS: list[str]
 
 class Compiled:
     """A scene dict converted and validated by the core (from compile())."""
 
 def compile(scene: dict[str, Any]) -> Compiled:
     """Convert and validate a scene dict once."""
+
+def compile_fields(fields: dict[str, Any], names: tuple[str, ...]) -> Compiled:
+    """Convert and validate a Scene once, from its ``__dict__`` and its body's field names."""
 
 class RunOutcome:
     """One run's outcome, kept in the core until asked for."""

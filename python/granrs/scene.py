@@ -323,7 +323,7 @@ class Scene:
         """The scene converted and validated by the core, once per scene (it is frozen)."""
         compiled = self.__dict__.get("_compiled_cache")
         if compiled is None:
-            compiled = _granrs.compile(self._plain())
+            compiled = _granrs.compile_fields(self.__dict__, _CORE_FIELDS[self.body])
             object.__setattr__(self, "_compiled_cache", compiled)
         return compiled
 
@@ -367,12 +367,15 @@ class Scene:
 _DEFAULTS: dict[str, Any] = {
     f.name: f.default for f in dataclasses.fields(Scene) if f.default is not dataclasses.MISSING
 }
-#: Per body, the fields the Rust core reads (those of the body; not coefficients_source).
+#: Per body, the fields the Rust core reads (those of the body; not coefficients_source),
+#: sorted (the order the core keeps them in).
 _CORE_FIELDS: dict[str, tuple[str, ...]] = {
     body: tuple(
-        f.name
-        for f in dataclasses.fields(Scene)
-        if body in BODY_FIELDS.get(f.name, (body,)) and f.name != "coefficients_source"
+        sorted(
+            f.name
+            for f in dataclasses.fields(Scene)
+            if body in BODY_FIELDS.get(f.name, (body,)) and f.name != "coefficients_source"
+        )
     )
     for body in BODIES
 }

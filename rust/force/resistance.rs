@@ -44,10 +44,17 @@ impl Coefficients {
     /// Validate: every value finite, etas >= 0, lambda >= 0. `prefix` names the field.
     pub fn validate(&self, prefix: &str) -> crate::error::Result<()> {
         use crate::error::check_range;
-        check_range(&format!("{prefix}.eta_h"), self.eta_h, 0.0, false)?;
-        check_range(&format!("{prefix}.eta_d"), self.eta_d, 0.0, false)?;
-        check_range(&format!("{prefix}.eta_v"), self.eta_v, 0.0, false)?;
-        check_range(&format!("{prefix}.lam"), self.lambda, 0.0, false)?;
+        for (name, value) in [
+            ("eta_h", self.eta_h),
+            ("eta_d", self.eta_d),
+            ("eta_v", self.eta_v),
+            ("lam", self.lambda),
+        ] {
+            // The field's name is built only for the error.
+            if !(value.is_finite() && value >= 0.0) {
+                check_range(&format!("{prefix}.{name}"), value, 0.0, false)?;
+            }
+        }
         Ok(())
     }
 }

@@ -838,7 +838,10 @@ pub fn solve<const N: usize>(
             // Accept the whole step.
             y = y1;
             cur = 1 - cur;
-            if model.project_sticking(&y.q, &mut y.qd, &modes) {
+            // `evals[cur]` is the step's end: it tells when the projection has nothing to do.
+            if model.sticking_may_drift(&evals[cur], &modes)
+                && model.project_sticking(&y.q, &mut y.qd, &modes)
+            {
                 stats.rhs_evals += 1;
                 model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
             }

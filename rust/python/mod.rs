@@ -5,19 +5,20 @@
 //! [`GranrsError`] becomes an instance of the matching class of `granrs.errors`, so that the
 //! Python and Rust layers share one exception tree.
 
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use crate::batch::{self, Source};
 use crate::error::GranrsError;
 use crate::integrate::Outcome;
 use crate::scene::AnyScene;
-use crate::spec::{SceneSpec, Value, EFFECTS, RECORDS};
+use crate::spec::{SceneSpec, Value, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -55,6 +56,13 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
     if v.is_none() {
         return Value::None;
     }
+    if v.is_exact_instance_of::<PyInt>() {
+        // As below for any other number; an int too large for a float is refused by type.
+        return match v.extract::<f64>() {
+            Ok(x) => Value::Num(x),
+            Err(_) => Value::Other("int".into()),
+        };
+    }
     if v.is_instance_of::<PyBool>() {
         return Value::Bool(v.is_truthy().unwrap_or(false));
     }
@@ -70,11 +78,11 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
                 .collect(),
         );
     }
-    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
-        return match v.extract::<Vec<String>>() {
-            Ok(names) => Value::Names(names),
-            Err(_) => Value::Other("a list that is not all strings".into()),
-        };
+    if let Ok(t) = v.cast::<PyTuple>() {
+        return names_from_py(t.iter());
+    }
+    if let Ok(l) = v.cast::<PyList>() {
+        return names_from_py(l.iter());
     }
     let type_name = v
         .get_type()
@@ -88,6 +96,18 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         Ok(x) => Value::Num(x),
         Err(_) => Value::Other(type_name),
     }
+}
+
+/// A list or tuple of names (`effects`, `record`) as a spec value.
+fn names_from_py<'py>(items: impl ExactSizeIterator<Item = Bound<'py, PyAny>>) -> Value {
+    let mut names = Vec::with_capacity(items.len());
+    for item in items {
+        match item.cast::<PyString>().ok().and_then(|s| s.to_str().ok()) {
+            Some(s) => names.push(s.to_owned()),
+            None => return Value::Other("a list that is not all strings".into()),
+        }
+    }
+    Value::Names(names)
 }
 
 /// A scene dict (from `granrs.Scene.to_dict()`) as a spec.
@@ -191,6 +211,72 @@ struct Compiled {
 #[pyfunction]
 fn compile(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Compiled> {
     let scene = scene_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
+    Ok(Compiled { scene })
+}
+
+/// A coefficients field read from a `granrs.Scene`: a `granrs.Coefficients` becomes the
+/// mapping its `as_dict()` gives (the same four keys in the same order); anything else
+/// converts as in a scene dict.
+fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
+    if v.is_none() || v.is_instance_of::<PyDict>() {
+        return value_from_py(v);
+    }
+    let mut entries = Vec::with_capacity(4);
+    for (key, name) in [
+        (pyo3::intern!(v.py(), "eta_h"), "eta_h"),
+        (pyo3::intern!(v.py(), "eta_d"), "eta_d"),
+        (pyo3::intern!(v.py(), "eta_v"), "eta_v"),
+        (pyo3::intern!(v.py(), "lam"), "lam"),
+    ] {
+        match v.getattr(key) {
+            Ok(x) => entries.push((name.to_owned(), value_from_py(&x))),
+            Err(_) => return value_from_py(v),
+        }
+    }
+    Value::Map(entries)
+}
+
+/// The spec of a `granrs.Scene` read straight from its attributes: `fields` is the
+/// instance's `__dict__`, `names` the fields its body uses (`scene._CORE_FIELDS`, sorted).
+/// The same values as the dict `Scene._plain()` builds, without building it.
+fn spec_from_fields(fields: &Bound<'_, PyDict>, names: &Bound<'_, PyTuple>) -> SceneSpec {
+    let mut pairs = Vec::with_capacity(names.len());
+    let mut known = 0;
+    for name in names.iter() {
+        let Ok(key) = name.cast::<PyString>() else {
+            continue;
+        };
+        let Ok(key_str) = key.to_str() else {
+            continue;
+        };
+        let Ok(Some(v)) = fields.get_item(key) else {
+            continue;
+        };
+        let value = if key_str.starts_with("coefficients") {
+            coefficients_from_py(&v)
+        } else {
+            value_from_py(&v)
+        };
+        let name = match SceneSpec::static_name(key_str, &mut known) {
+            Some(name) => Cow::Borrowed(name),
+            None => Cow::Owned(key_str.to_owned()),
+        };
+        pairs.push((name, value));
+    }
+    SceneSpec::from_sorted(pairs)
+}
+
+/// [`compile`] for a `granrs.Scene`, from its `__dict__` and its body's field names (see
+/// [`spec_from_fields`]): the same validation and errors, without the scene dict.
+#[pyfunction]
+fn compile_fields(
+    py: Python<'_>,
+    fields: &Bound<'_, PyDict>,
+    names: &Bound<'_, PyTuple>,
+) -> PyResult<Compiled> {
+    let scene = spec_from_fields(fields, names)
+        .build()
+        .map_err(|e| to_pyerr(py, e))?;
     Ok(Compiled { scene })
 }
 
@@ -549,6 +635,7 @@ fn resistance_force<'py>(
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
+    m.add_function(wrap_pyfunction!(compile_fields, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Compiled>()?;
     m.add_class::<RunOutcome>()?;
@@ -560,6 +647,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FORCE_OUTPUTS", crate::evaluate::OUTPUTS.to_vec())?;
     m.add("EFFECTS", EFFECTS.to_vec())?;
     m.add("RECORDS", RECORDS.to_vec())?;
+    m.add("SCENE_FIELDS", SCENE_FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(leg_segments, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

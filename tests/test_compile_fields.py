@@ -1,0 +1,105 @@
+"""``simulate`` compiles a Scene from its attributes (``_granrs.compile_fields``), without the
+dict ``Scene._plain()`` that ``_granrs.compile`` reads (issue 5: the call overhead of a new
+scene). The two must be the same conversion: the same runs, bitwise, and the same typed
+error naming the same field for bad input.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from typing import Any
+
+import pytest
+
+import granrs
+from granrs import Coefficients, Scene, _granrs, cases
+from granrs.errors import GranrsError
+from granrs.scene import _CORE_FIELDS
+
+
+def _via_dict(scene: Scene) -> Any:
+    return _granrs.compile(scene._plain())
+
+
+def _via_fields(scene: Scene) -> Any:
+    return _granrs.compile_fields(scene.__dict__, _CORE_FIELDS[scene.body])
+
+
+def _outcome(compiled: Any) -> dict[str, Any]:
+    d = _granrs.run(compiled).to_dict()
+    d.pop("run_seconds")
+    return d
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal, NaN equal to NaN (the results hold NaN for what did not happen)."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and math.isnan(a):
+        return isinstance(b, float) and math.isnan(b)
+    return bool(a == b)
+
+
+SCENES = [
+    cases.free_link(q_deg=45.0, v0=2.27),
+    cases.free_link(q_deg=0.0, v0=2.214).replace(sign_model="raw", apply_at="centroid"),
+    Scene(q_deg=30, v0=1, inertia=1e-3, record_stride=2, effects=("gravity", "static_v")),
+    Scene(sign_model="smooth", smooth_eps=2e-3, method="dopri5", rtol=1e-6, atol=1e-9),
+    cases.chain(1),
+    cases.chain(1).replace(pin_joint={"k": 0.5, "c": 0.01}, coefficients2=None),
+    cases.leg(v0=3.28),
+    cases.leg(v0=3.28).replace(knee={"k": 300.0, "c": 2.0}, sole_model="thesis", foot_deg=5.0),
+]
+
+
+def test_the_core_keeps_every_field_name() -> None:
+    """Every field a Scene sends is one the core knows by name (kept without a copy)."""
+    sent = set(itertools.chain.from_iterable(_CORE_FIELDS.values()))
+    assert sent == set(_granrs.SCENE_FIELDS)
+    for names in _CORE_FIELDS.values():
+        assert list(names) == sorted(names)
+
+
+@pytest.mark.parametrize("scene", SCENES, ids=lambda s: s.body)
+def test_fields_compile_as_the_dict_does(scene: Scene) -> None:
+    assert _same(_outcome(_via_fields(scene)), _outcome(_via_dict(scene)))
+    assert _same(
+        granrs.simulate(scene).summary, granrs.simulate(dataclasses.replace(scene)).summary
+    )
+
+
+BAD = [
+    {"mass": -1.0},
+    {"length": math.nan},
+    {"dt": 0},
+    {"t_end": 10**400},
+    {"record_stride": 1.5},
+    {"q_deg": True},
+    {"v0": "fast"},
+    {"apply_at": "heel"},
+    {"sign_model": "smooth", "smooth_eps": -1.0},
+    {"coefficients": Coefficients(eta_h=1.0, eta_d=1.0, eta_v=1.0, lam=1.0), "inertia": -2.0},
+]
+
+
+@pytest.mark.parametrize("change", BAD, ids=lambda c: ",".join(c))
+def test_bad_fields_raise_the_same_error(change: dict[str, Any]) -> None:
+    """The core validates a Scene's fields before any run, whichever way they arrive."""
+    try:
+        scene = Scene(**change)
+    except GranrsError:
+        pytest.skip("refused by Scene itself")
+    errors = []
+    for compile_ in (_via_dict, _via_fields):
+        with pytest.raises(GranrsError) as info:
+            compile_(scene)
+        errors.append(info.value)
+    a, b = errors
+    assert (type(a), a.field, str(a)) == (type(b), b.field, str(b))
+    with pytest.raises(type(a)) as info:
+        granrs.simulate(scene)
+    assert info.value.field == a.field
