@@ -920,10 +920,12 @@ impl<const N: usize> Model<N> {
             gen[1] += total.y;
             gen[2] += total.dot(&fr.lever(self.application_point(&self.contacts[0], centroid)));
         }
+        // M^-1 by multiplication: the divisions are off the force's path and overlap it.
+        let (inv_m, inv_i) = self.rigid_rod_inverse_mass_parts();
         let mut qdd = SVector::<f64, N>::zeros();
-        qdd[0] = gen[0] / mass;
-        qdd[1] = gen[1] / mass;
-        qdd[2] = gen[2] / link.inertia;
+        qdd[0] = gen[0] * inv_m;
+        qdd[1] = gen[1] * inv_m;
+        qdd[2] = gen[2] * inv_i;
         if forced && self.sign_model == SignModel::Modes && self.stuck(mode) {
             self.rigid_rod_reactions(rod, &fr, &geom, v_tip, mode, &mut qdd, out);
         }
@@ -978,7 +980,7 @@ impl<const N: usize> Model<N> {
     /// correct `qdd`, and store each reaction in place of its static term in `out`. E moves
     /// over the rod at half the rate of the immersed length, which the rows' bias holds.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(never)]
     fn rigid_rod_reactions(
         &self,
         rod: &RodContact,
@@ -997,6 +999,24 @@ impl<const N: usize> Model<N> {
             + fr.omega * slide;
         let (inv_m, inv_i) = self.rigid_rod_inverse_mass_parts();
         let k = stick.len;
+        if k == 1 {
+            // One row (a vertical rod holds v_Ex): its 1 x 1 system's inverse depends on the
+            // geometry alone, off the accelerations' path. A zero pivot takes the shift below.
+            let (axis, lever_e, lever_p) = (stick.axes[0], stick.lever_e[0], stick.lever_p[0]);
+            let a = inv_m + lever_e * (lever_p * inv_i);
+            if a.abs() > 1e-13 * a.abs().max(f64::MIN_POSITIVE) {
+                let inv_a = 1.0 / a;
+                let mult = -(a_bias[axis] + stick.velocity(0, qdd)) * inv_a;
+                qdd[axis] += mult * inv_m;
+                qdd[2] += mult * (lever_p * inv_i);
+                if axis == 0 {
+                    out.force.static_h = mult;
+                } else {
+                    out.force.static_v = mult;
+                }
+                return;
+            }
+        }
         let mut a = [[0.0; 2]; 2];
         let mut b = [0.0; 2];
         for i in 0..k {

@@ -6,8 +6,6 @@
 //! keeps one base spec and overrides a few fields per run ([`SceneSpec::set`]), which needs
 //! neither Python nor the GIL.
 
-use std::borrow::Cow;
-
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
 use crate::dynamics::{Effects, SignModel};
@@ -57,9 +55,26 @@ pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
 /// Names of the bodies.
 pub const BODIES: [&str; 3] = ["free_link", "chain", "leg"];
 
-/// Every field a `granrs.Scene` hands the core, sorted: a name found here is kept without
-/// an allocation of its own ([`SceneSpec::from_sorted`]).
-pub const SCENE_FIELDS: [&str; 43] = [
+/// The fields of a scene, in a table and a list: every field a `granrs.Scene` hands the
+/// core ([`SCENE_FIELDS`]) has a slot of the table, found by a `match` on its name (a switch
+/// on the length and an inlined comparison, no search); any other name goes to the list.
+macro_rules! scene_fields {
+    ($($name:literal,)*) => {
+        /// Every field a `granrs.Scene` hands the core, sorted.
+        pub const SCENE_FIELDS: [&str; [$($name,)*].len()] = [$($name,)*];
+
+        /// The slot of a field of [`SCENE_FIELDS`].
+        #[inline]
+        fn field_slot(name: &str) -> Option<usize> {
+            match name {
+                $($name => Some(const { position($name) }),)*
+                _ => None,
+            }
+        }
+    };
+}
+
+scene_fields! {
     "ankle",
     "apply_at",
     "atol",
@@ -103,13 +118,43 @@ pub const SCENE_FIELDS: [&str; 43] = [
     "trunk_deg",
     "v0",
     "vx0",
-];
+}
 
-/// A scene as named fields, kept sorted by name. Fields that a body does not use are
-/// ignored.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// Where `name` is in [`SCENE_FIELDS`] (at compile time).
+const fn position(name: &str) -> usize {
+    let mut i = 0;
+    while i < SCENE_FIELDS.len() {
+        let (a, b) = (SCENE_FIELDS[i].as_bytes(), name.as_bytes());
+        if a.len() == b.len() {
+            let mut j = 0;
+            while j < a.len() && a[j] == b[j] {
+                j += 1;
+            }
+            if j == a.len() {
+                return i;
+            }
+        }
+        i += 1;
+    }
+    panic!("not a scene field")
+}
+
+/// A scene as named fields. Fields that a body does not use are ignored.
+#[derive(Debug, Clone, PartialEq)]
 pub struct SceneSpec {
-    fields: Vec<(Cow<'static, str>, Value)>,
+    /// The fields of [`SCENE_FIELDS`], by slot.
+    known: [Option<Value>; SCENE_FIELDS.len()],
+    /// Any other field, sorted by name.
+    others: Vec<(String, Value)>,
+}
+
+impl Default for SceneSpec {
+    fn default() -> Self {
+        SceneSpec {
+            known: [const { None }; SCENE_FIELDS.len()],
+            others: Vec::new(),
+        }
+    }
 }
 
 fn missing(field: &str) -> GranrsError {
@@ -159,13 +204,6 @@ fn num(field: &str, v: Option<&Value>) -> Result<f64> {
     }
 }
 
-/// Name order (that of `str`).
-#[inline]
-fn name_cmp(a: &str, b: &str) -> std::cmp::Ordering {
-    // Byte by byte, inline: the names are short, and a call to `memcmp` costs more.
-    a.as_bytes().iter().cmp(b.as_bytes().iter())
-}
-
 fn map_get<'a>(entries: &'a [(String, Value)], k: &str) -> Option<&'a Value> {
     entries.iter().find(|(name, _)| name == k).map(|(_, v)| v)
 }
@@ -178,70 +216,39 @@ impl SceneSpec {
 
     /// A spec from (field, value) pairs; a later duplicate replaces an earlier one.
     pub fn from_pairs(pairs: Vec<(String, Value)>) -> Self {
-        Self::from_sorted(
-            pairs
-                .into_iter()
-                .map(|(name, value)| (Cow::Owned(name), value))
-                .collect(),
-        )
-    }
-
-    /// [`SceneSpec::from_pairs`] for names that may be borrowed (see [`SCENE_FIELDS`]);
-    /// cheapest when they come sorted, as a `granrs.Scene` sends them.
-    pub fn from_sorted(mut pairs: Vec<(Cow<'static, str>, Value)>) -> Self {
-        if pairs.is_sorted_by(|a, b| name_cmp(&a.0, &b.0).is_lt()) {
-            // Sorted without duplicates: the pairs are the fields.
-            return SceneSpec { fields: pairs };
-        }
-        if !pairs.is_sorted_by(|a, b| a.0 <= b.0) {
-            // Stable: equal names keep their order, so the last of each wins below.
-            pairs.sort_by(|a, b| a.0.cmp(&b.0));
-        }
-        let mut fields: Vec<(Cow<'static, str>, Value)> = Vec::with_capacity(pairs.len());
+        let mut spec = Self::new();
         for (name, value) in pairs {
-            match fields.last_mut() {
-                Some(last) if last.0 == name => last.1 = value,
-                _ => fields.push((name, value)),
-            }
+            spec.set(&name, value);
         }
-        SceneSpec { fields }
-    }
-
-    /// The name `name` as a `'static` string if it is one of [`SCENE_FIELDS`] at or after
-    /// position `*from` (advanced past it: a sorted run of names walks the table once).
-    pub fn static_name(name: &str, from: &mut usize) -> Option<&'static str> {
-        while let Some(&known) = SCENE_FIELDS.get(*from) {
-            match name_cmp(known, name) {
-                std::cmp::Ordering::Less => *from += 1,
-                std::cmp::Ordering::Equal => {
-                    *from += 1;
-                    return Some(known);
-                }
-                std::cmp::Ordering::Greater => return None,
-            }
-        }
-        None
+        spec
     }
 
     /// Set (or replace) a field.
     pub fn set(&mut self, field: &str, value: Value) {
+        if let Some(slot) = field_slot(field) {
+            self.known[slot] = Some(value);
+            return;
+        }
         match self
-            .fields
-            .binary_search_by(|(name, _)| name_cmp(name, field))
+            .others
+            .binary_search_by(|(name, _)| name.as_str().cmp(field))
         {
-            Ok(i) => self.fields[i].1 = value,
-            Err(i) => self
-                .fields
-                .insert(i, (Cow::Owned(field.to_string()), value)),
+            Ok(i) => self.others[i].1 = value,
+            Err(i) => self.others.insert(i, (field.to_string(), value)),
         }
     }
 
     /// A field's value, if present.
+    #[inline]
     pub fn get(&self, field: &str) -> Option<&Value> {
-        self.fields
-            .binary_search_by(|(name, _)| name_cmp(name, field))
-            .ok()
-            .map(|i| &self.fields[i].1)
+        match field_slot(field) {
+            Some(slot) => self.known[slot].as_ref(),
+            None => self
+                .others
+                .binary_search_by(|(name, _)| name.as_str().cmp(field))
+                .ok()
+                .map(|i| &self.others[i].1),
+        }
     }
 
     /// Whether a field is present and not `None`.
@@ -702,16 +709,25 @@ mod tests {
     }
 
     #[test]
-    fn scene_fields_are_sorted_and_found() {
+    fn scene_fields_have_their_own_slots() {
         assert!(SCENE_FIELDS.is_sorted_by(|a, b| a < b));
-        let mut from = 0;
-        for name in SCENE_FIELDS {
-            assert_eq!(SceneSpec::static_name(name, &mut from), Some(name));
+        for (i, name) in SCENE_FIELDS.iter().enumerate() {
+            assert_eq!(field_slot(name), Some(i));
         }
-        let mut from = 0;
-        assert_eq!(SceneSpec::static_name("mass", &mut from), Some("mass"));
-        assert_eq!(SceneSpec::static_name("diameter", &mut from), None);
-        assert_eq!(SceneSpec::static_name("zzz", &mut from), None);
+        assert_eq!(field_slot("zzz"), None);
+        // Known and other names, set twice, read back (the last value wins).
+        let mut s = SceneSpec::from_pairs(vec![
+            ("mass".into(), Value::Num(1.0)),
+            ("zeta".into(), Value::Num(2.0)),
+            ("alpha".into(), Value::Num(3.0)),
+            ("mass".into(), Value::Num(4.0)),
+        ]);
+        s.set("zeta", Value::Num(5.0));
+        assert_eq!(s.get("mass"), Some(&Value::Num(4.0)));
+        assert_eq!(s.get("zeta"), Some(&Value::Num(5.0)));
+        assert_eq!(s.get("alpha"), Some(&Value::Num(3.0)));
+        assert_eq!(s.get("length"), None);
+        assert_eq!(s.get("beta"), None);
     }
 
     #[test]

@@ -57,11 +57,9 @@ SCENES = [
 
 
 def test_the_core_keeps_every_field_name() -> None:
-    """Every field a Scene sends is one the core knows by name (kept without a copy)."""
+    """Every field a Scene sends has a slot of its own in the core's spec."""
     sent = set(itertools.chain.from_iterable(_CORE_FIELDS.values()))
     assert sent == set(_granrs.SCENE_FIELDS)
-    for names in _CORE_FIELDS.values():
-        assert list(names) == sorted(names)
 
 
 @pytest.mark.parametrize("scene", SCENES, ids=lambda s: s.body)

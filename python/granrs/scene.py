@@ -321,10 +321,12 @@ class Scene:
 
     def _compiled(self) -> Any:
         """The scene converted and validated by the core, once per scene (it is frozen)."""
-        compiled = self.__dict__.get("_compiled_cache")
+        fields = self.__dict__
+        compiled = fields.get("_compiled_cache")
         if compiled is None:
-            compiled = _granrs.compile_fields(self.__dict__, _CORE_FIELDS[self.body])
-            object.__setattr__(self, "_compiled_cache", compiled)
+            compiled = _granrs.compile_fields(fields, _CORE_FIELDS[fields["body"]])
+            # What object.__setattr__ does for a frozen dataclass, without its call.
+            fields["_compiled_cache"] = compiled
         return compiled
 
     def validate(self) -> Scene:
@@ -367,15 +369,12 @@ class Scene:
 _DEFAULTS: dict[str, Any] = {
     f.name: f.default for f in dataclasses.fields(Scene) if f.default is not dataclasses.MISSING
 }
-#: Per body, the fields the Rust core reads (those of the body; not coefficients_source),
-#: sorted (the order the core keeps them in).
+#: Per body, the fields the Rust core reads (those of the body; not coefficients_source).
 _CORE_FIELDS: dict[str, tuple[str, ...]] = {
     body: tuple(
-        sorted(
-            f.name
-            for f in dataclasses.fields(Scene)
-            if body in BODY_FIELDS.get(f.name, (body,)) and f.name != "coefficients_source"
-        )
+        f.name
+        for f in dataclasses.fields(Scene)
+        if body in BODY_FIELDS.get(f.name, (body,)) and f.name != "coefficients_source"
     )
     for body in BODIES
 }

@@ -5,7 +5,6 @@
 //! [`GranrsError`] becomes an instance of the matching class of `granrs.errors`, so that the
 //! Python and Rust layers share one exception tree.
 
-use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -237,11 +236,10 @@ fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
 }
 
 /// The spec of a `granrs.Scene` read straight from its attributes: `fields` is the
-/// instance's `__dict__`, `names` the fields its body uses (`scene._CORE_FIELDS`, sorted).
-/// The same values as the dict `Scene._plain()` builds, without building it.
+/// instance's `__dict__`, `names` the fields its body uses (`scene._CORE_FIELDS`). The same
+/// values as the dict `Scene._plain()` builds, without building it.
 fn spec_from_fields(fields: &Bound<'_, PyDict>, names: &Bound<'_, PyTuple>) -> SceneSpec {
-    let mut pairs = Vec::with_capacity(names.len());
-    let mut known = 0;
+    let mut spec = SceneSpec::new();
     for name in names.iter() {
         let Ok(key) = name.cast::<PyString>() else {
             continue;
@@ -257,13 +255,9 @@ fn spec_from_fields(fields: &Bound<'_, PyDict>, names: &Bound<'_, PyTuple>) -> S
         } else {
             value_from_py(&v)
         };
-        let name = match SceneSpec::static_name(key_str, &mut known) {
-            Some(name) => Cow::Borrowed(name),
-            None => Cow::Owned(key_str.to_owned()),
-        };
-        pairs.push((name, value));
+        spec.set(key_str, value);
     }
-    SceneSpec::from_sorted(pairs)
+    spec
 }
 
 /// [`compile`] for a `granrs.Scene`, from its `__dict__` and its body's field names (see
