@@ -127,6 +127,11 @@ def scenes(
     return scene.replace(dt=dt, t_end=t_end_for(dt))
 
 
+def energy_rise(energy: np.ndarray) -> float:
+    """The largest rise of a recorded energy above its running minimum [J]."""
+    return float(np.max(energy - np.minimum.accumulate(energy)))
+
+
 def energy_scale(scene: Scene, r: Result) -> float:
     """The energy the run has to lose or gain [J]: its start plus m g L (PE is measured
     from the surface, so E itself may pass through 0)."""
@@ -319,7 +324,7 @@ def test_centroid_energy_never_rises(scene: Scene) -> None:
     check_finite(r)
     assert r.series is not None
     energy = r.series["E"]
-    rise = float(np.max(energy - np.minimum.accumulate(energy)))
+    rise = energy_rise(energy)
     assert rise <= ENERGY_RTOL * energy_scale(scene, r), (rise, energy_scale(scene, r))
 
 
@@ -355,7 +360,7 @@ def test_centroid_energy_stuck_and_spinning() -> None:
     r = granrs.simulate(STUCK_AND_SPINNING.replace(record=RECORD))
     assert r.series is not None
     energy = r.series["E"]
-    rise = float(np.max(energy - np.minimum.accumulate(energy)))
+    rise = energy_rise(energy)
     assert rise <= ENERGY_RTOL * energy_scale(STUCK_AND_SPINNING, r), rise
 
 
@@ -372,7 +377,7 @@ def test_centroid_energy_with_the_plain_sign_rises_by_chatter() -> None:
             continue
         r = granrs.simulate(scene.replace(record=("energy",)))
         energy = r.series["E"] if r.series is not None else np.zeros(1)
-        rise = float(np.max(energy - np.minimum.accumulate(energy)))
+        rise = energy_rise(energy)
         worst = max(worst, rise / energy_scale(scene, r))
     assert math.isfinite(worst)
     assert worst < 1e-3  # first order in dt: far above the modes' 1e-8, far below 1
@@ -403,7 +408,7 @@ def test_centroid_energy_never_rises_unresolved_step() -> None:
         return
     assert r.series is not None
     energy = r.series["E"]
-    rise = float(np.max(energy - np.minimum.accumulate(energy)))
+    rise = energy_rise(energy)
     assert rise <= ENERGY_RTOL * energy_scale(scene, r)
 
 
@@ -451,7 +456,7 @@ def tip_energy_rise(
         worst["runs"] += 1
         energy = r.series["E"]
         scale = energy_scale(scene, r)
-        rise = float(np.max(energy - np.minimum.accumulate(energy))) / scale
+        rise = energy_rise(energy) / scale
         above = float(np.max(energy) - energy[0]) / scale
         rising += rise > ENERGY_RTOL
         if rise > worst["rise"]:
@@ -492,7 +497,7 @@ def test_tip_application_can_inject_energy() -> None:
     for r in (at_tip, at_e):
         assert r.series is not None
         energy = r.series["E"]
-        rises.append(float(np.max(energy - np.minimum.accumulate(energy))))
+        rises.append(energy_rise(energy))
     assert rises[0] > 0.01 * energy_scale(TIP_INJECTS, at_tip), rises
     assert rises[1] <= ENERGY_RTOL * energy_scale(TIP_INJECTS, at_e), rises
 

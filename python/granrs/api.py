@@ -14,6 +14,8 @@ __all__ = ["RK4_STABILITY_LIMIT", "simulate"]
 #: ``h lambda`` beyond which the classical RK4 is unstable for a real, negative rate
 #: (the stability region's extent on the negative real axis, 2.785).
 RK4_STABILITY_LIMIT = 2.785
+#: A rise of the mechanical energy beyond this fraction of its size counts as a rise.
+ENERGY_ROSE_RTOL = 1e-9
 
 
 def step_advice(dt: float, h_lambda: float, unresolved: int = 0) -> str:
@@ -73,4 +75,4 @@ def energy_rose(start: float, end: float) -> bool:
     its size): with steps the sign modes chattered through (``unresolved``), the sign of
     the chatter's error. Chatter at rest loses energy; a step too large for the contact
     gains it."""
-    return end - start > 1e-9 * max(abs(start), abs(end), 1e-12)
+    return end - start > ENERGY_ROSE_RTOL * max(abs(start), abs(end), 1e-12)

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from . import _granrs
-from .api import RK4_STABILITY_LIMIT
+from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
 from .coefficients import Coefficients
 from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
 from .result import JOINT_NAMES
@@ -319,7 +319,7 @@ def _warn_unresolved(frame: pd.DataFrame) -> None:
     h_lambda = frame["h_lambda"].to_numpy()
     start, end = frame["energy_start"].to_numpy(), frame["energy_end"].to_numpy()
     with np.errstate(invalid="ignore"):
-        rose = end - start > 1e-9 * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
+        rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
     bad = np.flatnonzero((h_lambda > RK4_STABILITY_LIMIT) | ((frame["unresolved"] > 0) & rose))
     if bad.size:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
