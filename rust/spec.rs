@@ -157,6 +157,8 @@ impl Default for SceneSpec {
     }
 }
 
+#[cold]
+#[inline(never)]
 fn missing(field: &str) -> GranrsError {
     GranrsError::InvalidScene {
         field: field.to_string(),
@@ -164,6 +166,8 @@ fn missing(field: &str) -> GranrsError {
     }
 }
 
+#[cold]
+#[inline(never)]
 fn wrong(field: &str, expected: &str, got: &Value) -> GranrsError {
     GranrsError::WrongType {
         field: field.to_string(),
@@ -172,6 +176,8 @@ fn wrong(field: &str, expected: &str, got: &Value) -> GranrsError {
     }
 }
 
+#[cold]
+#[inline(never)]
 fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
     GranrsError::UnknownName {
         field: field.to_string(),
@@ -181,6 +187,8 @@ fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
 }
 
 /// An error about key `k` of the mapping `field`, renamed to the field `field.k`.
+#[cold]
+#[inline(never)]
 fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
     match e {
         GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
