@@ -120,6 +120,9 @@ scene_fields! {
     "vx0",
 }
 
+/// The slots of the coefficients fields (see [`SceneSpec::set_slot`]).
+pub const COEFFICIENTS_SLOTS: [usize; 2] = [position("coefficients"), position("coefficients2")];
+
 /// Where `name` is in [`SCENE_FIELDS`] (at compile time).
 const fn position(name: &str) -> usize {
     let mut i = 0;
@@ -244,6 +247,16 @@ impl SceneSpec {
             Ok(i) => self.others[i].1 = value,
             Err(i) => self.others.insert(i, (field.to_string(), value)),
         }
+    }
+
+    /// The slot of a field of [`SCENE_FIELDS`], for [`SceneSpec::set_slot`].
+    pub fn slot_of(field: &str) -> Option<usize> {
+        field_slot(field)
+    }
+
+    /// Set the field of slot `slot` (see [`SceneSpec::slot_of`]).
+    pub fn set_slot(&mut self, slot: usize, value: Value) {
+        self.known[slot] = Some(value);
     }
 
     /// A field's value, if present.

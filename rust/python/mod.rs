@@ -17,7 +17,7 @@ use crate::batch::{self, Source};
 use crate::error::GranrsError;
 use crate::integrate::Outcome;
 use crate::scene::AnyScene;
-use crate::spec::{SceneSpec, Value, EFFECTS, RECORDS, SCENE_FIELDS};
+use crate::spec::{SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -235,27 +235,62 @@ fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
 
 /// The spec of a `granrs.Scene` read straight from its attributes: `fields` is the
 /// instance's `__dict__`, `names` the fields its body uses (`scene._CORE_FIELDS`). The same
-/// values as the dict `Scene._plain()` builds, without building it.
+/// values as the dict `Scene._plain()` builds, without building it. Each names tuple's slots
+/// are found once per thread (the tuples are module constants; see `SLOTS`).
 fn spec_from_fields(fields: &Bound<'_, PyDict>, names: &Bound<'_, PyTuple>) -> SceneSpec {
-    let mut spec = SceneSpec::new();
-    for name in names.iter() {
-        let Ok(key) = name.cast::<PyString>() else {
-            continue;
+    SLOTS.with_borrow_mut(|cache| {
+        let i = match cache.iter().position(|(t, _)| t.as_ptr() == names.as_ptr()) {
+            Some(i) => i,
+            None => {
+                if cache.len() >= 8 {
+                    cache.clear();
+                }
+                let slots = names
+                    .iter()
+                    .map(|n| {
+                        let name = n.cast::<PyString>().ok()?;
+                        SceneSpec::slot_of(name.to_str().ok()?)
+                    })
+                    .collect();
+                cache.push((names.clone().unbind(), slots));
+                cache.len() - 1
+            }
         };
-        let Ok(key_str) = key.to_str() else {
-            continue;
-        };
-        let Ok(Some(v)) = fields.get_item(key) else {
-            continue;
-        };
-        let value = if key_str.starts_with("coefficients") {
-            coefficients_from_py(&v)
-        } else {
-            value_from_py(&v)
-        };
-        spec.set(key_str, value);
-    }
-    spec
+        let slots = &cache[i].1;
+        let mut spec = SceneSpec::new();
+        for (k, slot) in slots.iter().enumerate() {
+            let Ok(name) = names.get_borrowed_item(k) else {
+                continue;
+            };
+            let Ok(key) = name.cast::<PyString>() else {
+                continue;
+            };
+            let Ok(Some(v)) = fields.get_item(key) else {
+                continue;
+            };
+            match *slot {
+                Some(slot) if COEFFICIENTS_SLOTS.contains(&slot) => {
+                    spec.set_slot(slot, coefficients_from_py(&v))
+                }
+                Some(slot) => spec.set_slot(slot, value_from_py(&v)),
+                None => {
+                    if let Ok(key_str) = key.to_str() {
+                        spec.set(key_str, value_from_py(&v));
+                    }
+                }
+            }
+        }
+        spec
+    })
+}
+
+/// A names tuple (kept alive, so that its address names it) and the spec slot of each name.
+type NamesSlots = (Py<PyTuple>, Vec<Option<usize>>);
+
+thread_local! {
+    /// Names tuples seen (a Scene's field names per body are a module constant) and the
+    /// spec slot of each name, so that a scene's fields are read without matching names.
+    static SLOTS: std::cell::RefCell<Vec<NamesSlots>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// [`compile`] for a `granrs.Scene`, from its `__dict__` and its body's field names (see
