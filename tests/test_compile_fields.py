@@ -83,6 +83,20 @@ def test_any_names_tuple_reads_the_same_fields() -> None:
     assert info.value.field == "mass"
 
 
+def test_the_compiled_scene_is_kept_on_the_scene() -> None:
+    """Compiled once per Scene (it is frozen); a dict without a known body is refused naming
+    the field."""
+    scene = cases.free_link(q_deg=30.0, v0=1.5)
+    first = scene._compiled()
+    assert scene._compiled() is first
+    assert scene.__dict__["_compiled_cache"] is first
+    assert _granrs.compiled_scene(scene.__dict__, _CORE_FIELDS) is first
+    for fields in ({"body": "tripod"}, {}):
+        with pytest.raises(GranrsError) as info:
+            _granrs.compiled_scene(fields, _CORE_FIELDS)
+        assert info.value.field == "body"
+
+
 BAD = [
     {"mass": -1.0},
     {"length": math.nan},

@@ -17,6 +17,9 @@ def compile(scene: dict[str, Any]) -> Compiled:
 def compile_fields(fields: dict[str, Any], names: tuple[str, ...]) -> Compiled:
     """Convert and validate a Scene once, from its ``__dict__`` and its body's field names."""
 
+def compiled_scene(fields: dict[str, Any], core_fields: dict[str, tuple[str, ...]]) -> Compiled:
+    """A Scene's compiled scene, cached in its ``__dict__`` (compiled on first use)."""
+
 class RunOutcome:
     """One run's outcome, kept in the core until asked for."""
 

@@ -307,6 +307,45 @@ fn compile_fields(
     Ok(Compiled { scene })
 }
 
+/// The compiled scene of a `granrs.Scene` from its `__dict__` (`fields`): the one cached
+/// there (`_compiled_cache`; the scene is frozen), or else compiled from the fields its body
+/// uses (`core_fields[body]`, see [`compile_fields`]) and cached. `Scene._compiled()`.
+#[pyfunction]
+fn compiled_scene<'py>(
+    py: Python<'py>,
+    fields: &Bound<'py, PyDict>,
+    core_fields: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let cache = pyo3::intern!(py, "_compiled_cache");
+    if let Some(compiled) = fields.get_item(cache)? {
+        return Ok(compiled);
+    }
+    let body = fields.get_item(pyo3::intern!(py, "body"))?;
+    let names = match &body {
+        Some(body) => core_fields.get_item(body)?,
+        None => None,
+    };
+    let Some(names) = names else {
+        // Not a body (a Scene refuses one already): the spec names the field.
+        let mut spec = SceneSpec::new();
+        if let Some(body) = &body {
+            spec.set("body", value_from_py(body));
+        }
+        return Err(to_pyerr(py, spec.body().err().unwrap_or_else(missing_body)));
+    };
+    let compiled = Bound::new(py, compile_fields(py, fields, names.cast::<PyTuple>()?)?)?;
+    fields.set_item(cache, &compiled)?;
+    Ok(compiled.into_any())
+}
+
+/// The error of a scene without a body.
+fn missing_body() -> GranrsError {
+    GranrsError::InvalidScene {
+        field: "body".into(),
+        message: "missing (a value is needed)".into(),
+    }
+}
+
 /// The outcome of one run, kept in Rust until Python asks for it: the headline numbers are
 /// getters, the rest comes as a dict from `to_dict` (built on first request by `Result`).
 #[pyclass(frozen, module = "granrs._granrs")]
@@ -655,6 +694,7 @@ fn resistance_force<'py>(
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(compile_fields, m)?)?;
+    m.add_function(wrap_pyfunction!(compiled_scene, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Compiled>()?;
     m.add_class::<RunOutcome>()?;
