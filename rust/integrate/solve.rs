@@ -666,6 +666,8 @@ pub fn solve<const N: usize>(
     let mut n: u64 = 0;
     let mut events_this_step = 0usize;
     let mut funcs: Vec<(Kind, usize)> = Vec::with_capacity(4 * MAX_CONTACTS);
+    // The modes `funcs` was listed for.
+    let mut funcs_modes: Option<Modes> = None;
 
     let update_fd_max = |summaries: &mut Vec<ContactSummary>, e: &Eval<N>, modes: &Modes| {
         for (ci, s) in summaries.iter_mut().enumerate() {
@@ -754,18 +756,14 @@ pub fn solve<const N: usize>(
             });
         }
 
-        // Which switching functions crossed?
-        active(model, &modes, &mut funcs);
+        // Which switching functions crossed? (The list changes only with the modes.)
+        if funcs_modes != Some(modes) {
+            active(model, &modes, &mut funcs);
+            funcs_modes = Some(modes);
+        }
         let mut earliest = f64::INFINITY;
         let mut hits: Vec<(Kind, usize, f64)> = Vec::new();
         if events_this_step < MAX_EVENTS_PER_STEP {
-            let dense = Hermite {
-                y0: y,
-                f0: k1,
-                y1,
-                f1: deriv_of(&y1, e1),
-                h,
-            };
             for &(kind, ci) in &funcs {
                 let g1 = switching(kind, ci, e1, &modes);
                 if !crossed(kind, g1) {
@@ -777,6 +775,13 @@ pub fn solve<const N: usize>(
                 } else if g0 == 0.0 {
                     0.0
                 } else {
+                    let dense = Hermite {
+                        y0: y,
+                        f0: k1,
+                        y1,
+                        f1: deriv_of(&y1, e1),
+                        h,
+                    };
                     let (theta, evals) = locate(
                         |th| {
                             let s = dense.at(th);
