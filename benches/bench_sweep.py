@@ -134,6 +134,7 @@ def part_overhead(repeat: int) -> list[str]:
     (``run_seconds``): the difference is the call's overhead, measured in the same call."""
     from granrs import _granrs
     from granrs.result import Result
+    from granrs.scene import _CORE_FIELDS
 
     lines = ["### Python call overhead of `simulate`", ""]
     lines += [
@@ -157,7 +158,7 @@ def part_overhead(repeat: int) -> list[str]:
             for s in scenes:
                 t0 = time.perf_counter()
                 # The body of granrs.simulate (api.py), with the core's own timing kept.
-                core = _granrs.run(s._compiled())
+                core = _granrs.run_scene(s.__dict__, _CORE_FIELDS)
                 Result(s, core)
                 totals.append(time.perf_counter() - t0)
                 cores.append(core.run_seconds)

@@ -91,6 +91,10 @@ def test_the_compiled_scene_is_kept_on_the_scene() -> None:
     assert scene._compiled() is first
     assert scene.__dict__["_compiled_cache"] is first
     assert _granrs.compiled_scene(scene.__dict__, _CORE_FIELDS) is first
+    # simulate() compiles through the same cache (run_scene).
+    fresh = cases.free_link(q_deg=30.0, v0=1.5)
+    assert _same(granrs.simulate(fresh).summary, granrs.simulate(scene).summary)
+    assert "_compiled_cache" in fresh.__dict__
     for fields in ({"body": "tripod"}, {}):
         with pytest.raises(GranrsError) as info:
             _granrs.compiled_scene(fields, _CORE_FIELDS)

@@ -33,6 +33,9 @@ class RunOutcome:
 def run(compiled: Compiled) -> RunOutcome:
     """Run a compiled scene."""
 
+def run_scene(fields: dict[str, Any], core_fields: dict[str, tuple[str, ...]]) -> RunOutcome:
+    """Run a Scene from its ``__dict__``: ``compiled_scene`` then ``run``."""
+
 def validate(scene: dict[str, Any]) -> None:
     """Validate a scene dict; raise the typed granrs error naming the first bad field."""
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from . import _granrs
 from .errors import InvalidParameterError
 from .result import Result
-from .scene import Scene
+from .scene import _CORE_FIELDS, Scene
 
 __all__ = ["simulate"]
 
@@ -28,4 +28,5 @@ def simulate(scene: Scene) -> Result:
         raise InvalidParameterError(
             f"simulate() takes a granrs.Scene, got {type(scene).__name__}", field="scene"
         )
-    return Result(scene, _granrs.run(scene._compiled()))
+    # scene._compiled() and _granrs.run in one call of the core.
+    return Result(scene, _granrs.run_scene(scene.__dict__, _CORE_FIELDS))

@@ -402,6 +402,18 @@ fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
     })
 }
 
+/// Run a `granrs.Scene` from its `__dict__`: [`compiled_scene`] then [`run`] in one call
+/// (the body of `granrs.simulate`).
+#[pyfunction]
+fn run_scene(
+    py: Python<'_>,
+    fields: &Bound<'_, PyDict>,
+    core_fields: &Bound<'_, PyDict>,
+) -> PyResult<RunOutcome> {
+    let compiled = compiled_scene(py, fields, core_fields)?;
+    run(py, compiled.cast::<Compiled>()?)
+}
+
 /// Validate a scene dict without running it (raises the typed error, or returns None).
 #[pyfunction]
 fn validate(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<()> {
@@ -695,6 +707,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(compile_fields, m)?)?;
     m.add_function(wrap_pyfunction!(compiled_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Compiled>()?;
     m.add_class::<RunOutcome>()?;
