@@ -31,7 +31,7 @@ pub const STATUS_FAILED: f64 = 3.0;
 pub const STATUS_CANCELLED: f64 = 4.0;
 
 /// Run-level columns.
-const RUN_COLUMNS: [&str; 10] = [
+const RUN_COLUMNS: [&str; 12] = [
     "status",
     "t_final",
     "steps",
@@ -39,9 +39,11 @@ const RUN_COLUMNS: [&str; 10] = [
     "root_evals",
     "events",
     "rejected",
+    "unresolved",
     "energy_start",
     "energy_end",
     "dissipated",
+    "h_lambda",
 ];
 /// Per-contact columns (prefixed `c{i}.`).
 const CONTACT_COLUMNS: [&str; 17] = [
@@ -104,9 +106,11 @@ pub fn summarize(out: &Outcome, row: &mut [f64]) {
         s.root_evals as f64,
         s.events as f64,
         s.rejected as f64,
+        s.unresolved as f64,
         out.energy_start,
         out.energy_end,
         out.dissipated,
+        out.h_lambda,
     ];
     row[..run.len()].copy_from_slice(&run);
     let mut k = run.len();

@@ -13,7 +13,7 @@
 //!   that the component's rate of change is zero, as in stick-slip friction (Karnopp). The
 //!   solver keeps the stick while `|R|` stays below the static term's magnitude.
 
-use nalgebra::{SMatrix, SVector, Vector2};
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 
 use crate::body::mechanism::Pose;
 use crate::body::rod::ApplyAt;
@@ -666,6 +666,59 @@ impl<const N: usize> Model<N> {
         }
     }
 
+    /// Inverse effective mass of contact `ci`'s immersed centroid E at `q`, with the locked
+    /// joints held: `W = J_E (M^-1 - M^-1 A^T (A M^-1 A^T)^-1 A M^-1) J_E^T` [1/kg], A the
+    /// locked joints' rows. Sticking rows are left out: they can only slow E down. With the
+    /// drag's velocity stiffness K it gives the drag's fastest rate, the largest eigenvalue
+    /// of `W K`, which a fixed RK4 step must keep below about 2.78 (its stability limit on
+    /// the negative real axis).
+    pub fn centroid_inverse_mass(&self, q: &SVector<f64, N>, ci: usize) -> Matrix2<f64> {
+        let nan = Matrix2::repeat(f64::NAN);
+        let Some(c) = self.contacts.get(ci) else {
+            return nan;
+        };
+        let pose = self.mechanism.pose(q);
+        let Some(chol) = self.mechanism.mass_matrix(&pose).cholesky() else {
+            return nan;
+        };
+        let centroid = self.geometry(c, &pose).centroid;
+        let locks: Vec<SVector<f64, N>> = self
+            .mechanism
+            .locked_rows()
+            .map(|(link, parent)| {
+                let mut a = SVector::<f64, N>::zeros();
+                a[2 + link] = 1.0;
+                a[2 + parent] = -1.0;
+                a
+            })
+            .collect();
+        let responses: Vec<SVector<f64, N>> = locks.iter().map(|a| chol.solve(a)).collect();
+        let schur = nalgebra::DMatrix::from_fn(locks.len(), locks.len(), |i, j| {
+            locks[i].dot(&responses[j])
+        });
+        let Some(schur_inv) = schur.try_inverse() else {
+            return nan;
+        };
+        let gen: [SVector<f64, N>; 2] = std::array::from_fn(|k| {
+            let mut g = SVector::<f64, N>::zeros();
+            self.mechanism
+                .add_point_force(&pose, c.link(), centroid, unit(k), &mut g);
+            g
+        });
+        let free: [SVector<f64, N>; 2] = std::array::from_fn(|k| chol.solve(&gen[k]));
+        let along: [Vec<f64>; 2] =
+            std::array::from_fn(|k| locks.iter().map(|a| a.dot(&free[k])).collect());
+        Matrix2::from_fn(|a, b| {
+            let mut held = 0.0;
+            for (i, ai) in along[a].iter().enumerate() {
+                for (j, bj) in along[b].iter().enumerate() {
+                    held += ai * schur_inv[(i, j)] * bj;
+                }
+            }
+            gen[a].dot(&free[b]) - held
+        })
+    }
+
     /// Whether any sticking component is in force under `modes`.
     #[inline]
     fn any_stuck(&self, modes: &Modes) -> bool {
@@ -817,14 +870,17 @@ impl<const N: usize> Model<N> {
         let mode = &modes[0];
         let geom = rod.geometry(tip.y, fr.axis);
         let forced = mode.in_contact && geom.depth > 0.0;
+        let centroid = Vector2::new(geom.centroid_s, rod.tip.y);
         if mode.in_contact {
             out.depth = geom.depth;
             out.immersion_margin = rod.length * fr.axis.y - geom.depth;
+            // E and the sign of e x v_E also at depth 0: entering, the drag's mode is
+            // chosen from them (a rod past horizontal enters with l = L, E its middle).
+            out.v_centroid = fr.velocity(centroid);
+            out.cross = fr.axis.x * out.v_centroid.y - fr.axis.y * out.v_centroid.x;
         }
         if forced {
-            let centroid = Vector2::new(geom.centroid_s, rod.tip.y);
-            let v_e = fr.velocity(centroid);
-            out.v_centroid = v_e;
+            let v_e = out.v_centroid;
             let (sx, sy) = match self.sign_model {
                 SignModel::Modes => (mode.sx.sign(), mode.sy.sign()),
                 SignModel::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
@@ -840,8 +896,7 @@ impl<const N: usize> Model<N> {
                 rod.immersed_volume(&geom),
             );
             let mut f = ForceComponents::default();
-            let cross_signed = fr.axis.x * v_e.y - fr.axis.y * v_e.x;
-            out.cross = cross_signed;
+            let cross_signed = out.cross;
             if self.effects.drag {
                 let cross = match self.sign_model {
                     SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
@@ -1071,13 +1126,26 @@ impl<const N: usize> Model<N> {
             }
             out.depth = geom.depth;
             out.immersion_margin = geom.margin;
-            if geom.depth <= 0.0 {
+            let is_rod = matches!(c.shape, Shape::Rod(_));
+            if geom.depth <= 0.0 && !is_rod {
                 continue;
             }
+            // A rod's E and sign of e x v_E also at depth 0: entering, the drag's mode is
+            // chosen from them (a rod past horizontal enters with l = L, E its middle).
             let v_e = self
                 .mechanism
                 .point_velocity(&pose, link, geom.centroid, qd);
             out.v_centroid = v_e;
+            let e = geom.cross_axis;
+            let cross_signed = e.x * v_e.y - e.y * v_e.x;
+            out.cross = if geom.sole.is_some() {
+                1.0
+            } else {
+                cross_signed
+            };
+            if geom.depth <= 0.0 {
+                continue;
+            }
             let (sx, sy) = match self.sign_model {
                 SignModel::Modes => (mode.sx.sign(), mode.sy.sign()),
                 SignModel::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
@@ -1093,13 +1161,6 @@ impl<const N: usize> Model<N> {
                 geom.volume,
             );
             let mut f = ForceComponents::default();
-            let e = geom.cross_axis;
-            let cross_signed = e.x * v_e.y - e.y * v_e.x;
-            out.cross = if geom.sole.is_some() {
-                1.0
-            } else {
-                cross_signed
-            };
             if self.effects.drag {
                 // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held
                 // (the kink at 0 is a located event).
@@ -1503,6 +1564,49 @@ mod tests {
     }
 
     /// Any other body keeps the general engine.
+    #[test]
+    fn centroid_inverse_mass_of_a_rod_and_of_a_locked_chain() {
+        // A free rod at q = 0.3 with its tip 0.05 m deep: E is l/2 above the tip, at
+        // r = L/2 - l/2 from the centre; the trace is 2/m + r^2/I.
+        let model = FreeLinkScene::default().model();
+        let link = &model.mechanism.links[0];
+        let (m, inertia, big_l) = (link.mass, link.inertia, 0.19);
+        let q0: f64 = 0.3;
+        let depth = 0.05;
+        let y = -depth + 0.5 * big_l * q0.cos();
+        let w = model.centroid_inverse_mass(&SVector::<f64, 3>::new(0.0, y, q0), 0);
+        // E = centre - r e; its velocity per unit force: 1/m + (r e_perp)(r e_perp)^T / I.
+        let r = 0.5 * big_l - 0.5 * depth / q0.cos();
+        let lever = Vector2::new(q0.cos(), -q0.sin()) * r;
+        let expected = Matrix2::identity() / m + lever * lever.transpose() / inertia;
+        assert!(
+            (w - expected).norm() < 1e-9 * expected.norm(),
+            "{w} {expected}"
+        );
+        // A chain: locking the pin can only make the tip's E heavier.
+        use crate::body::mechanism::Joint;
+        use crate::scene::ChainScene;
+        let q = SVector::<f64, 4>::new(0.0, 0.0, 0.2, 0.5);
+        let free = ChainScene {
+            joint: Joint::Free,
+            ..ChainScene::default()
+        }
+        .model();
+        let locked = ChainScene {
+            joint: Joint::Locked,
+            ..ChainScene::default()
+        }
+        .model();
+        let last = free.contacts.len() - 1;
+        let (wf, wl) = (
+            free.centroid_inverse_mass(&q, last),
+            locked.centroid_inverse_mass(&q, last),
+        );
+        let (tl, tf) = (wl.trace(), wf.trace());
+        assert!(tl.is_finite() && tl > 0.0 && tl < tf, "{wl} {wf}");
+        assert!(wl.symmetric_eigenvalues().min() >= -1e-12 * tl, "{wl}");
+    }
+
     #[test]
     fn only_a_rod_about_its_centre_of_mass_is_closed_form() {
         let mut model = FreeLinkScene::default().model();

@@ -47,9 +47,12 @@ SIGN_MODELS = ("modes", "raw", "smooth")
 MAX_STEPS = 2e4
 RECORD = ("state", "forces", "energy")
 FORCES = ("F_dx", "F_dy", "F_sh", "F_sv")
+#: Derandomized: CI draws the same examples every run (a failure found by a random run
+#: becomes a pinned reproducer below, not a flaky CI).
 SETTINGS = settings(
     max_examples=60,
     deadline=None,
+    derandomize=True,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
 
@@ -216,25 +219,18 @@ MIRROR_PARTS = Scene(
 )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason=(
-        "mirror symmetry breaks past the stability limit: MIRROR_PARTS and its mirror are "
-        "exact mirrors up to the re-entry at t = 0.1916 s, then from mirrored states one "
-        "step gives F_d = (2.5e5, -3.4e5) N and blows up (x_tip_end 3.1e5 m, q -> -2e135), "
-        "the other F_d = (0.86, 1.15) N (x_tip_end -0.2 m, status 'stopped' both): an "
-        "orientation-dependent branch in the engine at the re-entry of a flipped rod"
-    ),
-)
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 def test_mirror_symmetry_past_the_stability_limit() -> None:
-    """Minimal reproducer: simulate(MIRROR_PARTS) and its mirror (q_deg=-1.5,
-    omega0=-15.0). At dt = 1e-5 both agree as mirrors (x_tip_end +-0.20603 m)."""
+    """MIRROR_PARTS (drag only, 10 g, dt = 1e-3: not resolved) and its mirror (q_deg=-1.5,
+    omega0=-15.0): the rod spins past horizontal and re-enters with its tip T at t =
+    0.1916 s, where l jumps to L. Both runs must mirror each other. They did not: at depth
+    0 the drag's sign of e x v_E was not evaluated, so both entered with the mode "+"; the
+    mirrored run then had negative drag for a step and diverged while the other stopped.
+    At dt = 1e-5 both agree as mirrors (x_tip_end +-0.20603 m)."""
     assert not step_resolves(MIRROR_PARTS)
     a = simulate_or_fail(MIRROR_PARTS)
     b = simulate_or_fail(MIRROR_PARTS.replace(q_deg=-1.5, omega0=-15.0))
-    assert (a is None) == (b is None)
-    if a is None or b is None:
-        return
+    assert a is not None and b is not None
     for key in ("x_tip_end", "dq", "omega_end"):
         assert _mirror_close(a.summary[key], b.summary[key]), (key, a.summary[key], b.summary[key])
 
@@ -295,6 +291,7 @@ def test_each_force_term_does_non_positive_power(scene: Scene) -> None:
         assert np.all(values <= tol[name]), (name, float(np.max(values - tol[name])))
 
 
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @SETTINGS
 @given(scenes(sign_models=("raw", "smooth")))
 def test_each_force_term_does_non_positive_power_whole_domain(scene: Scene) -> None:
@@ -324,6 +321,42 @@ def test_centroid_energy_never_rises(scene: Scene) -> None:
     energy = r.series["E"]
     rise = float(np.max(energy - np.minimum.accumulate(energy)))
     assert rise <= ENERGY_RTOL * energy_scale(scene, r), (rise, energy_scale(scene, r))
+
+
+#: Found by test_centroid_energy_never_rises (random run, 2026-11-22): horizontal static
+#: term only, a 10 g rod thrown sideways; E sticks in x and the static force spins the rod
+#: up to 15.5 rad/s; at dt = 1e-3 s the energy jumps by 1.8e-8 J (5.5e-7 of the scale) at
+#: t = 0.1635 s, where the rod becomes fully immersed (l = L) and E stops sliding along it.
+STUCK_AND_SPINNING = Scene(
+    q_deg=7.0,
+    v0=0.0,
+    vx0=-1.0,
+    mass=0.01,
+    coefficients=Coefficients(eta_h=6.5, eta_d=0.0, eta_v=0.0, lam=0.0),
+    apply_at="centroid",
+    dt=1e-3,
+    t_end=0.3,
+)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "energy rises by 5.5e-7 of the scale at dt = 1e-3 s at the full-immersion event of a "
+        "rod stuck at E in x and spinning at 15 rad/s; at dt = 3e-4 the rise is 4.6e-15 and "
+        "at 1e-4 2e-17 (so it is not a smooth O(dt^4) error: a coarse-step event effect in "
+        "the stuck-while-turning regime, as in test_contact_reemerges_then_sticks_converges)"
+    ),
+)
+def test_centroid_energy_stuck_and_spinning() -> None:
+    """Minimal reproducer: simulate(STUCK_AND_SPINNING): KE + PE must not rise by more than
+    1e-8 of the energy scale (the step resolves the contact by the domain's rule)."""
+    assert step_resolves(STUCK_AND_SPINNING)
+    r = granrs.simulate(STUCK_AND_SPINNING.replace(record=RECORD))
+    assert r.series is not None
+    energy = r.series["E"]
+    rise = float(np.max(energy - np.minimum.accumulate(energy)))
+    assert rise <= ENERGY_RTOL * energy_scale(STUCK_AND_SPINNING, r), rise
 
 
 def test_centroid_energy_with_the_plain_sign_rises_by_chatter() -> None:
@@ -560,7 +593,10 @@ def test_sweep_of_random_scenes_whole_domain() -> None:
     """The same 1500 scenes as the domain draws them, unresolved steps included: every run
     must be finite or fail with its message (a 'failed' row), never return inf."""
     rng = np.random.default_rng(2024)
-    check_sweep([random_scene(rng, apply_at=("tip", "centroid")[i % 2]) for i in range(1500)])
+    scenes = [random_scene(rng, apply_at=("tip", "centroid")[i % 2]) for i in range(1500)]
+    # Some of these steps do not resolve their contact: the sweep must say so.
+    with pytest.warns(granrs.StepSizeWarning, match="did not resolve their contact"):
+        check_sweep(scenes)
 
 
 def test_blow_up_is_reported_not_returned() -> None:

@@ -15,8 +15,9 @@ Quick start::
 from __future__ import annotations
 
 from . import _granrs, cases, coefficients, data, scenefile
-from .api import simulate
+from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
+from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
 from .effects import EFFECT_INFO, Effect
 from .errors import (
@@ -24,7 +25,9 @@ from .errors import (
     GranrsError,
     InvalidParameterError,
     InvalidSceneError,
+    MeasurementError,
     SimulationError,
+    StepSizeWarning,
     UnknownNameError,
 )
 from .force import ResistanceForce, resistance_force
@@ -37,6 +40,8 @@ __all__ = [
     "EFFECTS",
     "EFFECT_INFO",
     "RECORDS",
+    "RK4_STABILITY_LIMIT",
+    "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
     "ContactResult",
@@ -44,12 +49,16 @@ __all__ = [
     "GranrsError",
     "InvalidParameterError",
     "InvalidSceneError",
+    "MeasurementError",
+    "Measurements",
     "ResistanceForce",
     "Result",
     "Scene",
     "SimulationError",
+    "StepSizeWarning",
     "UnknownNameError",
     "__version__",
+    "calibrate",
     "cases",
     "coefficients",
     "data",

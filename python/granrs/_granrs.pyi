@@ -27,6 +27,8 @@ class RunOutcome:
     t_s: float
     depth: float
     run_seconds: float
+    h_lambda: float
+    unresolved: int
     def to_dict(self) -> dict[str, Any]:
         """Everything, as a dict; once (the outcome moves out)."""
 

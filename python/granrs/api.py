@@ -2,12 +2,39 @@
 
 from __future__ import annotations
 
+import warnings
+
 from . import _granrs
-from .errors import InvalidParameterError
+from .errors import InvalidParameterError, StepSizeWarning
 from .result import Result
 from .scene import _CORE_FIELDS, Scene
 
-__all__ = ["simulate"]
+__all__ = ["RK4_STABILITY_LIMIT", "simulate"]
+
+#: ``h lambda`` beyond which the classical RK4 is unstable for a real, negative rate
+#: (the stability region's extent on the negative real axis, 2.785).
+RK4_STABILITY_LIMIT = 2.785
+
+
+def step_advice(dt: float, h_lambda: float, unresolved: int = 0) -> str:
+    """What to tell a user whose run did not resolve its contact: ``h_lambda`` above
+    :data:`RK4_STABILITY_LIMIT`, or ``unresolved`` steps the sign modes chattered through."""
+    if h_lambda > RK4_STABILITY_LIMIT:
+        why = (
+            f"dt times the drag's fastest rate reached {h_lambda:.3g} (RK4 is stable below "
+            f"{RK4_STABILITY_LIMIT})"
+        )
+        advice = f"use dt <= {dt * 0.5 / h_lambda:.2g} s (dt * rate <= 0.5)"
+    else:
+        why = (
+            f"in {unresolved} step{'s' if unresolved != 1 else ''} the force's signs switched "
+            "more than 32 times, the step was taken as it was, and the energy rose"
+        )
+        advice = "use a smaller dt"
+    return (
+        f"dt = {dt:g} s does not resolve this scene's contact: {why}, so the result is not "
+        f'the converged answer; {advice}, or method="dopri5"'
+    )
 
 
 def simulate(scene: Scene) -> Result:
@@ -29,4 +56,22 @@ def simulate(scene: Scene) -> Result:
             f"simulate() takes a granrs.Scene, got {type(scene).__name__}", field="scene"
         )
     # scene._compiled() and _granrs.run in one call of the core.
-    return Result(scene, _granrs.run_scene(scene.__dict__, _CORE_FIELDS))
+    outcome = _granrs.run_scene(scene.__dict__, _CORE_FIELDS)
+    result = Result(scene, outcome)
+    if outcome.h_lambda > RK4_STABILITY_LIMIT or (
+        outcome.unresolved
+        and energy_rose(result.summary["energy_start"], result.summary["energy_end"])
+    ):
+        warnings.warn(
+            StepSizeWarning(step_advice(scene.dt, outcome.h_lambda, outcome.unresolved)),
+            stacklevel=2,
+        )
+    return result
+
+
+def energy_rose(start: float, end: float) -> bool:
+    """Whether the mechanical energy ended above where it started, beyond rounding (1e-9 of
+    its size): with steps the sign modes chattered through (``unresolved``), the sign of
+    the chatter's error. Chatter at rest loses energy; a step too large for the contact
+    gains it."""
+    return end - start > 1e-9 * max(abs(start), abs(end), 1e-12)

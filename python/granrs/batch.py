@@ -14,6 +14,7 @@ from __future__ import annotations
 import difflib
 import math
 import uuid
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
@@ -21,8 +22,9 @@ import numpy as np
 import pandas as pd
 
 from . import _granrs
+from .api import RK4_STABILITY_LIMIT
 from .coefficients import Coefficients
-from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
 from .result import JOINT_NAMES
 from .scene import Scene
 
@@ -32,7 +34,7 @@ __all__ = ["STATUSES", "sweep"]
 STATUSES: tuple[str, ...] = ("stopped", "end_time", "not_stopped", "failed", "cancelled")
 #: Sweeps with at least this many runs show a progress bar by default (on a terminal).
 PROGRESS_MIN_RUNS = 2000
-_INT_COLUMNS = ("steps", "rhs_evals", "root_evals", "events", "rejected")
+_INT_COLUMNS = ("steps", "rhs_evals", "root_evals", "events", "rejected", "unresolved")
 
 
 def _plain(name: str, value: Any) -> Any:
@@ -302,4 +304,32 @@ def sweep(
     else:
         raw = _run_local(kwargs, 0, n, n_threads, progress)
     axis_frame = _axis_frame(keep_axes, 0, n) if keep_axes else None
-    return _frame(raw, raw["body"], axis_frame)
+    frame = _frame(raw, raw["body"], axis_frame)
+    _warn_unresolved(frame)
+    return frame
+
+
+def _warn_unresolved(frame: pd.DataFrame) -> None:
+    """One :class:`~granrs.errors.StepSizeWarning` for the runs whose step did not resolve
+    their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, or steps the sign
+    modes chattered through, ``unresolved`` > 0, with a rise in energy: see
+    :func:`granrs.api.energy_rose`)."""
+    if "h_lambda" not in frame.columns:
+        return
+    h_lambda = frame["h_lambda"].to_numpy()
+    start, end = frame["energy_start"].to_numpy(), frame["energy_end"].to_numpy()
+    with np.errstate(invalid="ignore"):
+        rose = end - start > 1e-9 * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
+    bad = np.flatnonzero((h_lambda > RK4_STABILITY_LIMIT) | ((frame["unresolved"] > 0) & rose))
+    if bad.size:
+        rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
+        warnings.warn(
+            StepSizeWarning(
+                f"{bad.size} of {len(frame)} runs (rows {rows}) did not resolve their contact "
+                f"(h_lambda above {RK4_STABILITY_LIMIT}, or 'unresolved' steps where the sign "
+                f"modes chattered and the energy rose); the largest h_lambda is "
+                f"{np.nanmax(h_lambda[bad]):.3g}. "
+                "Use a smaller dt (dt * rate <= 0.5) for those runs"
+            ),
+            stacklevel=3,
+        )

@@ -7,10 +7,13 @@ Usage::
     granrs scene new [--body BODY] [--out FILE]
     granrs reproduce [--out DIR] [--dt DT] [--chapter KEY ...] [--quiet]
     granrs bench accuracy [--out DIR] [--quick] [--repeats N] [--quiet]
+    granrs calibrate [--cases BODY] [--measurements thesis:NAME|FILE.csv] [--params P,...]
+                     [--per-angle] [--base NAME] [--fit ROWS] [--predict ROWS] [--json]
+                     [--out FILE.csv]
 
 Each subcommand is one ``_add_<name>`` function that declares its arguments and one
 ``_cmd_<name>`` function that runs it and returns the exit code; :data:`_COMMANDS` lists
-them (``calibrate`` is meant to be added the same way).
+them.
 
 Exit codes: 0 on success; 2 for invalid input (a usage error, a scene file that cannot be
 read, or any :class:`~granrs.errors.GranrsError` but a simulation failure: one line on
@@ -138,6 +141,160 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_calibrate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Declare ``granrs calibrate``."""
+    parser = sub.add_parser(
+        "calibrate",
+        help="fit the force coefficients (or the leg's joints) to measured depth and t_s",
+        description=(
+            "Fit parameters of the force law by weighted least squares to measured depths "
+            "and stopping times (granrs.calibrate), print the fitted values with standard "
+            "errors and ~95%% intervals and each row's residuals in units of the measured sd; "
+            "optionally predict other rows out of sample."
+        ),
+    )
+    parser.add_argument(
+        "--cases",
+        choices=["free_link", "chain", "leg"],
+        default=None,
+        help="the body (default: the thesis table's, or free_link for a CSV)",
+    )
+    parser.add_argument(
+        "--measurements",
+        default="thesis:table_3_1",
+        metavar="SPEC",
+        help=(
+            "thesis:table_3_1 (default), thesis:table_4_chain, thesis:table_5_1_means, "
+            "thesis:table_5_1, or a CSV file with the same columns"
+        ),
+    )
+    parser.add_argument(
+        "--params",
+        default="eta_h,eta_d,eta_v,lam",
+        metavar="P,...",
+        help=(
+            "comma-separated parameters: eta_h, eta_d, eta_v, lam; eta_v@45 (an angle node); "
+            "scale.eta_v (a factor on the base); joints.k, joints.c (leg)"
+        ),
+    )
+    parser.add_argument(
+        "--per-angle", action="store_true", help="free link: one value per measured angle"
+    )
+    parser.add_argument(
+        "--base", default=None, help="base coefficients: table_3_4 (default) or table_3_2"
+    )
+    parser.add_argument(
+        "--fit",
+        metavar="COLUMN=V,...",
+        default=None,
+        help="fit only these rows, e.g. q_deg=0,45,75 or v0_case=1,2",
+    )
+    parser.add_argument(
+        "--predict",
+        metavar="COLUMN=V,...",
+        default=None,
+        help="predict these rows with the fitted values (out of sample), e.g. q_deg=60",
+    )
+    parser.add_argument("--starts", type=int, default=1, metavar="N", help="starts (default 1)")
+    parser.add_argument("--dt", type=float, default=1e-4, metavar="DT", help="step [s]")
+    parser.add_argument("--json", action="store_true", help="print the result as JSON")
+    parser.add_argument(
+        "--out", metavar="FILE.csv", default=None, help="write the residuals per row to CSV"
+    )
+    parser.set_defaults(handler=_cmd_calibrate)
+
+
+def _row_filter(text: str, option: str) -> tuple[str, list[float]]:
+    """``COLUMN=V,...`` -> (column, values)."""
+    column, sep, values = text.partition("=")
+    try:
+        if not sep or not column.strip():
+            raise ValueError
+        numbers_ = [float(v) for v in values.split(",") if v.strip()]
+        if not numbers_:
+            raise ValueError
+    except ValueError:
+        raise InvalidParameterError(
+            f"{option} {text!r}: expected COLUMN=V,... (e.g. q_deg=0,45,75)",
+            field=option.lstrip("-"),
+        ) from None
+    return column.strip(), numbers_
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    """Run ``granrs calibrate``."""
+    from .calibrate import Measurements, calibrate
+
+    measurements = Measurements.load(args.measurements, args.cases)
+    cases = args.cases or measurements.body
+    fit_rows = measurements
+    if args.fit:
+        column, values = _row_filter(args.fit, "--fit")
+        fit_rows = measurements.subset(**{column: values})
+    test_rows = None
+    if args.predict:
+        column, values = _row_filter(args.predict, "--predict")
+        test_rows = measurements.subset(**{column: values})
+    if args.starts < 1:
+        raise InvalidParameterError(f"--starts must be >= 1; got {args.starts}", field="starts")
+    params = [p.strip() for p in args.params.split(",") if p.strip()]
+    kwargs: dict[str, Any] = {"per_angle": args.per_angle, "starts": args.starts, "dt": args.dt}
+    if args.base:
+        kwargs["base"] = args.base
+    result = calibrate(cases, fit_rows, params, **kwargs)
+    frame = result.residuals.assign(set="fit")
+    predicted = None
+    if test_rows is not None and len(test_rows):
+        predicted = result.predict(test_rows).assign(set="predicted")
+        frame = _concat([frame, predicted])
+    if args.out:
+        frame.to_csv(args.out, index=False)
+    if args.json:
+        out = result.to_dict()
+        if predicted is not None:
+            out["predicted"] = predicted.to_dict("records")
+        print(json.dumps(_plain(out), indent=2, allow_nan=False))
+        return 0
+    print(result.summary())
+    columns = [c for c in _CALIBRATE_COLUMNS if c in frame.columns]
+    header = list(columns)
+    rows = [[_number(v) for v in row] for row in frame[columns].itertuples(index=False)]
+    print()
+    print("\n".join(_table(header, rows)))
+    if predicted is not None:
+        from .calibrate import within
+
+        print(
+            f"predicted rows: depth within 1 sd {within(predicted, 'depth', 1)}, t_s within "
+            f"2 sd {within(predicted, 't_s', 2)} of {len(predicted)}"
+        )
+    return 0
+
+
+#: The residual columns ``granrs calibrate`` prints.
+_CALIBRATE_COLUMNS: tuple[str, ...] = (
+    "set",
+    "height_case",
+    "link",
+    "v0_case",
+    "q_deg",
+    "v0_mean",
+    "depth_mean",
+    "depth_sim",
+    "depth_z",
+    "t_s_mean",
+    "t_s_sim",
+    "t_s_z",
+)
+
+
+def _concat(frames: list[Any]) -> Any:
+    """``pandas.concat`` of residual frames (pandas imported only when calibrating)."""
+    import pandas as pd
+
+    return pd.concat(frames, ignore_index=True)
+
+
 #: What ``--series`` records when the scene records nothing.
 SERIES_RECORD: tuple[str, ...] = ("state", "forces", "energy")
 #: The output formats of ``--series``, by file extension.
@@ -232,6 +389,8 @@ _RUN_KEYS: tuple[str, ...] = (
     "root_evals",
     "events",
     "rejected",
+    "unresolved",
+    "h_lambda",
 )
 
 
@@ -403,6 +562,7 @@ _COMMANDS: tuple[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]],
     _add_scene,
     _add_reproduce,
     _add_bench,
+    _add_calibrate,
 )
 
 

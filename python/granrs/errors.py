@@ -15,7 +15,9 @@ __all__ = [
     "GranrsError",
     "InvalidParameterError",
     "InvalidSceneError",
+    "MeasurementError",
     "SimulationError",
+    "StepSizeWarning",
     "UnknownNameError",
 ]
 
@@ -44,5 +46,17 @@ class CoefficientTableError(InvalidSceneError):
     """A coefficient table could not be read or holds invalid values."""
 
 
+class MeasurementError(InvalidSceneError):
+    """A measurements table (for :func:`granrs.calibrate`) could not be read or holds
+    invalid values. ``field`` names the column (or ``"measurements"``)."""
+
+
 class SimulationError(GranrsError, RuntimeError):
     """The integration itself failed (a non-finite state); never raised for bad input."""
+
+
+class StepSizeWarning(UserWarning):
+    """The fixed step did not resolve the run: at the drag's stiffest moment, ``dt`` times
+    its fastest rate (``Result.summary["h_lambda"]``) exceeded RK4's stability limit
+    (:data:`granrs.RK4_STABILITY_LIMIT`). The run finished with finite numbers, but they are
+    not the converged answer: rerun with a smaller ``dt`` or ``method="dopri5"``."""

@@ -2296,3 +2296,7 @@ def reproduce(
     path = _write(out_path, report, ctx.figures)
     ctx.log(f"wrote {path} and {len(ctx.figures)} figures in {seconds:.1f} s")
     return path
+
+
+# The calibration chapter (issue 7) registers itself after chapter 5.
+from . import report_calibration as _report_calibration  # noqa: E402, F401

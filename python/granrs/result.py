@@ -36,6 +36,8 @@ SUMMARY_UNITS: dict[str, str] = {
     "root_evals": "-",
     "events": "-",
     "rejected": "-",
+    "unresolved": "-",
+    "h_lambda": "-",
 }
 
 # Friendly names of the generalized coordinates of each body.

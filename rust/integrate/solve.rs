@@ -122,6 +122,9 @@ pub struct Stats {
     pub events: usize,
     /// Steps rejected by the adaptive method's error control.
     pub rejected: usize,
+    /// Steps taken as they were after [`MAX_EVENTS_PER_STEP`] events within them: the
+    /// sign modes chattered, the step does not resolve the contact.
+    pub unresolved: usize,
 }
 
 /// The results of one contact.
@@ -201,8 +204,29 @@ pub struct Outcome {
     pub dissipated: f64,
     /// Per link: the joint that carries it.
     pub joints: Vec<JointSummary>,
+    /// Largest `dt * lambda` of the drag over the run: the step times the drag's fastest
+    /// rate, `2 |F_d| / |v_E|` times E's inverse effective mass (see
+    /// [`Model::centroid_inverse_mass`]), at the step where the drag was stiffest. Above
+    /// [`RK4_STABILITY_LIMIT`] the fixed step does not resolve the impact. NaN with the
+    /// adaptive method, 0 without drag.
+    pub h_lambda: f64,
     /// Time series, if any were asked for.
     pub series: Option<Series>,
+}
+
+/// `h lambda` beyond which the classical RK4 is unstable for a real, negative rate.
+pub const RK4_STABILITY_LIMIT: f64 = 2.785;
+
+/// The fastest rate [1/s] of a quadratic drag `F = -c |v| v` on a point of inverse effective
+/// mass `w`, with `k = |F| / |v|` and `dir` the unit velocity: the largest eigenvalue of
+/// `w K`, `K = dF/dv = -k (I + dir dir^T)` (twice as stiff along the motion as across).
+/// A rod's drag `-c |e x v| v` has the same stiffness broadside and less otherwise.
+fn drag_rate(w: &nalgebra::Matrix2<f64>, k: f64, dir: Vector2<f64>) -> f64 {
+    let stiffness = k * (nalgebra::Matrix2::identity() + dir * dir.transpose());
+    let p = w * stiffness;
+    let (tr, det) = (p.trace(), p.determinant());
+    // Both factors are symmetric positive semi-definite: the eigenvalues are real, >= 0.
+    0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
 }
 
 /// Relative tolerance of event location, in units of the step.
@@ -669,13 +693,25 @@ pub fn solve<const N: usize>(
     // The modes `funcs` was listed for.
     let mut funcs_modes: Option<Modes> = None;
 
-    let update_fd_max = |summaries: &mut Vec<ContactSummary>, e: &Eval<N>, modes: &Modes| {
-        for (ci, s) in summaries.iter_mut().enumerate() {
-            if !modes[ci].stopped {
-                s.f_d_max = s.f_d_max.max(e.contacts[ci].force.drag_magnitude());
+    // The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E). Squared
+    // norms: a square root only when a maximum is beaten.
+    let mut stiffest = (0.0f64, y.q, 0usize, Vector2::zeros());
+    let mut update_fd_max =
+        |summaries: &mut Vec<ContactSummary>, e: &Eval<N>, q: &SVector<f64, N>, modes: &Modes| {
+            for (ci, s) in summaries.iter_mut().enumerate() {
+                if !modes[ci].stopped {
+                    let c = &e.contacts[ci];
+                    let drag2 = c.force.drag.norm_squared();
+                    if drag2 > s.f_d_max * s.f_d_max {
+                        s.f_d_max = drag2.sqrt();
+                    }
+                    let speed2 = c.v_centroid.norm_squared();
+                    if speed2 > 0.0 && drag2 > stiffest.0 * speed2 {
+                        stiffest = (drag2 / speed2, *q, ci, c.v_centroid);
+                    }
+                }
             }
-        }
-    };
+        };
 
     let mut h_adapt = dt;
     let adaptive = matches!(options.method, Method::Dopri5 { .. });
@@ -763,7 +799,9 @@ pub fn solve<const N: usize>(
         }
         let mut earliest = f64::INFINITY;
         let mut hits: Vec<(Kind, usize, f64)> = Vec::new();
-        if events_this_step < MAX_EVENTS_PER_STEP {
+        if events_this_step >= MAX_EVENTS_PER_STEP {
+            stats.unresolved += 1;
+        } else {
             for &(kind, ci) in &funcs {
                 let g1 = switching(kind, ci, e1, &modes);
                 if !crossed(kind, g1) {
@@ -817,7 +855,7 @@ pub fn solve<const N: usize>(
             n += 1;
             events_this_step = 0;
             stats.steps += 1;
-            update_fd_max(&mut summaries, e0, &modes);
+            update_fd_max(&mut summaries, e0, &y.q, &modes);
             update_joints(&mut joints, &y, e0, &modes);
             if n.is_multiple_of(stride as u64) {
                 recorder.push(model, t, &y, e0, &modes);
@@ -848,7 +886,7 @@ pub fn solve<const N: usize>(
         stats.rhs_evals += 1;
         if h_star > 0.0 {
             stats.steps += 1;
-            update_fd_max(&mut summaries, &e_star_old, &modes);
+            update_fd_max(&mut summaries, &e_star_old, &y_star.q, &modes);
             update_joints(&mut joints, &y_star, &e_star_old, &modes);
         }
         // An event at the very start of the step is judged at the step's end.
@@ -957,7 +995,20 @@ pub fn solve<const N: usize>(
     if status != Status::Stopped && options.record.any() && recorder.t.last() != Some(&t) {
         recorder.push(model, t, &y, &e_end, &modes);
     }
+    let h_lambda = if adaptive {
+        f64::NAN
+    } else if stiffest.0 > 0.0 {
+        let (k2, q, ci, v) = stiffest;
+        dt * drag_rate(
+            &model.centroid_inverse_mass(&q, ci),
+            k2.sqrt(),
+            v.normalize(),
+        )
+    } else {
+        0.0
+    };
     let out = Outcome {
+        h_lambda,
         status,
         t_final: t,
         stats,

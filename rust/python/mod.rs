@@ -138,6 +138,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     stats.set_item("root_evals", out.stats.root_evals)?;
     stats.set_item("events", out.stats.events)?;
     stats.set_item("rejected", out.stats.rejected)?;
+    stats.set_item("unresolved", out.stats.unresolved)?;
     // The run-level entries of Result.summary, merged there with contact 0's in one update.
     let run = stats.copy()?;
     run.set_item("status", out.status.name())?;
@@ -145,6 +146,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     run.set_item("energy_start", out.energy_start)?;
     run.set_item("energy_end", out.energy_end)?;
     run.set_item("dissipated", out.dissipated)?;
+    run.set_item("h_lambda", out.h_lambda)?;
     d.set_item("run", run)?;
     d.set_item("stats", stats)?;
     d.set_item("energy_start", out.energy_start)?;
@@ -362,6 +364,12 @@ struct RunOutcome {
     /// Wall time of the run alone [s] (for measuring a call's overhead; not a result).
     #[pyo3(get)]
     run_seconds: f64,
+    /// Largest dt * lambda of the drag (see `Outcome::h_lambda`).
+    #[pyo3(get)]
+    h_lambda: f64,
+    /// Steps the sign modes chattered through (see `Stats::unresolved`).
+    #[pyo3(get)]
+    unresolved: usize,
     /// The rest, moved out (series included, without a copy) by the one `to_dict` call.
     out: Mutex<Option<Outcome>>,
 }
@@ -398,6 +406,8 @@ fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
         t_s: first.map_or(f64::NAN, |c| c.t_s),
         depth: first.map_or(f64::NAN, |c| c.depth),
         run_seconds: seconds,
+        h_lambda: out.h_lambda,
+        unresolved: out.stats.unresolved,
         out: Mutex::new(Some(out)),
     })
 }
