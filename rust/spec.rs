@@ -6,6 +6,8 @@
 //! keeps one base spec and overrides a few fields per run ([`SceneSpec::set`]), which needs
 //! neither Python nor the GIL.
 
+use std::borrow::Cow;
+
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
 use crate::dynamics::{Effects, SignModel};
@@ -23,12 +25,12 @@ pub enum Value {
     Bool(bool),
     /// A real number.
     Num(f64),
-    /// A string.
-    Str(String),
+    /// A string (see [`word`]).
+    Str(Cow<'static, str>),
     /// A list of names.
-    Names(Vec<String>),
+    Names(Vec<Cow<'static, str>>),
     /// A mapping (coefficients, a spring-damper).
-    Map(Vec<(String, Value)>),
+    Map(Vec<(Cow<'static, str>, Value)>),
     /// Anything else, by its type name (for the error message).
     Other(String),
 }
@@ -46,6 +48,26 @@ impl Value {
             Value::Other(t) => t.clone(),
         }
     }
+}
+
+/// `s` as a `'static` string when it is one of the words a scene uses (bodies, models,
+/// effects, series, mapping keys), found by a `match`; any other string is copied. A scene's
+/// strings then take no allocation.
+pub fn word(s: &str) -> Cow<'static, str> {
+    macro_rules! words {
+        ($($w:literal)*) => {
+            match s {
+                $($w => Cow::Borrowed($w),)*
+                _ => Cow::Owned(s.to_owned()),
+            }
+        };
+    }
+    words!(
+        "free_link" "chain" "leg" "tip" "centroid" "modes" "raw" "smooth" "rk4" "dopri5"
+        "first_stop" "all_stops" "time" "free" "locked" "box" "thesis" "gravity" "drag"
+        "static_h" "static_v" "joint_springs" "state" "forces" "energy" "eta_h" "eta_d"
+        "eta_v" "lam" "k" "c"
+    )
 }
 
 /// Names of the effects (force terms) a scene may list.
@@ -215,7 +237,7 @@ fn num(field: &str, v: Option<&Value>) -> Result<f64> {
     }
 }
 
-fn map_get<'a>(entries: &'a [(String, Value)], k: &str) -> Option<&'a Value> {
+fn map_get<'a>(entries: &'a [(Cow<'static, str>, Value)], k: &str) -> Option<&'a Value> {
     entries.iter().find(|(name, _)| name == k).map(|(_, v)| v)
 }
 
@@ -304,13 +326,13 @@ impl SceneSpec {
     pub fn str(&self, field: &str) -> Result<&str> {
         match self.get(field) {
             None => Err(missing(field)),
-            Some(Value::Str(s)) => Ok(s),
+            Some(Value::Str(s)) => Ok(s.as_ref()),
             Some(other) => Err(wrong(field, "a string", other)),
         }
     }
 
     /// A list of names (absent or `None` gives `None`).
-    fn names(&self, field: &str) -> Result<Option<&[String]>> {
+    fn names(&self, field: &str) -> Result<Option<&[Cow<'static, str>]>> {
         match self.get(field) {
             None | Some(Value::None) => Ok(None),
             Some(Value::Names(n)) => Ok(Some(n)),
@@ -333,7 +355,7 @@ impl SceneSpec {
             }
         };
         for (k, _) in entries {
-            if !["eta_h", "eta_d", "eta_v", "lam"].contains(&k.as_str()) {
+            if !["eta_h", "eta_d", "eta_v", "lam"].contains(&k.as_ref()) {
                 return Err(unknown(
                     &format!("{field}.{k}"),
                     k,
@@ -359,7 +381,7 @@ impl SceneSpec {
     fn joint(&self, field: &str, default: Joint) -> Result<Joint> {
         match self.get(field) {
             None | Some(Value::None) => Ok(default),
-            Some(Value::Str(name)) => match name.as_str() {
+            Some(Value::Str(name)) => match name.as_ref() {
                 "free" => Ok(Joint::Free),
                 "locked" => Ok(Joint::Locked),
                 other => Err(unknown(
@@ -402,7 +424,7 @@ impl SceneSpec {
         };
         let mut springs = false;
         for n in names {
-            match n.as_str() {
+            match n.as_ref() {
                 "gravity" => e.gravity = true,
                 "drag" => e.drag = true,
                 "static_h" => e.static_h = true,
@@ -417,7 +439,7 @@ impl SceneSpec {
     fn record(&self) -> Result<Record> {
         let mut r = Record::default();
         for n in self.names("record")?.unwrap_or_default() {
-            match n.as_str() {
+            match n.as_ref() {
                 "state" => r.state = true,
                 "forces" => r.forces = true,
                 "energy" => r.energy = true,
@@ -659,7 +681,7 @@ pub(crate) fn free_link_spec() -> SceneSpec {
                 ("lam", 0.25),
             ]
             .iter()
-            .map(|(k, v)| (k.to_string(), Value::Num(*v)))
+            .map(|(k, v)| (Cow::Borrowed(*k), Value::Num(*v)))
             .collect(),
         ),
     );

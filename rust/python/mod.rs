@@ -5,6 +5,7 @@
 //! [`GranrsError`] becomes an instance of the matching class of `granrs.errors`, so that the
 //! Python and Rust layers share one exception tree.
 
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -17,7 +18,7 @@ use crate::batch::{self, Source};
 use crate::error::GranrsError;
 use crate::integrate::Outcome;
 use crate::scene::AnyScene;
-use crate::spec::{SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
+use crate::spec::{word, SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -50,7 +51,7 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         return Value::Num(f.value());
     }
     if let Ok(s) = v.cast::<PyString>() {
-        return Value::Str(s.to_str().map(str::to_owned).unwrap_or_default());
+        return Value::Str(s.to_str().map(word).unwrap_or_default());
     }
     if v.is_none() {
         return Value::None;
@@ -70,7 +71,7 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
             d.iter()
                 .map(|(k, v)| {
                     (
-                        k.str().map(|s| s.to_string()).unwrap_or_default(),
+                        k.str().map(|s| word(&s.to_string())).unwrap_or_default(),
                         value_from_py(&v),
                     )
                 })
@@ -102,7 +103,7 @@ fn names_from_py<'py>(items: impl ExactSizeIterator<Item = Bound<'py, PyAny>>) -
     let mut names = Vec::with_capacity(items.len());
     for item in items {
         match item.cast::<PyString>().ok().and_then(|s| s.to_str().ok()) {
-            Some(s) => names.push(s.to_owned()),
+            Some(s) => names.push(word(s)),
             None => return Value::Other("a list that is not all strings".into()),
         }
     }
@@ -228,7 +229,7 @@ fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
         (pyo3::intern!(v.py(), "lam"), "lam"),
     ] {
         match v.getattr(key) {
-            Ok(x) => entries.push((name.to_owned(), value_from_py(&x))),
+            Ok(x) => entries.push((Cow::Borrowed(name), value_from_py(&x))),
             Err(_) => return value_from_py(v),
         }
     }
@@ -632,7 +633,10 @@ fn resistance_force<'py>(
     check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
     check_range("g", g, 0.0, false).map_err(err)?;
     let mut spec = SceneSpec::new();
-    spec.set("effects", Value::Names(effects));
+    spec.set(
+        "effects",
+        Value::Names(effects.into_iter().map(Cow::Owned).collect()),
+    );
     let effects = spec.effects().map_err(err)?.0;
     let sign = match sign_model {
         "raw" => Sign::Raw,
