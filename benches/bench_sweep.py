@@ -132,9 +132,6 @@ def part_sweep(n: int) -> list[str]:
 def part_overhead(repeat: int) -> list[str]:
     """Each call of simulate() timed whole, and the core's run inside it timed by the core
     (``run_seconds``): the difference is the call's overhead, measured in the same call."""
-    from granrs import _granrs
-    from granrs.result import Result
-
     lines = ["### Python call overhead of `simulate`", ""]
     lines += [
         "| scene | simulate() [us] | the run in the core [us] | overhead [us] | share "
@@ -156,11 +153,10 @@ def part_overhead(repeat: int) -> list[str]:
             totals, cores = [], []
             for s in scenes:
                 t0 = time.perf_counter()
-                # The body of granrs.simulate (api.py), with the core's own timing kept.
-                core = _granrs.run(s._compiled())
-                Result(s, core)
+                result = granrs.simulate(s)
                 totals.append(time.perf_counter() - t0)
-                cores.append(core.run_seconds)
+                # The core's own timing of the run inside that call.
+                cores.append(result._core.run_seconds)
             stats[label] = (statistics.median(totals), statistics.median(cores))
         total, core = stats["same"]
         over = total - core

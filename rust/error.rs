@@ -47,11 +47,18 @@ pub fn check_range(field: &str, value: f64, min: f64, strict: bool) -> Result<f6
     if ok {
         Ok(value)
     } else {
-        Err(GranrsError::InvalidParameter {
-            field: field.to_string(),
-            value,
-            allowed: format!("finite, {} {}", if strict { ">" } else { ">=" }, min),
-        })
+        Err(out_of_range(field, value, min, strict))
+    }
+}
+
+/// The error of [`check_range`], kept out of line (every valid scene calls it many times).
+#[cold]
+#[inline(never)]
+fn out_of_range(field: &str, value: f64, min: f64, strict: bool) -> GranrsError {
+    GranrsError::InvalidParameter {
+        field: field.to_string(),
+        value,
+        allowed: format!("finite, {} {}", if strict { ">" } else { ">=" }, min),
     }
 }
 
@@ -60,10 +67,17 @@ pub fn check_finite(field: &str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(GranrsError::InvalidParameter {
-            field: field.to_string(),
-            value,
-            allowed: "finite".to_string(),
-        })
+        Err(not_finite(field, value))
+    }
+}
+
+/// The error of [`check_finite`], kept out of line.
+#[cold]
+#[inline(never)]
+fn not_finite(field: &str, value: f64) -> GranrsError {
+    GranrsError::InvalidParameter {
+        field: field.to_string(),
+        value,
+        allowed: "finite".to_string(),
     }
 }

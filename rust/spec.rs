@@ -6,6 +6,8 @@
 //! keeps one base spec and overrides a few fields per run ([`SceneSpec::set`]), which needs
 //! neither Python nor the GIL.
 
+use std::borrow::Cow;
+
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
 use crate::dynamics::{Effects, SignModel};
@@ -23,12 +25,12 @@ pub enum Value {
     Bool(bool),
     /// A real number.
     Num(f64),
-    /// A string.
-    Str(String),
+    /// A string (see [`word`]).
+    Str(Cow<'static, str>),
     /// A list of names.
-    Names(Vec<String>),
+    Names(Vec<Cow<'static, str>>),
     /// A mapping (coefficients, a spring-damper).
-    Map(Vec<(String, Value)>),
+    Map(Vec<(Cow<'static, str>, Value)>),
     /// Anything else, by its type name (for the error message).
     Other(String),
 }
@@ -46,6 +48,26 @@ impl Value {
             Value::Other(t) => t.clone(),
         }
     }
+}
+
+/// `s` as a `'static` string when it is one of the words a scene uses (bodies, models,
+/// effects, series, mapping keys), found by a `match`; any other string is copied. A scene's
+/// strings then take no allocation.
+pub fn word(s: &str) -> Cow<'static, str> {
+    macro_rules! words {
+        ($($w:literal)*) => {
+            match s {
+                $($w => Cow::Borrowed($w),)*
+                _ => Cow::Owned(s.to_owned()),
+            }
+        };
+    }
+    words!(
+        "free_link" "chain" "leg" "tip" "centroid" "modes" "raw" "smooth" "rk4" "dopri5"
+        "first_stop" "all_stops" "time" "free" "locked" "box" "thesis" "gravity" "drag"
+        "static_h" "static_v" "joint_springs" "state" "forces" "energy" "eta_h" "eta_d"
+        "eta_v" "lam" "k" "c"
+    )
 }
 
 /// Names of the effects (force terms) a scene may list.
@@ -120,6 +142,9 @@ scene_fields! {
     "vx0",
 }
 
+/// The slots of the coefficients fields (see [`SceneSpec::set_slot`]).
+pub const COEFFICIENTS_SLOTS: [usize; 2] = [position("coefficients"), position("coefficients2")];
+
 /// Where `name` is in [`SCENE_FIELDS`] (at compile time).
 const fn position(name: &str) -> usize {
     let mut i = 0;
@@ -157,6 +182,8 @@ impl Default for SceneSpec {
     }
 }
 
+#[cold]
+#[inline(never)]
 fn missing(field: &str) -> GranrsError {
     GranrsError::InvalidScene {
         field: field.to_string(),
@@ -164,6 +191,8 @@ fn missing(field: &str) -> GranrsError {
     }
 }
 
+#[cold]
+#[inline(never)]
 fn wrong(field: &str, expected: &str, got: &Value) -> GranrsError {
     GranrsError::WrongType {
         field: field.to_string(),
@@ -172,6 +201,8 @@ fn wrong(field: &str, expected: &str, got: &Value) -> GranrsError {
     }
 }
 
+#[cold]
+#[inline(never)]
 fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
     GranrsError::UnknownName {
         field: field.to_string(),
@@ -181,6 +212,8 @@ fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
 }
 
 /// An error about key `k` of the mapping `field`, renamed to the field `field.k`.
+#[cold]
+#[inline(never)]
 fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
     match e {
         GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
@@ -204,7 +237,7 @@ fn num(field: &str, v: Option<&Value>) -> Result<f64> {
     }
 }
 
-fn map_get<'a>(entries: &'a [(String, Value)], k: &str) -> Option<&'a Value> {
+fn map_get<'a>(entries: &'a [(Cow<'static, str>, Value)], k: &str) -> Option<&'a Value> {
     entries.iter().find(|(name, _)| name == k).map(|(_, v)| v)
 }
 
@@ -236,6 +269,16 @@ impl SceneSpec {
             Ok(i) => self.others[i].1 = value,
             Err(i) => self.others.insert(i, (field.to_string(), value)),
         }
+    }
+
+    /// The slot of a field of [`SCENE_FIELDS`], for [`SceneSpec::set_slot`].
+    pub fn slot_of(field: &str) -> Option<usize> {
+        field_slot(field)
+    }
+
+    /// Set the field of slot `slot` (see [`SceneSpec::slot_of`]).
+    pub fn set_slot(&mut self, slot: usize, value: Value) {
+        self.known[slot] = Some(value);
     }
 
     /// A field's value, if present.
@@ -283,13 +326,13 @@ impl SceneSpec {
     pub fn str(&self, field: &str) -> Result<&str> {
         match self.get(field) {
             None => Err(missing(field)),
-            Some(Value::Str(s)) => Ok(s),
+            Some(Value::Str(s)) => Ok(s.as_ref()),
             Some(other) => Err(wrong(field, "a string", other)),
         }
     }
 
     /// A list of names (absent or `None` gives `None`).
-    fn names(&self, field: &str) -> Result<Option<&[String]>> {
+    fn names(&self, field: &str) -> Result<Option<&[Cow<'static, str>]>> {
         match self.get(field) {
             None | Some(Value::None) => Ok(None),
             Some(Value::Names(n)) => Ok(Some(n)),
@@ -312,7 +355,7 @@ impl SceneSpec {
             }
         };
         for (k, _) in entries {
-            if !["eta_h", "eta_d", "eta_v", "lam"].contains(&k.as_str()) {
+            if !["eta_h", "eta_d", "eta_v", "lam"].contains(&k.as_ref()) {
                 return Err(unknown(
                     &format!("{field}.{k}"),
                     k,
@@ -338,7 +381,7 @@ impl SceneSpec {
     fn joint(&self, field: &str, default: Joint) -> Result<Joint> {
         match self.get(field) {
             None | Some(Value::None) => Ok(default),
-            Some(Value::Str(name)) => match name.as_str() {
+            Some(Value::Str(name)) => match name.as_ref() {
                 "free" => Ok(Joint::Free),
                 "locked" => Ok(Joint::Locked),
                 other => Err(unknown(
@@ -381,7 +424,7 @@ impl SceneSpec {
         };
         let mut springs = false;
         for n in names {
-            match n.as_str() {
+            match n.as_ref() {
                 "gravity" => e.gravity = true,
                 "drag" => e.drag = true,
                 "static_h" => e.static_h = true,
@@ -396,7 +439,7 @@ impl SceneSpec {
     fn record(&self) -> Result<Record> {
         let mut r = Record::default();
         for n in self.names("record")?.unwrap_or_default() {
-            match n.as_str() {
+            match n.as_ref() {
                 "state" => r.state = true,
                 "forces" => r.forces = true,
                 "energy" => r.energy = true,
@@ -638,7 +681,7 @@ pub(crate) fn free_link_spec() -> SceneSpec {
                 ("lam", 0.25),
             ]
             .iter()
-            .map(|(k, v)| (k.to_string(), Value::Num(*v)))
+            .map(|(k, v)| (Cow::Borrowed(*k), Value::Num(*v)))
             .collect(),
         ),
     );

@@ -70,6 +70,37 @@ def test_fields_compile_as_the_dict_does(scene: Scene) -> None:
     )
 
 
+def test_any_names_tuple_reads_the_same_fields() -> None:
+    """The core keeps each names tuple's slots (by the tuple's identity): another tuple, in
+    another order, with a name it does not know, reads the same scene."""
+    scene = cases.free_link(q_deg=30.0, v0=1.5)
+    names = _CORE_FIELDS["free_link"]
+    want = _outcome(_via_dict(scene))
+    for other in (tuple(reversed(names)), (*names, "not_a_field"), names[::2] + names[1::2]):
+        assert _same(_outcome(_granrs.compile_fields(scene.__dict__, other)), want)
+    with pytest.raises(GranrsError) as info:
+        _granrs.compile_fields(scene.__dict__, tuple(n for n in names if n != "mass"))
+    assert info.value.field == "mass"
+
+
+def test_the_compiled_scene_is_kept_on_the_scene() -> None:
+    """Compiled once per Scene (it is frozen); a dict without a known body is refused naming
+    the field."""
+    scene = cases.free_link(q_deg=30.0, v0=1.5)
+    first = scene._compiled()
+    assert scene._compiled() is first
+    assert scene.__dict__["_compiled_cache"] is first
+    assert _granrs.compiled_scene(scene.__dict__, _CORE_FIELDS) is first
+    # simulate() compiles through the same cache (run_scene).
+    fresh = cases.free_link(q_deg=30.0, v0=1.5)
+    assert _same(granrs.simulate(fresh).summary, granrs.simulate(scene).summary)
+    assert "_compiled_cache" in fresh.__dict__
+    for fields in ({"body": "tripod"}, {}):
+        with pytest.raises(GranrsError) as info:
+            _granrs.compiled_scene(fields, _CORE_FIELDS)
+        assert info.value.field == "body"
+
+
 BAD = [
     {"mass": -1.0},
     {"length": math.nan},

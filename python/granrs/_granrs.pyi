@@ -17,6 +17,9 @@ def compile(scene: dict[str, Any]) -> Compiled:
 def compile_fields(fields: dict[str, Any], names: tuple[str, ...]) -> Compiled:
     """Convert and validate a Scene once, from its ``__dict__`` and its body's field names."""
 
+def compiled_scene(fields: dict[str, Any], core_fields: dict[str, tuple[str, ...]]) -> Compiled:
+    """A Scene's compiled scene, cached in its ``__dict__`` (compiled on first use)."""
+
 class RunOutcome:
     """One run's outcome, kept in the core until asked for."""
 
@@ -31,6 +34,9 @@ class RunOutcome:
 
 def run(compiled: Compiled) -> RunOutcome:
     """Run a compiled scene."""
+
+def run_scene(fields: dict[str, Any], core_fields: dict[str, tuple[str, ...]]) -> RunOutcome:
+    """Run a Scene from its ``__dict__``: ``compiled_scene`` then ``run``."""
 
 def validate(scene: dict[str, Any]) -> None:
     """Validate a scene dict; raise the typed granrs error naming the first bad field."""

@@ -7,7 +7,7 @@ import warnings
 from . import _granrs
 from .errors import InvalidParameterError, StepSizeWarning
 from .result import Result
-from .scene import Scene
+from .scene import _CORE_FIELDS, Scene
 
 __all__ = ["RK4_STABILITY_LIMIT", "simulate"]
 
@@ -57,7 +57,8 @@ def simulate(scene: Scene) -> Result:
         raise InvalidParameterError(
             f"simulate() takes a granrs.Scene, got {type(scene).__name__}", field="scene"
         )
-    outcome = _granrs.run(scene._compiled())
+    # scene._compiled() and _granrs.run in one call of the core.
+    outcome = _granrs.run_scene(scene.__dict__, _CORE_FIELDS)
     result = Result(scene, outcome)
     if outcome.h_lambda > RK4_STABILITY_LIMIT or (
         outcome.unresolved

@@ -321,13 +321,9 @@ class Scene:
 
     def _compiled(self) -> Any:
         """The scene converted and validated by the core, once per scene (it is frozen)."""
-        fields = self.__dict__
-        compiled = fields.get("_compiled_cache")
-        if compiled is None:
-            compiled = _granrs.compile_fields(fields, _CORE_FIELDS[fields["body"]])
-            # What object.__setattr__ does for a frozen dataclass, without its call.
-            fields["_compiled_cache"] = compiled
-        return compiled
+        # The core keeps it in self.__dict__["_compiled_cache"] (what object.__setattr__
+        # does for a frozen dataclass).
+        return _granrs.compiled_scene(self.__dict__, _CORE_FIELDS)
 
     def validate(self) -> Scene:
         """Check every field in the Rust core; raise the typed error naming the first bad one."""

@@ -141,10 +141,11 @@ pub fn static_terms(
     }
     let rg = medium.g * medium.rho_g;
     let h = c.eta_h * rg * width * d * d;
+    // d * (1 / L_ref): the division waits for L_ref alone, not for the depth.
     let depth_factor = if c.lambda == 0.0 {
         1.0
     } else {
-        (d / l_ref).powf(c.lambda)
+        (d * (1.0 / l_ref)).powf(c.lambda)
     };
     (h, c.eta_v * depth_factor * rg * volume)
 }

@@ -690,6 +690,8 @@ pub fn solve<const N: usize>(
     let mut n: u64 = 0;
     let mut events_this_step = 0usize;
     let mut funcs: Vec<(Kind, usize)> = Vec::with_capacity(4 * MAX_CONTACTS);
+    // The modes `funcs` was listed for.
+    let mut funcs_modes: Option<Modes> = None;
 
     // The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E). Squared
     // norms: a square root only when a maximum is beaten.
@@ -790,20 +792,16 @@ pub fn solve<const N: usize>(
             });
         }
 
-        // Which switching functions crossed?
-        active(model, &modes, &mut funcs);
+        // Which switching functions crossed? (The list changes only with the modes.)
+        if funcs_modes != Some(modes) {
+            active(model, &modes, &mut funcs);
+            funcs_modes = Some(modes);
+        }
         let mut earliest = f64::INFINITY;
         let mut hits: Vec<(Kind, usize, f64)> = Vec::new();
         if events_this_step >= MAX_EVENTS_PER_STEP {
             stats.unresolved += 1;
         } else {
-            let dense = Hermite {
-                y0: y,
-                f0: k1,
-                y1,
-                f1: deriv_of(&y1, e1),
-                h,
-            };
             for &(kind, ci) in &funcs {
                 let g1 = switching(kind, ci, e1, &modes);
                 if !crossed(kind, g1) {
@@ -815,6 +813,13 @@ pub fn solve<const N: usize>(
                 } else if g0 == 0.0 {
                     0.0
                 } else {
+                    let dense = Hermite {
+                        y0: y,
+                        f0: k1,
+                        y1,
+                        f1: deriv_of(&y1, e1),
+                        h,
+                    };
                     let (theta, evals) = locate(
                         |th| {
                             let s = dense.at(th);

@@ -5,6 +5,7 @@
 //! [`GranrsError`] becomes an instance of the matching class of `granrs.errors`, so that the
 //! Python and Rust layers share one exception tree.
 
+use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -17,7 +18,7 @@ use crate::batch::{self, Source};
 use crate::error::GranrsError;
 use crate::integrate::Outcome;
 use crate::scene::AnyScene;
-use crate::spec::{SceneSpec, Value, EFFECTS, RECORDS, SCENE_FIELDS};
+use crate::spec::{word, SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -50,7 +51,7 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         return Value::Num(f.value());
     }
     if let Ok(s) = v.cast::<PyString>() {
-        return Value::Str(s.to_str().map(str::to_owned).unwrap_or_default());
+        return Value::Str(s.to_str().map(word).unwrap_or_default());
     }
     if v.is_none() {
         return Value::None;
@@ -70,7 +71,7 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
             d.iter()
                 .map(|(k, v)| {
                     (
-                        k.str().map(|s| s.to_string()).unwrap_or_default(),
+                        k.str().map(|s| word(&s.to_string())).unwrap_or_default(),
                         value_from_py(&v),
                     )
                 })
@@ -102,7 +103,7 @@ fn names_from_py<'py>(items: impl ExactSizeIterator<Item = Bound<'py, PyAny>>) -
     let mut names = Vec::with_capacity(items.len());
     for item in items {
         match item.cast::<PyString>().ok().and_then(|s| s.to_str().ok()) {
-            Some(s) => names.push(s.to_owned()),
+            Some(s) => names.push(word(s)),
             None => return Value::Other("a list that is not all strings".into()),
         }
     }
@@ -228,7 +229,7 @@ fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
         (pyo3::intern!(v.py(), "lam"), "lam"),
     ] {
         match v.getattr(key) {
-            Ok(x) => entries.push((name.to_owned(), value_from_py(&x))),
+            Ok(x) => entries.push((Cow::Borrowed(name), value_from_py(&x))),
             Err(_) => return value_from_py(v),
         }
     }
@@ -237,27 +238,62 @@ fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
 
 /// The spec of a `granrs.Scene` read straight from its attributes: `fields` is the
 /// instance's `__dict__`, `names` the fields its body uses (`scene._CORE_FIELDS`). The same
-/// values as the dict `Scene._plain()` builds, without building it.
+/// values as the dict `Scene._plain()` builds, without building it. Each names tuple's slots
+/// are found once per thread (the tuples are module constants; see `SLOTS`).
 fn spec_from_fields(fields: &Bound<'_, PyDict>, names: &Bound<'_, PyTuple>) -> SceneSpec {
-    let mut spec = SceneSpec::new();
-    for name in names.iter() {
-        let Ok(key) = name.cast::<PyString>() else {
-            continue;
+    SLOTS.with_borrow_mut(|cache| {
+        let i = match cache.iter().position(|(t, _)| t.as_ptr() == names.as_ptr()) {
+            Some(i) => i,
+            None => {
+                if cache.len() >= 8 {
+                    cache.clear();
+                }
+                let slots = names
+                    .iter()
+                    .map(|n| {
+                        let name = n.cast::<PyString>().ok()?;
+                        SceneSpec::slot_of(name.to_str().ok()?)
+                    })
+                    .collect();
+                cache.push((names.clone().unbind(), slots));
+                cache.len() - 1
+            }
         };
-        let Ok(key_str) = key.to_str() else {
-            continue;
-        };
-        let Ok(Some(v)) = fields.get_item(key) else {
-            continue;
-        };
-        let value = if key_str.starts_with("coefficients") {
-            coefficients_from_py(&v)
-        } else {
-            value_from_py(&v)
-        };
-        spec.set(key_str, value);
-    }
-    spec
+        let slots = &cache[i].1;
+        let mut spec = SceneSpec::new();
+        for (k, slot) in slots.iter().enumerate() {
+            let Ok(name) = names.get_borrowed_item(k) else {
+                continue;
+            };
+            let Ok(key) = name.cast::<PyString>() else {
+                continue;
+            };
+            let Ok(Some(v)) = fields.get_item(key) else {
+                continue;
+            };
+            match *slot {
+                Some(slot) if COEFFICIENTS_SLOTS.contains(&slot) => {
+                    spec.set_slot(slot, coefficients_from_py(&v))
+                }
+                Some(slot) => spec.set_slot(slot, value_from_py(&v)),
+                None => {
+                    if let Ok(key_str) = key.to_str() {
+                        spec.set(key_str, value_from_py(&v));
+                    }
+                }
+            }
+        }
+        spec
+    })
+}
+
+/// A names tuple (kept alive, so that its address names it) and the spec slot of each name.
+type NamesSlots = (Py<PyTuple>, Vec<Option<usize>>);
+
+thread_local! {
+    /// Names tuples seen (a Scene's field names per body are a module constant) and the
+    /// spec slot of each name, so that a scene's fields are read without matching names.
+    static SLOTS: std::cell::RefCell<Vec<NamesSlots>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// [`compile`] for a `granrs.Scene`, from its `__dict__` and its body's field names (see
@@ -272,6 +308,45 @@ fn compile_fields(
         .build()
         .map_err(|e| to_pyerr(py, e))?;
     Ok(Compiled { scene })
+}
+
+/// The compiled scene of a `granrs.Scene` from its `__dict__` (`fields`): the one cached
+/// there (`_compiled_cache`; the scene is frozen), or else compiled from the fields its body
+/// uses (`core_fields[body]`, see [`compile_fields`]) and cached. `Scene._compiled()`.
+#[pyfunction]
+fn compiled_scene<'py>(
+    py: Python<'py>,
+    fields: &Bound<'py, PyDict>,
+    core_fields: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let cache = pyo3::intern!(py, "_compiled_cache");
+    if let Some(compiled) = fields.get_item(cache)? {
+        return Ok(compiled);
+    }
+    let body = fields.get_item(pyo3::intern!(py, "body"))?;
+    let names = match &body {
+        Some(body) => core_fields.get_item(body)?,
+        None => None,
+    };
+    let Some(names) = names else {
+        // Not a body (a Scene refuses one already): the spec names the field.
+        let mut spec = SceneSpec::new();
+        if let Some(body) = &body {
+            spec.set("body", value_from_py(body));
+        }
+        return Err(to_pyerr(py, spec.body().err().unwrap_or_else(missing_body)));
+    };
+    let compiled = Bound::new(py, compile_fields(py, fields, names.cast::<PyTuple>()?)?)?;
+    fields.set_item(cache, &compiled)?;
+    Ok(compiled.into_any())
+}
+
+/// The error of a scene without a body.
+fn missing_body() -> GranrsError {
+    GranrsError::InvalidScene {
+        field: "body".into(),
+        message: "missing (a value is needed)".into(),
+    }
 }
 
 /// The outcome of one run, kept in Rust until Python asks for it: the headline numbers are
@@ -336,6 +411,18 @@ fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
         unresolved: out.stats.unresolved,
         out: Mutex::new(Some(out)),
     })
+}
+
+/// Run a `granrs.Scene` from its `__dict__`: [`compiled_scene`] then [`run`] in one call
+/// (the body of `granrs.simulate`).
+#[pyfunction]
+fn run_scene(
+    py: Python<'_>,
+    fields: &Bound<'_, PyDict>,
+    core_fields: &Bound<'_, PyDict>,
+) -> PyResult<RunOutcome> {
+    let compiled = compiled_scene(py, fields, core_fields)?;
+    run(py, compiled.cast::<Compiled>()?)
 }
 
 /// Validate a scene dict without running it (raises the typed error, or returns None).
@@ -546,7 +633,10 @@ fn resistance_force<'py>(
     check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
     check_range("g", g, 0.0, false).map_err(err)?;
     let mut spec = SceneSpec::new();
-    spec.set("effects", Value::Names(effects));
+    spec.set(
+        "effects",
+        Value::Names(effects.into_iter().map(Cow::Owned).collect()),
+    );
     let effects = spec.effects().map_err(err)?.0;
     let sign = match sign_model {
         "raw" => Sign::Raw,
@@ -630,6 +720,8 @@ fn resistance_force<'py>(
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(compile_fields, m)?)?;
+    m.add_function(wrap_pyfunction!(compiled_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_class::<Compiled>()?;
     m.add_class::<RunOutcome>()?;
