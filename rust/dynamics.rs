@@ -209,6 +209,51 @@ pub struct ContactEval {
     pub bound_v: f64,
 }
 
+/// How stiff one contact's drag is at one evaluation: |F_d|^2 and |v_E|^2 (their ratio is
+/// the square of |F_d| / |v_E|, the drag's velocity stiffness up to a factor 1..2), the
+/// contact and v_E.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DragStiffness {
+    /// |F_d|^2 [N^2].
+    pub drag2: f64,
+    /// |v_E|^2 [m^2/s^2].
+    pub speed2: f64,
+    /// The contact.
+    pub contact: usize,
+    /// v_E [m/s].
+    pub v: Vector2<f64>,
+}
+
+impl DragStiffness {
+    /// Contact `ci`'s, from its evaluation.
+    #[inline]
+    pub fn of(ci: usize, c: &ContactEval) -> Self {
+        DragStiffness {
+            drag2: c.force.drag.norm_squared(),
+            speed2: c.v_centroid.norm_squared(),
+            contact: ci,
+            v: c.v_centroid,
+        }
+    }
+
+    /// (|F_d| / |v_E|)^2, 0 at rest.
+    #[inline]
+    pub fn k2(&self) -> f64 {
+        if self.speed2 > 0.0 {
+            self.drag2 / self.speed2
+        } else {
+            0.0
+        }
+    }
+
+    /// Whether this is stiffer than `other` (no division: products of squares).
+    #[inline]
+    pub fn beats(&self, other: &DragStiffness) -> bool {
+        self.speed2 > 0.0 && self.drag2 * other.speed2 > other.drag2 * self.speed2
+            || (other.speed2 == 0.0 && self.speed2 > 0.0 && self.drag2 > 0.0)
+    }
+}
+
 /// The result of one right-hand-side evaluation.
 #[derive(Debug, Clone, Copy)]
 pub struct Eval<const N: usize> {
@@ -794,15 +839,33 @@ impl<const N: usize> Model<N> {
         qd: &SVector<f64, N>,
         modes: &Modes,
     ) -> (SVector<f64, N>, f64, f64) {
+        let (qdd, power, joint_power, _) = self.rates_sampled(q, qd, modes);
+        (qdd, power, joint_power)
+    }
+
+    /// [`Model::rates`] and the drag's stiffest contact at the stage.
+    #[inline]
+    pub fn rates_sampled(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> (SVector<f64, N>, f64, f64, DragStiffness) {
         match self.rigid_rod() {
             Some(rod) => {
                 let mut contact = ContactEval::default();
                 let (qdd, power, _) = self.eval_rigid_rod(rod, q, qd, modes, &mut contact);
-                (qdd, power, 0.0)
+                (qdd, power, 0.0, DragStiffness::of(0, &contact))
             }
             None => {
                 let e = self.eval_general(q, qd, modes);
-                (e.qdd, e.power, e.joint_power)
+                let stiff = (0..self.contacts.len())
+                    .map(|ci| DragStiffness::of(ci, &e.contacts[ci]))
+                    .fold(
+                        DragStiffness::default(),
+                        |a, b| if b.beats(&a) { b } else { a },
+                    );
+                (e.qdd, e.power, e.joint_power, stiff)
             }
         }
     }

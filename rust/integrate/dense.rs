@@ -52,9 +52,17 @@ impl<const N: usize> Hermite<N> {
 /// Find a root of `g` in [0, 1] given `g(0) = g0 >= 0` and `g(1) = g1 < 0` (a sign change),
 /// by the Illinois variant of regula falsi. Returns `(theta, evaluations)`; `theta` is the
 /// right end of the final bracket, so that `g(theta) <= 0` (the event has happened there).
-pub fn locate(mut g: impl FnMut(f64) -> f64, g0: f64, g1: f64, tol: f64) -> (f64, usize) {
-    let (mut a, mut b) = (0.0f64, 1.0f64);
-    let (mut fa, mut fb) = (g0, g1);
+pub fn locate(g: impl FnMut(f64) -> f64, g0: f64, g1: f64, tol: f64) -> (f64, usize) {
+    locate_in(g, (0.0, g0), (1.0, g1), tol)
+}
+
+/// [`locate`] on the bracket `[a, b]` with `g(a) = fa >= 0` and `g(b) = fb < 0`.
+pub fn locate_in(
+    mut g: impl FnMut(f64) -> f64,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    tol: f64,
+) -> (f64, usize) {
     let mut side = 0i8;
     let mut evals = 0usize;
     while b - a > tol && evals < 200 {

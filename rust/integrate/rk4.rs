@@ -6,7 +6,7 @@
 
 use nalgebra::SVector;
 
-use crate::dynamics::{Eval, Model, Modes};
+use crate::dynamics::{DragStiffness, Eval, Model, Modes};
 
 /// The integrated state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,8 +76,24 @@ pub fn step<const N: usize>(
     k1: &Deriv<N>,
     h: f64,
 ) -> State<N> {
-    let f = |s: &State<N>| {
-        let (qdd, power, joint_power) = model.rates(&s.q, &s.qd, modes);
+    step_sampling(model, modes, y, k1, h, |_, _| {})
+}
+
+/// [`step`], showing `sample` each stage's coordinates and the drag's stiffest contact
+/// there: a step that does not resolve the contact meets, at its stages, a stiffness its
+/// ends do not show.
+#[inline]
+pub fn step_sampling<const N: usize>(
+    model: &Model<N>,
+    modes: &Modes,
+    y: &State<N>,
+    k1: &Deriv<N>,
+    h: f64,
+    mut sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
+) -> State<N> {
+    let mut f = |s: &State<N>| {
+        let (qdd, power, joint_power, stiff) = model.rates_sampled(&s.q, &s.qd, modes);
+        sample(&s.q, &stiff);
         Deriv {
             q: s.qd,
             qd: qdd,

@@ -8,10 +8,10 @@
 
 use nalgebra::{SVector, Vector2};
 
-use super::dense::{locate, Hermite};
-use super::rk4::{deriv_of, dopri5_step, step, Deriv, State};
+use super::dense::{locate, locate_in, Hermite};
+use super::rk4::{deriv_of, dopri5_step, step, step_sampling, Deriv, State};
 use crate::dynamics::{
-    ContactMode, Effects, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS,
+    ContactMode, DragStiffness, Effects, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS,
 };
 use crate::error::{GranrsError, Result};
 
@@ -206,7 +206,8 @@ pub struct Outcome {
     pub joints: Vec<JointSummary>,
     /// Largest `dt * lambda` of the drag over the run: the step times the drag's fastest
     /// rate, `2 |F_d| / |v_E|` times E's inverse effective mass (see
-    /// [`Model::centroid_inverse_mass`]), at the step where the drag was stiffest. Above
+    /// [`Model::centroid_inverse_mass`]), at the state where the drag was stiffest (step
+    /// ends, events and RK4 stages: see [`crate::integrate::rk4::step_sampling`]). Above
     /// [`RK4_STABILITY_LIMIT`] the fixed step does not resolve the impact. NaN with the
     /// adaptive method, 0 without drag.
     pub h_lambda: f64,
@@ -227,6 +228,22 @@ fn drag_rate(w: &nalgebra::Matrix2<f64>, k: f64, dir: Vector2<f64>) -> f64 {
     let (tr, det) = (p.trace(), p.determinant());
     // Both factors are symmetric positive semi-definite: the eigenvalues are real, >= 0.
     0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
+}
+
+/// The drag's stiffest moment of a run so far, and the coordinates where it was.
+struct Stiffest<const N: usize> {
+    best: DragStiffness,
+    q: SVector<f64, N>,
+}
+
+impl<const N: usize> Stiffest<N> {
+    #[inline]
+    fn offer(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
+        if s.beats(&self.best) {
+            self.best = *s;
+            self.q = *q;
+        }
+    }
 }
 
 /// Relative tolerance of event location, in units of the step.
@@ -693,25 +710,30 @@ pub fn solve<const N: usize>(
     // The modes `funcs` was listed for.
     let mut funcs_modes: Option<Modes> = None;
 
-    // The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E). Squared
-    // norms: a square root only when a maximum is beaten.
-    let mut stiffest = (0.0f64, y.q, 0usize, Vector2::zeros());
-    let mut update_fd_max =
-        |summaries: &mut Vec<ContactSummary>, e: &Eval<N>, q: &SVector<f64, N>, modes: &Modes| {
-            for (ci, s) in summaries.iter_mut().enumerate() {
-                if !modes[ci].stopped {
-                    let c = &e.contacts[ci];
-                    let drag2 = c.force.drag.norm_squared();
-                    if drag2 > s.f_d_max * s.f_d_max {
-                        s.f_d_max = drag2.sqrt();
-                    }
-                    let speed2 = c.v_centroid.norm_squared();
-                    if speed2 > 0.0 && drag2 > stiffest.0 * speed2 {
-                        stiffest = (drag2 / speed2, *q, ci, c.v_centroid);
-                    }
+    // The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E), over the
+    // step ends, the events and the RK4 stages (within a step that does not resolve the
+    // contact, the stages meet a stiffness the ends do not). Squared norms: a square root
+    // only when a maximum is beaten.
+    let mut stiffest = Stiffest {
+        best: DragStiffness::default(),
+        q: y.q,
+    };
+    let update_fd_max = |summaries: &mut Vec<ContactSummary>,
+                         stiffest: &mut Stiffest<N>,
+                         e: &Eval<N>,
+                         q: &SVector<f64, N>,
+                         modes: &Modes| {
+        for (ci, s) in summaries.iter_mut().enumerate() {
+            if !modes[ci].stopped {
+                let c = &e.contacts[ci];
+                let drag2 = c.force.drag.norm_squared();
+                if drag2 > s.f_d_max * s.f_d_max {
+                    s.f_d_max = drag2.sqrt();
                 }
+                stiffest.offer(q, &DragStiffness::of(ci, c));
             }
-        };
+        }
+    };
 
     let mut h_adapt = dt;
     let adaptive = matches!(options.method, Method::Dopri5 { .. });
@@ -755,7 +777,7 @@ pub fn solve<const N: usize>(
         let k1: Deriv<N> = deriv_of(&y, e0);
         let y1 = match options.method {
             Method::Rk4 => {
-                let y1 = step(model, &modes, &y, &k1, h);
+                let y1 = step_sampling(model, &modes, &y, &k1, h, |q, s| stiffest.offer(q, s));
                 model.eval_into(&y1.q, &y1.qd, &modes, e1_slot);
                 stats.rhs_evals += 4;
                 y1
@@ -855,12 +877,43 @@ pub fn solve<const N: usize>(
             n += 1;
             events_this_step = 0;
             stats.steps += 1;
-            update_fd_max(&mut summaries, e0, &y.q, &modes);
+            update_fd_max(&mut summaries, &mut stiffest, e0, &y.q, &modes);
             update_joints(&mut joints, &y, e0, &modes);
             if n.is_multiple_of(stride as u64) {
                 recorder.push(model, t, &y, e0, &modes);
             }
             continue;
+        }
+
+        // The interpolant's root is the step map's only to the interpolant's error, which is
+        // large where the step straddles a kink that no mode holds (the cap l <= L, a sole
+        // corner's entry). Polish each event on the map itself, h' -> g(step(y, h')), which
+        // is what the run will follow; its bracket [0, 1] is the step's own ends. Every hit
+        // is polished, so that mirror-image events stay simultaneous.
+        if options.method == Method::Rk4 && earliest > 0.0 && earliest < 1.0 {
+            for hit in hits.iter_mut() {
+                let (kind, ci, guess) = *hit;
+                if guess <= 0.0 || guess >= 1.0 {
+                    continue;
+                }
+                let g0 = switching(kind, ci, e0, &modes).max(0.0);
+                let g1 = switching(kind, ci, e1, &modes);
+                let mut map = |th: f64| {
+                    let s = step(model, &modes, &y, &k1, th * h);
+                    let e = model.eval(&s.q, &s.qd, &modes);
+                    switching(kind, ci, &e, &modes)
+                };
+                let at = map(guess);
+                let (theta, evals) = if at < 0.0 {
+                    locate_in(&mut map, (0.0, g0), (guess, at), ROOT_TOL)
+                } else {
+                    locate_in(&mut map, (guess, at), (1.0, g1), ROOT_TOL)
+                };
+                stats.root_evals += evals + 1;
+                stats.rhs_evals += 4 * (evals + 1);
+                hit.2 = theta;
+            }
+            earliest = hits.iter().fold(f64::INFINITY, |m, hit| m.min(hit.2));
         }
 
         // Step to the earliest event, exactly: a real RK4 step of the located length.
@@ -871,7 +924,7 @@ pub fn solve<const N: usize>(
             match options.method {
                 Method::Rk4 => {
                     stats.rhs_evals += 3;
-                    step(model, &modes, &y, &k1, h_star)
+                    step_sampling(model, &modes, &y, &k1, h_star, |q, s| stiffest.offer(q, s))
                 }
                 Method::Dopri5 { rtol, atol } => {
                     stats.rhs_evals += 6;
@@ -886,7 +939,13 @@ pub fn solve<const N: usize>(
         stats.rhs_evals += 1;
         if h_star > 0.0 {
             stats.steps += 1;
-            update_fd_max(&mut summaries, &e_star_old, &y_star.q, &modes);
+            update_fd_max(
+                &mut summaries,
+                &mut stiffest,
+                &e_star_old,
+                &y_star.q,
+                &modes,
+            );
             update_joints(&mut joints, &y_star, &e_star_old, &modes);
         }
         // An event at the very start of the step is judged at the step's end.
@@ -997,8 +1056,13 @@ pub fn solve<const N: usize>(
     }
     let h_lambda = if adaptive {
         f64::NAN
-    } else if stiffest.0 > 0.0 {
-        let (k2, q, ci, v) = stiffest;
+    } else if stiffest.best.k2() > 0.0 {
+        let (k2, q, ci, v) = (
+            stiffest.best.k2(),
+            stiffest.q,
+            stiffest.best.contact,
+            stiffest.best.v,
+        );
         dt * drag_rate(
             &model.centroid_inverse_mass(&q, ci),
             k2.sqrt(),
