@@ -885,15 +885,18 @@ pub fn solve<const N: usize>(
             continue;
         }
 
-        // The interpolant's root is the step map's only to the interpolant's error, which is
-        // large where the step straddles a kink that no mode holds (the cap l <= L, a sole
-        // corner's entry). Polish each event on the map itself, h' -> g(step(y, h')), which
-        // is what the run will follow; its bracket [0, 1] is the step's own ends. Every hit
-        // is polished, so that mirror-image events stay simultaneous.
+        // The interpolant's root is the step map's only to the interpolant's error: O(h^4)
+        // where the held modes keep the right-hand side smooth through the step, but first
+        // order where the step straddles a kink no mode holds: the cap of the immersed
+        // length (l <= L, a sole box under the surface) and the exit, where the static
+        // term's d^lambda has an unbounded derivative. Polish those events on the map
+        // itself, h' -> g(step(y, h')), which is what the run will follow; its bracket [0, 1]
+        // is the step's own ends. Every such hit is polished, so that mirror-image events
+        // stay simultaneous.
         if options.method == Method::Rk4 && earliest > 0.0 && earliest < 1.0 {
             for hit in hits.iter_mut() {
                 let (kind, ci, guess) = *hit;
-                if guess <= 0.0 || guess >= 1.0 {
+                if !matches!(kind, Kind::Immersion | Kind::Exit) || guess <= 0.0 || guess >= 1.0 {
                     continue;
                 }
                 let g0 = switching(kind, ci, e0, &modes).max(0.0);
