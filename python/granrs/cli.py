@@ -377,30 +377,14 @@ def _contact_names(result: Any) -> list[str]:
     return [names[i] if i < len(names) else f"c{i}" for i in range(len(result.contacts))]
 
 
-#: The run-level entries of ``Result.summary`` (the rest are contact 0's).
-_RUN_KEYS: tuple[str, ...] = (
-    "status",
-    "t_final",
-    "energy_start",
-    "energy_end",
-    "dissipated",
-    "steps",
-    "rhs_evals",
-    "root_evals",
-    "events",
-    "rejected",
-    "unresolved",
-    "h_lambda",
-)
-
-
 def summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
     """The run's summary as plain data (what ``granrs run --json`` prints): the scene file,
     body, status, the run's statistics, each contact's results by name, each joint's
     largest force and torque, and the units. NaN (e.g. ``t_s`` without a stop) is None."""
     from .result import SUMMARY_UNITS
 
-    run = {key: result.summary[key] for key in _RUN_KEYS if key in result.summary}
+    # The core's run-level entries of Result.summary (the rest are contact 0's).
+    run = dict(result._raw_dict()["run"])
     contacts = {
         name: {"stopped": c.stopped, **c.summary}
         for name, c in zip(_contact_names(result), result.contacts, strict=True)

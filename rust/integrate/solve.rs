@@ -820,7 +820,8 @@ pub fn solve<const N: usize>(
             funcs_modes = Some(modes);
         }
         let mut earliest = f64::INFINITY;
-        let mut hits: Vec<(Kind, usize, f64)> = Vec::new();
+        // (kind, contact, theta, g at the step's start, g at its end)
+        let mut hits: Vec<(Kind, usize, f64, f64, f64)> = Vec::new();
         if events_this_step >= MAX_EVENTS_PER_STEP {
             stats.unresolved += 1;
         } else {
@@ -857,7 +858,7 @@ pub fn solve<const N: usize>(
                     theta
                 };
                 earliest = earliest.min(theta);
-                hits.push((kind, ci, theta));
+                hits.push((kind, ci, theta, g0, g1));
             }
         }
 
@@ -895,12 +896,10 @@ pub fn solve<const N: usize>(
         // stay simultaneous.
         if options.method == Method::Rk4 && earliest > 0.0 && earliest < 1.0 {
             for hit in hits.iter_mut() {
-                let (kind, ci, guess) = *hit;
+                let (kind, ci, guess, g0, g1) = *hit;
                 if !matches!(kind, Kind::Immersion | Kind::Exit) || guess <= 0.0 || guess >= 1.0 {
                     continue;
                 }
-                let g0 = switching(kind, ci, e0, &modes).max(0.0);
-                let g1 = switching(kind, ci, e1, &modes);
                 let mut map = |th: f64| {
                     let s = step(model, &modes, &y, &k1, th * h);
                     let e = model.eval(&s.q, &s.qd, &modes);
@@ -958,7 +957,7 @@ pub fn solve<const N: usize>(
             y_star
         };
         let mut terminal = false;
-        for &(kind, ci, theta) in &hits {
+        for &(kind, ci, theta, _, _) in &hits {
             if theta > earliest + SIMULTANEOUS {
                 continue;
             }
