@@ -36,7 +36,7 @@ use nalgebra::SVector;
 
 use _granrs::body::Joint;
 use _granrs::dynamics::{ContactMode, Model, Modes, Slip, MAX_CONTACTS};
-use _granrs::force::Coefficients;
+use _granrs::forces::Coefficients;
 use _granrs::integrate::rk4::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Outcome, Record, SolveOptions, Status};
 use _granrs::scene::{ChainScene, FreeLinkScene, LegScene};
@@ -84,7 +84,7 @@ fn free_link_q45() -> FreeLinkScene {
     FreeLinkScene {
         q_deg: 45.0,
         v0: 2.27,
-        coefficients: TABLE_3_4_Q45,
+        forces: _granrs::forces::ForceSet::thesis(&[TABLE_3_4_Q45]),
         ..Default::default()
     }
 }
@@ -95,7 +95,7 @@ fn chain_case1() -> ChainScene {
     let mut s = ChainScene {
         q_deg: [-16.72, 13.48],
         v0: 2.575,
-        coefficients: [
+        forces: _granrs::forces::ForceSet::thesis(&[
             Coefficients {
                 eta_h: 8.0,
                 eta_d: 13.0,
@@ -108,7 +108,7 @@ fn chain_case1() -> ChainScene {
                 eta_v: 137.0,
                 lambda: 0.205,
             },
-        ],
+        ]),
         ..Default::default()
     };
     s.options.end = EndCondition::AllStops;

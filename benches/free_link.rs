@@ -21,9 +21,9 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::{SVector, Vector2};
 
+use _granrs::dynamics::terms_on;
 use _granrs::dynamics::{ContactMode, Modes, SignModel, Slip, MAX_CONTACTS};
-use _granrs::force::resistance::rod_force;
-use _granrs::force::{Coefficients, Medium, RodContactState};
+use _granrs::forces::{Coefficients, ContactState, ForceSet, Medium};
 use _granrs::integrate::rk4::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Record, SolveOptions, Status};
 use _granrs::scene::FreeLinkScene;
@@ -41,7 +41,7 @@ fn scene_q45() -> FreeLinkScene {
     FreeLinkScene {
         q_deg: 45.0,
         v0: 2.27,
-        coefficients: TABLE_3_4_Q45,
+        forces: _granrs::forces::ForceSet::thesis(&[TABLE_3_4_Q45]),
         ..Default::default()
     }
 }
@@ -130,7 +130,7 @@ fn table_3_5_scenes() -> Vec<FreeLinkScene> {
             FreeLinkScene {
                 q_deg,
                 v0: number(r, v0),
-                coefficients: nearest_row(&coefficients, q_deg),
+                forces: _granrs::forces::ForceSet::thesis(&[nearest_row(&coefficients, q_deg)]),
                 ..Default::default()
             }
         })
@@ -190,30 +190,41 @@ fn mid_impact(scene: &FreeLinkScene) -> (SVector<f64, 3>, SVector<f64, 3>, Modes
     (q, qd, modes)
 }
 
+/// The cost of one evaluation of each force term, and of the thesis's set as a whole (the
+/// per-term table of issue 16), on a mid-impact contact of the q = 45 row: 2 cm deep,
+/// moving down and sideways.
 fn force(c: &mut Criterion) {
     let mut g = c.benchmark_group("force");
-    // A mid-impact contact of the q = 45 row: 2 cm deep, moving down and sideways.
     let q = 45f64.to_radians();
     let depth = 0.02;
-    let state = RodContactState {
+    let d_c = 0.0127;
+    let l = depth / q.cos();
+    let v = Vector2::new(0.4, -1.3);
+    let axis = Vector2::new(q.sin(), q.cos());
+    let state = ContactState {
         depth,
-        immersed_length: depth / q.cos(),
-        axis: Vector2::new(q.sin(), q.cos()),
-        v_centroid: Vector2::new(0.4, -1.3),
+        volume: std::f64::consts::FRAC_PI_4 * d_c * d_c * l,
+        width: d_c,
+        l_ref: 0.190,
+        v: [v.x, v.y],
+        area_speed: d_c * l * (axis.x * v.y - axis.y * v.x).abs(),
+        sign: [1.0, -1.0],
     };
     let medium = Medium::default();
-    let d_c = 0.0127;
-    g.bench_function("rod_force", |b| {
+    let set = ForceSet::thesis(&[TABLE_3_4_Q45]);
+    for (k, info) in set.contact_info.iter().enumerate() {
+        let term = set.per_contact[0][k];
+        g.bench_function(format!("term/{}", info.name), |b| {
+            b.iter(|| black_box(&term).contact_force(black_box(&state), black_box(&medium)))
+        });
+    }
+    g.bench_function("thesis_set", |b| {
         b.iter(|| {
-            rod_force(
-                black_box(&TABLE_3_4_Q45),
-                black_box(&medium),
-                black_box(d_c),
-                black_box(d_c),
-                black_box(0.190),
+            terms_on(
+                black_box(&set),
+                black_box(&set.per_contact[0]),
                 black_box(&state),
-                black_box(1.0),
-                black_box(-1.0),
+                black_box(&medium),
             )
         })
     });
@@ -270,7 +281,7 @@ fn vertical_scene() -> FreeLinkScene {
     FreeLinkScene {
         q_deg: 0.0,
         v0: 2.214,
-        coefficients: Coefficients::TABLE_3_4_VERTICAL,
+        forces: _granrs::forces::ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]),
         ..Default::default()
     }
 }
@@ -280,7 +291,7 @@ fn impact(c: &mut Criterion) {
     let vertical = FreeLinkScene {
         q_deg: 0.0,
         v0: 2.214,
-        coefficients: Coefficients::TABLE_3_4_VERTICAL,
+        forces: _granrs::forces::ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]),
         ..Default::default()
     };
     // Table 3.5 as shipped has 31 rows (11 angles x 3 speeds, two rows missing in the source).

@@ -18,8 +18,8 @@ use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
 use crate::body::mechanism::Pose;
 use crate::body::rod::ApplyAt;
 use crate::body::{Mechanism, RodContact, RodGeometry, SoleContact, SoleModel};
-use crate::force::resistance::{raw_sign, static_terms};
-use crate::force::{Coefficients, ForceComponents, Medium};
+use crate::forces::registry::MAX_TERMS;
+use crate::forces::{AnyTerm, ContactState, ForceSet, Medium, Switch};
 
 /// Largest sticking-velocity violation [m/s] that the projection treats as drift.
 pub const PROJECTION_LIMIT: f64 = 1e-6;
@@ -104,30 +104,6 @@ impl Default for ContactMode {
 /// The modes of every contact.
 pub type Modes = [ContactMode; MAX_CONTACTS];
 
-/// Which force terms a scene evaluates. A term that is off is neither computed nor stored.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Effects {
-    /// Gravity on the body.
-    pub gravity: bool,
-    /// Dynamic drag F_d.
-    pub drag: bool,
-    /// Static horizontal term F_sh.
-    pub static_h: bool,
-    /// Static vertical term F_sv.
-    pub static_v: bool,
-}
-
-impl Default for Effects {
-    fn default() -> Self {
-        Effects {
-            gravity: true,
-            drag: true,
-            static_h: true,
-            static_v: true,
-        }
-    }
-}
-
 /// The shape of a contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Shape {
@@ -137,13 +113,12 @@ pub enum Shape {
     Sole(SoleContact),
 }
 
-/// One contact of a body with its coefficients.
+/// One contact of a body: which link, where, what shape. The force terms and their
+/// parameters per contact are the model's [`ForceSet`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
     /// Geometry: which link, where, what shape.
     pub shape: Shape,
-    /// Coefficients of the force law for this contact.
-    pub coefficients: Coefficients,
 }
 
 impl Contact {
@@ -180,8 +155,117 @@ pub struct Model<const N: usize> {
     pub apply_at: ApplyAt,
     /// Sign model of the static terms.
     pub sign_model: SignModel,
-    /// Which force terms are on.
-    pub effects: Effects,
+    /// The force terms that act, with their parameters per contact.
+    pub forces: ForceSet,
+}
+
+/// The forces on one contact: each listed contact term's (in the scene's order), and their
+/// sums by the thesis's classes (F_d dynamic, F_s static) [N].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactForce {
+    /// Each contact term's force, in the order of `ForceSet::contact_info` [N]; a sticking
+    /// reaction stands in place of the static terms that own the stuck component.
+    pub terms: [Vector2<f64>; MAX_TERMS],
+    /// Sum of the dynamic terms, F_d [N].
+    pub dynamic: Vector2<f64>,
+    /// Sum of the static terms (or their reactions), F_s [N].
+    pub statics: Vector2<f64>,
+}
+
+impl ContactForce {
+    /// Total resistance force F_R = F_d + F_s [N].
+    #[inline]
+    pub fn total(&self) -> Vector2<f64> {
+        self.dynamic + self.statics
+    }
+    /// |F_d| (thesis eq. 3.23) [N].
+    #[inline]
+    pub fn drag_magnitude(&self) -> f64 {
+        self.dynamic.norm()
+    }
+    /// |F_s| (thesis eq. 3.22) [N].
+    #[inline]
+    pub fn static_magnitude(&self) -> f64 {
+        self.statics.x.hypot(self.statics.y)
+    }
+    /// |F_r| (thesis eq. 3.24) [N].
+    #[inline]
+    pub fn total_magnitude(&self) -> f64 {
+        self.total().norm()
+    }
+
+    /// Put a sticking reaction `reaction` along `axis` in place of the static terms that own
+    /// that component's slip switch, and sum again.
+    fn set_reaction(&mut self, forces: &ForceSet, axis: usize, reaction: f64) {
+        let switch = if axis == 0 {
+            Switch::SlipX
+        } else {
+            Switch::SlipY
+        };
+        let owners = || {
+            forces
+                .contact_info
+                .iter()
+                .enumerate()
+                .filter(move |(_, i)| i.switches.contains(&switch))
+                .map(|(k, _)| k)
+        };
+        let n = owners().count();
+        let held: f64 = owners().map(|k| self.terms[k][axis].abs()).sum();
+        for k in owners() {
+            self.terms[k][axis] = if n == 1 || held == 0.0 {
+                reaction / n as f64
+            } else {
+                reaction * (self.terms[k][axis].abs() / held)
+            };
+        }
+        self.statics = Vector2::zeros();
+        for k in 0..forces.contact_info.len() {
+            if !forces.is_dynamic(k) {
+                self.statics += self.terms[k];
+            }
+        }
+    }
+}
+
+/// The contact terms `terms` (a contact's instances of `forces`' contact terms, in their
+/// order) on one contact's `state`: each term's force, their sums by class, and the bounds
+/// of a sticking reaction along x and y. The one evaluation of the force law, for a run of
+/// any body and for `granrs.resistance_force`.
+#[inline(always)]
+pub fn terms_on(
+    forces: &ForceSet,
+    terms: &[AnyTerm],
+    state: &ContactState<f64>,
+    medium: &Medium,
+) -> (ContactForce, [f64; 2]) {
+    let mut f = ContactForce::default();
+    let mut bound = [0.0; 2];
+    for (k, t) in terms.iter().enumerate() {
+        let tf = t.contact_force(state, medium);
+        let v = Vector2::new(tf.force[0], tf.force[1]);
+        f.terms[k] = v;
+        if forces.is_dynamic(k) {
+            f.dynamic += v;
+        } else {
+            f.statics += v;
+        }
+        bound[0] += tf.bound[0];
+        bound[1] += tf.bound[1];
+    }
+    (f, bound)
+}
+
+/// The thesis's plain sign: -1, 0 or +1.
+#[inline]
+pub fn raw_sign(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
 }
 
 /// What one evaluation finds at one contact.
@@ -197,16 +281,15 @@ pub struct ContactEval {
     pub lowest: f64,
     /// Velocity of the material point at the immersed centroid E [m/s].
     pub v_centroid: Vector2<f64>,
-    /// Force components (with any sticking reaction in place of its static term) [N].
-    pub force: ForceComponents,
+    /// Forces (with any sticking reaction in place of its static terms) [N].
+    pub force: ContactForce,
     /// e x v_E, the signed sine of a rod's drag reference area times |v_E| [m/s].
     pub cross: f64,
     /// Margin to full immersion [m] (negative when wholly immersed).
     pub immersion_margin: f64,
-    /// Magnitudes of the static terms (the bounds of a sticking reaction) [N].
-    pub bound_h: f64,
-    /// See `bound_h`.
-    pub bound_v: f64,
+    /// Magnitudes of the set-valued terms along x and y (the bounds of a sticking
+    /// reaction) [N].
+    pub bound: [f64; 2],
 }
 
 /// How stiff one contact's drag is at one evaluation: |F_d|^2 and |v_E|^2 (their ratio is
@@ -229,7 +312,7 @@ impl DragStiffness {
     #[inline]
     pub fn of(ci: usize, c: &ContactEval) -> Self {
         DragStiffness {
-            drag2: c.force.drag.norm_squared(),
+            drag2: c.force.dynamic.norm_squared(),
             speed2: c.v_centroid.norm_squared(),
             contact: ci,
             v: c.v_centroid,
@@ -457,6 +540,7 @@ fn apply_rows<const N: usize, const R: usize>(
     qdd: &mut SVector<f64, N>,
     contacts: &mut [ContactEval],
     joint_torque: &mut [f64; N],
+    forces: &ForceSet,
 ) {
     let k = rows.len;
     if k == 0 {
@@ -478,12 +562,7 @@ fn apply_rows<const N: usize, const R: usize>(
         *qdd += mult * r.response;
         match r.kind {
             RowKind::Stick { contact, axis } => {
-                let ce = &mut contacts[contact];
-                if axis == 0 {
-                    ce.force.static_h = mult;
-                } else {
-                    ce.force.static_v = mult;
-                }
+                contacts[contact].force.set_reaction(forces, axis, mult);
             }
             RowKind::Lock { link } => joint_torque[link] = mult,
         }
@@ -764,6 +843,51 @@ impl<const N: usize> Model<N> {
         })
     }
 
+    /// The acceleration of gravity on the body [m/s^2]: the medium's g while the `gravity`
+    /// term acts, else zero (the body then has no potential energy from gravity either).
+    #[inline(always)]
+    pub fn gravity(&self) -> f64 {
+        if self.forces.gravity {
+            self.medium.g
+        } else {
+            0.0
+        }
+    }
+
+    /// The signs of v_Ex and v_Ey that the static terms take in `mode`, by the sign model.
+    #[inline(always)]
+    fn signs(&self, mode: &ContactMode, v_e: Vector2<f64>) -> [f64; 2] {
+        match self.sign_model {
+            SignModel::Modes => [mode.sx.sign(), mode.sy.sign()],
+            SignModel::Raw => [raw_sign(v_e.x), raw_sign(v_e.y)],
+            SignModel::Smooth { eps } => [(v_e.x / eps).tanh(), (v_e.y / eps).tanh()],
+        }
+    }
+
+    /// |e x v_E| as the drag reads it: with its sign held in `Modes` (the kink at zero is a
+    /// located event), plainly otherwise.
+    #[inline(always)]
+    fn held_cross(&self, mode: &ContactMode, cross_signed: f64) -> f64 {
+        match self.sign_model {
+            SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
+            SignModel::Modes => cross_signed,
+            _ => cross_signed.abs(),
+        }
+    }
+
+    /// Evaluate the listed contact terms of contact `ci` on `state` into `out`: each term's
+    /// force, their sums by class, and the bounds of a sticking reaction. The one place the
+    /// force law is evaluated, for every body and for `granrs.resistance_force`.
+    #[inline(always)]
+    pub fn apply_terms(&self, ci: usize, state: &ContactState<f64>, out: &mut ContactEval) {
+        (out.force, out.bound) = terms_on(
+            &self.forces,
+            &self.forces.per_contact[ci],
+            state,
+            &self.medium,
+        );
+    }
+
     /// Whether any sticking component is in force under `modes`.
     #[inline]
     fn any_stuck(&self, modes: &Modes) -> bool {
@@ -775,8 +899,8 @@ impl<const N: usize> Model<N> {
     #[inline]
     fn stuck(&self, m: &ContactMode) -> bool {
         m.in_contact
-            && ((self.effects.static_h && m.sx == Slip::Stick)
-                || (self.effects.static_v && m.sy == Slip::Stick))
+            && ((self.forces.owns(Switch::SlipX) && m.sx == Slip::Stick)
+                || (self.forces.owns(Switch::SlipY) && m.sy == Slip::Stick))
     }
 
     /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
@@ -916,11 +1040,7 @@ impl<const N: usize> Model<N> {
     ) -> (SVector<f64, N>, f64, [f64; N]) {
         let link = &self.mechanism.links[0];
         let mass = link.mass + self.mechanism.root_mass;
-        let g = if self.effects.gravity {
-            self.medium.g
-        } else {
-            0.0
-        };
+        let g = self.gravity();
         let fr = RodFrame::new(q, qd);
         let mut gen = SVector::<f64, N>::zeros();
         gen[1] = -mass * g;
@@ -944,41 +1064,22 @@ impl<const N: usize> Model<N> {
         }
         if forced {
             let v_e = out.v_centroid;
-            let (sx, sy) = match self.sign_model {
-                SignModel::Modes => (mode.sx.sign(), mode.sy.sign()),
-                SignModel::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
-                SignModel::Smooth { eps } => ((v_e.x / eps).tanh(), (v_e.y / eps).tanh()),
+            let area_speed = if self.forces.reads_area_speed {
+                rod.diameter * geom.immersed_length * self.held_cross(mode, out.cross)
+            } else {
+                0.0
             };
-            let coef = &self.contacts[0].coefficients;
-            let (bh, bv) = static_terms(
-                coef,
-                &self.medium,
-                rod.diameter,
-                rod.length,
-                geom.depth,
-                rod.immersed_volume(&geom),
-            );
-            let mut f = ForceComponents::default();
-            let cross_signed = out.cross;
-            if self.effects.drag {
-                let cross = match self.sign_model {
-                    SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
-                    SignModel::Modes => cross_signed,
-                    _ => cross_signed.abs(),
-                };
-                let area_speed = rod.diameter * geom.immersed_length * cross;
-                f.drag = -(coef.eta_d * self.medium.rho_g * area_speed) * v_e;
-            }
-            if self.effects.static_h {
-                out.bound_h = bh;
-                f.static_h = -sx * bh;
-            }
-            if self.effects.static_v {
-                out.bound_v = bv;
-                f.static_v = -sy * bv;
-            }
-            out.force = f;
-            let total = f.total();
+            let state = ContactState {
+                depth: geom.depth,
+                volume: rod.immersed_volume(&geom),
+                width: rod.diameter,
+                l_ref: rod.length,
+                v: [v_e.x, v_e.y],
+                area_speed,
+                sign: self.signs(mode, v_e),
+            };
+            self.apply_terms(0, &state, out);
+            let total = out.force.total();
             gen[0] += total.x;
             gen[1] += total.y;
             gen[2] += total.dot(&fr.lever(self.application_point(&self.contacts[0], centroid)));
@@ -1024,8 +1125,8 @@ impl<const N: usize> Model<N> {
             lever_e: [0.0; 2],
             lever_p: [0.0; 2],
         };
-        let stuck_x = self.effects.static_h && mode.sx == Slip::Stick;
-        let stuck_y = self.effects.static_v && mode.sy == Slip::Stick;
+        let stuck_x = self.forces.owns(Switch::SlipX) && mode.sx == Slip::Stick;
+        let stuck_y = self.forces.owns(Switch::SlipY) && mode.sy == Slip::Stick;
         for (k, on) in [(0usize, stuck_x), (1usize, stuck_y)] {
             if on {
                 let i = stick.len;
@@ -1072,11 +1173,7 @@ impl<const N: usize> Model<N> {
                 let mult = -(a_bias[axis] + stick.velocity(0, qdd)) * inv_a;
                 qdd[axis] += mult * inv_m;
                 qdd[2] += mult * (lever_p * inv_i);
-                if axis == 0 {
-                    out.force.static_h = mult;
-                } else {
-                    out.force.static_v = mult;
-                }
+                out.force.set_reaction(&self.forces, axis, mult);
                 return;
             }
         }
@@ -1098,11 +1195,7 @@ impl<const N: usize> Model<N> {
             let axis = stick.axes[i];
             qdd[axis] += mult * inv_m;
             qdd[2] += mult * (stick.lever_p[i] * inv_i);
-            if axis == 0 {
-                out.force.static_h = mult;
-            } else {
-                out.force.static_v = mult;
-            }
+            out.force.set_reaction(&self.forces, axis, mult);
         }
     }
 
@@ -1160,16 +1253,15 @@ impl<const N: usize> Model<N> {
         modes: &Modes,
     ) -> Eval<N> {
         let pose = self.mechanism.pose(q);
-        let g = if self.effects.gravity {
-            self.medium.g
+        let g = self.gravity();
+        let mut rhs = self.mechanism.bias_forces(&pose, qd, g);
+        let mut joint_torque = [0.0; N];
+        let joint_power = if self.forces.joint_springs {
+            self.mechanism
+                .add_joint_torques(q, qd, &mut rhs, &mut joint_torque)
         } else {
             0.0
         };
-        let mut rhs = self.mechanism.bias_forces(&pose, qd, g);
-        let mut joint_torque = [0.0; N];
-        let joint_power = self
-            .mechanism
-            .add_joint_torques(q, qd, &mut rhs, &mut joint_torque);
         let mut contacts = [ContactEval::default(); MAX_CONTACTS];
         for (ci, c) in self.contacts.iter().enumerate() {
             let link = c.link();
@@ -1209,52 +1301,26 @@ impl<const N: usize> Model<N> {
             if geom.depth <= 0.0 {
                 continue;
             }
-            let (sx, sy) = match self.sign_model {
-                SignModel::Modes => (mode.sx.sign(), mode.sy.sign()),
-                SignModel::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
-                SignModel::Smooth { eps } => ((v_e.x / eps).tanh(), (v_e.y / eps).tanh()),
+            // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held (the
+            // kink at 0 is a located event).
+            let area_speed = match (&geom.sole, &c.shape) {
+                _ if !self.forces.reads_area_speed => 0.0,
+                (Some(sg), Shape::Sole(sole)) => sole.drag_area_speed(sg, v_e),
+                _ => geom.factor * self.held_cross(mode, cross_signed),
             };
-            let coef = &c.coefficients;
-            let (bh, bv) = static_terms(
-                coef,
-                &self.medium,
-                geom.width,
-                geom.l_ref,
-                geom.depth,
-                geom.volume,
-            );
-            let mut f = ForceComponents::default();
-            if self.effects.drag {
-                // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held
-                // (the kink at 0 is a located event).
-                let area_speed = match &geom.sole {
-                    Some(sg) => match &c.shape {
-                        Shape::Sole(sole) => sole.drag_area_speed(sg, v_e),
-                        Shape::Rod(_) => unreachable!("a rod has no polygon"),
-                    },
-                    None => {
-                        let cross = match self.sign_model {
-                            SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
-                            SignModel::Modes => cross_signed,
-                            _ => cross_signed.abs(),
-                        };
-                        geom.factor * cross
-                    }
-                };
-                f.drag = -(coef.eta_d * self.medium.rho_g * area_speed) * v_e;
-            }
-            if self.effects.static_h {
-                out.bound_h = bh;
-                f.static_h = -sx * bh;
-            }
-            if self.effects.static_v {
-                out.bound_v = bv;
-                f.static_v = -sy * bv;
-            }
-            out.force = f;
+            let state = ContactState {
+                depth: geom.depth,
+                volume: geom.volume,
+                width: geom.width,
+                l_ref: geom.l_ref,
+                v: [v_e.x, v_e.y],
+                area_speed,
+                sign: self.signs(mode, v_e),
+            };
+            self.apply_terms(ci, &state, out);
             let p = self.application_point(c, geom.centroid);
             self.mechanism
-                .add_point_force(&pose, link, p, f.total(), &mut rhs);
+                .add_point_force(&pose, link, p, out.force.total(), &mut rhs);
         }
         let mass = self.mechanism.mass_matrix(&pose);
         // Positive masses give a positive definite M for any finite state; a state that has
@@ -1333,8 +1399,8 @@ impl<const N: usize> Model<N> {
             if !mode.in_contact {
                 continue;
             }
-            let stuck_x = self.effects.static_h && mode.sx == Slip::Stick;
-            let stuck_y = self.effects.static_v && mode.sy == Slip::Stick;
+            let stuck_x = self.forces.owns(Switch::SlipX) && mode.sx == Slip::Stick;
+            let stuck_y = self.forces.owns(Switch::SlipY) && mode.sy == Slip::Stick;
             if !(stuck_x || stuck_y) {
                 continue;
             }
@@ -1390,7 +1456,7 @@ impl<const N: usize> Model<N> {
         joint_torque: &mut [f64; N],
     ) {
         let rows = self.constraint_rows(pose, q, qd, modes, chol);
-        apply_rows(&rows, qdd, contacts, joint_torque);
+        apply_rows(&rows, qdd, contacts, joint_torque, &self.forces);
     }
 
     /// Project `qd` so that every sticking component's velocity (and every locked joint's
@@ -1425,8 +1491,8 @@ impl<const N: usize> Model<N> {
             return true;
         }
         let (mode, v_e) = (&modes[0], e.contacts[0].v_centroid);
-        (self.effects.static_h && mode.sx == Slip::Stick && v_e.x != 0.0)
-            || (self.effects.static_v && mode.sy == Slip::Stick && v_e.y != 0.0)
+        (self.forces.owns(Switch::SlipX) && mode.sx == Slip::Stick && v_e.x != 0.0)
+            || (self.forces.owns(Switch::SlipY) && mode.sy == Slip::Stick && v_e.y != 0.0)
     }
 
     /// [`Model::project_sticking`] for any body (after the `any_stuck` check).
@@ -1462,21 +1528,23 @@ impl<const N: usize> Model<N> {
                 external[c.link()] += e.contacts[ci].force.total();
             }
         }
-        let g = if self.effects.gravity {
-            self.medium.g
-        } else {
-            0.0
-        };
+        let g = self.gravity();
         self.mechanism.joint_forces(&pose, qd, &e.qdd, g, &external)
     }
 
     /// Kinetic and potential energy at `(q, qd)` [J]; the potential energy is gravity's
-    /// plus the joints' springs'.
+    /// (while the `gravity` term acts) plus the joints' springs' (while `joint_springs`
+    /// acts).
     pub fn energies(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> (f64, f64) {
         let pose = self.mechanism.pose(q);
+        let springs = if self.forces.joint_springs {
+            self.mechanism.spring_energy(q)
+        } else {
+            0.0
+        };
         (
             self.mechanism.kinetic_energy(&pose, qd),
-            self.mechanism.potential_energy(&pose, self.medium.g) + self.mechanism.spring_energy(q),
+            self.mechanism.potential_energy(&pose, self.gravity()) + springs,
         )
     }
 }
@@ -1493,6 +1561,25 @@ mod tests {
 
     fn close(a: f64, b: f64, scale: f64) -> bool {
         (a - b).abs() <= 1e-13 * scale.max(a.abs()).max(b.abs())
+    }
+
+    /// The thesis's terms at Table 3.4's q = 0 row, those of `mask` only (bits: gravity,
+    /// drag, static_h, static_v), on `n` contacts.
+    pub(crate) fn thesis_subset(mask: u8, n: usize) -> ForceSet {
+        use crate::forces::TermSpec;
+        let all = [
+            TermSpec::new("gravity", &[]),
+            TermSpec::new("drag", &[("eta_d", 15.2)]),
+            TermSpec::new("static_h", &[("eta_h", 6.5)]),
+            TermSpec::new("static_v", &[("eta_v", 248.0), ("lam", 0.106)]),
+        ];
+        let specs: Vec<TermSpec> = all
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| mask & (1 << i) != 0)
+            .map(|(_, t)| t)
+            .collect();
+        ForceSet::build(&specs, n).unwrap()
     }
 
     proptest! {
@@ -1518,12 +1605,7 @@ mod tests {
             }
             .model();
             model.mechanism.root_mass = root_mass;
-            model.effects = Effects {
-                gravity: effects & 1 != 0,
-                drag: effects & 2 != 0,
-                static_h: effects & 4 != 0,
-                static_v: effects & 8 != 0,
-            };
+            model.forces = thesis_subset(effects, 1);
             let rod = model.rigid_rod().copied();
             prop_assert!(rod.is_some());
             let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
@@ -1565,10 +1647,10 @@ mod tests {
                 (ca.tip.x, cb.tip.x), (ca.tip.y, cb.tip.y), (ca.v_tip.x, cb.v_tip.x),
                 (ca.v_tip.y, cb.v_tip.y), (ca.depth, cb.depth), (ca.lowest, cb.lowest),
                 (ca.v_centroid.x, cb.v_centroid.x), (ca.v_centroid.y, cb.v_centroid.y),
-                (ca.force.drag.x, cb.force.drag.x), (ca.force.drag.y, cb.force.drag.y),
-                (ca.force.static_h, cb.force.static_h), (ca.force.static_v, cb.force.static_v),
+                (ca.force.dynamic.x, cb.force.dynamic.x), (ca.force.dynamic.y, cb.force.dynamic.y),
+                (ca.force.statics.x, cb.force.statics.x), (ca.force.statics.y, cb.force.statics.y),
                 (ca.cross, cb.cross), (ca.immersion_margin, cb.immersion_margin),
-                (ca.bound_h, cb.bound_h), (ca.bound_v, cb.bound_v),
+                (ca.bound[0], cb.bound[0]), (ca.bound[1], cb.bound[1]),
             ];
             // A sticking reaction (fields 10, 11) solves for what holds E against every
             // force on the body: its round-off scale is the body's m a (seen: 1.1e-16 N on

@@ -30,6 +30,13 @@ pub enum GranrsError {
         value: String,
         allowed: String,
     },
+    /// A force term has no parameter of this name.
+    #[error("unknown parameter `{field}` ({allowed}){hint}")]
+    UnknownParameter {
+        field: String,
+        allowed: String,
+        hint: String,
+    },
     /// A scene is inconsistent as a whole (e.g. a contact on a link that does not exist).
     #[error("invalid scene: `{field}`: {message}")]
     InvalidScene { field: String, message: String },
@@ -79,5 +86,45 @@ fn not_finite(field: &str, value: f64) -> GranrsError {
         field: field.to_string(),
         value,
         allowed: "finite".to_string(),
+    }
+}
+
+/// The closest of `candidates` to a mistyped `value` (at most two edits, or a third of its
+/// length, away), for "did you mean" in error messages.
+pub fn suggest<'a>(value: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let limit = 2.max(value.chars().count() / 3);
+    candidates
+        .map(|c| (edit_distance(value, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+/// Levenshtein distance between `a` and `b`.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suggests_the_near_miss_only() {
+        let names = ["gravity", "drag", "static_h", "static_v"];
+        assert_eq!(suggest("stati_v", names.iter().copied()), Some("static_v"));
+        assert_eq!(suggest("drgа", names.iter().copied()), Some("drag"));
+        assert_eq!(suggest("wind", names.iter().copied()), None);
     }
 }

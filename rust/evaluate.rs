@@ -11,9 +11,11 @@
 
 use nalgebra::Vector2;
 
-use crate::dynamics::Effects;
-use crate::force::resistance::{raw_sign, rod_force};
-use crate::force::{Coefficients, Medium, RodContactState};
+use crate::dynamics::{raw_sign, terms_on};
+use crate::forces::drag::Drag;
+use crate::forces::static_h::StaticH;
+use crate::forces::static_v::StaticV;
+use crate::forces::{AnyTerm, ContactState, ForceSet, Medium};
 
 /// Inputs per state, in this order.
 pub const INPUTS: [&str; 9] = [
@@ -34,7 +36,7 @@ pub enum Sign {
 }
 
 /// The rod and the sand, shared by every state.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RodSetup {
     /// Rod length L [m] (also L_ref).
     pub length: f64,
@@ -42,14 +44,15 @@ pub struct RodSetup {
     pub diameter: f64,
     /// The sand.
     pub medium: Medium,
-    /// Which terms are on.
-    pub effects: Effects,
+    /// The terms that act (the thesis's contact terms; each state brings their parameters).
+    pub forces: ForceSet,
     /// Sign model.
     pub sign: Sign,
 }
 
 /// Evaluate one state: `input` in the order of [`INPUTS`] (angle in degrees), `out` in the
-/// order of [`OUTPUTS`].
+/// order of [`OUTPUTS`]. The forces come from the same term evaluation as a run's
+/// ([`terms_on`]), with this state's coefficients.
 pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
     let [depth, q_deg, vx, vy, omega, eta_h, eta_d, eta_v, lam] = input;
     let q = q_deg.to_radians();
@@ -62,40 +65,43 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
     };
     let half = 0.5 * l;
     let v_e = Vector2::new(vx + half * omega * c, vy - half * omega * s);
-    let state = RodContactState {
+    let mut terms = setup.forces.per_contact[0].clone();
+    for t in terms.iter_mut() {
+        *t = match *t {
+            AnyTerm::Drag(_) => AnyTerm::Drag(Drag { eta_d }),
+            AnyTerm::StaticH(_) => AnyTerm::StaticH(StaticH { eta_h }),
+            AnyTerm::StaticV(_) => AnyTerm::StaticV(StaticV { eta_v, lam }),
+            other => other,
+        };
+    }
+    let sign = match setup.sign {
+        Sign::Raw => [raw_sign(v_e.x), raw_sign(v_e.y)],
+        Sign::Smooth(eps) => [(v_e.x / eps).tanh(), (v_e.y / eps).tanh()],
+    };
+    // A_r |v_E| = d_c l |e x v_E|: smooth at v_E = 0, no division.
+    let cross = (s * v_e.y - c * v_e.x).abs();
+    let state = ContactState {
         depth,
-        immersed_length: l,
-        axis: Vector2::new(s, c),
-        v_centroid: v_e,
+        volume: std::f64::consts::FRAC_PI_4 * setup.diameter * setup.diameter * l,
+        width: setup.diameter,
+        l_ref: setup.length,
+        v: [v_e.x, v_e.y],
+        area_speed: setup.diameter * l * cross,
+        sign,
     };
-    let coefficients = Coefficients {
-        eta_h: if setup.effects.static_h { eta_h } else { 0.0 },
-        eta_d: if setup.effects.drag { eta_d } else { 0.0 },
-        eta_v: if setup.effects.static_v { eta_v } else { 0.0 },
-        lambda: lam,
+    let (f, _) = if depth > 0.0 {
+        terms_on(&setup.forces, &terms, &state, &setup.medium)
+    } else {
+        Default::default()
     };
-    let (sx, sy) = match setup.sign {
-        Sign::Raw => (raw_sign(v_e.x), raw_sign(v_e.y)),
-        Sign::Smooth(eps) => ((v_e.x / eps).tanh(), (v_e.y / eps).tanh()),
-    };
-    let f = rod_force(
-        &coefficients,
-        &setup.medium,
-        setup.diameter,
-        setup.diameter,
-        setup.length,
-        &state,
-        sx,
-        sy,
-    );
     let total = f.total();
     let values = [
         total.x,
         total.y,
-        f.drag.x,
-        f.drag.y,
-        f.static_h,
-        f.static_v,
+        f.dynamic.x,
+        f.dynamic.y,
+        f.statics.x,
+        f.statics.y,
         l,
         half * s,
         half * c,
@@ -113,7 +119,7 @@ mod tests {
             length: 0.19,
             diameter: 0.0127,
             medium: Medium::default(),
-            effects: Effects::default(),
+            forces: ForceSet::thesis(&[crate::forces::Coefficients::TABLE_3_4_VERTICAL]),
             sign,
         }
     }

@@ -2,7 +2,7 @@
 //!
 //! The Rust core of the `granrs` Python package: the granular resistance force of the
 //! thesis "Bipedal impact with granular matter" (dynamic drag plus static depth-dependent
-//! terms, see [`force`]), planar articulated bodies ([`body`]), and a fixed-step RK4 with
+//! terms, see [`forces`]), planar articulated bodies ([`body`]), and a fixed-step RK4 with
 //! exact event handling ([`integrate`]). `shared/MODEL.md` fixes the frame and the reading of
 //! the thesis used throughout.
 //!
@@ -14,7 +14,7 @@ pub mod body;
 pub mod dynamics;
 pub mod error;
 pub mod evaluate;
-pub mod force;
+pub mod forces;
 pub mod integrate;
 pub mod scene;
 pub mod spec;

@@ -1,4 +1,4 @@
-//! What a run is: the body, its contacts and coefficients, the medium, the effects, the
+//! What a run is: the body, its contacts, the medium, the force terms (with their parameters), the
 //! initial state, the time step, the end condition and the outputs wanted.
 //!
 //! Field names are those of the Python `granrs.Scene`, so that an error names the field the
@@ -9,9 +9,9 @@ use nalgebra::{SVector, Vector2};
 
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, Link, Mechanism, RodContact, SoleContact, SoleModel};
-use crate::dynamics::{Contact, Effects, Model, Shape, SignModel};
+use crate::dynamics::{Contact, Model, Shape, SignModel};
 use crate::error::{check_finite, check_range, GranrsError, Result};
-use crate::force::{Coefficients, Medium};
+use crate::forces::{Coefficients, ForceSet, Medium};
 use crate::integrate::{solve, Method, Outcome, SolveOptions};
 
 /// The thesis's free link (sec. 3.2.1): a steel rod with round ends.
@@ -38,8 +38,6 @@ pub struct FreeLinkScene {
     pub inertia: Option<f64>,
     /// The sand.
     pub medium: Medium,
-    /// Coefficients of the force law.
-    pub coefficients: Coefficients,
     /// Initial angle from the vertical q [deg], |q| < 90.
     pub q_deg: f64,
     /// Initial downward speed of the rod v0 [m/s] (velocity (vx0, -v0)).
@@ -54,8 +52,8 @@ pub struct FreeLinkScene {
     pub apply_at: ApplyAt,
     /// Sign model of the static terms.
     pub sign_model: SignModel,
-    /// Which force terms are on.
-    pub effects: Effects,
+    /// The force terms that act, with their parameters per contact.
+    pub forces: ForceSet,
     /// Step, end and recording.
     pub options: SolveOptions,
 }
@@ -68,7 +66,6 @@ impl Default for FreeLinkScene {
             mass: free_link_defaults::MASS,
             inertia: None,
             medium: Medium::default(),
-            coefficients: Coefficients::TABLE_3_4_VERTICAL,
             q_deg: 0.0,
             v0: 2.214,
             depth0: 0.0,
@@ -76,7 +73,7 @@ impl Default for FreeLinkScene {
             omega0: 0.0,
             apply_at: ApplyAt::Tip,
             sign_model: SignModel::Modes,
-            effects: Effects::default(),
+            forces: ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]),
             options: SolveOptions::default(),
         }
     }
@@ -119,7 +116,6 @@ impl FreeLinkScene {
         if let Some(i) = self.inertia {
             check_range("inertia", i, 0.0, true)?;
         }
-        self.coefficients.validate("coefficients")?;
         validate_rod_angle("q_deg", self.q_deg)?;
         check_finite("omega0", self.omega0)?;
         validate_common(
@@ -161,12 +157,11 @@ impl FreeLinkScene {
                     length: self.length,
                     diameter: self.diameter,
                 }),
-                coefficients: self.coefficients,
             }],
             medium: self.medium,
             apply_at: self.apply_at,
             sign_model: self.sign_model,
-            effects: self.effects,
+            forces: self.forces.clone(),
         }
     }
 
@@ -215,7 +210,7 @@ fn validate_joint_stiffness<const N: usize>(
     options: &SolveOptions,
     names: &[&str],
 ) -> Result<()> {
-    if options.method != Method::Rk4 {
+    if options.method != Method::Rk4 || !model.forces.joint_springs {
         return Ok(());
     }
     let pose = model.mechanism.pose(q0);
@@ -325,8 +320,6 @@ pub struct ChainScene {
     pub joint: Joint,
     /// The sand.
     pub medium: Medium,
-    /// Coefficients of link 1's and link 2's contacts.
-    pub coefficients: [Coefficients; 2],
     /// Angles of link 1 and link 2 from the vertical [deg].
     pub q_deg: [f64; 2],
     /// Initial downward speed of the chain [m/s].
@@ -341,8 +334,8 @@ pub struct ChainScene {
     pub apply_at: ApplyAt,
     /// Sign model of the static terms.
     pub sign_model: SignModel,
-    /// Which force terms are on.
-    pub effects: Effects,
+    /// The force terms that act, with their parameters per contact.
+    pub forces: ForceSet,
     /// Step, end and recording.
     pub options: SolveOptions,
 }
@@ -357,7 +350,6 @@ impl Default for ChainScene {
             pin_mass: 0.0,
             joint: Joint::Free,
             medium: Medium::default(),
-            coefficients: [Coefficients::TABLE_3_4_VERTICAL; 2],
             q_deg: [-15.0, 15.0],
             v0: 2.29,
             depth0: 0.0,
@@ -365,7 +357,7 @@ impl Default for ChainScene {
             omega0: 0.0,
             apply_at: ApplyAt::Tip,
             sign_model: SignModel::Modes,
-            effects: Effects::default(),
+            forces: ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL; 2]),
             options: SolveOptions::default(),
         }
     }
@@ -382,8 +374,6 @@ impl ChainScene {
         }
         check_range("pin_mass", self.pin_mass, 0.0, false)?;
         validate_joint("pin_joint", &self.joint)?;
-        self.coefficients[0].validate("coefficients")?;
-        self.coefficients[1].validate("coefficients2")?;
         validate_rod_angle("q_deg", self.q_deg[0])?;
         validate_rod_angle("q2_deg", self.q_deg[1])?;
         check_finite("omega0", self.omega0)?;
@@ -437,7 +427,6 @@ impl ChainScene {
                 length: self.length,
                 diameter: self.diameter,
             }),
-            coefficients: self.coefficients[i],
         };
         Model {
             mechanism: Mechanism {
@@ -448,7 +437,7 @@ impl ChainScene {
             medium: self.medium,
             apply_at: self.apply_at,
             sign_model: self.sign_model,
-            effects: self.effects,
+            forces: self.forces.clone(),
         }
     }
 
@@ -571,8 +560,6 @@ pub struct LegScene {
     pub sole_model: SoleModel,
     /// The sand.
     pub medium: Medium,
-    /// Coefficients of the foot's contact.
-    pub coefficients: Coefficients,
     /// Initial downward speed [m/s].
     pub v0: f64,
     /// Initial depth of the sole's lowest point [m].
@@ -583,8 +570,8 @@ pub struct LegScene {
     pub apply_at: ApplyAt,
     /// Sign model of the static terms.
     pub sign_model: SignModel,
-    /// Which force terms are on.
-    pub effects: Effects,
+    /// The force terms that act, with their parameters per contact.
+    pub forces: ForceSet,
     /// Step, end and recording.
     pub options: SolveOptions,
 }
@@ -608,19 +595,18 @@ impl Default for LegScene {
                 rho_g: leg_defaults::RHO_G,
                 g: 9.81,
             },
-            // Thesis sec. 5.3.2, v0 = 3.28 m/s.
-            coefficients: Coefficients {
-                eta_h: 10.0,
-                eta_d: 13.0,
-                eta_v: 195.0,
-                lambda: 1.05,
-            },
             v0: 3.28,
             depth0: 0.0,
             vx0: 0.0,
             apply_at: ApplyAt::Tip,
             sign_model: SignModel::Modes,
-            effects: Effects::default(),
+            // Thesis sec. 5.3.2, v0 = 3.28 m/s.
+            forces: ForceSet::thesis(&[Coefficients {
+                eta_h: 10.0,
+                eta_d: 13.0,
+                eta_v: 195.0,
+                lambda: 1.05,
+            }]),
             options: SolveOptions::default(),
         }
     }
@@ -671,7 +657,6 @@ impl LegScene {
                 });
             }
         }
-        self.coefficients.validate("coefficients")?;
         validate_common(
             &self.medium,
             self.v0,
@@ -803,12 +788,11 @@ impl LegScene {
             },
             contacts: vec![Contact {
                 shape: Shape::Sole(self.sole()),
-                coefficients: self.coefficients,
             }],
             medium: self.medium,
             apply_at: self.apply_at,
             sign_model: self.sign_model,
-            effects: self.effects,
+            forces: self.forces.clone(),
         }
     }
 

@@ -10,9 +10,9 @@ use std::borrow::Cow;
 
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
-use crate::dynamics::{Effects, SignModel};
+use crate::dynamics::SignModel;
 use crate::error::{GranrsError, Result};
-use crate::force::{Coefficients, Medium};
+use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
 use crate::integrate::{EndCondition, Method, Record, SolveOptions};
 use crate::scene::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
 
@@ -31,6 +31,8 @@ pub enum Value {
     Names(Vec<Cow<'static, str>>),
     /// A mapping (coefficients, a spring-damper).
     Map(Vec<(Cow<'static, str>, Value)>),
+    /// A list of force terms, each with its parameters.
+    Terms(Vec<TermSpec>),
     /// Anything else, by its type name (for the error message).
     Other(String),
 }
@@ -45,6 +47,7 @@ impl Value {
             Value::Str(s) => format!("the string {s:?}"),
             Value::Names(_) => "a list".into(),
             Value::Map(_) => "a mapping".into(),
+            Value::Terms(_) => "a list of force terms".into(),
             Value::Other(t) => t.clone(),
         }
     }
@@ -111,6 +114,7 @@ scene_fields! {
     "end",
     "foot_deg",
     "foot_length",
+    "forces",
     "g",
     "height",
     "hip",
@@ -364,16 +368,37 @@ impl SceneSpec {
             }
         }
         let get = |k: &str| num(k, map_get(entries, k)).map_err(|e| within(e, field, k));
+        let c = [get("eta_h")?, get("eta_d")?, get("eta_v")?, get("lam")?];
+        for (name, v) in ["eta_h", "eta_d", "eta_v", "lam"].iter().zip(c) {
+            crate::error::check_range(&format!("{field}.{name}"), v, 0.0, false)?;
+        }
         Ok(Some(Coefficients {
-            eta_h: get("eta_h")?,
-            eta_d: get("eta_d")?,
-            eta_v: get("eta_v")?,
-            lambda: get("lam")?,
+            eta_h: c[0],
+            eta_d: c[1],
+            eta_v: c[2],
+            lambda: c[3],
         }))
     }
 
-    fn required_coefficients(&self, field: &str) -> Result<Coefficients> {
-        self.coefficients(field)?.ok_or_else(|| missing(field))
+    /// The force terms of a body with `n_contacts` contacts: the `forces` list, or (until
+    /// the Python layer hands the core its terms) the thesis's law from the `coefficients`
+    /// (per contact: `coefficients`, then `coefficients2`) and the `effects` names.
+    fn forces(&self, n_contacts: usize) -> Result<ForceSet> {
+        if let Some(v) = self.get("forces").filter(|v| **v != Value::None) {
+            return match v {
+                Value::Terms(specs) => ForceSet::build(specs, n_contacts),
+                Value::Names(n) if n.is_empty() => ForceSet::build(&[], n_contacts),
+                other => Err(wrong("forces", "a list of force terms", other)),
+            };
+        }
+        let first = self
+            .coefficients("coefficients")?
+            .ok_or_else(|| missing("coefficients"))?;
+        let mut per_contact = vec![first; n_contacts];
+        if n_contacts > 1 {
+            per_contact[1] = self.coefficients("coefficients2")?.unwrap_or(first);
+        }
+        thesis_law(self.names("effects")?, &per_contact)
     }
 
     /// A joint: `"free"`, `"locked"`, or a spring-damper `{"k": .., "c": ..}`; absent or
@@ -409,31 +434,6 @@ impl SceneSpec {
                 other,
             )),
         }
-    }
-
-    /// The effects, and whether spring-dampers are on (absent: every effect).
-    pub fn effects(&self) -> Result<(Effects, bool)> {
-        let Some(names) = self.names("effects")? else {
-            return Ok((Effects::default(), true));
-        };
-        let mut e = Effects {
-            gravity: false,
-            drag: false,
-            static_h: false,
-            static_v: false,
-        };
-        let mut springs = false;
-        for n in names {
-            match n.as_ref() {
-                "gravity" => e.gravity = true,
-                "drag" => e.drag = true,
-                "static_h" => e.static_h = true,
-                "static_v" => e.static_v = true,
-                "joint_springs" => springs = true,
-                other => return Err(unknown("effects", other, &EFFECTS)),
-            }
-        }
-        Ok((e, springs))
     }
 
     fn record(&self) -> Result<Record> {
@@ -486,7 +486,6 @@ impl SceneSpec {
             },
             other => return Err(unknown("method", other, &["rk4", "dopri5"])),
         };
-        let (effects, springs) = self.effects()?;
         Ok(Common {
             medium: Medium {
                 rho_g: self.f64("rho_g")?,
@@ -494,8 +493,6 @@ impl SceneSpec {
             },
             apply_at,
             sign_model,
-            effects,
-            springs,
             options: SolveOptions {
                 dt: self.f64("dt")?,
                 method,
@@ -509,14 +506,6 @@ impl SceneSpec {
         })
     }
 
-    /// A joint, with a spring-damper made free when the scene leaves out `joint_springs`.
-    fn joint_with(&self, field: &str, default: Joint, springs: bool) -> Result<Joint> {
-        Ok(match self.joint(field, default)? {
-            Joint::Spring { .. } if !springs => Joint::Free,
-            j => j,
-        })
-    }
-
     fn free_link(&self) -> Result<FreeLinkScene> {
         let c = self.common()?;
         Ok(FreeLinkScene {
@@ -525,7 +514,6 @@ impl SceneSpec {
             mass: self.f64("mass")?,
             inertia: self.opt_f64("inertia")?,
             medium: c.medium,
-            coefficients: self.required_coefficients("coefficients")?,
             q_deg: self.f64("q_deg")?,
             v0: c.v0,
             depth0: c.depth0,
@@ -533,7 +521,7 @@ impl SceneSpec {
             omega0: self.f64_or("omega0", 0.0)?,
             apply_at: c.apply_at,
             sign_model: c.sign_model,
-            effects: c.effects,
+            forces: self.forces(1)?,
             options: c.options,
         })
     }
@@ -541,7 +529,6 @@ impl SceneSpec {
     /// Link 2's angle defaults to the mirror of link 1's, its coefficients to link 1's.
     fn chain(&self) -> Result<ChainScene> {
         let c = self.common()?;
-        let coefficients = self.required_coefficients("coefficients")?;
         let q1 = self.f64("q_deg")?;
         Ok(ChainScene {
             length: self.f64("length")?,
@@ -549,12 +536,8 @@ impl SceneSpec {
             mass: self.f64("mass")?,
             inertia: self.opt_f64("inertia")?,
             pin_mass: self.f64_or("pin_mass", 0.0)?,
-            joint: self.joint_with("pin_joint", Joint::Free, c.springs)?,
+            joint: self.joint("pin_joint", Joint::Free)?,
             medium: c.medium,
-            coefficients: [
-                coefficients,
-                self.coefficients("coefficients2")?.unwrap_or(coefficients),
-            ],
             q_deg: [q1, self.opt_f64("q2_deg")?.unwrap_or(-q1)],
             v0: c.v0,
             depth0: c.depth0,
@@ -562,7 +545,7 @@ impl SceneSpec {
             omega0: self.f64_or("omega0", 0.0)?,
             apply_at: c.apply_at,
             sign_model: c.sign_model,
-            effects: c.effects,
+            forces: self.forces(2)?,
             options: c.options,
         })
     }
@@ -582,7 +565,7 @@ impl SceneSpec {
         };
         let mut joints = [Joint::Locked; 3];
         for (j, name) in joints.iter_mut().zip(LEG_JOINTS) {
-            *j = self.joint_with(name, Joint::Locked, c.springs)?;
+            *j = self.joint(name, Joint::Locked)?;
         }
         Ok(LegScene {
             body_mass: self.f64_or("body_mass", defaults.body_mass)?,
@@ -598,13 +581,12 @@ impl SceneSpec {
             foot_deg: self.f64_or("foot_deg", defaults.foot_deg)?,
             sole_model,
             medium: c.medium,
-            coefficients: self.required_coefficients("coefficients")?,
             v0: c.v0,
             depth0: c.depth0,
             vx0: c.vx0,
             apply_at: c.apply_at,
             sign_model: c.sign_model,
-            effects: c.effects,
+            forces: self.forces(1)?,
             options: c.options,
         })
     }
@@ -631,13 +613,33 @@ impl SceneSpec {
     }
 }
 
+/// The thesis's law with coefficients (eta_h, eta_d, eta_v, lambda) per contact, its terms
+/// limited to `names` (every term when `None`).
+pub fn thesis_law(
+    names: Option<&[Cow<'static, str>]>,
+    per_contact: &[Coefficients],
+) -> Result<ForceSet> {
+    let all = ForceSet::thesis(per_contact).specs();
+    let Some(names) = names else {
+        return ForceSet::build(&all, per_contact.len());
+    };
+    for n in names {
+        if !EFFECTS.contains(&n.as_ref()) {
+            return Err(unknown("effects", n, &EFFECTS));
+        }
+    }
+    let listed: Vec<TermSpec> = all
+        .into_iter()
+        .filter(|t| names.iter().any(|n| n == &t.name))
+        .collect();
+    ForceSet::build(&listed, per_contact.len())
+}
+
 /// The fields every body shares.
 struct Common {
     medium: Medium,
     apply_at: ApplyAt,
     sign_model: SignModel,
-    effects: Effects,
-    springs: bool,
     options: SolveOptions,
     v0: f64,
     depth0: f64,
@@ -700,12 +702,12 @@ mod tests {
         let mut by_hand = FreeLinkScene {
             q_deg: 45.0,
             v0: 2.27,
-            coefficients: Coefficients {
+            forces: ForceSet::thesis(&[Coefficients {
                 eta_h: 5.5,
                 eta_d: 11.0,
                 eta_v: 53.0,
                 lambda: 0.25,
-            },
+            }]),
             ..Default::default()
         };
         by_hand.options.record.stride = 1; // the spec's record_stride default
@@ -796,7 +798,10 @@ mod tests {
         let AnyScene::Chain(without) = s.build().unwrap() else {
             panic!()
         };
-        assert_eq!(without.joint, Joint::Free);
-        assert!(!without.effects.drag && without.effects.static_v);
+        // The joint keeps its spring-damper; without the `joint_springs` term it exerts
+        // nothing (the engine reads the force set, not a rewritten joint).
+        assert!(matches!(without.joint, Joint::Spring { .. }));
+        assert!(!without.forces.joint_springs);
+        assert_eq!(without.forces.names, vec!["gravity", "static_v"]);
     }
 }

@@ -55,7 +55,7 @@ fn vertical_drop_depth_and_stop_time_at_10_khz() {
     for v0 in [0.1, 0.3, 1.0, 2.214, 5.0, 10.0] {
         let s = FreeLinkScene {
             v0,
-            coefficients: table_3_4_vertical(),
+            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
             ..Default::default()
         };
         let out = s.run().unwrap();

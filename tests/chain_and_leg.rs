@@ -6,7 +6,7 @@ mod common;
 use _granrs::body::rod::ApplyAt;
 use _granrs::body::{Joint, Link, Mechanism, RodContact};
 use _granrs::dynamics::{Contact, Model, Shape};
-use _granrs::force::Coefficients;
+use _granrs::forces::Coefficients;
 use _granrs::integrate::{solve, EndCondition, Outcome, Record};
 use _granrs::scene::{ChainScene, FreeLinkScene, LegScene};
 use common::{exact_vertical_depth, table_3_4_vertical};
@@ -45,7 +45,7 @@ fn series<'a>(out: &'a Outcome, name: &str) -> &'a [f64] {
 fn vertical_chain_matches_the_exact_depth() {
     let mut chain = ChainScene {
         q_deg: [0.0, 0.0],
-        coefficients: [table_3_4_vertical(); 2],
+        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical(); 2]),
         v0: 1.0,
         ..Default::default()
     };
@@ -55,7 +55,7 @@ fn vertical_chain_matches_the_exact_depth() {
         length: chain.length,
         diameter: chain.diameter,
         mass: chain.mass,
-        coefficients: chain.coefficients[0],
+        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
         v0: chain.v0,
         ..Default::default()
     };
@@ -73,7 +73,7 @@ fn vertical_chain_matches_the_exact_depth() {
 fn mirror_symmetric_chain_stays_symmetric() {
     let mut chain = ChainScene {
         q_deg: [-15.0, 15.0],
-        coefficients: [table_4_4_case_1()[1]; 2],
+        forces: _granrs::forces::ForceSet::thesis(&[table_4_4_case_1()[1]; 2]),
         v0: 2.575,
         ..Default::default()
     };
@@ -96,7 +96,7 @@ fn mirror_symmetric_chain_stays_symmetric() {
 
     // The thesis's case 1: angles -16.72 / 13.48 deg, a coefficient set per link.
     chain.q_deg = [-16.72, 13.48];
-    chain.coefficients = table_4_4_case_1();
+    chain.forces = _granrs::forces::ForceSet::thesis(&table_4_4_case_1());
     let out = chain.run().unwrap();
     let (a, b) = (&out.contacts[0], &out.contacts[1]);
     assert!(a.stopped && b.stopped);
@@ -119,7 +119,7 @@ fn one_link_engine_is_the_free_link() {
         let scene = FreeLinkScene {
             q_deg,
             apply_at,
-            coefficients: table_3_4_vertical(),
+            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
             ..Default::default()
         };
         let reference = scene.run().unwrap();
@@ -143,12 +143,11 @@ fn one_link_engine_is_the_free_link() {
                     length: l,
                     diameter: d,
                 }),
-                coefficients: scene.coefficients,
             }],
             medium: scene.medium,
             apply_at,
             sign_model: scene.sign_model,
-            effects: scene.effects,
+            forces: scene.forces.clone(),
         };
         let q = q_deg.to_radians();
         let q0 = SVector::<f64, 3>::new(0.5 * l * q.sin(), 0.5 * l * q.cos(), q);
@@ -177,7 +176,7 @@ fn locked_coincident_chain_is_the_free_link_in_other_coordinates() {
             diameter: 0.0127,
             mass: 0.184,
             q_deg: [q_deg, q_deg],
-            coefficients: [table_3_4_vertical(); 2],
+            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical(); 2]),
             joint: Joint::Locked,
             v0: 2.214,
             ..Default::default()
@@ -186,7 +185,7 @@ fn locked_coincident_chain_is_the_free_link_in_other_coordinates() {
         let out = chain.run().unwrap();
         let rod = FreeLinkScene {
             q_deg,
-            coefficients: table_3_4_vertical(),
+            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
             v0: 2.214,
             ..Default::default()
         }
@@ -244,7 +243,7 @@ fn energy_bookkeeping_closes_per_body() {
             for joint in [Joint::Free, Joint::Locked, spring] {
                 let mut chain = ChainScene {
                     q_deg: [-16.72, 13.48],
-                    coefficients: table_4_4_case_1(),
+                    forces: _granrs::forces::ForceSet::thesis(&table_4_4_case_1()),
                     pin_mass: 0.005,
                     joint: if joint == spring { small_spring } else { joint },
                     apply_at,
@@ -347,7 +346,7 @@ fn pin_force_balances_the_pin_mass() {
     let chain = ChainScene {
         pin_mass: 0.01,
         q_deg: [-16.72, 13.48],
-        coefficients: table_4_4_case_1(),
+        forces: _granrs::forces::ForceSet::thesis(&table_4_4_case_1()),
         ..Default::default()
     };
     let model = chain.model();

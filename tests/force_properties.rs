@@ -6,9 +6,8 @@
 
 use proptest::prelude::*;
 
-use _granrs::dynamics::Effects;
 use _granrs::evaluate::{evaluate, RodSetup, Sign, OUTPUTS};
-use _granrs::force::Medium;
+use _granrs::forces::{Coefficients, ForceSet, Medium};
 
 const F_X: usize = 0;
 const F_Y: usize = 1;
@@ -22,7 +21,7 @@ fn setup(length: f64, diameter: f64, rho_g: f64, sign: Sign) -> RodSetup {
         length,
         diameter,
         medium: Medium { rho_g, g: 9.81 },
-        effects: Effects::default(),
+        forces: ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]),
         sign,
     }
 }

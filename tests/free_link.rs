@@ -9,7 +9,7 @@ use common::{exact_vertical_depth, table_3_4_vertical};
 fn vertical(v0: f64) -> FreeLinkScene {
     FreeLinkScene {
         v0,
-        coefficients: table_3_4_vertical(),
+        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
         ..Default::default()
     }
 }

@@ -4,7 +4,7 @@
 mod common;
 
 use _granrs::dynamics::{ContactMode, Slip, MAX_CONTACTS};
-use _granrs::force::Coefficients;
+use _granrs::forces::Coefficients;
 use _granrs::integrate::{EndCondition, Record, Series};
 use _granrs::scene::FreeLinkScene;
 use common::{exact_vertical_depth, table_3_4_vertical};
@@ -39,7 +39,7 @@ fn horizontal_stick_holds_velocity_at_zero() {
         v0: 0.0,
         depth0: 0.03,
         vx0: 0.05,
-        coefficients: table_3_4_vertical(),
+        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
         options: _granrs::integrate::SolveOptions {
             t_end: 0.05,
             ..Default::default()
@@ -71,12 +71,12 @@ fn vertical_stick_releases_when_bound_is_exceeded() {
         v0: 0.5,
         vx0: 0.3,
         // Table 3.4, row q = 45 deg.
-        coefficients: Coefficients {
+        forces: _granrs::forces::ForceSet::thesis(&[Coefficients {
             eta_h: 5.5,
             eta_d: 11.0,
             eta_v: 53.0,
             lambda: 0.25,
-        },
+        }]),
         options: _granrs::integrate::SolveOptions {
             t_end: 0.1,
             ..Default::default()
@@ -130,7 +130,7 @@ fn vertical_stick_releases_when_bound_is_exceeded() {
     }
     let e = scene.model().eval(&q, &qd, &modes);
     let c = &e.contacts[0];
-    let rel = (c.force.static_v.abs() - c.bound_v).abs() / c.bound_v;
+    let rel = (c.force.statics.y.abs() - c.bound[1]).abs() / c.bound[1];
     println!(
         "stick {:.6} s, release {:.6} s, |R| vs bound rel. {rel:.1e}",
         t[stick], t[release]
@@ -138,8 +138,8 @@ fn vertical_stick_releases_when_bound_is_exceeded() {
     assert!(
         rel < 1e-6,
         "reaction {} vs bound {}",
-        c.force.static_v,
-        c.bound_v
+        c.force.statics.y,
+        c.bound[1]
     );
 }
 
@@ -167,7 +167,7 @@ fn rk4_modes_is_fourth_order_away_from_entry() {
         v0: 1.0,
         depth0: 0.01,
         vx0: 0.3,
-        coefficients: table_3_4_vertical(),
+        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
         ..Default::default()
     };
     let run = |dt: f64| {
@@ -205,7 +205,7 @@ fn order_over_whole_impact_including_entry() {
     for &dt in &dts {
         let mut s = FreeLinkScene {
             v0: 2.214,
-            coefficients: table_3_4_vertical(),
+            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
             ..Default::default()
         };
         s.options.dt = dt;

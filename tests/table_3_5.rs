@@ -5,7 +5,7 @@
 
 mod common;
 
-use _granrs::force::Coefficients;
+use _granrs::forces::Coefficients;
 use _granrs::integrate::Status;
 use _granrs::scene::FreeLinkScene;
 use common::read_csv;
@@ -56,7 +56,7 @@ fn table_3_5_depths_median_within_6_percent() {
         let s = FreeLinkScene {
             q_deg: q,
             v0,
-            coefficients,
+            forces: _granrs::forces::ForceSet::thesis(&[coefficients]),
             ..Default::default()
         };
         let out = s.run().unwrap();

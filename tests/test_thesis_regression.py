@@ -17,7 +17,7 @@ import sys
 import pytest
 
 sys.path.insert(0, str(pathlib.Path(__file__).parent))
-from record_thesis_cases import KEYS, cases, record  # noqa: E402
+from record_thesis_cases import KEYS, cases, record
 
 RECORD = json.loads((pathlib.Path(__file__).parent / "data" / "thesis_cases.json").read_text())
 RTOL = 1e-9

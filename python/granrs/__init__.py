@@ -14,7 +14,7 @@ Quick start::
 
 from __future__ import annotations
 
-from . import _granrs, cases, coefficients, data, scenefile
+from . import _granrs, cases, coefficients, data, forces, scenefile
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
@@ -62,6 +62,7 @@ __all__ = [
     "cases",
     "coefficients",
     "data",
+    "forces",
     "resistance_force",
     "scenefile",
     "simulate",

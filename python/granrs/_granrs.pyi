@@ -1,13 +1,36 @@
 """Type stubs of the compiled core (rust/python/mod.rs). Use the public API in granrs instead."""
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, final
 
+__all__ = [
+    "EFFECTS",
+    "FORCE_INPUTS",
+    "FORCE_OUTPUTS",
+    "RECORDS",
+    "SCENE_FIELDS",
+    "Compiled",
+    "RunOutcome",
+    "__version__",
+    "check_term",
+    "compile",
+    "compile_fields",
+    "compiled_scene",
+    "leg_segments",
+    "resistance_force",
+    "run",
+    "run_scene",
+    "sweep",
+    "term_infos",
+    "validate",
+    "validate_sweep",
+]
 __version__: str
 EFFECTS: list[str]
 RECORDS: list[str]
 SCENE_FIELDS: list[str]
 
+@final
 class Compiled:
     """A scene dict converted and validated by the core (from compile())."""
 
@@ -20,6 +43,7 @@ def compile_fields(fields: dict[str, Any], names: tuple[str, ...]) -> Compiled:
 def compiled_scene(fields: dict[str, Any], core_fields: dict[str, tuple[str, ...]]) -> Compiled:
     """A Scene's compiled scene, cached in its ``__dict__`` (compiled on first use)."""
 
+@final
 class RunOutcome:
     """One run's outcome, kept in the core until asked for."""
 
@@ -80,3 +104,9 @@ def resistance_force(
 ) -> Any:
     """The rod force over n states: nine contiguous float64 arrays (FORCE_INPUTS order) in,
     an n x 10 array (FORCE_OUTPUTS order) out."""
+
+def term_infos() -> list[dict[str, Any]]:
+    """Every registered force term's description (name, equation, params, ...)."""
+
+def check_term(name: str, params: dict[str, Any]) -> dict[str, float | tuple[float, ...]]:
+    """Check one term's name and parameters; every parameter with defaults filled in."""

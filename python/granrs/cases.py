@@ -72,8 +72,7 @@ def free_link(
         body="free_link",
         q_deg=q,
         v0=_number(v0, "v0"),
-        coefficients=coef,
-        coefficients_source=source,
+        **_law(coef, None, source, overrides),
         dt=_number(dt, "dt"),
         apply_at=apply_at,
         **{k: v for k, v in FREE_LINK.items() if k not in overrides},
@@ -101,6 +100,19 @@ LEG: dict[str, float] = {
     "tibia_length": 0.432,
     "rho_g": 1600.0,
 }
+
+
+def _law(
+    c1: Coefficients, c2: Coefficients | None, source: str, overrides: Mapping[str, Any]
+) -> dict[str, Any]:
+    """The scene fields of a case's force law: its coefficient table's row(s), unless the
+    caller gives ``forces=`` (then the terms carry their own parameters)."""
+    if "forces" in overrides:
+        return {"coefficients_source": "the scene's forces"}
+    law: dict[str, Any] = {"coefficients": c1, "coefficients_source": source}
+    if c2 is not None:
+        law["coefficients2"] = c2
+    return law
 
 
 def _coefficients_arg(value: Any, field: str) -> Coefficients:
@@ -204,9 +216,7 @@ def chain(
         q_deg=q1,
         q2_deg=q2,
         v0=spec["v0"],
-        coefficients=c1,
-        coefficients2=c2,
-        coefficients_source=source,
+        **_law(c1, c2, source, overrides),
         dt=_number(dt, "dt"),
         apply_at=apply_at,
         **{k: v for k, v in CHAIN.items() if k not in overrides},
@@ -251,8 +261,7 @@ def leg(
     base = Scene(
         body="leg",
         v0=v,
-        coefficients=coef,
-        coefficients_source=source,
+        **_law(coef, None, source, overrides),
         dt=_number(dt, "dt"),
         apply_at=apply_at,
         **{k: val for k, val in fields.items() if k not in overrides},

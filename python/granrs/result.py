@@ -105,6 +105,7 @@ class Result:
         series: recorded time series (numpy arrays by name), or None. Multi-contact bodies
             keep the ``c0.``/``c1.`` prefixes; joint and link series are named
             ``<joint>.Fx/Fy/torque`` and ``<link>.KE/PE``.
+        terms: the names of the force terms that acted, in the order of ``scene.forces``.
     """
 
     __slots__ = ("_core", "_d", "_raw", "scene")
@@ -182,6 +183,11 @@ class Result:
     @property
     def series(self) -> dict[str, np.ndarray] | None:
         return self._parts()["series"]  # type: ignore[no-any-return]
+
+    @property
+    def terms(self) -> tuple[str, ...]:
+        """The names of the force terms that acted, in the order of ``scene.forces``."""
+        return tuple(self._raw_dict()["terms"])
 
     @property
     def stopped(self) -> bool:

@@ -30,6 +30,7 @@ from . import _granrs
 from .coefficients import Coefficients
 from .effects import EFFECTS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+from .forces import Term, as_terms
 
 __all__ = ["BODIES", "BODY_FIELDS", "EFFECTS", "JOINTS", "RECORDS", "JointSpec", "Scene"]
 
@@ -147,6 +148,11 @@ class Scene:
             exactly, sticking handled), ``"raw"`` (the thesis's plain sign) or ``"smooth"``
             (tanh(v / smooth_eps)).
         smooth_eps: velocity scale of the ``"smooth"`` sign model [m/s].
+        forces: the force terms that act, a list of :mod:`granrs.forces` terms each with
+            its parameters (``[granrs.forces.gravity(), granrs.forces.static_v(eta_v=248.0,
+            lam=0.106)]``); ``[]``: nothing acts. ``None`` (the default): the thesis's law
+            with ``coefficients`` (and ``coefficients2``) limited to ``effects``. A scene
+            gives either ``forces`` or those three.
         effects: the force terms to evaluate, from ``EFFECTS`` (all by default; see
             :data:`granrs.EFFECT_INFO` for each term's parameters and units); a term not
             listed is neither computed nor stored, and a spring-damper joint is free
@@ -207,6 +213,7 @@ class Scene:
     sign_model: str = "modes"
     smooth_eps: float = 1e-3
     effects: tuple[str, ...] = EFFECTS
+    forces: tuple[Term, ...] | None = None
     dt: float = 1e-4
     method: str = "rk4"
     rtol: float = 1e-8
@@ -278,6 +285,16 @@ class Scene:
                     field=name,
                 )
         object.__setattr__(self, "effects", _names(self.effects, "effects", EFFECTS))
+        if self.forces is not None:
+            object.__setattr__(self, "forces", as_terms(self.forces))
+            for name in ("coefficients", "coefficients2", "effects"):
+                if getattr(self, name) != _DEFAULTS[name]:
+                    raise InvalidSceneError(
+                        f"forces= replaces coefficients, coefficients2 and effects (each term "
+                        f"carries its own parameters): give {name} as a term's parameters "
+                        "instead, e.g. granrs.forces.static_v(eta_v=248.0, lam=0.106)",
+                        field=name,
+                    )
         object.__setattr__(self, "record", _names(self.record, "record", RECORDS))
 
     def replace(self, **changes: Any) -> Scene:
@@ -298,6 +315,8 @@ class Scene:
         d["coefficients2"] = None if self.coefficients2 is None else self.coefficients2.as_dict()
         d["effects"] = list(self.effects)
         d["record"] = list(self.record)
+        if self.forces is not None:
+            d["forces"] = list(self.forces)
         return d
 
     def _plain(self) -> dict[str, Any]:
@@ -312,6 +331,8 @@ class Scene:
                 cached["coefficients2"] = self.coefficients2.as_dict()
             cached["effects"] = list(self.effects)
             cached["record"] = list(self.record)
+            if self.forces is not None:
+                cached["forces"] = list(self.forces)
             object.__setattr__(self, "_plain_cache", cached)
         return cached
 

@@ -106,6 +106,7 @@ _NOTES: dict[str, str] = {
     "record_stride": "record every n-th step",
     "q2_deg": "deg, link 2's angle; left out: -q_deg (mirror image)",
     "coefficients2": "link 2's coefficients; left out: link 1's",
+    "forces": "the force terms: [[forces]] tables, each term = name and its parameters",
     "pin_mass": "kg, point mass at the pin",
     "pin_joint": "free, locked or { k = N m/rad, c = N m s/rad }",
     "body_mass": "kg, the leg carries half",
@@ -221,8 +222,20 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
             continue
         value = getattr(scene, name)
         note = _NOTES.get(name) if comments else None
+        if scene.forces is not None and name in (*_COEFFICIENT_TABLES, "effects"):
+            continue  # the terms carry their parameters
         if value is None:
             lines.append(f"# {name} = ...  ({note})" if note else f"# {name} = (left out)")
+            continue
+        if name == "forces":
+            for t in value:
+                tables.append("")
+                tables.append("[[forces]]")
+                tables.append(f"term = {_format_value(t.name)}")
+                tables.extend(
+                    f"{_format_key(k)} = {_format_value(list(v) if isinstance(v, tuple) else v)}"
+                    for k, v in t.params.items()
+                )
             continue
         if name in _COEFFICIENT_TABLES:
             table = value.as_dict() if isinstance(value, Coefficients) else dict(value)
@@ -288,6 +301,7 @@ def key_lines(text: str) -> dict[tuple[str, ...], int]:
     A plain scan of the text: table headers, ``key =`` lines and dotted keys; lines inside a
     multi-line string are skipped."""
     lines: dict[tuple[str, ...], int] = {}
+    arrays: dict[tuple[str, ...], int] = {}
     table: tuple[str, ...] = ()
     in_string: str | None = None
     for number, raw in enumerate(text.splitlines(), start=1):
@@ -298,6 +312,10 @@ def key_lines(text: str) -> dict[tuple[str, ...], int]:
         header = _HEADER_RE.match(raw)
         if header:
             table = _split_key(header.group(1))
+            if raw.lstrip().startswith("[["):
+                # An array of tables: the n-th is ("name", "#n").
+                count = arrays[table] = arrays.get(table, -1) + 1
+                table = (*table, f"#{count}")
             path = table
         else:
             key = _KEY_RE.match(raw)
@@ -405,6 +423,37 @@ def _coefficients(name: str, value: Any, locate: Callable[[tuple[str, ...]], str
         raise _reraise(exc, locate((name, sub) if sub else (name,))) from None
 
 
+def _forces(value: Any, locate: Callable[[tuple[str, ...]], str]) -> tuple[Any, ...]:
+    """The ``[[forces]]`` tables as terms: each ``term = "name"`` and its parameters (a
+    number, or a list with one per contact). An error names the term, the parameter and the
+    line of its ``[[forces]]`` table."""
+    from . import forces
+
+    if not isinstance(value, list) or not all(isinstance(t, dict) for t in value):
+        raise InvalidParameterError(
+            f"{locate(('forces',))}: forces must be [[forces]] tables, each with "
+            '`term = "name"` and its parameters',
+            field="forces",
+        )
+    out = []
+    for i, table in enumerate(value):
+        where = locate(("forces", f"#{i}"))
+        params = dict(table)
+        name = params.pop("term", None)
+        if not isinstance(name, str):
+            raise InvalidParameterError(
+                f'{where}: [[forces]] table {i + 1} needs `term = "name"` (one of '
+                f"{', '.join(forces.TERMS)})",
+                field="forces",
+            )
+        params = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
+        try:
+            out.append(forces.term(name, **params))
+        except InvalidSceneError as exc:
+            raise _reraise(exc, where) from None
+    return tuple(out)
+
+
 def _build(
     data: dict[str, Any],
     locate: Callable[[tuple[str, ...]], str],
@@ -429,6 +478,9 @@ def _build(
     for name, value in data.items():
         if name in _COEFFICIENT_TABLES:
             fields[name] = _coefficients(name, value, locate)
+            continue
+        if name == "forces":
+            fields[name] = _forces(value, locate)
             continue
         try:
             fields[name] = _as_field_value(name, value)

@@ -11,9 +11,10 @@ use nalgebra::{SVector, Vector2};
 use super::dense::{locate, locate_in, Hermite};
 use super::rk4::{deriv_of, dopri5_step, step, step_sampling, Deriv, State};
 use crate::dynamics::{
-    ContactMode, DragStiffness, Effects, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS,
+    ContactMode, DragStiffness, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS,
 };
 use crate::error::{GranrsError, Result};
+use crate::forces::{ForceSet, Switch};
 
 /// When a run ends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -213,6 +214,8 @@ pub struct Outcome {
     pub h_lambda: f64,
     /// Time series, if any were asked for.
     pub series: Option<Series>,
+    /// The terms that acted, in the scene's order.
+    pub terms: Vec<&'static str>,
 }
 
 /// `h lambda` beyond which the classical RK4 is unstable for a real, negative rate.
@@ -278,8 +281,8 @@ fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) 
         Kind::Exit => -c.lowest,
         Kind::SlipX => modes[ci].sx.sign() * c.v_centroid.x,
         Kind::SlipY => modes[ci].sy.sign() * c.v_centroid.y,
-        Kind::StickX => c.bound_h - c.force.static_h.abs(),
-        Kind::StickY => c.bound_v - c.force.static_v.abs(),
+        Kind::StickX => c.bound[0] - c.force.statics.x.abs(),
+        Kind::StickY => c.bound[1] - c.force.statics.y.abs(),
         Kind::Stop => -c.v_tip.y,
         Kind::Cross => modes[ci].cross.sign() * c.cross,
         Kind::Immersion => {
@@ -309,14 +312,15 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
         if with_modes {
             // A contact held in both directions has v_E = 0: no drag, and e x v_E is
             // round-off whose sign would flip back and forth (Zeno events).
-            let held = model.effects.static_h
-                && model.effects.static_v
-                && m.sx == Slip::Stick
-                && m.sy == Slip::Stick;
-            if model.effects.drag && !held {
+            let (own_x, own_y) = (
+                model.forces.owns(Switch::SlipX),
+                model.forces.owns(Switch::SlipY),
+            );
+            let held = own_x && own_y && m.sx == Slip::Stick && m.sy == Slip::Stick;
+            if model.forces.owns(Switch::Cross) && !held {
                 out.push((Kind::Cross, ci));
             }
-            if model.effects.static_h {
+            if own_x {
                 out.push((
                     if m.sx == Slip::Stick {
                         Kind::StickX
@@ -326,7 +330,7 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
                     ci,
                 ));
             }
-            if model.effects.static_v {
+            if own_y {
                 out.push((
                     if m.sy == Slip::Stick {
                         Kind::StickY
@@ -376,9 +380,9 @@ fn choose_slip<const N: usize>(
         stats.rhs_evals += 1;
         let c = e.contacts[ci];
         if axis == 0 {
-            (c.force.static_h, c.bound_h, c.v_centroid.x)
+            (c.force.statics.x, c.bound[0], c.v_centroid.x)
         } else {
-            (c.force.static_v, c.bound_v, c.v_centroid.y)
+            (c.force.statics.y, c.bound[1], c.v_centroid.y)
         }
     };
     let (mut reaction, mut bound, v) = judge(at, stats);
@@ -457,7 +461,7 @@ struct Recorder {
 }
 
 impl Recorder {
-    fn new(on: Record, effects: Effects, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
+    fn new(on: Record, forces: &ForceSet, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
         let mut names = Vec::new();
         if on.state {
             for i in 0..n_dof {
@@ -473,19 +477,13 @@ impl Recorder {
             let mut fields = vec![
                 "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "v_E_x", "v_E_y",
             ];
-            if effects.drag {
-                fields.extend(["F_dx", "F_dy"]);
+            for info in &forces.contact_info {
+                fields.extend(info.columns.iter().map(|(name, _)| *name));
             }
-            if effects.static_h {
-                fields.push("F_sh");
-            }
-            if effects.static_v {
-                fields.push("F_sv");
-            }
-            if effects.static_h {
+            if forces.owns(Switch::SlipX) {
                 fields.push("mode_x");
             }
-            if effects.static_v {
+            if forces.owns(Switch::SlipY) {
                 fields.push("mode_y");
             }
             for c in 0..n_contacts {
@@ -571,18 +569,17 @@ impl Recorder {
                 ] {
                     put(&mut self.cols, v);
                 }
-                let fx = model.effects;
-                for (on, v) in [
-                    (fx.drag, c.force.drag.x),
-                    (fx.drag, c.force.drag.y),
-                    (fx.static_h, c.force.static_h),
-                    (fx.static_v, c.force.static_v),
-                    (fx.static_h, mode(m.sx)),
-                    (fx.static_v, mode(m.sy)),
-                ] {
-                    if on {
-                        put(&mut self.cols, v);
+                let forces = &model.forces;
+                for (k, info) in forces.contact_info.iter().enumerate() {
+                    for &(_, axis) in info.columns {
+                        put(&mut self.cols, c.force.terms[k][axis]);
                     }
+                }
+                if forces.owns(Switch::SlipX) {
+                    put(&mut self.cols, mode(m.sx));
+                }
+                if forces.owns(Switch::SlipY) {
+                    put(&mut self.cols, mode(m.sy));
                 }
             }
             if self.n_links > 1 {
@@ -602,7 +599,9 @@ impl Recorder {
             if self.n_links > 1 {
                 let pose = model.mechanism.pose(&y.q);
                 for i in 0..self.n_links {
-                    let (k, p) = model.mechanism.link_energy(&pose, &y.qd, model.medium.g, i);
+                    let (k, p) = model
+                        .mechanism
+                        .link_energy(&pose, &y.qd, model.gravity(), i);
                     put(&mut self.cols, k);
                     put(&mut self.cols, p);
                 }
@@ -678,7 +677,9 @@ pub fn solve<const N: usize>(
     let n_links = model.mechanism.n_links();
     let link_energy = |y: &State<N>, i: usize| {
         let pose = model.mechanism.pose(&y.q);
-        model.mechanism.link_energy(&pose, &y.qd, model.medium.g, i)
+        model
+            .mechanism
+            .link_energy(&pose, &y.qd, model.gravity(), i)
     };
     let link_e0: Vec<(f64, f64)> = (0..n_links).map(|i| link_energy(&y, i)).collect();
     let mut joints = vec![JointSummary::default(); n_links];
@@ -694,7 +695,7 @@ pub fn solve<const N: usize>(
             }
         };
 
-    let mut recorder = Recorder::new(options.record, model.effects, N, nc, n_links);
+    let mut recorder = Recorder::new(options.record, &model.forces, N, nc, n_links);
     let stride = options.record.stride.max(1);
     let mut t = 0.0f64;
     // The evaluations at the step's start (`evals[cur]`) and end: an accepted step swaps
@@ -726,7 +727,7 @@ pub fn solve<const N: usize>(
         for (ci, s) in summaries.iter_mut().enumerate() {
             if !modes[ci].stopped {
                 let c = &e.contacts[ci];
-                let drag2 = c.force.drag.norm_squared();
+                let drag2 = c.force.dynamic.norm_squared();
                 if drag2 > s.f_d_max * s.f_d_max {
                     s.f_d_max = drag2.sqrt();
                 }
@@ -1085,6 +1086,7 @@ pub fn solve<const N: usize>(
         dissipated: y.dissipated,
         joints,
         series: recorder.finish(),
+        terms: model.forces.names.clone(),
     };
     check_outcome(model, &out)?;
     Ok(out)
@@ -1143,7 +1145,7 @@ fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> 
                 Shape::Sole(s) => s.length + s.height,
             })
             .sum::<f64>();
-    let scale = out.energy_start.abs() + mass * model.medium.g * size + 1e-12 * mass;
+    let scale = out.energy_start.abs() + mass * model.gravity() * size + 1e-12 * mass;
     let gain = out.energy_end - out.energy_start;
     if !out.energy_end.is_finite() || gain > DIVERGENCE_FACTOR * scale {
         return fail(format!(

@@ -5,6 +5,8 @@
 //! [`GranrsError`] becomes an instance of the matching class of `granrs.errors`, so that the
 //! Python and Rust layers share one exception tree.
 
+mod terms;
+
 use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -21,13 +23,14 @@ use crate::scene::AnyScene;
 use crate::spec::{word, SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
-fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
+pub(crate) fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
     let (class, field) = match &err {
         GranrsError::InvalidParameter { field, .. } => {
             ("InvalidParameterError", Some(field.clone()))
         }
         GranrsError::WrongType { field, .. } => ("InvalidParameterError", Some(field.clone())),
         GranrsError::UnknownName { field, .. } => ("UnknownNameError", Some(field.clone())),
+        GranrsError::UnknownParameter { field, .. } => ("UnknownNameError", Some(field.clone())),
         GranrsError::InvalidScene { field, .. } => ("InvalidSceneError", Some(field.clone())),
         GranrsError::NonFinite { .. } => ("SimulationError", None),
     };
@@ -79,9 +82,23 @@ fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         );
     }
     if let Ok(t) = v.cast::<PyTuple>() {
+        if let Some(first) = t.iter().next() {
+            if first.cast::<PyString>().is_err() {
+                if let Some(terms) = terms::terms_from_py(t.iter()) {
+                    return terms;
+                }
+            }
+        }
         return names_from_py(t.iter());
     }
     if let Ok(l) = v.cast::<PyList>() {
+        if let Some(first) = l.iter().next() {
+            if first.cast::<PyString>().is_err() {
+                if let Some(terms) = terms::terms_from_py(l.iter()) {
+                    return terms;
+                }
+            }
+        }
         return names_from_py(l.iter());
     }
     let type_name = v
@@ -153,6 +170,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     d.set_item("energy_start", out.energy_start)?;
     d.set_item("energy_end", out.energy_end)?;
     d.set_item("work_sand", out.work_sand)?;
+    d.set_item("terms", PyTuple::new(py, &out.terms)?)?;
     let contacts = PyList::empty(py);
     let stopped = PyList::empty(py);
     for c in &out.contacts {
@@ -632,12 +650,13 @@ fn resistance_force<'py>(
     check_range("diameter", diameter, 0.0, true).map_err(err)?;
     check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
     check_range("g", g, 0.0, false).map_err(err)?;
-    let mut spec = SceneSpec::new();
-    spec.set(
-        "effects",
-        Value::Names(effects.into_iter().map(Cow::Owned).collect()),
-    );
-    let effects = spec.effects().map_err(err)?.0;
+    let names: Vec<Cow<'static, str>> = effects.into_iter().map(Cow::Owned).collect();
+    // The terms' parameters come with each state; these are placeholders.
+    let forces = crate::spec::thesis_law(
+        Some(&names),
+        &[crate::forces::Coefficients::TABLE_3_4_VERTICAL],
+    )
+    .map_err(err)?;
     let sign = match sign_model {
         "raw" => Sign::Raw,
         "smooth" => Sign::Smooth(check_range("smooth_eps", smooth_eps, 0.0, true).map_err(err)?),
@@ -678,8 +697,8 @@ fn resistance_force<'py>(
     let setup = RodSetup {
         length,
         diameter,
-        medium: crate::force::Medium { rho_g, g },
-        effects,
+        medium: crate::forces::Medium { rho_g, g },
+        forces,
         sign,
     };
     let width = OUTPUTS.len();
@@ -735,6 +754,8 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RECORDS", RECORDS.to_vec())?;
     m.add("SCENE_FIELDS", SCENE_FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(leg_segments, m)?)?;
+    m.add_function(wrap_pyfunction!(terms::term_infos, m)?)?;
+    m.add_function(wrap_pyfunction!(terms::check_term, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,13 +1,30 @@
 //! Shared helpers of the cargo integration tests.
 #![allow(dead_code)]
 
-use _granrs::force::Coefficients;
+use _granrs::forces::Coefficients;
 use _granrs::scene::FreeLinkScene;
+
+/// The `static_v` term of a free link's force set (panics without one).
+pub fn static_v_of(s: &FreeLinkScene) -> Coefficients {
+    let k = s
+        .forces
+        .contact_info
+        .iter()
+        .position(|i| i.name == "static_v")
+        .unwrap();
+    let p = s.forces.per_contact[0][k].params();
+    Coefficients {
+        eta_h: f64::NAN,
+        eta_d: f64::NAN,
+        eta_v: p[0],
+        lambda: p[1],
+    }
+}
 
 /// Work done against F_sv by a vertical rod sunk to depth d (force at the tip): with
 /// l = min(d, L), int_0^d eta_v (s/L)^lambda g rho (pi d_c^2/4) min(s, L) ds.
 pub fn vertical_static_work(s: &FreeLinkScene, d: f64) -> f64 {
-    let c = s.coefficients;
+    let c = static_v_of(s);
     let a = c.eta_v * s.medium.g * s.medium.rho_g * std::f64::consts::PI * s.diameter.powi(2) / 4.0;
     let l = s.length;
     let lam = c.lambda;

@@ -1,0 +1,44 @@
+//! `gravity`: the weight of every link.
+//!
+//! ```text
+//! F_i = m_i g (0, -1)   at each link's centre of mass
+//! ```
+//!
+//! - **Source:** `shared/MODEL.md`, "Frame and notation" (g = 9.81 m/s^2, as in the thesis).
+//! - **Parameters:** none; g is the medium's (`Scene.g`), which also scales the static
+//!   terms whether or not this term acts.
+//! - **Reads:** each link's mass and centre of mass.
+//! - **Switches:** none.
+//! - **Energy:** with this term the potential energy is gravity's, m g y; without it the
+//!   body has none from gravity (a free link with nothing acting keeps E = KE).
+
+use super::{Acts, Class, Term, TermInfo};
+
+/// Gravity on the body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gravity;
+
+impl Term for Gravity {
+    const INFO: TermInfo = TermInfo {
+        name: "gravity",
+        summary: "the weight of every link, at its centre of mass",
+        equation: "F_i = -m_i g y_hat  (each link i)",
+        source: "shared/MODEL.md, frame and notation",
+        params: &[],
+        acts: Acts::Body,
+        class: Class::Static,
+        velocity_dependent: false,
+        reads: "each link's mass and centre of mass; g of the medium",
+        reads_area_speed: false,
+        switches: &[],
+        columns: &[],
+    };
+
+    fn from_params(_values: &[f64]) -> Self {
+        Gravity
+    }
+
+    fn params(&self) -> Vec<f64> {
+        Vec::new()
+    }
+}

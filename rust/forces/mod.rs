@@ -1,0 +1,227 @@
+//! Force terms: the open model's unit of physics.
+//!
+//! A scene lists the terms that act on its body ([`ForceSet`]); a term that is not listed is
+//! neither evaluated nor stored, and its sign switches are not watched. Each term is one file
+//! here, opening (as a REBOUNDx effect does) with its equation in granrs's frame
+//! (`shared/MODEL.md`: x right, y up, sand surface at y = 0), its source, its parameters with
+//! units and defaults, and the switches it owns. Its [`TermInfo`] is the one description of
+//! it: validation, the TOML tables, the Python constructors (`granrs.forces`), the docs and
+//! the error messages all read it.
+//!
+//! Two kinds of term:
+//! - **contact terms** ([`Acts::Contact`]: `drag`, `static_h`, `static_v`) read one
+//!   contact's geometry and kinematics ([`ContactState`]) and return the force on it
+//!   ([`TermForce`]), applied at the scene's point of application; their parameters may
+//!   differ per contact;
+//! - **body terms** ([`Acts::Body`]: `gravity`, `joint_springs`) act through the mechanism
+//!   (the weight of every link, the joints' spring-dampers) and have no per-contact force.
+//!
+//! A term's arithmetic is generic over [`Real`], so that the same code can later run on
+//! several scenes at once in SIMD lanes (a lane type implementing [`Real`]) without a second
+//! copy of the physics.
+//!
+//! Adding a term: one file with a struct implementing [`Term`], one line in the registry
+//! (`registry.rs`), one constructor in `python/granrs/forces.py`. See `docs/forces.md`.
+
+use std::fmt::Debug;
+use std::ops::{Add, Mul, Neg, Sub};
+
+pub mod drag;
+pub mod gravity;
+pub mod joint_springs;
+pub mod registry;
+pub mod static_h;
+pub mod static_v;
+
+pub use registry::{AnyTerm, Coefficients, ForceSet, TermSpec, TERMS};
+
+/// The number type of a term's arithmetic: `f64` for one scene; a SIMD lane type for several
+/// scenes at once (later). Only the operations the terms use.
+pub trait Real:
+    Copy + Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+{
+    /// The value `x` (in every lane).
+    fn splat(x: f64) -> Self;
+    /// `self^e`.
+    fn powf(self, e: Self) -> Self;
+    /// `1 / self`.
+    fn recip(self) -> Self;
+}
+
+impl Real for f64 {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn powf(self, e: Self) -> Self {
+        f64::powf(self, e)
+    }
+    #[inline(always)]
+    fn recip(self) -> Self {
+        1.0 / self
+    }
+}
+
+/// The granular medium (and the gravity that loads it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Medium<F = f64> {
+    /// Bulk density of the sand, packing included [kg/m^3] (thesis sec. 3.3.1: 1650).
+    pub rho_g: F,
+    /// Gravitational acceleration [m/s^2] (9.81, as in the thesis). The static terms scale
+    /// with it whether or not the `gravity` term acts on the body.
+    pub g: F,
+}
+
+impl Default for Medium {
+    fn default() -> Self {
+        Medium {
+            rho_g: 1650.0,
+            g: 9.81,
+        }
+    }
+}
+
+/// What a contact term reads: one contact's geometry and kinematics below the surface
+/// (`shared/MODEL.md`, "Contact geometry"). The engine fills it once per contact and
+/// evaluation, and evaluates a contact term only where `depth > 0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactState<F> {
+    /// Depth of the contact d [m] (a rod's tip depth; a sole's immersed area / f_s).
+    pub depth: F,
+    /// Immersed volume V [m^3] (a rod's pi d_c^2 / 4 l).
+    pub volume: F,
+    /// Width w of the contact [m] (d_c for a rod, the sole length f_s for a foot).
+    pub width: F,
+    /// Reference length L_ref of the depth factor [m] (the rod length; the tibia).
+    pub l_ref: F,
+    /// Velocity of the immersed centroid E, v_E [m/s].
+    pub v: [F; 2],
+    /// Reference area times speed, A_r |v_E| [m^2/s] (a rod's d_c l |e x v_E|, with the sign
+    /// of e x v_E held through the step in the `modes` sign model).
+    pub area_speed: F,
+    /// The signs of v_Ex and v_Ey as the sign model gives them: held (-1, 0 or +1, 0 where
+    /// sticking), plain `sign()`, or `tanh(v / eps)`.
+    pub sign: [F; 2],
+}
+
+/// What a contact term returns: its force and, for a set-valued (Coulomb-like) term, the
+/// bound of the reaction it can supply when the velocity component it opposes is held at
+/// zero (sticking).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TermForce<F> {
+    /// Force on the contact (x, y) [N].
+    pub force: [F; 2],
+    /// Largest reaction along x and y it supplies while sticking [N] (zero for a term that
+    /// owns no slip switch).
+    pub bound: [F; 2],
+}
+
+/// The discrete switches of the engine a term can own. The solver watches a switch only
+/// while a listed term owns it ("modes" sign model), locates its crossing inside the step,
+/// and holds the mode between crossings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Switch {
+    /// The sign of e x v_E (a rod's drag reference area |e x v_E| has a kink at 0).
+    Cross,
+    /// The sign of v_Ex, with sticking in x (Karnopp) when both sides push back.
+    SlipX,
+    /// The sign of v_Ey, with sticking in y.
+    SlipY,
+}
+
+impl Switch {
+    /// The switch's name, as the docs write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Switch::Cross => "sign of e x v_E",
+            Switch::SlipX => "sign of v_Ex, sticking in x",
+            Switch::SlipY => "sign of v_Ey, sticking in y",
+        }
+    }
+}
+
+/// Where a term acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Acts {
+    /// On each contact in the sand, at the scene's point of application.
+    Contact,
+    /// On the body through its mechanism (every link's weight, the joints).
+    Body,
+}
+
+/// Which of the thesis's summary forces a contact term adds to: the dynamic force F_d
+/// (eq. 3.23; its largest magnitude, `F_d_max`) or the static F_s (eq. 3.22; `F_s_end`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Class {
+    /// Grows with speed (F_d).
+    Dynamic,
+    /// Depends on the velocity only through a sign (F_s).
+    Static,
+}
+
+/// One parameter of a term.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Param {
+    /// Its name (`static_v.eta_v` in errors and calibration).
+    pub name: &'static str,
+    /// Unit ("-" for dimensionless).
+    pub unit: &'static str,
+    /// Default value.
+    pub default: f64,
+    /// Where the default comes from.
+    pub source: &'static str,
+    /// Smallest allowed value (inclusive); every value must also be finite.
+    pub min: f64,
+    /// What it is.
+    pub description: &'static str,
+}
+
+/// Everything known about a term, for validation, docs, TOML and errors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TermInfo {
+    /// The name a scene lists (`granrs.forces.term(name)`, TOML `term = "name"`).
+    pub name: &'static str,
+    /// One line: what the term is.
+    pub summary: &'static str,
+    /// The term in granrs's frame, as plain text.
+    pub equation: &'static str,
+    /// Paper, thesis section and equation numbers.
+    pub source: &'static str,
+    /// Its parameters, in the order of [`Term::from_params`].
+    pub params: &'static [Param],
+    /// Where it acts.
+    pub acts: Acts,
+    /// For a contact term, which summary force it adds to.
+    pub class: Class,
+    /// Whether its magnitude grows with speed.
+    pub velocity_dependent: bool,
+    /// What it reads of the state.
+    pub reads: &'static str,
+    /// Whether it reads [`ContactState::area_speed`] (computed only when a listed term
+    /// does: a sole's projected area is a polygon clip).
+    pub reads_area_speed: bool,
+    /// The switches it owns.
+    pub switches: &'static [Switch],
+    /// Its per-contact series columns (`c{i}.{column}` with `record=("forces",)`) and the
+    /// force component each holds (0 = x, 1 = y).
+    pub columns: &'static [(&'static str, usize)],
+}
+
+/// A force term. Implemented by one struct per file; the registry lists them.
+pub trait Term: Copy + Debug + PartialEq {
+    /// The term's description.
+    const INFO: TermInfo;
+    /// The term from its parameter values, in the order of `INFO.params`, already checked.
+    fn from_params(values: &[f64]) -> Self;
+    /// Its parameter values, in the order of `INFO.params`.
+    fn params(&self) -> Vec<f64>;
+    /// The force on one contact in the sand (contact terms; body terms return zero).
+    #[inline(always)]
+    fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce {
+            force: [F::splat(0.0); 2],
+            bound: [F::splat(0.0); 2],
+        }
+    }
+}

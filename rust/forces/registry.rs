@@ -1,0 +1,407 @@
+//! The registry of force terms, and a scene's [`ForceSet`].
+//!
+//! One line per term in [`registry!`]: the macro builds [`AnyTerm`] (an enum, so that the
+//! hot path dispatches with a `match`, not a virtual call) and [`TERMS`], every term's
+//! [`TermInfo`] in the order the docs list them.
+
+use super::{
+    drag, gravity, joint_springs, static_h, static_v, Acts, Class, ContactState, Medium, Real,
+    Switch, Term, TermForce, TermInfo,
+};
+use crate::error::{suggest, GranrsError, Result};
+
+/// Most contact terms a scene may list (the per-term forces of an evaluation are a
+/// fixed-size array, so that an evaluation allocates nothing).
+pub const MAX_TERMS: usize = 6;
+
+macro_rules! registry {
+    ($($variant:ident($ty:ty),)*) => {
+        /// Any registered term, with its parameters for one contact.
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum AnyTerm {
+            $(#[doc = concat!("[`", stringify!($ty), "`]")] $variant($ty),)*
+        }
+
+        /// Every registered term's description.
+        pub static TERMS: &[&TermInfo] = &[$(&<$ty as Term>::INFO,)*];
+
+        impl AnyTerm {
+            /// The term's description.
+            pub fn info(&self) -> &'static TermInfo {
+                match self {
+                    $(AnyTerm::$variant(_) => &<$ty as Term>::INFO,)*
+                }
+            }
+
+            /// Its parameter values, in the order of its `info().params`.
+            pub fn params(&self) -> Vec<f64> {
+                match self {
+                    $(AnyTerm::$variant(t) => t.params(),)*
+                }
+            }
+
+            /// The term `name` from checked parameter values (`None`: no such term).
+            fn from_name(name: &str, values: &[f64]) -> Option<AnyTerm> {
+                $(if name == <$ty as Term>::INFO.name {
+                    return Some(AnyTerm::$variant(<$ty as Term>::from_params(values)));
+                })*
+                None
+            }
+
+            /// The force on one contact in the sand.
+            #[inline(always)]
+            pub fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+                match self {
+                    $(AnyTerm::$variant(t) => t.contact_force(c, m),)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    Gravity(gravity::Gravity),
+    Drag(drag::Drag),
+    StaticH(static_h::StaticH),
+    StaticV(static_v::StaticV),
+    JointSprings(joint_springs::JointSprings),
+}
+
+/// The description of the term `name`, or a typed error naming it (with a near miss).
+pub fn info_of(name: &str) -> Result<&'static TermInfo> {
+    TERMS
+        .iter()
+        .copied()
+        .find(|t| t.name == name)
+        .ok_or_else(|| unknown_term(name))
+}
+
+#[cold]
+#[inline(never)]
+fn unknown_term(name: &str) -> GranrsError {
+    let names: Vec<&str> = TERMS.iter().map(|t| t.name).collect();
+    let hint = suggest(name, names.iter().copied())
+        .map(|s| format!("; did you mean `{s}`?"))
+        .unwrap_or_default();
+    GranrsError::UnknownName {
+        field: "term".into(),
+        value: name.into(),
+        allowed: format!("{}{hint}", names.join(", ")),
+    }
+}
+
+/// A row of the thesis's coefficient tables (Tables 3.4, 4.4, sec. 5.3.2): the parameters
+/// of its law's three contact terms, for [`ForceSet::thesis`]. Not a scene field: a scene
+/// holds its terms, each with its own parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients {
+    /// `static_h.eta_h` [-].
+    pub eta_h: f64,
+    /// `drag.eta_d` [-].
+    pub eta_d: f64,
+    /// `static_v.eta_v` [-].
+    pub eta_v: f64,
+    /// `static_v.lam` [-].
+    pub lambda: f64,
+}
+
+impl Coefficients {
+    /// Table 3.4 of the thesis at q = 0 (the vertical rod): the terms' defaults.
+    pub const TABLE_3_4_VERTICAL: Coefficients = Coefficients {
+        eta_h: 6.5,
+        eta_d: 15.2,
+        eta_v: 248.0,
+        lambda: 0.106,
+    };
+
+    /// (eta_h, eta_d, eta_v, lambda).
+    pub fn as_array(&self) -> [f64; 4] {
+        [self.eta_h, self.eta_d, self.eta_v, self.lambda]
+    }
+}
+
+/// One term as a scene lists it: its name and its parameters, each one value for every
+/// contact or one per contact.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TermSpec {
+    /// The term's name.
+    pub name: String,
+    /// Its parameters by name; a missing one takes its default.
+    pub params: Vec<(String, Vec<f64>)>,
+}
+
+impl TermSpec {
+    /// The term `name` with `params` given once for every contact.
+    pub fn new(name: &str, params: &[(&str, f64)]) -> Self {
+        TermSpec {
+            name: name.into(),
+            params: params
+                .iter()
+                .map(|(k, v)| ((*k).to_string(), vec![*v]))
+                .collect(),
+        }
+    }
+
+    /// Check the term and its parameters for a body with `n_contacts` contacts, and give the
+    /// values per contact (`[contact][param]`, in the order of the term's `params`).
+    pub fn resolve(&self, n_contacts: usize) -> Result<(&'static TermInfo, Vec<Vec<f64>>)> {
+        let info = info_of(&self.name)?;
+        for (k, _) in &self.params {
+            if !info.params.iter().any(|p| p.name == k) {
+                return Err(unknown_param(info, k));
+            }
+        }
+        let mut per_contact = vec![Vec::with_capacity(info.params.len()); n_contacts.max(1)];
+        for p in info.params {
+            let field = || format!("{}.{}", info.name, p.name);
+            let given = self
+                .params
+                .iter()
+                .rev()
+                .find(|(k, _)| k == p.name)
+                .map(|(_, v)| v.as_slice());
+            let values: Vec<f64> = match given {
+                None => vec![p.default],
+                Some(v) => v.to_vec(),
+            };
+            if values.len() != 1 && values.len() != n_contacts {
+                return Err(GranrsError::InvalidScene {
+                    field: field(),
+                    message: format!(
+                        "{} values given; one for every contact or one per contact ({n_contacts})",
+                        values.len()
+                    ),
+                });
+            }
+            for &v in &values {
+                if !(v.is_finite() && v >= p.min) {
+                    return Err(GranrsError::InvalidParameter {
+                        field: field(),
+                        value: v,
+                        allowed: format!("finite, >= {} ({} [{}])", p.min, p.description, p.unit),
+                    });
+                }
+            }
+            for (ci, row) in per_contact.iter_mut().enumerate() {
+                row.push(if values.len() == 1 {
+                    values[0]
+                } else {
+                    values[ci]
+                });
+            }
+        }
+        Ok((info, per_contact))
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn unknown_param(info: &TermInfo, name: &str) -> GranrsError {
+    let names: Vec<&str> = info.params.iter().map(|p| p.name).collect();
+    let hint = suggest(name, names.iter().copied())
+        .map(|s| format!("; did you mean `{}.{s}`?", info.name))
+        .unwrap_or_default();
+    GranrsError::UnknownParameter {
+        field: format!("{}.{name}", info.name),
+        allowed: if names.is_empty() {
+            format!("{} takes no parameters", info.name)
+        } else {
+            format!("{} takes {}", info.name, names.join(", "))
+        },
+        hint,
+    }
+}
+
+/// The terms a scene lists, ready for the engine: which body terms act, and each contact
+/// term with its parameters per contact, in the scene's order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceSet {
+    /// Every listed term's name, in the scene's order.
+    pub names: Vec<&'static str>,
+    /// Whether `gravity` acts.
+    pub gravity: bool,
+    /// Whether `joint_springs` acts.
+    pub joint_springs: bool,
+    /// The contact terms per contact, in the scene's order: `per_contact[c][k]`.
+    pub per_contact: Vec<Vec<AnyTerm>>,
+    /// The contact terms' descriptions, in the same order.
+    pub contact_info: Vec<&'static TermInfo>,
+    /// Whether some listed term owns each switch ([`Switch::Cross`], `SlipX`, `SlipY`).
+    pub owns: [bool; 3],
+    /// Whether a listed term reads A_r |v_E|.
+    pub reads_area_speed: bool,
+}
+
+impl ForceSet {
+    /// Check `specs` for a body with `n_contacts` contacts. Every error names the term and
+    /// parameter (`static_v.eta_v`), before any work starts.
+    pub fn build(specs: &[TermSpec], n_contacts: usize) -> Result<ForceSet> {
+        let mut set = ForceSet {
+            names: Vec::with_capacity(specs.len()),
+            gravity: false,
+            joint_springs: false,
+            per_contact: vec![Vec::new(); n_contacts],
+            contact_info: Vec::new(),
+            owns: [false; 3],
+            reads_area_speed: false,
+        };
+        for spec in specs {
+            let (info, values) = spec.resolve(n_contacts)?;
+            if set.names.contains(&info.name) {
+                return Err(GranrsError::InvalidScene {
+                    field: "forces".into(),
+                    message: format!("`{}` is listed twice", info.name),
+                });
+            }
+            set.names.push(info.name);
+            match info.acts {
+                Acts::Body => {
+                    set.gravity |= info.name == gravity::Gravity::INFO.name;
+                    set.joint_springs |= info.name == joint_springs::JointSprings::INFO.name;
+                }
+                Acts::Contact => {
+                    if set.contact_info.len() == MAX_TERMS {
+                        return Err(GranrsError::InvalidScene {
+                            field: "forces".into(),
+                            message: format!("at most {MAX_TERMS} contact terms"),
+                        });
+                    }
+                    set.contact_info.push(info);
+                    for (ci, row) in set.per_contact.iter_mut().enumerate() {
+                        let term =
+                            AnyTerm::from_name(info.name, &values[ci]).expect("a registered term");
+                        row.push(term);
+                    }
+                    for s in info.switches {
+                        set.owns[*s as usize] = true;
+                    }
+                    set.reads_area_speed |= info.reads_area_speed;
+                }
+            }
+        }
+        Ok(set)
+    }
+
+    /// Whether a listed term owns `switch`.
+    #[inline(always)]
+    pub fn owns(&self, switch: Switch) -> bool {
+        self.owns[switch as usize]
+    }
+
+    /// Whether the k-th contact term adds to the dynamic force F_d.
+    #[inline(always)]
+    pub fn is_dynamic(&self, k: usize) -> bool {
+        self.contact_info[k].class == Class::Dynamic
+    }
+
+    /// The listed terms as specs (per-contact values collapsed where all contacts agree).
+    pub fn specs(&self) -> Vec<TermSpec> {
+        let mut out = Vec::with_capacity(self.names.len());
+        let mut k = 0;
+        for &name in &self.names {
+            let info = info_of(name).expect("a listed term");
+            let mut params = Vec::new();
+            if info.acts == Acts::Contact {
+                for (pi, p) in info.params.iter().enumerate() {
+                    let vals: Vec<f64> = self
+                        .per_contact
+                        .iter()
+                        .map(|row| row[k].params()[pi])
+                        .collect();
+                    let same = vals.windows(2).all(|w| w[0] == w[1]);
+                    let vals = if same { vals[..1].to_vec() } else { vals };
+                    params.push((p.name.to_string(), vals));
+                }
+                k += 1;
+            }
+            out.push(TermSpec {
+                name: name.into(),
+                params,
+            });
+        }
+        out
+    }
+
+    /// The thesis's law: gravity, drag, static_h, static_v and the joints' springs, with
+    /// a row of the thesis's coefficient tables per contact.
+    pub fn thesis(per_contact: &[Coefficients]) -> ForceSet {
+        let col = |i: usize| {
+            per_contact
+                .iter()
+                .map(|c| c.as_array()[i])
+                .collect::<Vec<_>>()
+        };
+        let specs = [
+            TermSpec::new("gravity", &[]),
+            TermSpec {
+                name: "drag".into(),
+                params: vec![("eta_d".into(), col(1))],
+            },
+            TermSpec {
+                name: "static_h".into(),
+                params: vec![("eta_h".into(), col(0))],
+            },
+            TermSpec {
+                name: "static_v".into(),
+                params: vec![("eta_v".into(), col(2)), ("lam".into(), col(3))],
+            },
+            TermSpec::new("joint_springs", &[]),
+        ];
+        ForceSet::build(&specs, per_contact.len()).expect("the thesis's law")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_term_is_registered_once_with_its_own_name() {
+        let mut names: Vec<&str> = TERMS.iter().map(|t| t.name).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), TERMS.len());
+        for t in TERMS {
+            let term = AnyTerm::from_name(
+                t.name,
+                &t.params.iter().map(|p| p.default).collect::<Vec<_>>(),
+            );
+            assert_eq!(term.map(|x| x.info().name), Some(t.name));
+        }
+    }
+
+    #[test]
+    fn unknown_terms_and_parameters_are_named_with_a_near_miss() {
+        let err = ForceSet::build(&[TermSpec::new("stati_v", &[])], 1).unwrap_err();
+        assert!(err.to_string().contains("did you mean `static_v`"), "{err}");
+        let err = ForceSet::build(&[TermSpec::new("static_v", &[("eta", 1.0)])], 1).unwrap_err();
+        assert!(
+            matches!(&err, GranrsError::UnknownParameter { field, .. } if field == "static_v.eta")
+        );
+        assert!(
+            err.to_string().contains("did you mean `static_v.eta_v`"),
+            "{err}"
+        );
+        let err = ForceSet::build(&[TermSpec::new("drag", &[("eta_d", -1.0)])], 1).unwrap_err();
+        assert!(
+            matches!(&err, GranrsError::InvalidParameter { field, .. } if field == "drag.eta_d")
+        );
+        let err =
+            ForceSet::build(&[TermSpec::new("static_v", &[("lam", f64::NAN)])], 1).unwrap_err();
+        assert!(
+            matches!(&err, GranrsError::InvalidParameter { field, .. } if field == "static_v.lam")
+        );
+    }
+
+    #[test]
+    fn parameters_per_contact_or_for_all() {
+        let spec = TermSpec {
+            name: "static_v".into(),
+            params: vec![("eta_v".into(), vec![1.0, 2.0]), ("lam".into(), vec![0.5])],
+        };
+        let set = ForceSet::build(std::slice::from_ref(&spec), 2).unwrap();
+        assert_eq!(set.per_contact[1][0].params(), vec![2.0, 0.5]);
+        assert_eq!(set.specs()[0], spec);
+        assert!(ForceSet::build(&[spec], 3).is_err());
+    }
+}

@@ -1,0 +1,70 @@
+//! `static_h`: the thesis's static horizontal term, growing with the square of the depth.
+//!
+//! ```text
+//! F_sh = - sgn(v_Ex) * eta_h * g * rho_g * w * d^2        (along x)
+//! ```
+//!
+//! with `w` the contact's width (d_c for a rod, the sole length f_s for a foot, as in
+//! eq. 5.3) and `d` its depth.
+//!
+//! - **Source:** the thesis, eqs. 2.2 and 3.2 (`shared/MODEL.md`, "Resistance force").
+//! - **Parameters:** `eta_h` [-], the horizontal static scaling constant; default 6.5, thesis
+//!   Table 3.4 at q = 0.
+//! - **Reads:** the medium's g and rho_g, the contact's width and depth, the sign of v_Ex.
+//! - **Switches:** the sign of v_Ex, with sticking ([`Switch::SlipX`]): the term is
+//!   Coulomb-like; in the `modes` sign model its sign is held through a step, the switch is
+//!   located, and where both sides push back v_Ex is held at zero by a reaction bounded by
+//!   the term's magnitude (Karnopp).
+//! - **Series:** `F_sh` (and `mode_x`, the held sign).
+
+use super::{Acts, Class, ContactState, Medium, Param, Real, Switch, Term, TermForce, TermInfo};
+
+/// The static horizontal term F_sh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticH {
+    /// Horizontal static scaling constant eta_h [-].
+    pub eta_h: f64,
+}
+
+impl Term for StaticH {
+    const INFO: TermInfo = TermInfo {
+        name: "static_h",
+        summary: "static horizontal resistance, Coulomb-like in the sign of v_Ex",
+        equation: "F_sh = -sgn(v_Ex) eta_h g rho_g w d^2  (along x)",
+        source: "thesis eqs. 2.2, 3.2 (shared/MODEL.md)",
+        params: &[Param {
+            name: "eta_h",
+            unit: "-",
+            default: 6.5,
+            source: "thesis Table 3.4, q = 0",
+            min: 0.0,
+            description: "horizontal static scaling constant",
+        }],
+        acts: Acts::Contact,
+        class: Class::Static,
+        velocity_dependent: false,
+        reads: "g, rho_g; the contact's width w, depth d and the sign of v_Ex",
+        reads_area_speed: false,
+        switches: &[Switch::SlipX],
+        columns: &[("F_sh", 0)],
+    };
+
+    fn from_params(values: &[f64]) -> Self {
+        StaticH { eta_h: values[0] }
+    }
+
+    fn params(&self) -> Vec<f64> {
+        vec![self.eta_h]
+    }
+
+    #[inline(always)]
+    fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        let zero = F::splat(0.0);
+        let rg = m.g * m.rho_g;
+        let bound = F::splat(self.eta_h) * rg * c.width * c.depth * c.depth;
+        TermForce {
+            force: [-c.sign[0] * bound, zero],
+            bound: [bound, zero],
+        }
+    }
+}
