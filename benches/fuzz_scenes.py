@@ -43,7 +43,7 @@ import time
 from typing import Any
 
 import granrs
-from granrs import Scene, _granrs, cases, scenefile
+from granrs import Scene, _granrs, cases, forces, scenefile
 from granrs.errors import GranrsError
 
 FIELDS = [
@@ -176,6 +176,12 @@ def base_scenes() -> list[Scene]:
         cases.leg(v0=2.35, joints={"k": 300.0, "c": 5.0}),
         Scene(body="chain", pin_joint={"k": 1.0, "c": 0.1}, record=("state",)),
         Scene(method="dopri5", sign_model="smooth", end="time"),
+        # Force terms as [[forces]] tables, per contact on the chain (issue 16).
+        cases.free_link(45.0, 1.0, forces=[forces.gravity(), forces.static_v(eta_v=100.0)]),
+        cases.chain(
+            case=1, forces=[forces.gravity(), forces.drag(eta_d=(13.0, 10.0)), forces.static_h()]
+        ),
+        cases.leg(v0=3.28, forces=[]),
     ]
 
 
@@ -204,7 +210,13 @@ def mutate_toml(rng: random.Random, text: str) -> str:
                 lines[i] = f"{rng.choice(FIELDS)}{rng.choice(['', 'x', '.k', '2'])} ={rest}"
         elif op == 6:
             lines.insert(
-                i, rng.choice(["[coefficients]", "[coefficients2]", "[knee]", "[[q_deg]]", "[x.y]"])
+                i,
+                rng.choice(
+                    [
+                        *("[coefficients]", "[coefficients2]", "[knee]", "[[q_deg]]", "[x.y]"),
+                        *("[[forces]]", 'term = "drag"', 'term = "stati_v"', "eta_d = [1.0]"),
+                    ]
+                ),
             )
         elif op == 7 and lines:  # insert or flip characters
             line = lines[i]

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 import granrs
-from granrs import Coefficients, Scene
+from granrs import Coefficients, Scene, forces
 
 SCALE = {"eta_h": 6.5, "eta_d": 15.2, "eta_v": 248.0, "lam": 0.106}
 SIGN_MODELS = ("modes", "raw", "smooth")
@@ -71,12 +71,9 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
                 vx0=float(vx0[i]),
                 omega0=float(omega0[i]),
                 mass=float(mass[i]),
-                coefficients=Coefficients(
-                    eta_h=SCALE["eta_h"] * f[0],
-                    eta_d=SCALE["eta_d"] * f[1],
-                    eta_v=SCALE["eta_v"] * f[2],
-                    lam=SCALE["lam"] * f[3],
-                ),
+                # A third of the scenes give the law as force terms: a random subset of
+                # the thesis's terms (issue 16), the rest as coefficients.
+                **_law(rng, f),
                 dt=float(dt[i]),
                 t_end=float(t_end[i]),
                 sign_model=SIGN_MODELS[sign[i]],
@@ -86,7 +83,23 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
     return out
 
 
+def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
+    values = {k: SCALE[k] * x for k, x in zip(("eta_h", "eta_d", "eta_v", "lam"), f, strict=True)}
+    if rng.random() >= 1 / 3:
+        return {"coefficients": Coefficients(**values)}
+    terms = [
+        forces.gravity(),
+        forces.drag(eta_d=values["eta_d"]),
+        forces.static_h(eta_h=values["eta_h"]),
+        forces.static_v(eta_v=values["eta_v"], lam=values["lam"]),
+    ]
+    keep = rng.random(len(terms)) < 0.75
+    return {"forces": [t for t, k in zip(terms, keep, strict=True) if k]}
+
+
 def describe(scene: Scene) -> str:
+    if scene.forces is not None:
+        return f"{scene!r}"
     c = scene.coefficients
     return (
         f"Scene(q_deg={scene.q_deg!r}, v0={scene.v0!r}, vx0={scene.vx0!r}, "
