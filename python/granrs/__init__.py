@@ -15,6 +15,7 @@ Quick start::
 from __future__ import annotations
 
 from . import _granrs, cases, coefficients, data, forces, scenefile
+from .animate import ImpactAnimation, animate
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
@@ -47,6 +48,7 @@ __all__ = [
     "ContactResult",
     "Effect",
     "GranrsError",
+    "ImpactAnimation",
     "InvalidParameterError",
     "InvalidSceneError",
     "MeasurementError",
@@ -58,6 +60,7 @@ __all__ = [
     "StepSizeWarning",
     "UnknownNameError",
     "__version__",
+    "animate",
     "calibrate",
     "cases",
     "coefficients",

@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import html
 import math
+import os
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .scene import Scene
+
+if TYPE_CHECKING:
+    from .animate import ImpactAnimation
 
 __all__ = ["JOINT_NAMES", "LINK_NAMES", "SUMMARY_UNITS", "ContactResult", "Result"]
 
@@ -202,6 +207,66 @@ class Result:
             raise ValueError("nothing was recorded: set Scene.record, e.g. record=('state',)")
         frame = pd.DataFrame(self.series)
         return frame.set_index("t")
+
+    def animate(
+        self,
+        frame_dt: float | None = None,
+        speed: float | None = None,
+        fps: float | None = None,
+        *,
+        out: str | os.PathLike[str] | None = None,
+        dpi: float = 100.0,
+    ) -> ImpactAnimation:
+        """An animation of this run from its recorded series (the scene must record
+        ``"state"``, and ``"forces"`` for the force arrows): see :func:`granrs.animate`.
+
+        Args:
+            frame_dt: simulated time per frame [s]; the animation has
+                ``floor(t_end / frame_dt) + 1`` frames.
+            speed: simulated seconds per second of movie [-] (``frame_dt * fps``).
+            fps: frames per second of the movie [1/s].
+            out: also write it to this ``.gif``, ``.mp4`` or ``.html`` file.
+            dpi: resolution of written frames [dots per inch].
+        """
+        from .animate import animate
+
+        return animate(self, frame_dt, speed, fps, out=out, dpi=dpi)
+
+    def _repr_html_(self) -> str:
+        """Jupyter: the status and a compact table of each contact's results with units."""
+        names = LINK_NAMES.get(self.scene.body, ())
+        columns = (
+            ("t_s", "t_s [ms]", 1e3),
+            ("depth", "depth [mm]", 1e3),
+            ("dq", "dq [deg]", 180.0 / math.pi),
+            ("F_d_max", "F_d_max [N]", 1.0),
+            ("F_r_end", "F_r_end [N]", 1.0),
+            ("dE", "dE [J]", 1.0),
+        )
+
+        def cell(value: Any, factor: float) -> str:
+            try:
+                number = float(value) * factor
+            except (TypeError, ValueError):
+                return "-"
+            return "-" if math.isnan(number) else f"{number:.4g}"
+
+        head = "".join(f"<th>{html.escape(title)}</th>" for _, title, _ in columns)
+        rows = []
+        for i, c in enumerate(self.contacts):
+            name = names[i] if i < len(names) else f"c{i}"
+            cells = "".join(f"<td>{cell(c.summary.get(k), f)}</td>" for k, _, f in columns)
+            stopped = "yes" if c.stopped else "no"
+            rows.append(f"<tr><td>{html.escape(name)}</td><td>{stopped}</td>{cells}</tr>")
+        summary = self.summary
+        caption = (
+            f"granrs {html.escape(self.scene.body)}: {html.escape(self.status)}, "
+            f"{summary.get('steps', '-')} steps, {summary.get('rhs_evals', '-')} rhs evaluations"
+        )
+        return (
+            f"<table><caption>{caption}</caption>"
+            f"<tr><th>contact</th><th>stopped</th>{head}</tr>{''.join(rows)}</table>"
+        )
 
     def __repr__(self) -> str:
         t_s = "not stopped" if math.isnan(self.t_s) else f"{self.t_s * 1e3:.4f} ms"

@@ -1,0 +1,437 @@
+"""``granrs.animate``, ``Result.animate`` and ``granrs animate`` (issue 20: an impact you can
+watch): frame count and times, frames that change, the body and the arrows where the recorded
+numbers put them, typed errors before anything is drawn, the CLI writing a GIF per example
+scene, and ``Result._repr_html_``.
+
+Expected positions and forces come from the recorded series (the core's own ``tip_x``,
+``tip_y``, ``depth``, ``v_E_x`` ... columns), never from the drawing code.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib import animation as mpl_animation
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from PIL import Image
+
+import granrs
+from granrs import cases
+from granrs.animate import ImpactAnimation, check_output, frame_count, playback
+from granrs.cli import main
+from granrs.errors import GranrsError, InvalidParameterError
+
+# The module (granrs.animate, the attribute, is the function).
+animate_module = importlib.import_module("granrs.animate")
+EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples" / "scenes").glob("*.toml"))
+RECORD = ("state", "forces")
+
+
+def run(scene: granrs.Scene, record: tuple[str, ...] = RECORD) -> granrs.Result:
+    return granrs.simulate(scene.replace(record=record))
+
+
+@pytest.fixture(scope="module")
+def free_link() -> granrs.Result:
+    return run(cases.free_link(q_deg=45.0, v0=2.27))
+
+
+@pytest.fixture(scope="module")
+def chain() -> granrs.Result:
+    return run(cases.chain(case=1))
+
+
+@pytest.fixture(scope="module")
+def leg() -> granrs.Result:
+    return run(cases.leg(v0=3.28))
+
+
+def rgba(anim: ImpactAnimation, k: int) -> np.ndarray:
+    """Frame ``k`` rendered with the Agg canvas, as an (h, w, 4) array."""
+    anim.draw(k)
+    canvas = anim.figure.canvas
+    assert isinstance(canvas, FigureCanvasAgg)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba()).copy()
+
+
+# --- frames ---------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("frame_dt", [0.001, 0.0025, 0.004, 0.007, 0.02, 1.0])
+def test_frame_count_is_floor_of_span_over_frame_dt_plus_one(
+    free_link: granrs.Result, frame_dt: float
+) -> None:
+    """Issue 20: one frame per frame_dt of simulated time, floor(t_end / frame_dt) + 1."""
+    assert free_link.series is not None
+    t_end = float(free_link.series["t"][-1])  # 0.02567... s: no quotient is whole here
+    anim = granrs.animate(free_link, frame_dt=frame_dt)
+    assert anim.n_frames == math.floor(t_end / frame_dt) + 1
+    assert anim.frame_times[0] == 0.0
+    np.testing.assert_allclose(np.diff(anim.frame_times), frame_dt, rtol=1e-12)
+    assert anim.frame_times[-1] <= t_end
+
+
+def test_frame_count_counts_a_whole_quotient_despite_round_off() -> None:
+    """0.3 / 0.1 is 2.9999999999999996 in floating point; the run of 0.3 s has frames at
+    0, 0.1, 0.2 and 0.3 s: 4 frames, not 3."""
+    result = run(cases.free_link(q_deg=45.0, v0=2.27).replace(end="time", t_end=0.3))
+    assert result.series is not None
+    assert math.isclose(result.series["t"][-1], 0.3, rel_tol=1e-12)
+    anim = granrs.animate(result, frame_dt=0.1)
+    assert anim.n_frames == 4
+    np.testing.assert_allclose(anim.frame_times, [0.0, 0.1, 0.2, 0.3], rtol=1e-12)
+    assert frame_count(0.3, 0.1) == 4
+    assert frame_count(0.0299, 0.01) == 3
+
+
+def test_first_and_last_frames_differ(free_link: granrs.Result) -> None:
+    """The picture moves: frame 0 (at the surface) and the last (at the stop) differ, while
+    frame 0 drawn again is the same picture (so the difference is the frame's)."""
+    anim = granrs.animate(free_link, frame_dt=0.005)
+    first = rgba(anim, 0)
+    last = rgba(anim, anim.n_frames - 1)
+    again = rgba(anim, 0)
+    assert first.shape == last.shape
+    changed = np.any(first != last, axis=-1).mean()
+    assert changed > 0.005, changed
+    np.testing.assert_array_equal(first, again)
+
+
+def test_result_animate_is_a_func_animation(free_link: granrs.Result) -> None:
+    """Result.animate delegates to granrs.animate and returns a FuncAnimation."""
+    anim = free_link.animate(frame_dt=0.005)
+    assert isinstance(anim, mpl_animation.FuncAnimation)
+    assert anim.result is free_link
+    assert anim.n_frames == granrs.animate(free_link, frame_dt=0.005).n_frames
+    assert "animate" in granrs.__all__
+
+
+def test_animation_shows_inline_as_a_javascript_player(free_link: granrs.Result) -> None:
+    """Jupyter: _repr_html_ gives the JavaScript player with one embedded image per frame."""
+    anim = granrs.animate(free_link, frame_dt=0.01)
+    html = anim._repr_html_()
+    assert "<script" in html
+    assert html.count("data:image/png;base64") == anim.n_frames == 3
+
+
+# --- the picture follows the numbers --------------------------------------------------------
+
+
+@pytest.mark.parametrize("body", ["free_link", "chain", "leg"])
+def test_drawn_contacts_are_at_the_recorded_tips(
+    body: str, free_link: granrs.Result, chain: granrs.Result, leg: granrs.Result
+) -> None:
+    """Each contact's reference point placed from the recorded coordinates and the scene's
+    geometry (rod tip, middle of the sole) is where the core recorded it, and the depth shown
+    is the recorded depth. frame_dt is a multiple of dt, so every frame is a recorded sample."""
+    result = {"free_link": free_link, "chain": chain, "leg": leg}[body]
+    series = result.series
+    assert series is not None
+    anim = granrs.animate(result, frame_dt=0.002)
+    rows = np.searchsorted(series["t"], anim.frame_times - 1e-12)
+    np.testing.assert_allclose(series["t"][rows], anim.frame_times, atol=1e-12)
+    n = len(result.contacts)
+    assert len(anim._pose.contacts) == n
+    for i, contact in enumerate(anim._pose.contacts):
+        prefix = f"c{i}." if n > 1 else ""
+        np.testing.assert_allclose(
+            contact.reference[:, 0], series[f"{prefix}tip_x"][rows], atol=1e-12
+        )
+        np.testing.assert_allclose(
+            contact.reference[:, 1], series[f"{prefix}tip_y"][rows], atol=1e-12
+        )
+        np.testing.assert_allclose(anim.depths[:, i], series[f"{prefix}depth"][rows], atol=1e-12)
+    anim.draw(anim.n_frames - 1)
+    for i in range(n):
+        text = anim._depth_text.get_text()
+        prefix = f"c{i}." if n > 1 else ""
+        assert f"{series[f'{prefix}depth'][rows[-1]] * 1e3:.1f} mm" in text
+
+
+def test_force_arrows_end_where_the_recorded_force_says(chain: granrs.Result) -> None:
+    """The sum's arrow runs from the tip to tip + scale * (F_dx + F_sh, F_dy + F_sv), and
+    the terms laid tip to tail end at the same point."""
+    series = chain.series
+    assert series is not None
+    anim = granrs.animate(chain, frame_dt=0.001)
+    k = anim.n_frames // 2
+    row = int(np.searchsorted(series["t"], anim.frame_times[k] - 1e-12))
+    anim.draw(k)
+    scale = anim.force_scale
+    assert scale > 0.0
+    for i, arrows in enumerate(anim._views[0].arrows):
+        p = f"c{i}."
+        tip = np.array([series[p + "tip_x"][row], series[p + "tip_y"][row]])
+        force = np.array(
+            [
+                series[p + "F_dx"][row] + series[p + "F_sh"][row],
+                series[p + "F_dy"][row] + series[p + "F_sv"][row],
+            ]
+        )
+        assert np.hypot(*force) > 0.1  # both links are in the sand by mid-run
+        start, end = (np.array(xy) * 1e-3 for xy in arrows["total"]._posA_posB)
+        np.testing.assert_allclose(start, tip, atol=1e-9)
+        np.testing.assert_allclose(end, tip + scale * force, atol=1e-9)
+        last_term_end = np.array(arrows["static_v"]._posA_posB[1]) * 1e-3
+        np.testing.assert_allclose(last_term_end, tip + scale * force, atol=1e-9)
+        drag_end = np.array(arrows["drag"]._posA_posB[1]) * 1e-3
+        drag = np.array([series[p + "F_dx"][row], series[p + "F_dy"][row]])
+        np.testing.assert_allclose(drag_end, tip + scale * drag, atol=1e-9)
+
+
+def test_centroid_forces_start_at_the_body_point_moving_at_v_E() -> None:
+    """apply_at="centroid": the arrows start at the immersed centroid E, the body point whose
+    velocity the core records as v_E (v_centre + omega * s * n for the rod)."""
+    result = run(cases.free_link(q_deg=30.0, v0=2.0).replace(apply_at="centroid"))
+    series = result.series
+    assert series is not None
+    anim = granrs.animate(result, frame_dt=0.002)
+    rows = np.searchsorted(series["t"], anim.frame_times - 1e-12)
+    e_point = anim._pose.contacts[0].applied
+    centre = np.stack([series["x"][rows], series["y"][rows]], axis=-1)
+    q, omega = series["q"][rows], series["omega"][rows]
+    axis = np.stack([np.sin(q), np.cos(q)], axis=-1)
+    s = np.einsum("ij,ij->i", e_point - centre, axis)  # E's place along the rod
+    normal = np.stack([np.cos(q), -np.sin(q)], axis=-1)
+    v_point = (
+        np.stack([series["vx"][rows], series["vy"][rows]], axis=-1) + (omega * s)[:, None] * normal
+    )
+    immersed = series["depth"][rows] > 0.0
+    assert immersed.sum() > 5
+    np.testing.assert_allclose(v_point[immersed, 0], series["v_E_x"][rows][immersed], atol=1e-9)
+    np.testing.assert_allclose(v_point[immersed, 1], series["v_E_y"][rows][immersed], atol=1e-9)
+    # E lies on the rod's axis, between the tip and the surface.
+    assert np.all(s[immersed] >= -0.5 * result.scene.length - 1e-12)
+    assert np.all(e_point[immersed, 1] <= 1e-12)
+
+
+def test_state_without_forces_draws_the_body_without_arrows() -> None:
+    """record=("state",): the body moves, no arrow, and the legend says why."""
+    result = run(cases.free_link(q_deg=45.0, v0=2.27), record=("state",))
+    anim = granrs.animate(result, frame_dt=0.005)
+    assert anim.force_scale == 0.0
+    assert all(not arrows for arrows in anim._views[0].arrows)
+    legend = anim.figure.legends[0]
+    assert legend.get_title().get_text() == "forces not recorded"
+
+
+def test_only_the_scene_s_terms_get_arrows() -> None:
+    """A vertical drop with gravity and static_v only records no drag and no static_h: one
+    term arrow (static_v) and the sum."""
+    scene = cases.free_link(q_deg=0.0, v0=1.0).replace(effects=("gravity", "static_v"))
+    anim = granrs.animate(run(scene), frame_dt=0.005)
+    assert set(anim._views[0].arrows[0]) == {"static_v", "total"}
+    labels = [t.get_text() for t in anim.figure.legends[0].get_texts()]
+    assert "static_v" in labels and "drag" not in labels
+
+
+# --- playback -------------------------------------------------------------------------------
+
+
+def test_playback_speed_is_frame_dt_times_fps() -> None:
+    """Any two of frame_dt, speed, fps give the third; defaults fps 25 and speed 0.02."""
+    assert playback() == pytest.approx((0.02 / 25, 0.02, 25.0))
+    assert playback(frame_dt=0.002) == pytest.approx((0.002, 0.05, 25.0))
+    assert playback(speed=0.1) == pytest.approx((0.004, 0.1, 25.0))
+    assert playback(fps=10) == pytest.approx((0.002, 0.02, 10.0))
+    assert playback(frame_dt=0.001, speed=0.01) == pytest.approx((0.001, 0.01, 10.0))
+    assert playback(frame_dt=0.001, fps=50) == pytest.approx((0.001, 0.05, 50.0))
+    assert playback(speed=0.03, fps=15) == pytest.approx((0.002, 0.03, 15.0))
+    assert playback(0.001, 0.02, 20) == pytest.approx((0.001, 0.02, 20.0))
+
+
+# --- errors, before anything is drawn -------------------------------------------------------
+
+
+@pytest.fixture
+def nothing_drawn(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Fail the test if the animation gets as far as placing the body."""
+
+    def boom(*_: object) -> None:
+        raise AssertionError("a frame was drawn before the error")
+
+    monkeypatch.setattr(animate_module, "_pose", boom)
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+@pytest.mark.parametrize("field", ["frame_dt", "speed", "fps", "dpi"])
+@pytest.mark.parametrize("value", [0.0, -1.0, math.nan, math.inf, "fast", True])
+def test_non_positive_playback_is_a_typed_error(
+    free_link: granrs.Result, field: str, value: object
+) -> None:
+    with pytest.raises(InvalidParameterError) as info:
+        granrs.animate(free_link, **{field: value})  # type: ignore[arg-type]
+    assert info.value.field == field
+    assert field in str(info.value)
+    assert isinstance(info.value, ValueError) and isinstance(info.value, GranrsError)
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+def test_inconsistent_playback_is_a_typed_error(free_link: granrs.Result) -> None:
+    with pytest.raises(InvalidParameterError, match="frame_dt \\* fps") as info:
+        granrs.animate(free_link, frame_dt=0.001, speed=0.5, fps=25)
+    assert info.value.field == "speed"
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+def test_too_many_frames_is_a_typed_error(free_link: granrs.Result) -> None:
+    with pytest.raises(InvalidParameterError, match="frames") as info:
+        granrs.animate(free_link, frame_dt=1e-7)
+    assert info.value.field == "frame_dt"
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+@pytest.mark.parametrize("record", [(), ("energy",)])
+def test_a_result_without_state_is_a_typed_error(record: tuple[str, ...]) -> None:
+    result = run(cases.free_link(q_deg=45.0, v0=2.27), record=record)
+    with pytest.raises(InvalidParameterError, match="recorded no state") as info:
+        granrs.animate(result)
+    assert info.value.field == "record"
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+def test_not_a_result_is_a_typed_error() -> None:
+    with pytest.raises(InvalidParameterError, match=r"granrs\.Result") as info:
+        granrs.animate(cases.free_link(q_deg=45.0, v0=2.27))  # type: ignore[arg-type]
+    assert info.value.field == "result"
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+@pytest.mark.parametrize("name", ["impact.avi", "impact", "impact.png"])
+def test_unknown_output_suffix_is_a_typed_error(
+    free_link: granrs.Result, tmp_path: Path, name: str
+) -> None:
+    with pytest.raises(InvalidParameterError, match="unknown suffix") as info:
+        granrs.animate(free_link, out=tmp_path / name)
+    assert info.value.field == "out"
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+def test_unwritable_output_paths_are_typed_errors(free_link: granrs.Result, tmp_path: Path) -> None:
+    """A missing directory, a file where the directory should be, a directory where the
+    file should be, and (for a user other than root) a read-only directory."""
+    a_file = tmp_path / "file.txt"
+    a_file.write_text("x")
+    a_dir = tmp_path / "taken.gif"
+    a_dir.mkdir()
+    for out, why in [
+        (tmp_path / "missing" / "impact.gif", "does not exist"),
+        (a_file / "impact.gif", "does not exist"),
+        (a_dir, "a directory"),
+    ]:
+        with pytest.raises(InvalidParameterError, match=why) as info:
+            granrs.animate(free_link, out=out)
+        assert info.value.field == "out"
+    if os.geteuid() != 0:  # root writes anywhere
+        locked = tmp_path / "locked"
+        locked.mkdir(mode=0o500)
+        with pytest.raises(InvalidParameterError, match="not writable"):
+            check_output(locked / "impact.gif")
+
+
+@pytest.mark.usefixtures("nothing_drawn")
+def test_mp4_without_ffmpeg_is_a_typed_error(
+    free_link: granrs.Result, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(mpl_animation.writers, "is_available", lambda name: False)
+    with pytest.raises(InvalidParameterError, match="ffmpeg") as info:
+        granrs.animate(free_link, out=tmp_path / "impact.mp4")
+    assert info.value.field == "out"
+
+
+# --- writing --------------------------------------------------------------------------------
+
+
+def gif_frames(path: Path) -> int:
+    with Image.open(path) as image:
+        assert image.format == "GIF"
+        return int(image.n_frames)
+
+
+def test_animate_writes_gif_and_html(free_link: granrs.Result, tmp_path: Path) -> None:
+    anim = granrs.animate(free_link, frame_dt=0.01, out=tmp_path / "impact.gif")
+    assert gif_frames(tmp_path / "impact.gif") == anim.n_frames == 3
+    anim.write(tmp_path / "impact.html")
+    html = (tmp_path / "impact.html").read_text()
+    assert html.count("data:image/png;base64") == 3
+
+
+@pytest.mark.skipif(
+    not mpl_animation.writers.is_available("ffmpeg"), reason="ffmpeg is not installed"
+)
+def test_animate_writes_mp4_where_ffmpeg_is(free_link: granrs.Result, tmp_path: Path) -> None:
+    granrs.animate(free_link, frame_dt=0.01, out=tmp_path / "impact.mp4")
+    assert (tmp_path / "impact.mp4").stat().st_size > 1000
+
+
+# --- the command line -----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_cli_animate_writes_a_gif_per_example_scene(
+    path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 20: `granrs animate SCENE.toml --out impact.gif` for each example scene; the GIF
+    has one frame per 10 ms of the run (its length from the same scene run directly)."""
+    out = tmp_path / "impact.gif"
+    code = main(["animate", str(path), "--out", str(out), "--frame-dt", "0.01", "--dpi", "50"])
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    assert f"animation written to {out}" in err
+    series = granrs.simulate(granrs.Scene.from_toml(path).replace(record=("state",))).series
+    assert series is not None
+    assert gif_frames(out) == math.floor(series["t"][-1] / 0.01) + 1
+
+
+def test_cli_animate_checks_the_output_before_the_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A bad --out or --fps is exit code 2 with one line naming it, and nothing runs."""
+
+    def no_run(*_: object) -> None:
+        raise AssertionError("the scene ran")
+
+    monkeypatch.setattr(granrs.api, "simulate", no_run)
+    scene = str(EXAMPLES[0])
+    for argv, needle in [
+        (["--out", str(tmp_path / "x.avi")], "unknown suffix"),
+        (["--out", str(tmp_path / "no" / "x.gif")], "does not exist"),
+        (["--out", str(tmp_path / "x.gif"), "--fps", "0"], "fps"),
+        (["--out", str(tmp_path / "x.gif"), "--frame-dt", "-0.01"], "frame_dt"),
+    ]:
+        code = main(["animate", scene, *argv])
+        _, err = capsys.readouterr()
+        assert code == 2, err
+        lines = err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("granrs: error: ") and needle in lines[0]
+    assert not any(tmp_path.iterdir())
+
+
+def test_cli_animate_writes_html(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "impact.html"
+    code = main(["animate", str(EXAMPLES[0]), "--out", str(out), "--speed", "0.2", "--fps", "10"])
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    assert "<script" in out.read_text()
+
+
+# --- Result._repr_html_ ---------------------------------------------------------------------
+
+
+def test_result_repr_html_has_a_row_per_contact(chain: granrs.Result) -> None:
+    """Notebooks: a table with the status and each link's t_s, depth and dE with units."""
+    html = chain._repr_html_()
+    assert html.startswith("<table>") and html.endswith("</table>")
+    assert "stopped" in html and "t_s [ms]" in html and "depth [mm]" in html and "dE [J]" in html
+    assert html.count("<tr>") == 3  # the header and two links
+    for name, contact in zip(["link1", "link2"], chain.contacts, strict=True):
+        assert f"<td>{name}</td>" in html
+        assert f"{contact.depth * 1e3:.4g}" in html
+    assert f"{chain.contacts[1].t_s * 1e3:.4g}" in html
+    assert math.isnan(chain.contacts[0].t_s) and "<td>-</td>" in html
