@@ -8,10 +8,11 @@ never runs a second simulation. Each frame shows, to scale and in millimetres:
   or the leg's foot (its box, f_s long and 0.039 H high from the sole to the ankle) with the
   shank, thigh and half trunk as lines between the joints, and the foot's contact box dashed;
 * the sand (y < 0) and the immersed part of each contact shaded;
-* the force on each contact as one arrow per term of the force law from its point of
-  application (the tip, the middle of the sole, or the immersed centroid E with
+* the force on each contact as one arrow per term of the force law, laid tip to tail from
+  its point of application (the tip, the middle of the sole, or the immersed centroid E with
   ``apply_at="centroid"``): drag (F_dx, F_dy), static_h (F_sh, along x), static_v (F_sv,
-  along y), and their sum, on one fixed scale for the whole animation (stated in the legend);
+  along y), over a wide grey arrow for their sum, on one scale for the whole animation (the
+  largest recorded force is 0.6 of the rod's length or of the tibia; stated in the legend);
 * a clock (simulated time) and each contact's depth.
 
 Frame ``k`` shows the recorded series at ``t = k * frame_dt`` (linear interpolation between
