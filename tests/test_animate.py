@@ -12,6 +12,8 @@ from __future__ import annotations
 import importlib
 import math
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,12 +24,13 @@ from PIL import Image
 
 import granrs
 from granrs import cases
-from granrs.animate import ImpactAnimation, check_output, frame_count, playback
+from granrs._animation import ImpactAnimation
+from granrs.animate import check_output, frame_count, playback
 from granrs.cli import main
 from granrs.errors import GranrsError, InvalidParameterError
 
-# The module (granrs.animate, the attribute, is the function).
-animate_module = importlib.import_module("granrs.animate")
+# The drawing module (it imports matplotlib; granrs.animate, the attribute, is the function).
+drawing = importlib.import_module("granrs._animation")
 EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples" / "scenes").glob("*.toml"))
 RECORD = ("state", "forces")
 
@@ -256,7 +259,7 @@ def nothing_drawn(monkeypatch: pytest.MonkeyPatch) -> None:
     def boom(*_: object) -> None:
         raise AssertionError("a frame was drawn before the error")
 
-    monkeypatch.setattr(animate_module, "_pose", boom)
+    monkeypatch.setattr(drawing, "_pose", boom)
 
 
 @pytest.mark.usefixtures("nothing_drawn")
@@ -435,3 +438,17 @@ def test_result_repr_html_has_a_row_per_contact(chain: granrs.Result) -> None:
         assert f"{contact.depth * 1e3:.4g}" in html
     assert f"{chain.contacts[1].t_s * 1e3:.4g}" in html
     assert math.isnan(chain.contacts[0].t_s) and "<td>-</td>" in html
+
+
+def test_import_granrs_does_not_import_matplotlib() -> None:
+    """``import granrs`` stays light: matplotlib loads with the first animation (or
+    ``granrs.ImpactAnimation``), which is then the FuncAnimation subclass."""
+    code = (
+        "import sys, granrs\n"
+        "assert 'matplotlib' not in sys.modules, 'matplotlib imported'\n"
+        "from matplotlib.animation import FuncAnimation\n"
+        "assert issubclass(granrs.ImpactAnimation, FuncAnimation)\n"
+        "assert 'ImpactAnimation' in granrs.__all__ and callable(granrs.animate)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr

@@ -14,8 +14,10 @@ Quick start::
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 from . import _granrs, cases, coefficients, data, forces, scenefile
-from .animate import ImpactAnimation, animate
+from .animate import animate
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
@@ -34,6 +36,9 @@ from .errors import (
 from .force import ResistanceForce, resistance_force
 from .result import ContactResult, Result
 from .scene import EFFECTS, RECORDS, Scene
+
+if TYPE_CHECKING:
+    from ._animation import ImpactAnimation
 
 __version__: str = _granrs.__version__
 
@@ -71,3 +76,12 @@ __all__ = [
     "simulate",
     "sweep",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    # granrs.ImpactAnimation imports matplotlib: loaded on first use (see granrs.animate).
+    if name == "ImpactAnimation":
+        from ._animation import ImpactAnimation
+
+        return ImpactAnimation
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -13,7 +13,7 @@ import numpy as np
 from .scene import Scene
 
 if TYPE_CHECKING:
-    from .animate import ImpactAnimation
+    from ._animation import ImpactAnimation
 
 __all__ = ["JOINT_NAMES", "LINK_NAMES", "SUMMARY_UNITS", "ContactResult", "Result"]
 
