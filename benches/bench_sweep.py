@@ -41,6 +41,7 @@ import numpy as np
 
 import granrs
 from granrs import cases
+from granrs.forces import select, thesis
 
 PARTS = ("sweep", "overhead", "prune", "force")
 
@@ -182,9 +183,11 @@ def part_prune(repeat: int) -> list[str]:
     variants = {
         "every effect, every series recorded": base.replace(record=("state", "forces", "energy")),
         "every effect, summary only": base,
-        "gravity + static_v, summary only": base.replace(effects=("gravity", "static_v")),
+        "gravity + static_v, summary only": base.replace(
+            forces=select(thesis(), *("gravity", "static_v"))
+        ),
         "gravity + static_v, every series": base.replace(
-            effects=("gravity", "static_v"), record=("state", "forces", "energy")
+            forces=select(thesis(), *("gravity", "static_v")), record=("state", "forces", "energy")
         ),
     }
     n = 200

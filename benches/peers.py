@@ -68,6 +68,7 @@ from scipy.integrate import solve_ivp
 
 import granrs
 from granrs import _granrs
+from granrs.forces import thesis_row
 
 #: RK4 step of granrs's default and of the numba peers [s] (thesis: 10 kHz).
 DT = 1e-4
@@ -100,7 +101,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 def parameters(scene: granrs.Scene) -> np.ndarray:
     """The peers' parameter vector: m, I, L, d_c, rho_g, g, eta_h, eta_d, eta_v, lambda."""
-    c = scene.coefficients
+    c = thesis_row(scene.forces)
     inertia = scene.inertia
     if inertia is None:
         inertia = scene.mass * (scene.length**2 / 12.0 + scene.diameter**2 / 16.0)

@@ -90,11 +90,22 @@ fn not_finite(field: &str, value: f64) -> GranrsError {
 }
 
 /// The closest of `candidates` to a mistyped `value` (at most two edits, or a third of its
-/// length, away), for "did you mean" in error messages.
+/// length, away; or one a prefix of the other, `lambda` for `lam`), for "did you mean" in
+/// error messages.
 pub fn suggest<'a>(value: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
     let limit = 2.max(value.chars().count() / 3);
+    let prefix = |c: &str| c.len() >= 3 && (value.starts_with(c) || c.starts_with(value));
     candidates
-        .map(|c| (edit_distance(value, c), c))
+        .map(|c| {
+            (
+                if prefix(c) {
+                    1
+                } else {
+                    edit_distance(value, c)
+                },
+                c,
+            )
+        })
         .filter(|(d, _)| *d <= limit)
         .min_by_key(|(d, _)| *d)
         .map(|(_, c)| c)
@@ -126,5 +137,6 @@ mod tests {
         assert_eq!(suggest("stati_v", names.iter().copied()), Some("static_v"));
         assert_eq!(suggest("drgа", names.iter().copied()), Some("drag"));
         assert_eq!(suggest("wind", names.iter().copied()), None);
+        assert_eq!(suggest("lambda", ["eta_v", "lam"].into_iter()), Some("lam"));
     }
 }

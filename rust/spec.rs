@@ -105,12 +105,9 @@ scene_fields! {
     "atol",
     "body",
     "body_mass",
-    "coefficients",
-    "coefficients2",
     "depth0",
     "diameter",
     "dt",
-    "effects",
     "end",
     "foot_deg",
     "foot_length",
@@ -145,9 +142,6 @@ scene_fields! {
     "v0",
     "vx0",
 }
-
-/// The slots of the coefficients fields (see [`SceneSpec::set_slot`]).
-pub const COEFFICIENTS_SLOTS: [usize; 2] = [position("coefficients"), position("coefficients2")];
 
 /// Where `name` is in [`SCENE_FIELDS`] (at compile time).
 const fn position(name: &str) -> usize {
@@ -344,61 +338,18 @@ impl SceneSpec {
         }
     }
 
-    /// A coefficients mapping (`eta_h`, `eta_d`, `eta_v`, `lam`); absent or `None` gives
-    /// `None`.
-    fn coefficients(&self, field: &str) -> Result<Option<Coefficients>> {
-        let entries = match self.get(field) {
-            None | Some(Value::None) => return Ok(None),
-            Some(Value::Map(m)) => m,
-            Some(other) => {
-                return Err(wrong(
-                    field,
-                    "a mapping with eta_h, eta_d, eta_v, lam",
-                    other,
-                ))
-            }
-        };
-        for (k, _) in entries {
-            if !["eta_h", "eta_d", "eta_v", "lam"].contains(&k.as_ref()) {
-                return Err(unknown(
-                    &format!("{field}.{k}"),
-                    k,
-                    &["eta_h", "eta_d", "eta_v", "lam"],
-                ));
-            }
-        }
-        let get = |k: &str| num(k, map_get(entries, k)).map_err(|e| within(e, field, k));
-        let c = [get("eta_h")?, get("eta_d")?, get("eta_v")?, get("lam")?];
-        for (name, v) in ["eta_h", "eta_d", "eta_v", "lam"].iter().zip(c) {
-            crate::error::check_range(&format!("{field}.{name}"), v, 0.0, false)?;
-        }
-        Ok(Some(Coefficients {
-            eta_h: c[0],
-            eta_d: c[1],
-            eta_v: c[2],
-            lambda: c[3],
-        }))
-    }
-
-    /// The force terms of a body with `n_contacts` contacts: the `forces` list, or (until
-    /// the Python layer hands the core its terms) the thesis's law from the `coefficients`
-    /// (per contact: `coefficients`, then `coefficients2`) and the `effects` names.
+    /// The force terms of a body with `n_contacts` contacts: the `forces` list (absent: the
+    /// thesis's law with each term's defaults, Table 3.4 at q = 0, as `granrs.Scene`'s).
     fn forces(&self, n_contacts: usize) -> Result<ForceSet> {
-        if let Some(v) = self.get("forces").filter(|v| **v != Value::None) {
-            return match v {
-                Value::Terms(specs) => ForceSet::build(specs, n_contacts),
-                Value::Names(n) if n.is_empty() => ForceSet::build(&[], n_contacts),
-                other => Err(wrong("forces", "a list of force terms", other)),
-            };
+        match self.get("forces") {
+            None | Some(Value::None) => Ok(ForceSet::thesis(&vec![
+                Coefficients::TABLE_3_4_VERTICAL;
+                n_contacts
+            ])),
+            Some(Value::Terms(specs)) => ForceSet::build(specs, n_contacts),
+            Some(Value::Names(n)) if n.is_empty() => ForceSet::build(&[], n_contacts),
+            Some(other) => Err(wrong("forces", "a list of force terms", other)),
         }
-        let first = self
-            .coefficients("coefficients")?
-            .ok_or_else(|| missing("coefficients"))?;
-        let mut per_contact = vec![first; n_contacts];
-        if n_contacts > 1 {
-            per_contact[1] = self.coefficients("coefficients2")?.unwrap_or(first);
-        }
-        thesis_law(self.names("effects")?, &per_contact)
     }
 
     /// A joint: `"free"`, `"locked"`, or a spring-damper `{"k": .., "c": ..}`; absent or
@@ -673,20 +624,14 @@ pub(crate) fn free_link_spec() -> SceneSpec {
     ] {
         s.set(k, Value::Str(v.into()));
     }
-    s.set(
-        "coefficients",
-        Value::Map(
-            [
-                ("eta_h", 5.5),
-                ("eta_d", 11.0),
-                ("eta_v", 53.0),
-                ("lam", 0.25),
-            ]
-            .iter()
-            .map(|(k, v)| (Cow::Borrowed(*k), Value::Num(*v)))
-            .collect(),
-        ),
-    );
+    // Table 3.4, row q = 45 deg.
+    let row = Coefficients {
+        eta_h: 5.5,
+        eta_d: 11.0,
+        eta_v: 53.0,
+        lambda: 0.25,
+    };
+    s.set("forces", Value::Terms(ForceSet::thesis(&[row]).specs()));
     s
 }
 
@@ -732,19 +677,21 @@ mod tests {
         );
         let mut s = free_link_spec();
         s.set(
-            "coefficients",
-            Value::Map(vec![("eta_h".into(), Value::Num(1.0))]),
+            "forces",
+            Value::Terms(vec![TermSpec::new("drag", &[("eta_d", -1.0)])]),
         );
         assert!(
-            matches!(s.build(), Err(GranrsError::InvalidScene { field, .. }) if field == "coefficients.eta_d")
+            matches!(s.build(), Err(GranrsError::InvalidParameter { field, .. }) if field == "drag.eta_d")
         );
         let mut s = free_link_spec();
-        s.set(
-            "effects",
-            Value::Names(vec!["gravity".into(), "wind".into()]),
-        );
+        s.set("forces", Value::Terms(vec![TermSpec::new("wind", &[])]));
         assert!(
-            matches!(s.build(), Err(GranrsError::UnknownName { field, value, .. }) if field == "effects" && value == "wind")
+            matches!(s.build(), Err(GranrsError::UnknownName { field, value, .. }) if field == "term" && value == "wind")
+        );
+        let mut s = free_link_spec();
+        s.set("forces", Value::Num(1.0));
+        assert!(
+            matches!(s.build(), Err(GranrsError::WrongType { field, .. }) if field == "forces")
         );
         let mut s = free_link_spec();
         s.set("body", Value::Str("tripod".into()));
@@ -792,8 +739,11 @@ mod tests {
         };
         assert!(matches!(with.joint, Joint::Spring { .. }));
         s.set(
-            "effects",
-            Value::Names(vec!["gravity".into(), "static_v".into()]),
+            "forces",
+            Value::Terms(vec![
+                TermSpec::new("gravity", &[]),
+                TermSpec::new("static_v", &[]),
+            ]),
         );
         let AnyScene::Chain(without) = s.build().unwrap() else {
             panic!()

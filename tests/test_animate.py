@@ -28,6 +28,7 @@ from granrs._animation import ImpactAnimation
 from granrs.animate import check_output, frame_count, playback
 from granrs.cli import main
 from granrs.errors import GranrsError, InvalidParameterError
+from granrs.forces import select, thesis
 
 # The drawing module (it imports matplotlib; granrs.animate, the attribute, is the function).
 drawing = importlib.import_module("granrs._animation")
@@ -227,7 +228,9 @@ def test_state_without_forces_draws_the_body_without_arrows() -> None:
 def test_only_the_scene_s_terms_get_arrows() -> None:
     """A vertical drop with gravity and static_v only records no drag and no static_h: one
     term arrow (static_v) and the sum."""
-    scene = cases.free_link(q_deg=0.0, v0=1.0).replace(effects=("gravity", "static_v"))
+    scene = cases.free_link(q_deg=0.0, v0=1.0).replace(
+        forces=select(thesis(), *("gravity", "static_v"))
+    )
     anim = granrs.animate(run(scene), frame_dt=0.005)
     assert set(anim._views[0].arrows[0]) == {"static_v", "total"}
     labels = [t.get_text() for t in anim.figure.legends[0].get_texts()]

@@ -233,7 +233,7 @@ def test_free_link_defaults_are_the_thesis_rod() -> None:
         RHO_G,
         G,
     )
-    assert scene.coefficients == Coefficients(ETA_H_0, ETA_D_0, ETA_V_0, LAMBDA_0)
+    assert scene.forces == granrs.forces.thesis(Coefficients(ETA_H_0, ETA_D_0, ETA_V_0, LAMBDA_0))
     assert scene.dt == 1e-4
     assert scene.apply_at == "tip"
 

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 import granrs
 from granrs import cases, data
 from granrs.errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+from granrs.forces import thesis_row
 
 
 def _csv_rows(name: str) -> list[dict[str, float]]:
@@ -28,7 +29,7 @@ class TestChainCase:
         assert scene.body == "chain"
         assert scene.q_deg == exp[0]["q0_deg"] and scene.q2_deg == exp[1]["q0_deg"]
         assert scene.v0 == pytest.approx((exp[0]["v0_mean"] + exp[1]["v0_mean"]) / 2)
-        for c, row in ((scene.coefficients, coef[0]), (scene.coefficients2, coef[1])):
+        for c, row in ((thesis_row(scene.forces), coef[0]), (thesis_row(scene.forces, 1), coef[1])):
             assert (c.eta_h, c.eta_d, c.eta_v, c.lam) == (
                 row["eta_h"],
                 row["eta_d"],
@@ -43,9 +44,10 @@ class TestChainCase:
     def test_one_coefficient_set_applies_to_both_links(self) -> None:
         c = granrs.Coefficients(eta_h=9, eta_d=12, eta_v=100, lam=0.2)
         scene = cases.chain(2, coefficients=c)
-        assert scene.coefficients == c and scene.coefficients2 == c
+        assert thesis_row(scene.forces) == c and thesis_row(scene.forces, 1) == c
+        assert scene.forces == granrs.forces.thesis(c)  # one value for both links
         pair = cases.chain(2, coefficients=(c, {"eta_h": 1, "eta_d": 2, "eta_v": 3, "lam": 0.1}))
-        assert pair.coefficients2.eta_v == 3
+        assert thesis_row(pair.forces, 1).eta_v == 3
 
     def test_result_has_a_result_per_link(self) -> None:
         r = granrs.simulate(cases.chain(1, end="all_stops"))
@@ -110,7 +112,7 @@ class TestLeg:
     def test_thesis_rows(self, v0: float) -> None:
         row = next(r for r in _csv_rows("human_coefficients") if r["v0"] == v0)
         scene = cases.leg(v0)
-        c = scene.coefficients
+        c = thesis_row(scene.forces)
         assert (c.eta_h, c.eta_d, c.eta_v, c.lam) == (
             row["eta_h"],
             row["eta_d"],
@@ -153,7 +155,7 @@ class TestLeg:
         """A rigid leg sinking flat is close to a point mass of half the body on the sole
         (an independent model, integrated here with numpy): the body barely turns."""
         r = granrs.simulate(cases.leg(3.28))
-        c = r.scene.coefficients
+        c = thesis_row(r.scene.forces)
         m, rho, g, fs, ws, ll = 75.35 / 2, 1600.0, 9.81, 0.254, 0.086, 0.432
         d, v, t, dt = 0.0, 3.28, 0.0, 1e-6
         while v > 0:

@@ -22,6 +22,7 @@ from granrs import Coefficients, cases
 from granrs.calibrate import Measurements, calibrate, evaluate, within
 from granrs.cli import main
 from granrs.errors import InvalidParameterError, MeasurementError, UnknownNameError
+from granrs.forces import thesis
 
 #: The truth of the synthetic tests, and the noise added to every measured value.
 TRUE = Coefficients(eta_h=8.0, eta_d=12.0, eta_v=200.0, lam=0.3)
@@ -105,8 +106,8 @@ def test_finite_differences_are_above_the_noise() -> None:
     scatter of second differences over steps of 1e-6."""
     base = cases.free_link(30.0, 1.8, coefficients=TRUE)
     factors = 1.0 + 1e-6 * np.arange(8)
-    scenes = [base.replace(coefficients=Coefficients(8.0, 12.0, 200.0 * f, 0.3)) for f in factors]
-    scenes.append(base.replace(coefficients=Coefficients(8.0, 12.0, 200.0 * 1.001, 0.3)))
+    scenes = [base.replace(forces=thesis(Coefficients(8.0, 12.0, 200.0 * f, 0.3))) for f in factors]
+    scenes.append(base.replace(forces=thesis(Coefficients(8.0, 12.0, 200.0 * 1.001, 0.3))))
     out = granrs.sweep(scenes, progress=False)
     for q in ("t_s", "depth"):
         values = out[q].to_numpy()

@@ -14,8 +14,9 @@ from typing import Any
 import pytest
 
 import granrs
-from granrs import Coefficients, Scene, _granrs, cases
+from granrs import Scene, _granrs, cases
 from granrs.errors import GranrsError
+from granrs.forces import select, thesis
 from granrs.scene import _CORE_FIELDS
 
 
@@ -47,10 +48,16 @@ def _same(a: Any, b: Any) -> bool:
 SCENES = [
     cases.free_link(q_deg=45.0, v0=2.27),
     cases.free_link(q_deg=0.0, v0=2.214).replace(sign_model="raw", apply_at="centroid"),
-    Scene(q_deg=30, v0=1, inertia=1e-3, record_stride=2, effects=("gravity", "static_v")),
+    Scene(
+        q_deg=30,
+        v0=1,
+        inertia=1e-3,
+        record_stride=2,
+        forces=select(thesis(), *("gravity", "static_v")),
+    ),
     Scene(sign_model="smooth", smooth_eps=2e-3, method="dopri5", rtol=1e-6, atol=1e-9),
     cases.chain(1),
-    cases.chain(1).replace(pin_joint={"k": 0.5, "c": 0.01}, coefficients2=None),
+    cases.chain(1).replace(pin_joint={"k": 0.5, "c": 0.01}),
     cases.leg(v0=3.28),
     cases.leg(v0=3.28).replace(knee={"k": 300.0, "c": 2.0}, sole_model="thesis", foot_deg=5.0),
 ]
@@ -111,7 +118,7 @@ BAD = [
     {"v0": "fast"},
     {"apply_at": "heel"},
     {"sign_model": "smooth", "smooth_eps": -1.0},
-    {"coefficients": Coefficients(eta_h=1.0, eta_d=1.0, eta_v=1.0, lam=1.0), "inertia": -2.0},
+    {"forces": (granrs.forces.drag(eta_d=1.0),), "inertia": -2.0},
 ]
 
 

@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 import granrs
 from granrs import cases
 from granrs.errors import InvalidParameterError, UnknownNameError
+from granrs.forces import thesis_row
 
 L, DC, RHO, G = 0.19, 0.0127, 1650.0, 9.81
 C = {"eta_h": 5.5, "eta_d": 11.0, "eta_v": 53.0, "lam": 0.25}
@@ -98,7 +99,7 @@ def test_agrees_with_the_forces_the_simulator_records() -> None:
         s["v_tip_x"],
         s["v_tip_y"],
         s["omega"],
-        coefficients=scene.coefficients,
+        coefficients=thesis_row(scene.forces),
     )
     np.testing.assert_allclose(f.F_dx, s["F_dx"], rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(f.F_dy, s["F_dy"], rtol=1e-10, atol=1e-10)

@@ -38,30 +38,34 @@ def test_terms_run_in_the_scene_order() -> None:
     assert granrs.simulate(scene).terms == ("static_v", "gravity", "drag")
 
 
-@pytest.mark.parametrize(
-    "scene",
-    [
-        granrs.cases.free_link(q_deg=45, v0=2.27),
-        granrs.cases.free_link(q_deg=0, v0=1.0, apply_at="centroid"),
-        granrs.cases.chain(case=1, end="all_stops"),
-        granrs.cases.chain(case=3, end="all_stops"),
-        granrs.cases.leg(v0=3.28, joints={"k": 300.0, "c": 5.0}),
-    ],
-    ids=["free_link", "free_link_centroid", "chain1", "chain3", "leg_sprung"],
-)
-def test_the_thesis_law_as_terms_is_the_thesis_law(scene: granrs.Scene) -> None:
-    """The same law given as terms (per contact for the chain) gives identical results."""
-    as_terms = forces.thesis(scene.coefficients, *filter(None, [scene.coefficients2]))
-    reset = {"coefficients": granrs.Scene().coefficients}
-    if scene.body == "chain":
-        reset["coefficients2"] = None
-    other = scene.replace(forces=as_terms, **reset)
-    a, b = granrs.simulate(scene), granrs.simulate(other)
-    for ca, cb in zip(a.contacts, b.contacts, strict=True):
-        for key in ("t_s", "depth", "dE", "F_d_max", "F_s_end"):
-            assert ca.summary[key] == cb.summary[key] or (
-                math.isnan(ca.summary[key]) and math.isnan(cb.summary[key])
-            ), key
+def test_the_cases_give_the_thesis_law_as_terms() -> None:
+    """granrs.cases build the thesis's terms from its tables (values typed here from the
+    thesis: Table 3.4 row q = 45; Table 4.4 case 1 per link)."""
+    assert granrs.cases.free_link(q_deg=45, v0=2.27).forces == (
+        forces.gravity(),
+        forces.drag(eta_d=11.0),
+        forces.static_h(eta_h=5.5),
+        forces.static_v(eta_v=53.0, lam=0.25),
+        forces.joint_springs(),
+    )
+    assert granrs.cases.chain(case=1).forces == (
+        forces.gravity(),
+        forces.drag(eta_d=(13.0, 10.0)),
+        forces.static_h(eta_h=(8.0, 11.8)),
+        forces.static_v(eta_v=(33.0, 137.0), lam=(0.125, 0.205)),
+        forces.joint_springs(),
+    )
+
+
+def test_the_default_scene_is_the_thesis_law_at_its_defaults() -> None:
+    assert granrs.Scene().forces == forces.thesis()
+    assert forces.thesis() == (
+        forces.gravity(),
+        forces.drag(),
+        forces.static_h(),
+        forces.static_v(),
+        forces.joint_springs(),
+    )
 
 
 def test_a_term_left_out_is_not_evaluated_nor_stored() -> None:
@@ -115,11 +119,22 @@ def test_per_contact_parameters_must_match_the_contacts() -> None:
     assert info.value.field == "drag.eta_d"
 
 
-def test_forces_and_coefficients_are_not_mixed() -> None:
-    base = granrs.cases.free_link(q_deg=45, v0=1.0)  # Table 3.4's q = 45 row
-    with pytest.raises(granrs.InvalidSceneError) as info:
-        base.replace(forces=[forces.gravity()])
-    assert info.value.field == "coefficients"
+@pytest.mark.parametrize("old", ["coefficients", "coefficients2", "effects"])
+def test_the_old_fields_say_what_to_write(old: str) -> None:
+    """Issue 16: coefficients and effects are the terms' business now."""
+    base = granrs.cases.free_link(q_deg=45, v0=1.0)
+    with pytest.raises(granrs.UnknownNameError) as info:
+        base.replace(**{old: None})
+    assert info.value.field == old
+    assert "forces=" in str(info.value)
+
+
+def test_select_keeps_the_named_terms_in_order() -> None:
+    scene = granrs.cases.free_link(q_deg=45, v0=1.0)
+    kept = forces.select(scene.forces, "static_v", "gravity")
+    assert kept == (forces.gravity(), forces.static_v(eta_v=53.0, lam=0.25))
+    with pytest.raises(granrs.UnknownNameError, match="did you mean `drag`"):
+        forces.select(scene.forces, "drg")
 
 
 def test_forces_must_be_terms() -> None:

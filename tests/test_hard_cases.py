@@ -25,6 +25,7 @@ import pytest
 
 import granrs
 from granrs import Coefficients, Result, Scene, cases
+from granrs.forces import select, thesis, thesis_row
 
 # The thesis's free link (sec. 3.2.1), sand (sec. 3.3.1) and Table 3.4 row q = 0, written
 # out here so that the exact answers do not come from the code under test.
@@ -275,11 +276,11 @@ def test_lambda_to_zero(lam: float) -> None:
 
 def test_lambda_to_zero_chain_and_leg() -> None:
     """lambda = 0 on both chain links and on the leg's sole."""
-    zero = with_lam(0.0, CHAIN.coefficients)
-    zero2 = with_lam(0.0, CHAIN.coefficients2 or CHAIN.coefficients)
-    r, ref = run_and_reference(CHAIN.replace(coefficients=zero, coefficients2=zero2), 10, "stopped")
+    zero = with_lam(0.0, thesis_row(CHAIN.forces))
+    zero2 = with_lam(0.0, thesis_row(CHAIN.forces, 1) or thesis_row(CHAIN.forces))
+    r, ref = run_and_reference(CHAIN.replace(forces=thesis(zero, zero2)), 10, "stopped")
     assert_agrees(r, ref, depth_rtol=CHAIN_RTOL, ts_atol=1e-9)
-    leg = LEG.replace(coefficients=with_lam(0.0, LEG.coefficients))
+    leg = LEG.replace(forces=thesis(with_lam(0.0, thesis_row(LEG.forces))))
     r, ref = run_and_reference(leg, 10, "stopped")
     assert_agrees(r, ref, depth_rtol=LEG_RTOL, ts_atol=LEG_RTOL * ref.t_s)
 
@@ -302,11 +303,11 @@ def test_lambda_above_one(lam: float) -> None:
 
 def test_lambda_above_one_chain_and_leg() -> None:
     """lambda = 2 on the chain; the leg's own Table 5 lambda is 1.05 already, and 2 too."""
-    two = with_lam(2.0, CHAIN.coefficients)
-    r, ref = run_and_reference(CHAIN.replace(coefficients=two, coefficients2=two), 10, "stopped")
+    two = with_lam(2.0, thesis_row(CHAIN.forces))
+    r, ref = run_and_reference(CHAIN.replace(forces=thesis(two, two)), 10, "stopped")
     assert_agrees(r, ref, depth_rtol=CHAIN_RTOL, ts_atol=1e-9)
-    assert LEG.coefficients.lam > 1.0
-    leg = LEG.replace(coefficients=with_lam(2.0, LEG.coefficients))
+    assert thesis_row(LEG.forces).lam > 1.0
+    leg = LEG.replace(forces=thesis(with_lam(2.0, thesis_row(LEG.forces))))
     r, ref = run_and_reference(leg, 10, "stopped")
     assert_agrees(r, ref, depth_rtol=LEG_RTOL, ts_atol=LEG_RTOL * ref.t_s)
 
@@ -547,12 +548,14 @@ def test_stiff_coefficients_chain_and_leg() -> None:
     a slow approach to rest and is ill-conditioned: measured 1e-2 at dt/100)."""
     chain = CHAIN.replace(
         mass=1e-3,
-        coefficients=scaled(10.0, CHAIN.coefficients),
-        coefficients2=scaled(10.0, CHAIN.coefficients2 or CHAIN.coefficients),
+        forces=thesis(
+            scaled(10.0, thesis_row(CHAIN.forces)),
+            scaled(10.0, thesis_row(CHAIN.forces, 1) or thesis_row(CHAIN.forces)),
+        ),
     )
     r, ref = run_and_reference(chain, 100, "stopped")
     assert_agrees(r, ref, depth_rtol=1e-4, ts_atol=1e-4 * max(c.t_s for c in ref.contacts))
-    leg = LEG.replace(coefficients=scaled(100.0, LEG.coefficients))
+    leg = LEG.replace(forces=thesis(scaled(100.0, thesis_row(LEG.forces))))
     # h_lambda 2.77 at dt = 1e-4, at the edge of the stability limit (2.785), yet as dt/100
     # to 1e-4 in depth: a StepSizeWarning here would be conservative, not wrong.
     with warnings.catch_warnings():
@@ -575,7 +578,7 @@ def test_never_stops_before_t_end() -> None:
     zero = Coefficients(eta_h=0.0, eta_d=0.0, eta_v=0.0, lam=0.0)
     for scene in (
         cases.free_link(30.0, 2.0, coefficients=zero, t_end=t_end),
-        Scene(q_deg=30.0, v0=2.0, effects=("gravity",), t_end=t_end),
+        Scene(q_deg=30.0, v0=2.0, forces=select(thesis(), *("gravity",)), t_end=t_end),
     ):
         r = granrs.simulate(scene)
         assert_finite(r, "not_stopped")

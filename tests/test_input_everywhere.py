@@ -189,13 +189,12 @@ def test_wrong_type_for_a_name(field: str, value: Any) -> None:
 @pytest.mark.parametrize(
     ("kw", "field"),
     [
-        ({"effects": None}, "effects"),
-        ({"effects": 3}, "effects"),
+        ({"forces": None}, "forces"),
+        ({"forces": 3}, "forces"),
+        ({"forces": ("gravity",)}, "forces"),
+        ({"forces": {"eta_h": 1.0}}, "forces"),
         ({"record": 3}, "record"),
         ({"record": ("state", None)}, "record"),
-        ({"coefficients": "table_3_4"}, "coefficients"),
-        ({"coefficients": 1.0}, "coefficients"),
-        ({"coefficients": {"eta_h": 1.0}}, "coefficients"),
         ({"body": True}, "body"),
         ({"body": None}, "body"),
     ],
@@ -222,11 +221,10 @@ def test_chain_pin_joint_names_pin_joint() -> None:
     expect(lambda: granrs.simulate(CHAIN.replace(pin_joint=bad)), "pin_joint.k")
 
 
-def test_coefficients2_names_coefficients2() -> None:
-    """Minimal reproducer: Scene(body="chain", coefficients2={"eta_h": 1, "eta_d": 1,
-    "eta_v": 1, "lam": -1})."""
-    bad = {"eta_h": 1.0, "eta_d": 1.0, "eta_v": 1.0, "lam": -1.0}
-    expect(lambda: Scene(body="chain", coefficients2=bad), "coefficients2.lam")
+def test_link_2_s_parameter_names_the_term() -> None:
+    """Minimal reproducer: link 2's lambda negative, given per contact."""
+    bad = granrs.forces.static_v
+    expect(lambda: Scene(body="chain", forces=[bad(lam=(0.1, -1.0))]), "static_v.lam")
 
 
 def test_replace_refuses_unknown_fields_and_other_bodies() -> None:
@@ -329,14 +327,10 @@ TOML_BAD = [
     ("v0 = [1.0]\n", "v0", 1),
     ("dt = 12:00:00\n", "dt", 1),
     ("record = [1, 2]\n", "record", 1),
-    ('effects = ["gravity", 3]\n', "effects", 1),
+    ('forces = ["gravity", 3]\n', "forces", 1),
     ("coefficients = 3\n", "coefficients", 1),
-    ("[coefficients]\neta_h = 1.0\neta_d = 1.0\neta_v = 1.0\nlam = true\n", "coefficients.lam", 5),
-    (
-        'body = "chain"\n[coefficients2]\neta_h = "x"\neta_d = 1.0\neta_v = 1.0\nlam = 0.1\n',
-        "coefficients2.eta_h",
-        3,
-    ),
+    ('\n[[forces]]\nterm = "static_v"\nlam = true\n', "static_v.lam", 2),
+    ('body = "chain"\n[[forces]]\nterm = "drag"\neta_d = [1.0, "x"]\n', "drag.eta_d", 2),
 ]
 
 
@@ -399,9 +393,9 @@ def one_line(err: str) -> str:
         ("q2_deg=nan", "q2_deg"),
         ("v0=-inf", "v0"),
         ("dt=0", "dt"),
-        ("coefficients.eta_v=-3", "eta_v"),
-        ("coefficients.lam=true", "lam"),
-        ("coefficients.mu=1", "mu"),
+        ("static_v.eta_v=-3", "static_v.eta_v"),
+        ("static_v.lam=true", "static_v.lam"),
+        ("static_v.mu=1", "static_v.mu"),
         ("apply_at=centre", "apply_at"),
         ("effects=gravity", "effects"),
         ("record_stride=0.5", "record_stride"),

@@ -40,6 +40,7 @@ from hypothesis import strategies as st
 
 import granrs
 from granrs import Coefficients, Result, Scene
+from granrs.forces import thesis, thesis_row
 
 #: Table 3.4 at q = 0: the scale of the coefficients (the domain is 0..10x these).
 SCALE = {"eta_h": 6.5, "eta_d": 15.2, "eta_v": 248.0, "lam": 0.106}
@@ -69,7 +70,7 @@ def rates(scene: Scene) -> tuple[float, float]:
     v is the largest speed the rod can have: the initial one plus a fall of L. With the
     ``smooth`` sign, tanh(v / eps) adds the rate 4 F_s / (m eps) near rest, F_s the largest
     static force: that of the spring k that absorbs all the energy, sqrt(2 k E)."""
-    c = scene.coefficients
+    c = thesis_row(scene.forces)
     v = math.hypot(scene.v0, scene.vx0) + abs(scene.omega0) * scene.length
     v += math.sqrt(2.0 * scene.g * scene.length)
     drag = 4.0 * c.eta_d * scene.rho_g * scene.diameter * scene.length * v / scene.mass
@@ -111,7 +112,7 @@ def scenes(
         vx0=draw(st.one_of(st.just(0.0), st.floats(-2.0, 2.0))),
         omega0=draw(st.one_of(st.just(0.0), st.floats(-20.0, 20.0))),
         mass=10.0 ** draw(st.floats(-3.0, 2.0)),
-        coefficients=coefficients,
+        forces=thesis(coefficients),
         apply_at=draw(st.sampled_from(apply_at)),
         sign_model=draw(st.sampled_from(sign_models)),
         dt=1e-4,
@@ -220,7 +221,7 @@ MIRROR_PARTS = Scene(
     mass=0.01,
     dt=1e-3,
     t_end=0.3,
-    coefficients=Coefficients(eta_h=0.0, eta_d=15.2, eta_v=0.0, lam=0.0),
+    forces=thesis(Coefficients(eta_h=0.0, eta_d=15.2, eta_v=0.0, lam=0.0)),
 )
 
 
@@ -337,7 +338,7 @@ STUCK_AND_SPINNING = Scene(
     v0=0.0,
     vx0=-1.0,
     mass=0.01,
-    coefficients=Coefficients(eta_h=6.5, eta_d=0.0, eta_v=0.0, lam=0.0),
+    forces=thesis(Coefficients(eta_h=6.5, eta_d=0.0, eta_v=0.0, lam=0.0)),
     apply_at="centroid",
     dt=1e-3,
     t_end=0.3,
@@ -388,11 +389,13 @@ def test_centroid_energy_never_rises_unresolved_step() -> None:
         dt=0.00042469238738902614,
         t_end=0.3,
         apply_at="centroid",
-        coefficients=Coefficients(
-            eta_h=58.36127622830018,
-            eta_d=150.37275349570797,
-            eta_v=827.4179780793743,
-            lam=0.49665650686981155,
+        forces=thesis(
+            Coefficients(
+                eta_h=58.36127622830018,
+                eta_d=150.37275349570797,
+                eta_v=827.4179780793743,
+                lam=0.49665650686981155,
+            )
         ),
         record=("energy",),
     )
@@ -420,7 +423,7 @@ def random_scene(rng: np.random.Generator, **fixed: Any) -> Scene:
         "vx0": rng.uniform(-2.0, 2.0) if rng.random() < 0.5 else 0.0,
         "omega0": rng.uniform(-20.0, 20.0) if rng.random() < 0.5 else 0.0,
         "mass": 10.0 ** rng.uniform(-3.0, 2.0),
-        "coefficients": Coefficients(**{k: v * rng.uniform(0, 10) for k, v in SCALE.items()}),
+        "forces": thesis(Coefficients(**{k: v * rng.uniform(0, 10) for k, v in SCALE.items()})),
         "sign_model": SIGN_MODELS[int(rng.integers(3))],
         "dt": dt,
         "t_end": t_end_for(dt),
@@ -468,11 +471,13 @@ TIP_INJECTS = Scene(
     mass=10.873012299341996,
     dt=0.00044981417675368194,
     t_end=0.3,
-    coefficients=Coefficients(
-        eta_h=35.91637436940101,
-        eta_d=4.9463052993698655,
-        eta_v=51.9281928100492,
-        lam=0.05800022960674102,
+    forces=thesis(
+        Coefficients(
+            eta_h=35.91637436940101,
+            eta_d=4.9463052993698655,
+            eta_v=51.9281928100492,
+            lam=0.05800022960674102,
+        )
     ),
     record=("energy",),
 )
@@ -512,7 +517,7 @@ def test_measure_tip_energy_injection() -> None:
             print(
                 f"  worst: q_deg={s.q_deg!r}, v0={s.v0!r}, vx0={s.vx0!r}, omega0={s.omega0!r}, "
                 f"mass={s.mass!r}, dt={s.dt!r}, sign_model={s.sign_model!r}, "
-                f"coefficients={s.coefficients}"
+                f"coefficients={thesis_row(s.forces)}"
             )
 
 
@@ -572,11 +577,13 @@ BLOWS_UP_TO_INF = Scene(
     dt=0.0003108636710855665,
     t_end=0.3,
     sign_model="raw",
-    coefficients=Coefficients(
-        eta_h=39.627668521544585,
-        eta_d=146.26441509520092,
-        eta_v=116.62286464761162,
-        lam=0.6619883229043338,
+    forces=thesis(
+        Coefficients(
+            eta_h=39.627668521544585,
+            eta_d=146.26441509520092,
+            eta_v=116.62286464761162,
+            lam=0.6619883229043338,
+        )
     ),
 )
 

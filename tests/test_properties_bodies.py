@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 
 import granrs
 from granrs import Coefficients, Scene, cases
+from granrs.forces import thesis, thesis_row
 
 #: Derandomized, as in test_properties.py: the same examples on every CI run.
 SETTINGS = settings(
@@ -50,8 +51,10 @@ def chains(draw: st.DrawFn, apply_at: str = "tip") -> Scene:
         vx0=draw(st.floats(-1.0, 1.0)),
         omega0=draw(st.floats(-10.0, 10.0)),
         mass=draw(st.floats(0.01, 0.2)),
-        coefficients=_scaled(base.coefficients, f),
-        coefficients2=_scaled(base.coefficients2 or base.coefficients, f),
+        forces=thesis(
+            _scaled(thesis_row(base.forces), f),
+            _scaled(thesis_row(base.forces, 1) or thesis_row(base.forces), f),
+        ),
         pin_joint=pin,
         apply_at=apply_at,
         end="all_stops",
@@ -66,7 +69,7 @@ def legs(draw: st.DrawFn, apply_at: str = "tip") -> Scene:
     return base.replace(
         body_mass=draw(st.floats(40.0, 120.0)),
         v0=draw(st.floats(0.5, 4.0)),
-        coefficients=_scaled(base.coefficients, draw(st.floats(0.5, 2.0))),
+        forces=thesis(_scaled(thesis_row(base.forces), draw(st.floats(0.5, 2.0)))),
         ankle=draw(joint),
         knee=draw(joint),
         hip=draw(joint),

@@ -17,9 +17,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import granrs
 from granrs import Coefficients, Scene, cases
 from granrs.errors import InvalidParameterError, InvalidSceneError, UnknownNameError
-from granrs.scene import BODY_FIELDS, EFFECTS, RECORDS
+from granrs.forces import select, thesis
+from granrs.scene import BODY_FIELDS, RECORDS
 from granrs.scenefile import dumps, key_lines, load, loads, parse_override, template
 
 if sys.version_info >= (3, 11):
@@ -80,14 +82,14 @@ def test_writes_exactly_the_fields_of_the_body(body: str) -> None:
     }
     assert set(data) == expected | {"format"}
     assert data["format"] == 1
-    assert data["coefficients"] == scene.coefficients.as_dict()
+    assert data["forces"] == [t.to_dict() for t in scene.forces]
 
 
 def test_none_fields_are_left_out() -> None:
     """A field whose value is None is not a key (TOML has no null); loading gives None."""
     scene = Scene(body="chain", q_deg=10.0)
     data = tomllib.loads(dumps(scene))
-    for name in ("inertia", "q2_deg", "coefficients2"):
+    for name in ("inertia", "q2_deg"):
         assert name not in data
         assert getattr(loads(dumps(scene)), name) is None
 
@@ -99,8 +101,8 @@ AWKWARD = [
     {"q_deg": -0.0, "vx0": -0.0, "omega0": -0.0, "depth0": -0.0, "v0": -0.0},
     {"rho_g": 2.0**60, "mass": 1e22, "g": 12345678901234567.0},
     {"length": 1.0000000000000002, "diameter": 0.30000000000000004},
-    {"coefficients": Coefficients(eta_h=1e-300, eta_d=0.1 + 0.2, eta_v=2.0**53, lam=0.0)},
-    {"record_stride": 7, "record": ("energy", "state"), "effects": ()},
+    {"forces": thesis(Coefficients(eta_h=1e-300, eta_d=0.1 + 0.2, eta_v=2.0**53, lam=0.0))},
+    {"record_stride": 7, "record": ("energy", "state"), "forces": ()},
     {"coefficients_source": 'a "quoted" \\ back\\slash\nnew line\ttab \x01 \x7f # = [x] é ∂'},
     {"coefficients_source": ""},
     {"coefficients_source": "'''\"\"\"\\u0041"},
@@ -143,13 +145,17 @@ COEF = st.builds(
     lam=st.floats(0.0, 3.0),
 )
 POSITIVE = st.floats(1e-3, 1e3)
-SUBSETS_EFFECTS = st.lists(st.sampled_from(EFFECTS), unique=True).map(tuple)
+SUBSETS_TERMS = st.lists(st.sampled_from(granrs.forces.TERMS), unique=True).map(tuple)
+#: The thesis's terms with random parameters, a random subset of them (one contact's
+#: parameters for every contact, or for the chain one per link).
+FORCES = st.tuples(COEF, SUBSETS_TERMS).map(lambda a: select(thesis(a[0]), *a[1]))
+FORCES_CHAIN = st.tuples(COEF, COEF, SUBSETS_TERMS).map(lambda a: select(thesis(a[0], a[1]), *a[2]))
 SUBSETS_RECORD = st.lists(st.sampled_from(RECORDS), unique=True).map(tuple)
 
 COMMON = {
     "rho_g": POSITIVE,
     "g": st.floats(0.0, 100.0),
-    "coefficients": COEF,
+    "forces": FORCES,
     "coefficients_source": st.text(max_size=30),
     "v0": st.floats(0.0, 10.0),
     "depth0": st.floats(0.0, 0.05),
@@ -157,7 +163,6 @@ COMMON = {
     "apply_at": st.sampled_from(["tip", "centroid"]),
     "sign_model": st.sampled_from(["modes", "raw", "smooth"]),
     "smooth_eps": st.floats(1e-300, 1.0),
-    "effects": SUBSETS_EFFECTS,
     "dt": st.floats(1e-6, 1e-3),
     "method": st.sampled_from(["rk4", "dopri5"]),
     "rtol": st.floats(1e-14, 1e-2),
@@ -177,7 +182,7 @@ RODS = {
 }
 CHAIN = {
     "q2_deg": st.none() | st.floats(-89.9, 89.9),
-    "coefficients2": st.none() | COEF,
+    "forces": FORCES | FORCES_CHAIN,
     "pin_mass": st.floats(0.0, 1.0),
     "pin_joint": JOINT,
 }
@@ -279,7 +284,7 @@ def test_duplicate_key_is_a_syntax_error_at_its_line() -> None:
 
 @pytest.mark.parametrize(
     ("typo", "suggestion"),
-    [("lenght", "length"), ("v_0", "v0"), ("cofficients", "coefficients"), ("formt", "format")],
+    [("lenght", "length"), ("v_0", "v0"), ("focres", "forces"), ("formt", "format")],
 )
 def test_unknown_key_names_it_with_line_and_suggestion(typo: str, suggestion: str) -> None:
     """Issue 5: an unknown key raises UnknownNameError naming it, its line and the closest
@@ -299,22 +304,35 @@ def test_unknown_key_without_a_close_match_has_no_suggestion() -> None:
     assert "did you mean" not in str(info.value)
 
 
-def test_unknown_key_in_coefficients_table() -> None:
-    text = 'body = "free_link"\n\n[coefficients]\neta_h = 1.0\neta_d = 1.0\neta_v = 1.0\n'
-    text += "lambda = 0.1\n"
+def test_unknown_parameter_in_a_forces_table() -> None:
+    """Issue 16: an unknown parameter names term.param, its near miss and its table's line."""
+    text = 'body = "free_link"\n\n[[forces]]\nterm = "gravity"\n\n[[forces]]\n'
+    text += 'term = "static_v"\neta_v = 1.0\nlambda = 0.1\n'
     with pytest.raises(UnknownNameError) as info:
         loads(text)
-    assert info.value.field == "coefficients.lambda"
-    assert str(info.value).startswith(f"<string>:{line_of(text, 'lambda')}:")
-    assert "did you mean 'lam'?" in str(info.value)
+    assert info.value.field == "static_v.lambda"
+    assert str(info.value).startswith("<string>:6:")
+    assert "did you mean `static_v.lam`?" in str(info.value)
 
 
-def test_missing_coefficient_points_at_the_table() -> None:
-    text = "q_deg = 1.0\n[coefficients]\neta_h = 1.0\neta_d = 1.0\nlam = 0.1\n"
+def test_a_forces_table_without_a_term_points_at_the_table() -> None:
+    text = "q_deg = 1.0\n[[forces]]\neta_h = 1.0\n"
     with pytest.raises(InvalidParameterError) as info:
         loads(text)
-    assert info.value.field == "coefficients.eta_v"
-    assert str(info.value).startswith(f"<string>:{line_of(text, '[coefficients]')}:")
+    assert info.value.field == "forces"
+    assert str(info.value).startswith("<string>:2:")
+    assert "term" in str(info.value)
+
+
+@pytest.mark.parametrize("key", ["coefficients", "coefficients2", "effects"])
+def test_keys_of_the_earlier_format_say_what_to_write(key: str) -> None:
+    """Issue 16: the law is [[forces]] tables now; the old keys fail with what to write."""
+    text = f"q_deg = 1.0\n{key} = 1.0\n"
+    with pytest.raises(UnknownNameError) as info:
+        loads(text)
+    assert info.value.field == key
+    assert "[[forces]]" in str(info.value)
+    assert str(info.value).startswith("<string>:2:")
 
 
 @pytest.mark.parametrize(
@@ -328,8 +346,8 @@ def test_missing_coefficient_points_at_the_table() -> None:
         ("record_stride = true", InvalidParameterError, "record_stride"),
         ('apply_at = "tail"', UnknownNameError, "apply_at"),
         ('body = "arm"', UnknownNameError, "body"),
-        ('effects = ["gravity", "lift"]', UnknownNameError, "effects"),
-        ('effects = "gravity"', InvalidParameterError, "effects"),
+        ('forces = ["gravity", "lift"]', InvalidParameterError, "forces"),
+        ('forces = "gravity"', InvalidParameterError, "forces"),
         ("dt = 1970-01-01", InvalidParameterError, "dt"),
         ('knee = "locked"', InvalidSceneError, None),  # default value: allowed
         ('knee = "free"', InvalidSceneError, "knee"),  # not a free-link field
@@ -353,26 +371,16 @@ def test_bad_value_raises_typed_error_with_key_line(
     assert field in str(info.value)
 
 
-def test_bad_coefficient_points_at_its_line_in_each_table() -> None:
-    """coefficients2's bad value names coefficients2 (not coefficients) and its own line."""
+def test_bad_per_contact_value_points_at_its_table() -> None:
+    """A bad value of link 2 names the term's parameter and the line of its table."""
     text = (
-        'body = "chain"\nq_deg = 10.0\n\n[coefficients]\neta_h = 1.0\neta_d = 1.0\n'
-        "eta_v = 1.0\nlam = 0.1\n\n[coefficients2]\neta_h = 1.0\neta_d = -1.0\n"
-        "eta_v = 1.0\nlam = 0.1\n"
+        'body = "chain"\nq_deg = 10.0\n\n[[forces]]\nterm = "gravity"\n\n[[forces]]\n'
+        'term = "drag"\neta_d = [1.0, -1.0]\n'
     )
     with pytest.raises(InvalidParameterError) as info:
         loads(text)
-    assert info.value.field == "coefficients2.eta_d"
-    assert str(info.value).startswith(f"<string>:{line_of(text, 'eta_d = -1.0')}:")
-
-
-def test_dotted_coefficient_key_is_found() -> None:
-    text = "q_deg = 5.0\ncoefficients.eta_h = 1.0\ncoefficients.eta_d = 1.0\n"
-    text += "coefficients.eta_v = -3.0\ncoefficients.lam = 0.1\n"
-    with pytest.raises(InvalidParameterError) as info:
-        loads(text)
-    assert info.value.field == "coefficients.eta_v"
-    assert str(info.value).startswith("<string>:4:")
+    assert info.value.field == "drag.eta_d"
+    assert str(info.value).startswith("<string>:7:")
 
 
 def test_joint_spring_error_points_at_the_joint_line() -> None:
@@ -446,9 +454,14 @@ def test_parse_override_rejects(arg: str) -> None:
 
 
 def test_overrides_replace_file_values_and_errors_name_them() -> None:
-    text = "q_deg = 10.0\n[coefficients]\neta_h = 1.0\neta_d = 1.0\neta_v = 1.0\nlam = 0.1\n"
-    scene = loads(text, overrides={"q_deg": 20, "coefficients.eta_h": 7.5})
-    assert scene.q_deg == 20.0 and scene.coefficients.eta_h == 7.5
+    text = 'q_deg = 10.0\n[[forces]]\nterm = "static_h"\neta_h = 1.0\n'
+    scene = loads(text, overrides={"q_deg": 20, "static_h.eta_h": 7.5})
+    assert scene.q_deg == 20.0 and scene.forces == (granrs.forces.static_h(eta_h=7.5),)
+    with pytest.raises(InvalidSceneError, match="no \\[\\[forces\\]\\] table"):
+        loads(text, overrides={"drag.eta_d": 1.0})
+    with pytest.raises(InvalidParameterError) as info:
+        loads(text, source="f.toml", overrides={"static_h.eta_h": -1.0})
+    assert str(info.value).startswith("f.toml: --set static_h.eta_h=-1.0:")
     with pytest.raises(InvalidParameterError) as info:
         loads(text, source="f.toml", overrides={"q_deg": 100.0})
     assert str(info.value).startswith("f.toml: --set q_deg=100.0:")
@@ -462,7 +475,7 @@ def test_key_lines() -> None:
         'coefficients_source = """\nlength = 5\n"""\n'
         '"q_deg" = 1.0\n'
         "knee = { k = 1.0, c = 2.0 }\n"
-        "[coefficients]\neta_h = 1.0\n  lam = 0.2\n"
+        '[[forces]]\nterm = "drag"\n  eta_d = 0.2\n[[forces]]\nterm = "gravity"\n'
     )
     lines = key_lines(text)
     assert lines[("format",)] == 2
@@ -470,6 +483,7 @@ def test_key_lines() -> None:
     assert ("length",) not in lines  # inside a multi-line string
     assert lines[("q_deg",)] == 6
     assert lines[("knee",)] == 7
-    assert lines[("coefficients",)] == 8
-    assert lines[("coefficients", "eta_h")] == 9
-    assert lines[("coefficients", "lam")] == 10
+    assert lines[("forces", "#0")] == 8
+    assert lines[("forces", "#0", "term")] == 9
+    assert lines[("forces", "#0", "eta_d")] == 10
+    assert lines[("forces", "#1", "term")] == 12

@@ -18,6 +18,7 @@ import pytest
 import granrs
 from granrs import _granrs, cases
 from granrs.errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+from granrs.forces import select, thesis
 
 # Summary keys a sweep row shares with Result.summary.
 SHARED = (
@@ -86,13 +87,13 @@ def test_thread_count_does_not_change_results() -> None:
     pd.testing.assert_frame_equal(one, two)
 
 
-def test_coefficient_and_effect_axes() -> None:
+def test_forces_axis() -> None:
     base = cases.free_link(q_deg=0, v0=2.0)
     weak = granrs.Coefficients(eta_h=6.5, eta_d=15.2, eta_v=124.0, lam=0.106)
-    df = granrs.sweep(base, coefficients=[base.coefficients, weak])
+    df = granrs.sweep(base, forces=[base.forces, thesis(weak)])
     # Half the vertical static force: the vertical rod sinks deeper.
     assert df.loc[1, "depth"] > df.loc[0, "depth"]
-    df = granrs.sweep(base, effects=[granrs.EFFECTS, ("gravity", "static_v")])
+    df = granrs.sweep(base, forces=[base.forces, select(base.forces, "gravity", "static_v")])
     # A vertical drop feels only F_sv: pruning the other terms changes nothing.
     assert df.loc[0, "depth"] == pytest.approx(df.loc[1, "depth"], rel=1e-12)
 
@@ -182,8 +183,8 @@ def test_docstring_examples() -> None:
     import doctest
 
     import granrs.batch
-    import granrs.effects
+    import granrs.forces
 
-    for module in (granrs.batch, granrs.effects):
+    for module in (granrs.batch, granrs.forces):
         failures, tried = doctest.testmod(module, verbose=False, report=True)
         assert tried > 0 and failures == 0, module.__name__

@@ -28,6 +28,7 @@ from granrs.errors import (
     InvalidSceneError,
     UnknownNameError,
 )
+from granrs.forces import thesis
 
 NAN = math.nan
 INF = math.inf
@@ -146,20 +147,19 @@ def test_unknown_name(path: str, field: str, value: str) -> None:
 @pytest.mark.parametrize(
     ("field", "value"),
     [
-        ("effects", ("gravity", "magnetism")),
-        ("effects", ("Drag",)),
         ("record", ("state", "torque")),
         ("record", ("energies",)),
     ],
 )
 def test_unknown_list_entry(path: str, field: str, value: tuple[str, ...]) -> None:
-    """An unknown entry of effects or record raises UnknownNameError naming the list."""
+    """An unknown entry of record raises UnknownNameError naming the list (an unknown force
+    term: tests/test_forces.py)."""
     err = raises_naming(PATHS[path](field, value), UnknownNameError, field)
     assert value[-1] in str(err)
 
 
 @pytest.mark.parametrize("path", sorted(PATHS))
-@pytest.mark.parametrize("field", ["effects", "record"])
+@pytest.mark.parametrize("field", ["forces", "record"])
 def test_name_list_given_as_string(path: str, field: str) -> None:
     """A bare string where a list of names is expected is refused (not read letter by
     letter)."""
@@ -187,13 +187,16 @@ GOOD = {"eta_h": 5.5, "eta_d": 11.0, "eta_v": 53.0, "lam": 0.25}
 @pytest.mark.parametrize("value", [-1.0, -1e-12, NAN, INF, -INF])
 def test_bad_coefficient(name: str, value: float) -> None:
     """A negative or non-finite coefficient raises InvalidParameterError naming
-    coefficients.<name>, whether given as Coefficients, as a mapping to free_link, or in a
-    Scene."""
+    coefficients.<name>, whether given as Coefficients or as a mapping to free_link; as the
+    terms of a Scene, it names the term's parameter (static_v.lam)."""
     bad = {**GOOD, name: value}
     field = f"coefficients.{name}"
     raises_naming(lambda: Coefficients(**bad), InvalidParameterError, field)
     raises_naming(lambda: cases.free_link(45, 2.27, coefficients=bad), InvalidParameterError, field)
-    raises_naming(lambda: granrs.simulate(Scene(coefficients=bad)), InvalidParameterError, field)
+    term = {"eta_h": "static_h", "eta_d": "drag", "eta_v": "static_v", "lam": "static_v"}[name]
+    raises_naming(
+        lambda: granrs.simulate(Scene(forces=thesis(bad))), InvalidParameterError, f"{term}.{name}"
+    )
 
 
 @pytest.mark.parametrize("name", COEFFICIENT_FIELDS)
@@ -299,7 +302,7 @@ def test_valid_scene_passes() -> None:
         {"vx0": -1.0},
         {"record_stride": 3, "record": ("state",)},
         {"sign_model": "smooth", "smooth_eps": 1e-2},
-        {"effects": ()},
+        {"forces": ()},
     ):
         scene = Scene(t_end=0.01, **kw)
         scene.validate()

@@ -22,7 +22,6 @@ from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
-from .effects import EFFECT_INFO, Effect
 from .errors import (
     CoefficientTableError,
     GranrsError,
@@ -35,7 +34,7 @@ from .errors import (
 )
 from .force import ResistanceForce, resistance_force
 from .result import ContactResult, Result
-from .scene import EFFECTS, RECORDS, Scene
+from .scene import RECORDS, Scene
 
 if TYPE_CHECKING:
     from ._animation import ImpactAnimation
@@ -43,15 +42,12 @@ if TYPE_CHECKING:
 __version__: str = _granrs.__version__
 
 __all__ = [
-    "EFFECTS",
-    "EFFECT_INFO",
     "RECORDS",
     "RK4_STABILITY_LIMIT",
     "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
     "ContactResult",
-    "Effect",
     "GranrsError",
     "ImpactAnimation",
     "InvalidParameterError",

@@ -25,6 +25,7 @@ from . import _granrs
 from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
 from .coefficients import Coefficients
 from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
+from .forces import Term
 from .result import JOINT_NAMES
 from .scene import Scene
 
@@ -43,16 +44,21 @@ def _plain(name: str, value: Any) -> Any:
         return value.as_dict()
     if isinstance(value, np.generic):
         return value.item()
-    if name in ("effects", "record") and isinstance(value, tuple):
+    if name == "record" and isinstance(value, tuple):
         return list(value)
+    if name == "forces":
+        return [t.to_dict() if isinstance(t, Term) else t for t in value]
     return value
 
 
 def _axis_values(name: str, values: Any) -> list[Any]:
     if isinstance(values, (str, bytes, Mapping, Coefficients)) or not isinstance(values, Iterable):
         values = [values]
-    if name in ("effects", "record") and all(isinstance(v, str) for v in values):
+    if name == "record" and all(isinstance(v, str) for v in values):
         # One list of names is one value of the axis, not an axis of names.
+        values = [tuple(values)]
+    if name == "forces" and all(isinstance(v, Term) for v in values):
+        # One list of terms is one value of the axis.
         values = [tuple(values)]
     out = list(values)
     if not out:

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from . import data
+from . import data, forces
 from .coefficients import Coefficients, resolve
 from .errors import InvalidParameterError
 from .scene import Scene
@@ -105,14 +105,12 @@ LEG: dict[str, float] = {
 def _law(
     c1: Coefficients, c2: Coefficients | None, source: str, overrides: Mapping[str, Any]
 ) -> dict[str, Any]:
-    """The scene fields of a case's force law: its coefficient table's row(s), unless the
-    caller gives ``forces=`` (then the terms carry their own parameters)."""
+    """The scene fields of a case's force law: the thesis's terms with its coefficient
+    table's row(s) as their parameters, unless the caller gives ``forces=``."""
     if "forces" in overrides:
         return {"coefficients_source": "the scene's forces"}
-    law: dict[str, Any] = {"coefficients": c1, "coefficients_source": source}
-    if c2 is not None:
-        law["coefficients2"] = c2
-    return law
+    rows = (c1,) if c2 is None else (c1, c2)
+    return {"forces": forces.thesis(*rows), "coefficients_source": source}
 
 
 def _coefficients_arg(value: Any, field: str) -> Coefficients:

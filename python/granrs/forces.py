@@ -45,10 +45,12 @@ __all__ = [
     "gravity",
     "info",
     "joint_springs",
+    "select",
     "static_h",
     "static_v",
     "term",
     "thesis",
+    "thesis_row",
 ]
 
 #: A parameter's value: one number for every contact, or one per contact.
@@ -172,6 +174,14 @@ class Term:
         """The term's equation, parameters with units, source, switches and columns."""
         return _INFO[self.name]
 
+    def to_dict(self) -> dict[str, Any]:
+        """The term as plain values: ``{"term": name, param: float or list, ...}`` (the
+        form of a TOML ``[[forces]]`` table)."""
+        return {
+            "term": self.name,
+            **{k: list(v) if isinstance(v, tuple) else v for k, v in self.params.items()},
+        }
+
     def replace(self, **params: ParamValue) -> Term:
         """A copy with some parameters changed (checked like the constructor)."""
         return Term(self.name, {**self.params, **params})
@@ -268,6 +278,37 @@ def thesis(coefficients: Any = None, *more: Any) -> tuple[Term, ...]:
         static_h(eta_h=col("eta_h")),
         static_v(eta_v=col("eta_v"), lam=col("lam")),
         joint_springs(),
+    )
+
+
+def select(terms: Iterable[Term], *names: str) -> tuple[Term, ...]:
+    """The terms of ``terms`` whose names are among ``names``, in their order (what the
+    ``effects=`` names of earlier versions did): ``select(scene.forces, "gravity",
+    "static_v")``. An unknown name raises, with a near miss."""
+    for n in names:
+        info(n)
+    return tuple(t for t in terms if t.name in names)
+
+
+def thesis_row(terms: Iterable[Term], contact: int = 0) -> Any:
+    """The thesis-law parameters of ``terms`` at one contact as a
+    :class:`granrs.Coefficients` row (eta_h, eta_d, eta_v, lam), for reading them the way
+    the thesis's tables print them; ``None`` unless drag, static_h and static_v are all
+    listed. A view of the terms, not a second copy: change the terms to change the law."""
+    from .coefficients import Coefficients
+
+    by_name = {t.name: t.params for t in terms}
+    if not {"drag", "static_h", "static_v"} <= set(by_name):
+        return None
+
+    def at(v: ParamValue) -> float:
+        return float(v[contact]) if isinstance(v, tuple) else float(v)
+
+    return Coefficients(
+        eta_h=at(by_name["static_h"]["eta_h"]),
+        eta_d=at(by_name["drag"]["eta_d"]),
+        eta_v=at(by_name["static_v"]["eta_v"]),
+        lam=at(by_name["static_v"]["lam"]),
     )
 
 

@@ -7,8 +7,8 @@ belong to one body only are listed in :data:`BODY_FIELDS`; setting one for anoth
 raises :class:`~granrs.errors.InvalidSceneError`. :mod:`granrs.cases` builds the thesis's
 scenes with every default set.
 
-A scene is plain data: the body and its size, the sand, the coefficients of the force law,
-the initial state, the step, the end condition, the force terms (effects) to evaluate and
+A scene is plain data: the body and its size, the sand, the force terms that act (each with
+its parameters: :mod:`granrs.forces`), the initial state, the step, the end condition and
 the time series to record. :func:`granrs.simulate` runs it. Every field is checked by the
 Rust core (one set of rules for Python, TOML and the CLI) before any work starts; an invalid
 field raises a :class:`~granrs.errors.InvalidSceneError` subclass whose ``field`` names it.
@@ -23,16 +23,14 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from . import _granrs
-from .coefficients import Coefficients
-from .effects import EFFECTS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
-from .forces import Term, as_terms
+from .forces import Term, as_terms, thesis
 
-__all__ = ["BODIES", "BODY_FIELDS", "EFFECTS", "JOINTS", "RECORDS", "JointSpec", "Scene"]
+__all__ = ["BODIES", "BODY_FIELDS", "JOINTS", "RECORDS", "JointSpec", "Scene"]
 
 #: The body models.
 BODIES: tuple[str, ...] = ("free_link", "chain", "leg")
@@ -44,8 +42,24 @@ JointSpec = str | Mapping[str, float]
 #: Time series a scene may list in ``record``.
 RECORDS: tuple[str, ...] = ("state", "forces", "energy")
 
-#: Table 3.4 of the thesis at q = 0 (the vertical rod).
-_TABLE_3_4_VERTICAL = Coefficients(eta_h=6.5, eta_d=15.2, eta_v=248.0, lam=0.106)
+#: The thesis's law with each term's defaults (Table 3.4 of the thesis at q = 0).
+_THESIS_DEFAULT: tuple[Term, ...] = thesis()
+
+#: Fields of earlier versions and what to write instead.
+_REPLACED: dict[str, str] = {
+    "coefficients": (
+        "the force terms carry their parameters: forces=granrs.forces.thesis(coefficients) "
+        "(or granrs.cases.free_link(..., coefficients=...), which builds them)"
+    ),
+    "coefficients2": (
+        "give link 2's parameters per contact: forces=granrs.forces.thesis(link1, link2) "
+        "(or granrs.cases.chain(..., coefficients=(link1, link2)))"
+    ),
+    "effects": (
+        "list the terms that act: forces=granrs.forces.select(scene.forces, 'gravity', "
+        "'static_v') or forces=[granrs.forces.gravity(), granrs.forces.static_v(...)]"
+    ),
+}
 
 
 def _names(value: Any, field_name: str, allowed: tuple[str, ...]) -> tuple[str, ...]:
@@ -98,7 +112,6 @@ BODY_FIELDS: dict[str, tuple[str, ...]] = {
     "q_deg": ("free_link", "chain"),
     "omega0": ("free_link", "chain"),
     "q2_deg": ("chain",),
-    "coefficients2": ("chain",),
     "pin_mass": ("chain",),
     "pin_joint": ("chain",),
     "body_mass": ("leg",),
@@ -133,9 +146,8 @@ class Scene:
             cylinder, m (L^2/12 + d_c^2/16).
         rho_g: bulk density of the sand, packing included [kg/m^3] (thesis sec. 3.3.1: 1650).
         g: gravitational acceleration [m/s^2] (9.81).
-        coefficients: the force law's coefficients (default: Table 3.4 at q = 0); the
-            chain's link 1, the leg's foot.
-        coefficients_source: where the coefficients come from (for reports; not used).
+        coefficients_source: where the force terms' parameters come from (for reports; not
+            used by the run).
         q_deg: initial angle of the rod (chain: link 1) from the vertical [deg],
             -90 < q_deg < 90.
         v0: initial downward speed [m/s], >= 0.
@@ -148,15 +160,11 @@ class Scene:
             exactly, sticking handled), ``"raw"`` (the thesis's plain sign) or ``"smooth"``
             (tanh(v / smooth_eps)).
         smooth_eps: velocity scale of the ``"smooth"`` sign model [m/s].
-        forces: the force terms that act, a list of :mod:`granrs.forces` terms each with
-            its parameters (``[granrs.forces.gravity(), granrs.forces.static_v(eta_v=248.0,
-            lam=0.106)]``); ``[]``: nothing acts. ``None`` (the default): the thesis's law
-            with ``coefficients`` (and ``coefficients2``) limited to ``effects``. A scene
-            gives either ``forces`` or those three.
-        effects: the force terms to evaluate, from ``EFFECTS`` (all by default; see
-            :data:`granrs.EFFECT_INFO` for each term's parameters and units); a term not
-            listed is neither computed nor stored, and a spring-damper joint is free
-            without ``"joint_springs"``.
+        forces: the force terms that act, a list of :mod:`granrs.forces` terms, each with
+            its parameters (one value for every contact or one per contact). Default: the
+            thesis's law (gravity, drag, static_h, static_v, joint_springs) with each term's
+            defaults, Table 3.4 at q = 0. A term not listed is neither computed nor stored,
+            and a spring-damper joint is free without ``joint_springs``; ``[]``: nothing acts.
         dt: step of the fixed-step RK4 [s] (thesis sec. 3.3.2: 10 kHz, 1e-4); the first
             step of ``"dopri5"``.
         method: ``"rk4"`` (default: classical RK4 on the grid n dt) or ``"dopri5"``
@@ -171,7 +179,6 @@ class Scene:
 
     Chain only (thesis chapter 4):
         q2_deg: link 2's angle from the vertical [deg]; ``None``: -q_deg (mirror image).
-        coefficients2: link 2's coefficients; ``None``: the same as link 1's.
         pin_mass: mass of the pin, a point mass at the joint [kg] (0).
         pin_joint: the pin: ``"free"`` (the thesis's frictionless joint, sec. 4.1),
             ``"locked"`` or ``{"k": .., "c": ..}`` (rest angle: the initial one).
@@ -202,7 +209,6 @@ class Scene:
     inertia: float | None = None
     rho_g: float = 1650.0
     g: float = 9.81
-    coefficients: Coefficients = field(default=_TABLE_3_4_VERTICAL)
     coefficients_source: str = "Table 3.4, row q = 0 deg"
     q_deg: float = 0.0
     v0: float = 2.214
@@ -212,8 +218,7 @@ class Scene:
     apply_at: str = "tip"
     sign_model: str = "modes"
     smooth_eps: float = 1e-3
-    effects: tuple[str, ...] = EFFECTS
-    forces: tuple[Term, ...] | None = None
+    forces: tuple[Term, ...] = _THESIS_DEFAULT
     dt: float = 1e-4
     method: str = "rk4"
     rtol: float = 1e-8
@@ -223,7 +228,6 @@ class Scene:
     record: tuple[str, ...] = ()
     record_stride: int = 1
     q2_deg: float | None = None
-    coefficients2: Coefficients | None = None
     pin_mass: float = 0.0
     pin_joint: JointSpec = "free"
     body_mass: float = 75.35
@@ -252,28 +256,6 @@ class Scene:
                     f"{name} must be a value, not None (its default: {_DEFAULTS[name]!r})",
                     field=name,
                 )
-        for name in ("coefficients", "coefficients2"):
-            coefficients = getattr(self, name)
-            if coefficients is None and name == "coefficients2":
-                continue
-            if isinstance(coefficients, Mapping):
-                try:
-                    coefficients = Coefficients(**dict(coefficients))
-                except InvalidSceneError as exc:
-                    # Name the scene's field (coefficients2.lam), not the class's.
-                    field = getattr(exc, "field", None) or name
-                    renamed = f"{name}.{field.partition('.')[2]}" if "." in field else name
-                    raise type(exc)(str(exc).replace(field, renamed), field=renamed) from exc
-                except TypeError as exc:
-                    raise InvalidParameterError(
-                        f"{name} needs exactly eta_h, eta_d, eta_v, lam: {exc}", field=name
-                    ) from exc
-            if not isinstance(coefficients, Coefficients):
-                raise InvalidParameterError(
-                    f"{name} must be a granrs.Coefficients, got {type(coefficients).__name__}",
-                    field=name,
-                )
-            object.__setattr__(self, name, coefficients)
         for name in ("pin_joint", "ankle", "knee", "hip"):
             object.__setattr__(self, name, _joint(getattr(self, name), name))
         defaults = _DEFAULTS
@@ -284,23 +266,17 @@ class Scene:
                     f"not {self.body!r}",
                     field=name,
                 )
-        object.__setattr__(self, "effects", _names(self.effects, "effects", EFFECTS))
-        if self.forces is not None:
-            object.__setattr__(self, "forces", as_terms(self.forces))
-            for name in ("coefficients", "coefficients2", "effects"):
-                if getattr(self, name) != _DEFAULTS[name]:
-                    raise InvalidSceneError(
-                        f"forces= replaces coefficients, coefficients2 and effects (each term "
-                        f"carries its own parameters): give {name} as a term's parameters "
-                        "instead, e.g. granrs.forces.static_v(eta_v=248.0, lam=0.106)",
-                        field=name,
-                    )
+        object.__setattr__(self, "forces", as_terms(self.forces))
         object.__setattr__(self, "record", _names(self.record, "record", RECORDS))
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with some fields changed; an unknown field raises UnknownNameError."""
         known = {f.name for f in dataclasses.fields(self)}
         for name in changes:
+            if name in _REPLACED:
+                raise UnknownNameError(
+                    f"Scene has no field {name!r} any more: {_REPLACED[name]}", field=name
+                )
             if name not in known:
                 raise UnknownNameError(
                     f"Scene has no field {name!r}; fields: {', '.join(sorted(known))}",
@@ -311,12 +287,8 @@ class Scene:
     def to_dict(self) -> dict[str, Any]:
         """The scene as plain Python values, every field (a new dict)."""
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        d["coefficients"] = self.coefficients.as_dict()
-        d["coefficients2"] = None if self.coefficients2 is None else self.coefficients2.as_dict()
-        d["effects"] = list(self.effects)
+        d["forces"] = [t.to_dict() for t in self.forces]
         d["record"] = list(self.record)
-        if self.forces is not None:
-            d["forces"] = list(self.forces)
         return d
 
     def _plain(self) -> dict[str, Any]:
@@ -326,13 +298,8 @@ class Scene:
         if cached is None:
             fields = self.__dict__
             cached = {name: fields[name] for name in _CORE_FIELDS[self.body]}
-            cached["coefficients"] = self.coefficients.as_dict()
-            if "coefficients2" in cached and self.coefficients2 is not None:
-                cached["coefficients2"] = self.coefficients2.as_dict()
-            cached["effects"] = list(self.effects)
+            cached["forces"] = list(self.forces)
             cached["record"] = list(self.record)
-            if self.forces is not None:
-                cached["forces"] = list(self.forces)
             object.__setattr__(self, "_plain_cache", cached)
         return cached
 

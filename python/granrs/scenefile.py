@@ -7,18 +7,20 @@ The format (``format = 1``)::
     body = "free_link"
     length = 0.19            # m
     q_deg = 45.0             # deg
-    effects = ["gravity", "drag", "static_h", "static_v"]
     record = []
     knee = { k = 300.0, c = 5.0 }   # leg joints: "free", "locked" or a spring-damper
 
-    [coefficients]
-    eta_h = 5.5
-    eta_d = 11.0
-    eta_v = 53.0
-    lam = 0.25
+    [[forces]]
+    term = "gravity"
 
-Top-level keys are :class:`~granrs.Scene` field names; ``coefficients`` and
-``coefficients2`` are tables of ``eta_h``, ``eta_d``, ``eta_v`` and ``lam``. A field left
+    [[forces]]
+    term = "static_v"
+    eta_v = 53.0
+    lam = [0.25, 0.3]        # one value per contact, or one for all
+
+Top-level keys are :class:`~granrs.Scene` field names; each ``[[forces]]`` table is one
+force term (:mod:`granrs.forces`): ``term`` names it and its other keys are its parameters;
+the tables list the terms that act, in order (no table: the default terms). A field left
 out takes its default (the fields whose default is ``None`` can only be left out). The
 writer (:func:`dumps`) writes every field that applies to the scene's body
 (:data:`~granrs.scene.BODY_FIELDS`) and floats via ``repr``, so that
@@ -44,10 +46,9 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-from . import _granrs
-from .coefficients import Coefficients
+from . import _granrs, forces
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
-from .scene import BODIES, BODY_FIELDS, EFFECTS, RECORDS, Scene
+from .scene import BODIES, BODY_FIELDS, RECORDS, Scene
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -72,10 +73,16 @@ SUPPORTED_FORMATS: tuple[int, ...] = (1,)
 _FIELDS: tuple[dataclasses.Field[Any], ...] = dataclasses.fields(Scene)
 _FIELD_NAMES: tuple[str, ...] = tuple(f.name for f in _FIELDS)
 _FLOAT_FIELDS = frozenset(f.name for f in _FIELDS if "float" in str(f.type))
-_COEFFICIENT_TABLES = ("coefficients", "coefficients2")
-_COEFFICIENT_KEYS = ("eta_h", "eta_d", "eta_v", "lam")
 _JOINT_FIELDS = ("pin_joint", "ankle", "knee", "hip")
 _KNOWN_KEYS = ("format", *_FIELD_NAMES)
+#: Keys of earlier versions of the format and what to write instead.
+_TOML_REPLACED: dict[str, str] = {
+    "coefficients": 'the law must be [[forces]] tables (term = "drag" with eta_d = ..., '
+    'term = "static_v" with eta_v and lam, ...; `granrs scene new` writes them)',
+    "coefficients2": "link 2's values must be given per contact in the [[forces]] tables "
+    "(eta_d = [13.0, 10.0]: link 1, link 2)",
+    "effects": 'the terms that act must be listed as [[forces]] tables (term = "gravity", ...)',
+}
 
 #: One short note per field (unit first), written as a trailing comment.
 _NOTES: dict[str, str] = {
@@ -86,7 +93,7 @@ _NOTES: dict[str, str] = {
     "inertia": "kg m^2 about the centre of mass; left out: solid cylinder",
     "rho_g": "kg/m^3, bulk density of the sand",
     "g": "m/s^2",
-    "coefficients_source": "where the coefficients come from (not used by the run)",
+    "coefficients_source": "where the terms' parameters come from (not used by the run)",
     "q_deg": "deg from the vertical, -90 < q_deg < 90",
     "v0": "m/s downward, >= 0",
     "depth0": "m, initial depth of the tip, >= 0",
@@ -95,7 +102,6 @@ _NOTES: dict[str, str] = {
     "apply_at": "tip or centroid",
     "sign_model": "modes, raw or smooth",
     "smooth_eps": "m/s, velocity scale of the smooth sign model",
-    "effects": f"from {', '.join(EFFECTS)}",
     "dt": "s, RK4 step (first step of dopri5)",
     "method": "rk4 or dopri5",
     "rtol": "dopri5 relative tolerance",
@@ -105,7 +111,6 @@ _NOTES: dict[str, str] = {
     "record": f"series to record, from {', '.join(RECORDS)}",
     "record_stride": "record every n-th step",
     "q2_deg": "deg, link 2's angle; left out: -q_deg (mirror image)",
-    "coefficients2": "link 2's coefficients; left out: link 1's",
     "forces": "the force terms: [[forces]] tables, each term = name and its parameters",
     "pin_mass": "kg, point mass at the pin",
     "pin_joint": "free, locked or { k = N m/rad, c = N m s/rad }",
@@ -172,8 +177,6 @@ def _format_value(value: Any) -> str:
         return _format_float(float(value))
     if isinstance(value, str):
         return _format_string(value)
-    if isinstance(value, Coefficients):
-        value = value.as_dict()
     if isinstance(value, Mapping):
         items = ", ".join(f"{_format_key(k)} = {_format_value(v)}" for k, v in value.items())
         return "{ " + items + " }" if items else "{}"
@@ -222,12 +225,12 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
             continue
         value = getattr(scene, name)
         note = _NOTES.get(name) if comments else None
-        if scene.forces is not None and name in (*_COEFFICIENT_TABLES, "effects"):
-            continue  # the terms carry their parameters
         if value is None:
             lines.append(f"# {name} = ...  ({note})" if note else f"# {name} = (left out)")
             continue
         if name == "forces":
+            if not value:
+                lines.append(_line(name, "[]", "nothing acts"))
             for t in value:
                 tables.append("")
                 tables.append("[[forces]]")
@@ -236,12 +239,6 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
                     f"{_format_key(k)} = {_format_value(list(v) if isinstance(v, tuple) else v)}"
                     for k, v in t.params.items()
                 )
-            continue
-        if name in _COEFFICIENT_TABLES:
-            table = value.as_dict() if isinstance(value, Coefficients) else dict(value)
-            tables.append("")
-            tables.append(f"[{name}]" + (f"  # {note}" if note and name != "coefficients" else ""))
-            tables.extend(f"{_format_key(k)} = {_format_value(v)}" for k, v in table.items())
             continue
         lines.append(_line(name, _format_value(value), note))
     return "\n".join(lines + tables) + "\n"
@@ -296,7 +293,8 @@ def _split_key(path: str) -> tuple[str, ...]:
 
 def key_lines(text: str) -> dict[tuple[str, ...], int]:
     """The first line (1-based) at which each key path (and each of its prefixes) is set:
-    ``{("length",): 4, ("coefficients",): 12, ("coefficients", "eta_h"): 13, ...}``.
+    ``{("length",): 4, ("forces", "#0"): 12, ("forces", "#0", "term"): 13, ...}`` (the
+    n-th table of an array of tables is ``"#n"``).
 
     A plain scan of the text: table headers, ``key =`` lines and dotted keys; lines inside a
     multi-line string are skipped."""
@@ -397,38 +395,10 @@ def _as_field_value(name: str, value: Any) -> Any:
     return value
 
 
-def _coefficients(name: str, value: Any, locate: Callable[[tuple[str, ...]], str]) -> Any:
-    """The ``[coefficients]`` table as :class:`Coefficients`, errors naming the sub-key."""
-    if not isinstance(value, dict):
-        return value  # Scene raises the typed error naming the field
-    for key in value:
-        if key not in _COEFFICIENT_KEYS:
-            raise UnknownNameError(
-                f"{locate((name, key))}: unknown key {key!r} in [{name}]; allowed: "
-                f"{', '.join(_COEFFICIENT_KEYS)}{_suggest(key, _COEFFICIENT_KEYS)}",
-                field=f"{name}.{key}",
-            )
-    missing = [k for k in _COEFFICIENT_KEYS if k not in value]
-    if missing:
-        raise InvalidParameterError(
-            f"{locate((name,))}: [{name}] needs all of {', '.join(_COEFFICIENT_KEYS)}; "
-            f"missing {', '.join(missing)}",
-            field=f"{name}.{missing[0]}",
-        )
-    try:
-        return Coefficients(**value)
-    except InvalidSceneError as exc:
-        sub = (exc.field or "").rpartition(".")[2]
-        exc.field = f"{name}.{sub}" if sub else name
-        raise _reraise(exc, locate((name, sub) if sub else (name,))) from None
-
-
 def _forces(value: Any, locate: Callable[[tuple[str, ...]], str]) -> tuple[Any, ...]:
     """The ``[[forces]]`` tables as terms: each ``term = "name"`` and its parameters (a
     number, or a list with one per contact). An error names the term, the parameter and the
     line of its ``[[forces]]`` table."""
-    from . import forces
-
     if not isinstance(value, list) or not all(isinstance(t, dict) for t in value):
         raise InvalidParameterError(
             f"{locate(('forces',))}: forces must be [[forces]] tables, each with "
@@ -468,6 +438,11 @@ def _build(
             field="format",
         )
     for name in data:
+        if name in _TOML_REPLACED:
+            raise UnknownNameError(
+                f"{locate((name,))}: {name!r} is not a scene key any more: {_TOML_REPLACED[name]}",
+                field=name,
+            )
         if name not in _FIELD_NAMES:
             raise UnknownNameError(
                 f"{locate((name,))}: unknown key {name!r}: not a Scene field"
@@ -476,9 +451,6 @@ def _build(
             )
     fields: dict[str, Any] = {}
     for name, value in data.items():
-        if name in _COEFFICIENT_TABLES:
-            fields[name] = _coefficients(name, value, locate)
-            continue
         if name == "forces":
             fields[name] = _forces(value, locate)
             continue
@@ -499,7 +471,8 @@ def parse_override(text: str) -> tuple[str, Any]:
     """``"field=value"`` (a ``--set`` argument) as ``(field, value)``: the value is a TOML
     value (``30``, ``1e-5``, ``"tip"``, ``["state"]``, ``{ k = 300.0, c = 5.0 }``); a bare
     word that is not one is taken as a string (``body=chain``). ``field`` may be dotted
-    (``coefficients.eta_h=7``)."""
+    (``knee.k=300``); ``term.param`` sets a parameter of the ``[[forces]]`` table of that
+    term (``static_v.eta_v=300``)."""
     key, sep, value = text.partition("=")
     key = key.strip()
     if not sep or not key:
@@ -528,6 +501,26 @@ def _apply_overrides(
         path = tuple(part.strip() for part in key.split("."))
         shown = _format_value(value) if _is_writable(value) else repr(value)
         where = f"--set {key}={shown}"
+        if len(path) == 2 and path[0] in forces.TERMS:
+            # term.param: a parameter of that term's [[forces]] table (a file without
+            # tables has the default terms).
+            if "forces" not in data:
+                data["forces"] = [t.to_dict() for t in Scene().forces]
+            tables = data.get("forces")
+            found = [
+                i
+                for i, t in enumerate(tables if isinstance(tables, list) else [])
+                if isinstance(t, dict) and t.get("term") == path[0]
+            ]
+            if not found:
+                raise InvalidSceneError(
+                    f"{where}: the scene has no [[forces]] table with term = {path[0]!r}",
+                    field=key,
+                )
+            tables[found[0]][path[1]] = value  # type: ignore[index]
+            origins[("forces", f"#{found[0]}", path[1])] = where
+            origins[("forces", f"#{found[0]}")] = where
+            continue
         target = data
         for part in path[:-1]:
             existing = target.get(part)
@@ -551,7 +544,7 @@ def _is_writable(value: Any) -> bool:
 def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | None = None) -> Scene:
     """A validated :class:`~granrs.Scene` from TOML text; ``source`` names it in errors.
 
-    ``overrides`` (``{"q_deg": 30.0, "coefficients.eta_h": 7.0}``) replace values of the
+    ``overrides`` (``{"q_deg": 30.0, "static_v.eta_v": 300.0}``) replace values of the
     file before validation; an error in one points at ``--set field=value``.
     """
     try:

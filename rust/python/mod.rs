@@ -20,7 +20,7 @@ use crate::batch::{self, Source};
 use crate::error::GranrsError;
 use crate::integrate::Outcome;
 use crate::scene::AnyScene;
-use crate::spec::{word, SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
+use crate::spec::{word, SceneSpec, Value, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
 pub(crate) fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
@@ -232,28 +232,6 @@ fn compile(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Compiled> {
     Ok(Compiled { scene })
 }
 
-/// A coefficients field read from a `granrs.Scene`: a `granrs.Coefficients` becomes the
-/// mapping its `as_dict()` gives (the same four keys in the same order); anything else
-/// converts as in a scene dict.
-fn coefficients_from_py(v: &Bound<'_, PyAny>) -> Value {
-    if v.is_none() || v.is_instance_of::<PyDict>() {
-        return value_from_py(v);
-    }
-    let mut entries = Vec::with_capacity(4);
-    for (key, name) in [
-        (pyo3::intern!(v.py(), "eta_h"), "eta_h"),
-        (pyo3::intern!(v.py(), "eta_d"), "eta_d"),
-        (pyo3::intern!(v.py(), "eta_v"), "eta_v"),
-        (pyo3::intern!(v.py(), "lam"), "lam"),
-    ] {
-        match v.getattr(key) {
-            Ok(x) => entries.push((Cow::Borrowed(name), value_from_py(&x))),
-            Err(_) => return value_from_py(v),
-        }
-    }
-    Value::Map(entries)
-}
-
 /// The spec of a `granrs.Scene` read straight from its attributes: `fields` is the
 /// instance's `__dict__`, `names` the fields its body uses (`scene._CORE_FIELDS`). The same
 /// values as the dict `Scene._plain()` builds, without building it. Each names tuple's slots
@@ -290,9 +268,6 @@ fn spec_from_fields(fields: &Bound<'_, PyDict>, names: &Bound<'_, PyTuple>) -> S
                 continue;
             };
             match *slot {
-                Some(slot) if COEFFICIENTS_SLOTS.contains(&slot) => {
-                    spec.set_slot(slot, coefficients_from_py(&v))
-                }
                 Some(slot) => spec.set_slot(slot, value_from_py(&v)),
                 None => {
                     if let Ok(key_str) = key.to_str() {

@@ -142,6 +142,17 @@ pub fn terms_from_py<'py>(
         if item.cast::<PyString>().is_ok() {
             return None;
         }
+        if let Ok(d) = item.cast::<PyDict>() {
+            // A term as plain values (`Term.to_dict()`, a TOML table): "term" and its params.
+            let name = d.get_item("term").ok()??;
+            let name = name.cast::<PyString>().ok()?.to_str().ok()?.to_string();
+            let pairs = d.iter().filter(|(k, _)| k.to_string() != "term");
+            specs.push(TermSpec {
+                name,
+                params: params_from_py(pairs),
+            });
+            continue;
+        }
         let name = item.getattr("name").ok()?;
         let name = name.cast::<PyString>().ok()?.to_str().ok()?.to_string();
         // Any mapping (a Term's params are read-only): its items as (key, value) pairs.
