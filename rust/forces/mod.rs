@@ -26,6 +26,8 @@
 use std::fmt::Debug;
 use std::ops::{Add, Mul, Neg, Sub};
 
+#[cfg(test)]
+pub mod constant;
 pub mod drag;
 pub mod gravity;
 pub mod joint_springs;

@@ -15,34 +15,34 @@ use crate::error::{suggest, GranrsError, Result};
 pub const MAX_TERMS: usize = 6;
 
 macro_rules! registry {
-    ($($variant:ident($ty:ty),)*) => {
+    ($($(#[$m:meta])* $variant:ident($ty:ty),)*) => {
         /// Any registered term, with its parameters for one contact.
         #[derive(Debug, Clone, Copy, PartialEq)]
         pub enum AnyTerm {
-            $(#[doc = concat!("[`", stringify!($ty), "`]")] $variant($ty),)*
+            $($(#[$m])* #[doc = concat!("[`", stringify!($ty), "`]")] $variant($ty),)*
         }
 
         /// Every registered term's description.
-        pub static TERMS: &[&TermInfo] = &[$(&<$ty as Term>::INFO,)*];
+        pub static TERMS: &[&TermInfo] = &[$($(#[$m])* &<$ty as Term>::INFO,)*];
 
         impl AnyTerm {
             /// The term's description.
             pub fn info(&self) -> &'static TermInfo {
                 match self {
-                    $(AnyTerm::$variant(_) => &<$ty as Term>::INFO,)*
+                    $($(#[$m])* AnyTerm::$variant(_) => &<$ty as Term>::INFO,)*
                 }
             }
 
             /// Its parameter values, in the order of its `info().params`.
             pub fn params(&self) -> Vec<f64> {
                 match self {
-                    $(AnyTerm::$variant(t) => t.params(),)*
+                    $($(#[$m])* AnyTerm::$variant(t) => t.params(),)*
                 }
             }
 
             /// The term `name` from checked parameter values (`None`: no such term).
             fn from_name(name: &str, values: &[f64]) -> Option<AnyTerm> {
-                $(if name == <$ty as Term>::INFO.name {
+                $($(#[$m])* if name == <$ty as Term>::INFO.name {
                     return Some(AnyTerm::$variant(<$ty as Term>::from_params(values)));
                 })*
                 None
@@ -52,7 +52,7 @@ macro_rules! registry {
             #[inline(always)]
             pub fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
                 match self {
-                    $(AnyTerm::$variant(t) => t.contact_force(c, m),)*
+                    $($(#[$m])* AnyTerm::$variant(t) => t.contact_force(c, m),)*
                 }
             }
         }
@@ -65,6 +65,9 @@ registry! {
     StaticH(static_h::StaticH),
     StaticV(static_v::StaticV),
     JointSprings(joint_springs::JointSprings),
+    // The worked example of docs/forces.md, a fixture of the crate's own tests.
+    #[cfg(test)]
+    Constant(super::constant::Constant),
 }
 
 /// The description of the term `name`, or a typed error naming it (with a near miss).
