@@ -1,0 +1,164 @@
+"""The documentation site covers the package (issue 20: "documented like a scientific Python
+library").
+
+The API reference and the force-term pages are generated from the package when the docs
+are built (``docs/_ext/granrs_docs.py``, called by ``docs/conf.py``). These tests read what
+that generator writes, without Sphinx, and compare it with ``granrs.__all__``,
+``granrs.forces.TERMS`` and the ``Scene`` dataclass. With ``GRANRS_DOCS_HTML`` set to a
+built site (``.ci/run`` sets it after building the docs), they also check the built pages.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import importlib.util
+import io
+import os
+import re
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+import granrs
+from granrs import forces
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
+
+
+def _generator() -> ModuleType:
+    name = "granrs_docs"
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, DOCS / "_ext" / "granrs_docs.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+gen = _generator()
+
+
+#: Python blocks of the pages that are not run, by (page, index among its python blocks).
+NOT_RUN = {
+    ("forces.md", 1): "a constructor to add to python/granrs/forces.py (a worked example)",
+    ("sweeps.md", 2): "needs a Dask scheduler",
+}
+#: Blocks that show an error: the exception they must raise.
+RAISES = {("getting_started.md", 1): "InvalidParameterError"}
+
+
+def _pages() -> list[Path]:
+    skip = {"_build", "generated", "auto_examples", "_templates", "_ext"}
+    return sorted(p for p in DOCS.rglob("*.md") if not skip & set(p.relative_to(DOCS).parts))
+
+
+def _built_site() -> Path:
+    html = os.environ.get("GRANRS_DOCS_HTML")
+    if not html:
+        pytest.skip("GRANRS_DOCS_HTML is not set: no built site to check")
+    path = Path(html)
+    assert (path / "index.html").is_file(), f"GRANRS_DOCS_HTML={html} holds no built site"
+    return path
+
+
+def test_api_reference_lists_every_public_name_once() -> None:
+    """Every name of granrs.__all__ has an autosummary entry (and so a page) in the API
+    reference, and nothing else does."""
+    entries = gen.autosummary_entries(gen.api_rst())
+    assert sorted(set(entries)) == sorted(entries), "a name is listed twice"
+    missing = sorted(set(granrs.__all__) - set(entries))
+    extra = sorted(set(entries) - set(granrs.__all__))
+    assert not missing, f"public names missing from the API reference: {missing}"
+    assert not extra, f"API reference lists names that are not public: {extra}"
+
+
+def test_api_sections_name_only_public_names() -> None:
+    """The hand-ordered sections of the API reference (API_SECTIONS) list no name that has
+    left granrs.__all__; a new public name needs no edit (it is documented anyway)."""
+    assert gen.stale_api_names() == []
+
+
+def test_autosummary_entries_reads_the_tables() -> None:
+    """The parser the two tests above rely on finds the entries, and only them."""
+    text = ".. autosummary::\n   :toctree: api\n\n   simulate\n   sweep\n\nNot an entry\n"
+    assert gen.autosummary_entries(text) == ["simulate", "sweep"]
+
+
+def test_every_force_term_has_a_page_from_the_registry() -> None:
+    """One generated page per registered term, with its equation and each parameter's
+    name and default as granrs.forces.info gives them."""
+    pages = gen.generated_pages()
+    for name in forces.TERMS:
+        page = pages[f"{gen.GENERATED}/terms/{name}.rst"]
+        info = forces.info(name)
+        assert info.equation in page
+        for p in info.params:
+            assert f"``{p.name}``" in page and repr(p.default) in page
+        assert f'term = "{name}"' in page
+    index = pages[f"{gen.GENERATED}/terms/index.rst"]
+    assert all(f"<term-{name}>" in index for name in forces.TERMS)
+
+
+def test_scene_docstring_describes_every_field() -> None:
+    """The body pages' field tables take each field's description from the Scene
+    docstring: every field must have one."""
+    described = gen.scene_field_docs()
+    undescribed = [f.name for f in dataclasses.fields(granrs.Scene) if f.name not in described]
+    assert undescribed == []
+
+
+@pytest.mark.parametrize("page", _pages(), ids=lambda p: str(p.relative_to(DOCS)))
+def test_docs_pages_python_examples_run(
+    page: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every ```python block of a page runs as written, in order, in one namespace (as a
+    reader would paste them), with no warning."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    monkeypatch.chdir(tmp_path)  # pages write scene.toml and the like
+    name = str(page.relative_to(DOCS))
+    namespace: dict[str, object] = {}
+    blocks = re.findall(r"```python\n(.*?)```", page.read_text(encoding="utf-8"), re.S)
+    for i, block in enumerate(blocks):
+        if (name, i) in NOT_RUN:
+            continue
+        code = compile(block, f"{name}, python block {i}", "exec")
+        with contextlib.redirect_stdout(io.StringIO()):
+            if (name, i) in RAISES:
+                with pytest.raises(granrs.GranrsError) as caught:
+                    exec(code, namespace)
+                assert type(caught.value).__name__ == RAISES[(name, i)]
+            else:
+                exec(code, namespace)
+    plt.close("all")
+
+
+def test_built_api_reference_covers_every_public_name() -> None:
+    """In the built site, each public name has its page and the API index links to it."""
+    html = _built_site()
+    index = (html / "generated" / "api.html").read_text(encoding="utf-8")
+    for name in granrs.__all__:
+        page = html / "generated" / "api" / f"granrs.{name}.html"
+        assert page.is_file(), f"no page for granrs.{name}"
+        assert re.search(rf'href="api/granrs\.{re.escape(name)}\.html"', index), name
+
+
+def test_built_site_has_every_term_and_gallery_page() -> None:
+    """In the built site, each force term has its page and every gallery script its
+    executed page with a figure."""
+    html = _built_site()
+    for name in forces.TERMS:
+        assert (html / "generated" / "terms" / f"{name}.html").is_file(), name
+    scripts = sorted((DOCS.parent / "examples" / "gallery").glob("plot_*.py"))
+    assert scripts
+    for script in scripts:
+        page = (html / "auto_examples" / f"{script.stem}.html").read_text(encoding="utf-8")
+        assert f"sphx_glr_{script.stem}_001.png" in page, f"{script.name} drew no figure"
