@@ -63,9 +63,6 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
             "coefficients",
             "resistance_force",
             "ResistanceForce",
-            "Effect",
-            "EFFECTS",
-            "EFFECT_INFO",
         ),
     ),
     (
@@ -472,35 +469,13 @@ def leg_segments_rows() -> list[list[str]]:
 #: fixed in the package: object name -> ((text, replacement), ...). A fix-up that no longer
 #: matches fails the build (like a strict xfail), so that it is removed once the docstring
 #: is fixed.
-DOCSTRING_FIXUPS: dict[str, tuple[tuple[str, str], ...]] = {
-    # An inline literal cannot end in a space: ``# ``.
-    "granrs.scenefile.dumps": (("``# ``", '``"# "``'),),
-}
+DOCSTRING_FIXUPS: dict[str, tuple[tuple[str, str], ...]] = {}
 
 #: Cross-references in granrs docstrings whose target is not public (so not documented):
 #: (role, target) -> where. They are reported, not fixed here; each is a finding for the
 #: package's docstrings. An entry that stops being needed fails the build, so that it is
 #: removed once the docstring is fixed.
-KNOWN_BROKEN_REFERENCES: dict[tuple[str, str], str] = {
-    ("class", "granrs.effects.Parameter"): (
-        "granrs.Effect.parameters is a tuple of granrs.effects.Parameter, a class that is "
-        "not public (in no __all__)"
-    ),
-    ("func", "check_output"): (
-        "granrs.ImpactAnimation.write: :func:`check_output` (granrs.animate.check_output, "
-        "not public)"
-    ),
-    ("data", "MAX_FRAMES"): (
-        "granrs.animate: :data:`MAX_FRAMES` (granrs.animate.MAX_FRAMES, not public; "
-        "granrs.animate the name is the function)"
-    ),
-    ("data", "granrs.scene.BODY_FIELDS"): (
-        "granrs.scenefile module docstring: granrs.scene is not a public module"
-    ),
-    ("data", "STATUSES"): (
-        "granrs.sweep, Returns: :data:`STATUSES` (granrs.batch.STATUSES, not public)"
-    ),
-}
+KNOWN_BROKEN_REFERENCES: dict[tuple[str, str], str] = {}
 
 
 def attributes_section(doc: str | None) -> list[str]:
@@ -548,7 +523,7 @@ def documented_attributes() -> dict[str, list[str]]:
 
 def long_values(limit: int = 300) -> list[str]:
     """The documented constants whose value is too long to show in full (e.g.
-    ``granrs.EFFECT_INFO``): their pages show the description only."""
+    ``granrs.RECORDS``): their pages show the description only."""
     out = []
     for name in public_names():
         obj = getattr(granrs, name, None)

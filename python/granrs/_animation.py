@@ -543,7 +543,7 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
 
     def write(self, path: str | os.PathLike[str]) -> Path:
         """Write the animation to ``path``: ``.gif`` (Pillow), ``.mp4`` (ffmpeg) or ``.html``
-        (a self-contained JavaScript player). The path is checked first (:func:`check_output`).
+        (a self-contained JavaScript player). The path is checked first, before any frame is drawn.
         Returns the path."""
         out = check_output(path)
         suffix = out.suffix.lower()

@@ -212,8 +212,8 @@ def animate(
         InvalidParameterError: before any frame is drawn, naming the field: ``result`` not a
             Result, or one that recorded no state (``field="record"``); ``frame_dt``,
             ``speed``, ``fps`` or ``dpi`` not positive (or inconsistent); more than
-            :data:`MAX_FRAMES` frames (``field="frame_dt"``); ``out`` with an unknown suffix
-            or in a missing or unwritable directory.
+            ``granrs.animate.MAX_FRAMES`` frames (``field="frame_dt"``); ``out`` with an
+            unknown suffix or in a missing or unwritable directory.
     """
     from .result import Result
 

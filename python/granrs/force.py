@@ -111,7 +111,8 @@ def resistance_force(
         rho_g: bulk density of the sand [kg/m^3] (thesis sec. 3.3.1: 1650).
         g: gravitational acceleration [m/s^2].
         effects: the force terms to evaluate, from ``drag``, ``static_h``, ``static_v``
-            (others of :data:`granrs.EFFECTS` are accepted and have no force here).
+            (the names of :mod:`granrs.forces`; ``gravity`` and ``joint_springs`` are accepted
+            and have no force here).
         sign_model: ``"raw"`` (the thesis's sign(): 0 at zero velocity) or ``"smooth"``
             (``tanh(v / smooth_eps)``). The simulator's default ``"modes"`` holds signs
             through a step and needs a time history, so it is not offered here.

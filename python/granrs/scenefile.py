@@ -23,7 +23,7 @@ force term (:mod:`granrs.forces`): ``term`` names it and its other keys are its 
 the tables list the terms that act, in order (no table: the default terms). A field left
 out takes its default (the fields whose default is ``None`` can only be left out). The
 writer (:func:`dumps`) writes every field that applies to the scene's body
-(:data:`~granrs.scene.BODY_FIELDS`) and floats via ``repr``, so that
+(``granrs.scene.BODY_FIELDS``) and floats via ``repr``, so that
 ``loads(dumps(scene)) == scene`` exactly.
 
 Reading validates in full (``Scene(...).validate()``) and every error points at the
@@ -208,7 +208,7 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
 
     Fields whose value is ``None`` (their default) are written as comments only.
     ``comments=False`` leaves out the per-field notes; ``header`` adds lines (each prefixed
-    with ``# ``) after the version line.
+    with ``"# "``) after the version line.
     """
     if not isinstance(scene, Scene):
         raise InvalidParameterError(
