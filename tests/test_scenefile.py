@@ -19,10 +19,11 @@ from hypothesis import strategies as st
 
 import granrs
 from granrs import Coefficients, Scene, cases
+from granrs.cases import template
 from granrs.errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from granrs.forces import select, thesis
 from granrs.scene import BODY_FIELDS, RECORDS
-from granrs.scenefile import dumps, key_lines, load, loads, parse_override, template
+from granrs.scenefile import dumps, key_lines, load, loads, parse_override
 
 if sys.version_info >= (3, 11):
     import tomllib

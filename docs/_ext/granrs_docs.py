@@ -3,7 +3,7 @@
 Nothing here is written by hand twice: the API reference lists ``granrs.__all__``, each force
 term's page reads ``granrs.forces.info(name)`` (the Rust core's registry), the body tables
 read the :class:`granrs.Scene` dataclass, its docstring and :mod:`granrs.cases`, and the
-scene templates come from :func:`granrs.scenefile.template`. So these pages cannot drift
+scene templates come from :func:`granrs.cases.template`. So these pages cannot drift
 from the code.
 
 ``docs/conf.py`` calls :func:`generate` before Sphinx looks for source files (so that the
@@ -741,7 +741,7 @@ def setup(app: Any) -> dict[str, Any]:
         required_arguments = 1
 
         def run(self) -> list[Any]:
-            text = granrs.scenefile.template(self.arguments[0])
+            text = granrs.cases.template(self.arguments[0])
             block = nodes.literal_block(text, text)
             block["language"] = "toml"
             return [block]

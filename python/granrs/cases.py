@@ -13,12 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from . import data, forces
+from . import data, forces, scenefile
 from .coefficients import Coefficients, resolve
-from .errors import InvalidParameterError
-from .scene import Scene
+from .errors import InvalidParameterError, UnknownNameError
+from .scene import BODIES, Scene
 
-__all__ = ["CHAIN", "FREE_LINK", "LEG", "chain", "chain_case", "free_link", "leg"]
+__all__ = ["CHAIN", "FREE_LINK", "LEG", "chain", "chain_case", "free_link", "leg", "template"]
 
 #: The thesis's free link (sec. 3.2.1 and 3.3.1): SI units.
 FREE_LINK: dict[str, float] = {
@@ -266,3 +266,23 @@ def leg(
     )
     scene = base.replace(**overrides) if overrides else base
     return scene.validate()
+
+
+def template(body: str) -> str:
+    """A commented scene file for ``body``: the thesis's scene (this module's cases) with
+    every field written out: the free link at q = 0 deg, v0 = 2.214 m/s (Table 3.5 row 1),
+    chain case 1 (Table 4.1), the leg at 3.28 m/s (sec. 5.3.2)."""
+    if body == "free_link":
+        scene = free_link(q_deg=0.0, v0=2.214)
+        what = "the thesis's free link (sec. 3.2.1), vertical, v0 = 2.214 m/s"
+    elif body == "chain":
+        scene = chain(case=1)
+        what = "the thesis's two-link chain, case 1 of Table 4.1"
+    elif body == "leg":
+        scene = leg(v0=3.28)
+        what = "one leg of the thesis's subject (chapter 5) landing at 3.28 m/s"
+    else:
+        raise UnknownNameError(f"unknown body {body!r}; allowed: {', '.join(BODIES)}", field="body")
+    return scenefile.dumps(
+        scene, header=f"Template: {what}. Edit any value; delete a line for its default."
+    )

@@ -622,9 +622,9 @@ def _add_scene(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 def _cmd_scene(args: argparse.Namespace) -> int:
     """Run ``granrs scene new``."""
-    from . import scenefile
+    from . import cases
 
-    text = scenefile.template(args.body)
+    text = cases.template(args.body)
     if args.out is None:
         sys.stdout.write(text)
         return 0

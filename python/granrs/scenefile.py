@@ -48,7 +48,7 @@ from typing import Any
 
 from . import _granrs, forces
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
-from .scene import BODIES, BODY_FIELDS, RECORDS, Scene
+from .scene import BODY_FIELDS, RECORDS, Scene
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -62,7 +62,6 @@ __all__ = [
     "load",
     "loads",
     "parse_override",
-    "template",
 ]
 
 #: Version of the scene file format written by :func:`dumps` (the ``format`` key).
@@ -249,26 +248,6 @@ def dump(scene: Scene, path: str | os.PathLike[str]) -> str:
     text = dumps(scene)
     Path(path).write_text(text, encoding="utf-8")
     return text
-
-
-def template(body: str) -> str:
-    """A commented scene file for ``body``: the thesis's scene (:mod:`granrs.cases`) with
-    every field written out: the free link at q = 0 deg, v0 = 2.214 m/s (Table 3.5 row 1),
-    chain case 1 (Table 4.1), the leg at 3.28 m/s (sec. 5.3.2)."""
-    from . import cases
-
-    if body == "free_link":
-        scene = cases.free_link(q_deg=0.0, v0=2.214)
-        what = "the thesis's free link (sec. 3.2.1), vertical, v0 = 2.214 m/s"
-    elif body == "chain":
-        scene = cases.chain(case=1)
-        what = "the thesis's two-link chain, case 1 of Table 4.1"
-    elif body == "leg":
-        scene = cases.leg(v0=3.28)
-        what = "one leg of the thesis's subject (chapter 5) landing at 3.28 m/s"
-    else:
-        raise UnknownNameError(f"unknown body {body!r}; allowed: {', '.join(BODIES)}", field="body")
-    return dumps(scene, header=f"Template: {what}. Edit any value; delete a line for its default.")
 
 
 # ---------------------------------------------------------------------------------------
