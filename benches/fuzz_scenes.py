@@ -289,7 +289,7 @@ def accepted(target: str, exc: BaseException) -> bool:
 def fuzz(n: int, seed: int, timeout: float, verbose: bool = True) -> int:
     rng = random.Random(seed)
     scenes = base_scenes()
-    texts = [scenefile.template(b) for b in ("free_link", "chain", "leg")]
+    texts = [cases.template(b) for b in ("free_link", "chain", "leg")]
     texts += [scenefile.dumps(s) for s in scenes]
     dicts = [s.to_dict() for s in scenes]
     counts: collections.Counter[tuple[str, str]] = collections.Counter()
