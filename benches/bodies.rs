@@ -37,7 +37,7 @@ use nalgebra::SVector;
 use _granrs::body::Joint;
 use _granrs::dynamics::{ContactMode, Model, Modes, Slip, MAX_CONTACTS};
 use _granrs::forces::Coefficients;
-use _granrs::integrate::rk4::{deriv_of, step, State};
+use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Outcome, Record, SolveOptions, Status};
 use _granrs::scene::{ChainScene, FreeLinkScene, LegScene};
 

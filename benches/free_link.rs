@@ -24,7 +24,7 @@ use nalgebra::{SVector, Vector2};
 use _granrs::dynamics::terms_on;
 use _granrs::dynamics::{ContactMode, Modes, SignModel, Slip, MAX_CONTACTS};
 use _granrs::forces::{Coefficients, ContactState, ForceSet, Medium};
-use _granrs::integrate::rk4::{deriv_of, step, State};
+use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Record, SolveOptions, Status};
 use _granrs::scene::FreeLinkScene;
 

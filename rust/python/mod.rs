@@ -18,7 +18,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use crate::batch::{self, Source};
 use crate::error::GranrsError;
-use crate::integrate::Outcome;
+use crate::integrate::{FieldValue, Outcome, OUTCOME_FIELDS};
 use crate::scene::AnyScene;
 use crate::spec::{word, SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
 
@@ -145,53 +145,53 @@ fn scene_from_dict(d: &Bound<'_, PyDict>) -> Result<AnyScene, GranrsError> {
     spec_from_dict(d).build()
 }
 
-/// Convert an outcome to a dict of Python values; series move into numpy without copying.
+/// A field's value as a Python value: a float, an int, a bool, or a status's name.
+fn field_to_py(py: Python<'_>, v: FieldValue) -> PyResult<Bound<'_, PyAny>> {
+    Ok(match v {
+        FieldValue::Real(x) => x.into_pyobject(py)?.into_any(),
+        FieldValue::Count(n) => n.into_pyobject(py)?.into_any(),
+        FieldValue::Flag(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        FieldValue::Status(s) => s.name().into_pyobject(py)?.into_any(),
+    })
+}
+
+/// Convert an outcome to a dict of Python values, its summaries read from the one table of
+/// output fields ([`OUTCOME_FIELDS`]); series move into numpy without copying.
 fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, PyDict>> {
+    let fields = &OUTCOME_FIELDS;
     let d = PyDict::new(py);
     d.set_item("status", out.status.name())?;
     d.set_item("t_final", out.t_final)?;
+    // The work counters; and the run-level entries of Result.summary (the counters first),
+    // merged there with contact 0's in one update.
     let stats = PyDict::new(py);
-    stats.set_item("steps", out.stats.steps)?;
-    stats.set_item("rhs_evals", out.stats.rhs_evals)?;
-    stats.set_item("root_evals", out.stats.root_evals)?;
-    stats.set_item("events", out.stats.events)?;
-    stats.set_item("rejected", out.stats.rejected)?;
-    stats.set_item("unresolved", out.stats.unresolved)?;
-    // The run-level entries of Result.summary, merged there with contact 0's in one update.
+    for f in fields.run {
+        if let v @ FieldValue::Count(_) = (f.read)(&out) {
+            stats.set_item(f.name, field_to_py(py, v)?)?;
+        }
+    }
     let run = stats.copy()?;
-    run.set_item("status", out.status.name())?;
-    run.set_item("t_final", out.t_final)?;
-    run.set_item("energy_start", out.energy_start)?;
-    run.set_item("energy_end", out.energy_end)?;
-    run.set_item("dissipated", out.dissipated)?;
-    run.set_item("h_lambda", out.h_lambda)?;
+    for f in fields.run {
+        match (f.read)(&out) {
+            FieldValue::Count(_) => {}
+            v => run.set_item(f.name, field_to_py(py, v)?)?,
+        }
+    }
     d.set_item("run", run)?;
     d.set_item("stats", stats)?;
     d.set_item("energy_start", out.energy_start)?;
     d.set_item("energy_end", out.energy_end)?;
     d.set_item("work_sand", out.work_sand)?;
     d.set_item("terms", PyTuple::new(py, &out.terms)?)?;
+    // Each contact's summary; whether it stopped goes in a list of its own.
     let contacts = PyList::empty(py);
     let stopped = PyList::empty(py);
     for c in &out.contacts {
         stopped.append(c.stopped)?;
         let cd = PyDict::new(py);
-        cd.set_item("t_s", c.t_s)?;
-        cd.set_item("depth", c.depth)?;
-        cd.set_item("dq", c.dq)?;
-        cd.set_item("omega_end", c.omega_end)?;
-        cd.set_item("F_d_max", c.f_d_max)?;
-        cd.set_item("F_s_end", c.f_s_end)?;
-        cd.set_item("F_r_end", c.f_r_end)?;
-        cd.set_item("dKE", c.d_ke)?;
-        cd.set_item("dPE", c.d_pe)?;
-        cd.set_item("dE", c.d_e)?;
-        cd.set_item("work_sand", c.work_sand)?;
-        cd.set_item("x_tip_end", c.tip_end.x)?;
-        cd.set_item("t_entry", c.t_entry)?;
-        cd.set_item("link_dKE", c.link_d_ke)?;
-        cd.set_item("link_dPE", c.link_d_pe)?;
-        cd.set_item("link_dE", c.link_d_ke + c.link_d_pe)?;
+        for f in fields.contact.iter().filter(|f| f.name != "stopped") {
+            cd.set_item(f.name, field_to_py(py, (f.read)(c))?)?;
+        }
         contacts.append(cd)?;
     }
     d.set_item("contacts", contacts)?;
@@ -200,8 +200,9 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     let joints = PyList::empty(py);
     for j in &out.joints {
         let jd = PyDict::new(py);
-        jd.set_item("F_max", j.f_max)?;
-        jd.set_item("torque_max", j.torque_max)?;
+        for f in fields.joint {
+            jd.set_item(f.name, field_to_py(py, (f.read)(j))?)?;
+        }
         joints.append(jd)?;
     }
     d.set_item("joints", joints)?;
