@@ -8,13 +8,13 @@
 
 use std::borrow::Cow;
 
+use crate::bodies::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
 use crate::dynamics::SignModel;
 use crate::error::{GranrsError, Result};
 use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
 use crate::integrate::{EndCondition, Method, Record, SolveOptions};
-use crate::scene::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
 
 /// A field's value, as plain data.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,7 +1,7 @@
 //! The free link's closed form against the general engine, and the inverse effective mass.
 
 use super::*;
-use crate::scene::FreeLinkScene;
+use crate::bodies::FreeLinkScene;
 use nalgebra::Matrix2;
 use proptest::prelude::*;
 
@@ -179,8 +179,8 @@ fn centroid_inverse_mass_of_a_rod_and_of_a_locked_chain() {
         "{w} {expected}"
     );
     // A chain: locking the pin can only make the tip's E heavier.
+    use crate::bodies::ChainScene;
     use crate::body::mechanism::Joint;
-    use crate::scene::ChainScene;
     let q = SVector::<f64, 4>::new(0.0, 0.0, 0.2, 0.5);
     let free = ChainScene {
         joint: Joint::Free,

@@ -17,9 +17,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use crate::batch::{self, Source};
+use crate::bodies::AnyScene;
 use crate::error::GranrsError;
 use crate::integrate::{FieldValue, Outcome, OUTCOME_FIELDS};
-use crate::scene::AnyScene;
 use crate::spec::{word, SceneSpec, Value, COEFFICIENTS_SLOTS, EFFECTS, RECORDS, SCENE_FIELDS};
 
 /// Convert a core error to the matching `granrs.errors` exception.
