@@ -34,12 +34,12 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::SVector;
 
+use _granrs::bodies::{ChainScene, FreeLinkScene, LegScene};
 use _granrs::body::Joint;
 use _granrs::dynamics::{ContactMode, Model, Modes, Slip, MAX_CONTACTS};
 use _granrs::forces::Coefficients;
-use _granrs::integrate::rk4::{deriv_of, step, State};
+use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Outcome, Record, SolveOptions, Status};
-use _granrs::scene::{ChainScene, FreeLinkScene, LegScene};
 
 /// A velocity component below this [m/s] sticks (the solver's own threshold).
 const SLIP_SPEED: f64 = 1e-9;

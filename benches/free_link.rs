@@ -21,12 +21,12 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::{SVector, Vector2};
 
+use _granrs::bodies::FreeLinkScene;
 use _granrs::dynamics::terms_on;
 use _granrs::dynamics::{ContactMode, Modes, SignModel, Slip, MAX_CONTACTS};
 use _granrs::forces::{Coefficients, ContactState, ForceSet, Medium};
-use _granrs::integrate::rk4::{deriv_of, step, State};
+use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Record, SolveOptions, Status};
-use _granrs::scene::FreeLinkScene;
 
 /// Table 3.4 of the thesis, row q = 45 deg.
 const TABLE_3_4_Q45: Coefficients = Coefficients {

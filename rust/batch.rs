@@ -16,57 +16,19 @@ use std::sync::Mutex;
 use rayon::prelude::*;
 
 use crate::error::{GranrsError, Result};
-use crate::integrate::{Outcome, Status};
+use crate::integrate::{Outcome, Status, OUTCOME_FIELDS};
 use crate::spec::{SceneSpec, Value};
 
-/// Status codes of the `status` column.
-pub const STATUS_STOPPED: f64 = 0.0;
+/// Status codes of the `status` column ([`Status::code`]).
+pub const STATUS_STOPPED: f64 = Status::Stopped.code();
 /// `t_end` reached with the end condition `time`.
-pub const STATUS_END_TIME: f64 = 1.0;
+pub const STATUS_END_TIME: f64 = Status::EndTime.code();
 /// `t_end` reached before the stop.
-pub const STATUS_NOT_STOPPED: f64 = 2.0;
+pub const STATUS_NOT_STOPPED: f64 = Status::NotStopped.code();
 /// The run failed (its message is in [`BatchOut::failures`]).
 pub const STATUS_FAILED: f64 = 3.0;
 /// The run was not started (the batch was cancelled).
 pub const STATUS_CANCELLED: f64 = 4.0;
-
-/// Run-level columns.
-const RUN_COLUMNS: [&str; 12] = [
-    "status",
-    "t_final",
-    "steps",
-    "rhs_evals",
-    "root_evals",
-    "events",
-    "rejected",
-    "unresolved",
-    "energy_start",
-    "energy_end",
-    "dissipated",
-    "h_lambda",
-];
-/// Per-contact columns (prefixed `c{i}.`).
-const CONTACT_COLUMNS: [&str; 17] = [
-    "stopped",
-    "t_s",
-    "depth",
-    "dq",
-    "omega_end",
-    "F_d_max",
-    "F_s_end",
-    "F_r_end",
-    "dKE",
-    "dPE",
-    "dE",
-    "work_sand",
-    "x_tip_end",
-    "t_entry",
-    "link_dKE",
-    "link_dPE",
-    "link_dE",
-];
-/// Per-joint columns (prefixed `joint{i}.`).
-const JOINT_COLUMNS: [&str; 2] = ["F_max", "torque_max"];
 
 /// Contacts and reported joints of a body.
 pub fn body_shape(body: &str) -> (usize, usize) {
@@ -77,71 +39,38 @@ pub fn body_shape(body: &str) -> (usize, usize) {
     }
 }
 
-/// The summary columns of a body, in row order.
+/// The summary columns of a body, in row order: the run's fields of [`OUTCOME_FIELDS`],
+/// then each contact's (prefixed `c{i}.`) and each reported joint's (`joint{j}.`).
 pub fn columns(body: &str) -> Vec<String> {
     let (nc, nj) = body_shape(body);
-    let mut out: Vec<String> = RUN_COLUMNS.iter().map(|s| s.to_string()).collect();
+    let fields = &OUTCOME_FIELDS;
+    let mut out: Vec<String> = fields.run.iter().map(|f| f.name.to_string()).collect();
     for i in 0..nc {
-        out.extend(CONTACT_COLUMNS.iter().map(|c| format!("c{i}.{c}")));
+        out.extend(fields.contact.iter().map(|f| format!("c{i}.{}", f.name)));
     }
     for j in 0..nj {
-        out.extend(JOINT_COLUMNS.iter().map(|c| format!("joint{j}.{c}")));
+        out.extend(fields.joint.iter().map(|f| format!("joint{j}.{}", f.name)));
     }
     out
 }
 
 /// Write one outcome into its row (`row.len() == columns(body).len()`).
 pub fn summarize(out: &Outcome, row: &mut [f64]) {
-    let status = match out.status {
-        Status::Stopped => STATUS_STOPPED,
-        Status::EndTime => STATUS_END_TIME,
-        Status::NotStopped => STATUS_NOT_STOPPED,
-    };
-    let s = &out.stats;
-    let run = [
-        status,
-        out.t_final,
-        s.steps as f64,
-        s.rhs_evals as f64,
-        s.root_evals as f64,
-        s.events as f64,
-        s.rejected as f64,
-        s.unresolved as f64,
-        out.energy_start,
-        out.energy_end,
-        out.dissipated,
-        out.h_lambda,
-    ];
-    row[..run.len()].copy_from_slice(&run);
-    let mut k = run.len();
-    let nj = (row.len() - k - out.contacts.len() * CONTACT_COLUMNS.len()) / JOINT_COLUMNS.len();
-    for c in &out.contacts {
-        let values = [
-            if c.stopped { 1.0 } else { 0.0 },
-            c.t_s,
-            c.depth,
-            c.dq,
-            c.omega_end,
-            c.f_d_max,
-            c.f_s_end,
-            c.f_r_end,
-            c.d_ke,
-            c.d_pe,
-            c.d_e,
-            c.work_sand,
-            c.tip_end.x,
-            c.t_entry,
-            c.link_d_ke,
-            c.link_d_pe,
-            c.link_d_ke + c.link_d_pe,
-        ];
-        row[k..k + values.len()].copy_from_slice(&values);
-        k += values.len();
+    let fields = &OUTCOME_FIELDS;
+    let mut cells = row.iter_mut();
+    for (f, cell) in fields.run.iter().zip(&mut cells) {
+        *cell = (f.read)(out).as_f64();
     }
-    for j in out.joints.iter().take(nj) {
-        row[k] = j.f_max;
-        row[k + 1] = j.torque_max;
-        k += 2;
+    for c in &out.contacts {
+        for (f, cell) in fields.contact.iter().zip(&mut cells) {
+            *cell = (f.read)(c).as_f64();
+        }
+    }
+    // The row has room for the body's reported joints (none for a free link).
+    for j in &out.joints {
+        for (f, cell) in fields.joint.iter().zip(&mut cells) {
+            *cell = (f.read)(j).as_f64();
+        }
     }
 }
 

@@ -10,13 +10,13 @@
 //! `cargo test` needs no Python.
 
 pub mod batch;
+pub mod bodies;
 pub mod body;
 pub mod dynamics;
 pub mod error;
 pub mod evaluate;
 pub mod forces;
 pub mod integrate;
-pub mod scene;
 pub mod spec;
 
 #[cfg(feature = "python")]

@@ -6,8 +6,8 @@
 
 mod common;
 
+use _granrs::bodies::FreeLinkScene;
 use _granrs::dynamics::SignModel;
-use _granrs::scene::FreeLinkScene;
 use common::{exact_vertical_depth, table_3_4_vertical, vertical_static_work};
 
 /// t_s = int_0^df dd / v(d), with d = df (1 - u^2) to remove the 1/sqrt singularity at df;

@@ -3,12 +3,12 @@
 
 mod common;
 
+use _granrs::bodies::{ChainScene, FreeLinkScene, LegScene};
 use _granrs::body::rod::ApplyAt;
 use _granrs::body::{Joint, Link, Mechanism, RodContact};
 use _granrs::dynamics::{Contact, Model, Shape};
 use _granrs::forces::Coefficients;
 use _granrs::integrate::{solve, EndCondition, Outcome, Record};
-use _granrs::scene::{ChainScene, FreeLinkScene, LegScene};
 use common::{exact_vertical_depth, table_3_4_vertical};
 use nalgebra::{SVector, Vector2};
 

@@ -2,8 +2,8 @@
 
 mod common;
 
+use _granrs::bodies::FreeLinkScene;
 use _granrs::integrate::{EndCondition, Status};
-use _granrs::scene::FreeLinkScene;
 use common::{exact_vertical_depth, table_3_4_vertical};
 
 fn vertical(v0: f64) -> FreeLinkScene {

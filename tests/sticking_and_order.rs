@@ -3,10 +3,10 @@
 
 mod common;
 
+use _granrs::bodies::FreeLinkScene;
 use _granrs::dynamics::{ContactMode, Slip, MAX_CONTACTS};
 use _granrs::forces::Coefficients;
 use _granrs::integrate::{EndCondition, Record, Series};
-use _granrs::scene::FreeLinkScene;
 use common::{exact_vertical_depth, table_3_4_vertical};
 use nalgebra::SVector;
 

@@ -5,9 +5,9 @@
 
 mod common;
 
+use _granrs::bodies::FreeLinkScene;
 use _granrs::forces::Coefficients;
 use _granrs::integrate::Status;
-use _granrs::scene::FreeLinkScene;
 use common::read_csv;
 
 /// Table 3.4 row at the tabulated angle nearest |q| (ties to the larger |q|).

@@ -72,9 +72,9 @@ impl Term for Constant {
 
 #[cfg(test)]
 mod tests {
+    use crate::bodies::FreeLinkScene;
     use crate::forces::{ForceSet, TermSpec};
     use crate::integrate::{EndCondition, Record};
-    use crate::scene::FreeLinkScene;
 
     /// Issue 16: a new term takes one file and one registry line, and then runs. A vertical
     /// rod already in the sand, pushed up by a constant 2 m g at its tip against gravity,

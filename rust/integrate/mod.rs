@@ -1,11 +1,20 @@
-//! Time integration: the fixed-step RK4, its cubic Hermite dense output, event location
-//! and the solve loop.
+//! Time integration, one file per piece (after diffrax and REBOUND): the loop itself
+//! ([`solve`](mod@solve): step, detect, handle, observe), the step ([`stepper`]: RK4 and
+//! Dopri5, dense output), where the steps end ([`control`]), the events ([`events`]), what
+//! the run keeps of itself ([`observe`]) and what it returns ([`outcome`], with the one
+//! table of output fields [`OUTCOME_FIELDS`]).
 
-pub mod dense;
-pub mod rk4;
+pub mod control;
+pub mod events;
+pub mod observe;
+pub mod outcome;
 pub mod solve;
+pub mod stepper;
 
-pub use solve::{
-    solve, ContactSummary, EndCondition, JointSummary, Method, Outcome, Record, Series,
-    SolveOptions, Stats, Status,
+pub use observe::{Record, DIVERGENCE_FACTOR, RK4_STABILITY_LIMIT};
+pub use outcome::{
+    ContactSummary, Field, FieldValue, JointSummary, Outcome, OutcomeFields, Series, Stats, Status,
+    OUTCOME_FIELDS,
 };
+pub use solve::{solve, EndCondition, SolveOptions};
+pub use stepper::Method;

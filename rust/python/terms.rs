@@ -7,7 +7,7 @@ use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 use crate::forces::{Acts, Class, TermSpec, TERMS};
 use crate::spec::Value;
 
-use super::to_pyerr;
+use super::errors::to_pyerr;
 
 /// Every registered term's description, in the registry's order: name, summary, equation,
 /// source, acts (`"contact"` or `"body"`), class, velocity_dependent, reads, switches,

@@ -1,8 +1,8 @@
 //! Shared helpers of the cargo integration tests.
 #![allow(dead_code)]
 
+use _granrs::bodies::FreeLinkScene;
 use _granrs::forces::Coefficients;
-use _granrs::scene::FreeLinkScene;
 
 /// The `static_v` term of a free link's force set (panics without one).
 pub fn static_v_of(s: &FreeLinkScene) -> Coefficients {

@@ -1,4 +1,8 @@
-//! The classical fourth-order Runge-Kutta step on the body's state.
+//! The steppers (diffrax's `AbstractSolver.step`): one step of the classical fourth-order
+//! Runge-Kutta method or of the adaptive Dormand-Prince 5(4) pair on the body's state, its
+//! end, its error estimate (Dopri5), and its dense output (the cubic Hermite interpolant
+//! through both ends and their derivatives, free with RK4: the end derivative is the next
+//! step's first stage).
 //!
 //! The state is the generalized coordinates, their rates, and the work done by the sand
 //! on the body (integrated alongside, so that the energy balance can be checked against an
@@ -6,7 +10,22 @@
 
 use nalgebra::SVector;
 
+use super::outcome::Stats;
 use crate::dynamics::{DragStiffness, Eval, Model, Modes};
+
+/// The time stepper.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Classical RK4 on the fixed grid `n dt` (default; the thesis ran at 10 kHz).
+    Rk4,
+    /// Adaptive Dormand-Prince 5(4): tolerances instead of a step; `dt` is the first step.
+    Dopri5 {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance [SI units of each coordinate].
+        atol: f64,
+    },
+}
 
 /// The integrated state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -219,4 +238,108 @@ pub fn dopri5_step<const N: usize>(
     }
     let err = (sum / (2 * N) as f64).sqrt();
     (y1, e7, err)
+}
+
+/// A whole step of `method` of size `h` from `y`, whose derivative `k1` is known: the new
+/// state, its evaluation written into `e1`, and the error estimate's weighted RMS norm (0 for
+/// RK4, which has none). RK4 shows `sample` each stage's coordinates and the drag's stiffest
+/// contact there (see [`step_sampling`]). Counts the evaluations in `stats`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn full_step<const N: usize>(
+    model: &Model<N>,
+    method: Method,
+    modes: &Modes,
+    y: &State<N>,
+    k1: &Deriv<N>,
+    h: f64,
+    e1: &mut Eval<N>,
+    stats: &mut Stats,
+    sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
+) -> (State<N>, f64) {
+    match method {
+        Method::Rk4 => {
+            let y1 = step_sampling(model, modes, y, k1, h, sample);
+            model.eval_into(&y1.q, &y1.qd, modes, e1);
+            stats.rhs_evals += 4;
+            (y1, 0.0)
+        }
+        Method::Dopri5 { rtol, atol } => {
+            let (y1, e, err) = dopri5_step(model, modes, y, k1, h, rtol, atol);
+            stats.rhs_evals += 6;
+            *e1 = e;
+            (y1, err)
+        }
+    }
+}
+
+/// A step of `method` of size `h` from `y` to a located event, without the evaluation at
+/// its end (RK4: three evaluations; Dopri5 spends its six). RK4 shows `sample` its stages.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn partial_step<const N: usize>(
+    model: &Model<N>,
+    method: Method,
+    modes: &Modes,
+    y: &State<N>,
+    k1: &Deriv<N>,
+    h: f64,
+    stats: &mut Stats,
+    sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
+) -> State<N> {
+    match method {
+        Method::Rk4 => {
+            stats.rhs_evals += 3;
+            step_sampling(model, modes, y, k1, h, sample)
+        }
+        Method::Dopri5 { rtol, atol } => {
+            stats.rhs_evals += 6;
+            dopri5_step(model, modes, y, k1, h, rtol, atol).0
+        }
+    }
+}
+
+/// The cubic Hermite interpolant of one step: its dense output.
+#[derive(Debug, Clone, Copy)]
+pub struct Hermite<const N: usize> {
+    /// State at the start.
+    pub y0: State<N>,
+    /// Derivative at the start.
+    pub f0: Deriv<N>,
+    /// State at the end.
+    pub y1: State<N>,
+    /// Derivative at the end.
+    pub f1: Deriv<N>,
+    /// Step size [s].
+    pub h: f64,
+}
+
+impl<const N: usize> Hermite<N> {
+    /// The interpolated state at `theta` in [0, 1] of the step.
+    #[inline]
+    pub fn at(&self, theta: f64) -> State<N> {
+        let t = theta;
+        let t2 = t * t;
+        let t3 = t2 * t;
+        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+        let h10 = t3 - 2.0 * t2 + t;
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h11 = t3 - t2;
+        let h = self.h;
+        State {
+            q: h00 * self.y0.q + (h10 * h) * self.f0.q + h01 * self.y1.q + (h11 * h) * self.f1.q,
+            qd: h00 * self.y0.qd
+                + (h10 * h) * self.f0.qd
+                + h01 * self.y1.qd
+                + (h11 * h) * self.f1.qd,
+            work: h00 * self.y0.work
+                + h10 * h * self.f0.work
+                + h01 * self.y1.work
+                + h11 * h * self.f1.work,
+            dissipated: h00 * self.y0.dissipated
+                + h10 * h * self.f0.dissipated
+                + h01 * self.y1.dissipated
+                + h11 * h * self.f1.dissipated,
+        }
+    }
 }

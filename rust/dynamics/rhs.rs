@@ -1,0 +1,458 @@
+//! The right-hand side of every body: geometry -> terms -> constraints.
+//!
+//! For each contact in the sand: its immersed geometry ([`Geometry`]), the velocity of its
+//! immersed centroid E, the force terms on it ([`terms_on`], the one evaluation of the force
+//! law) and their generalized force through the Jacobian of the point of application; then
+//! the mass matrix, its Cholesky factor, and the constraints in force (locked joints,
+//! sticking; `constraints.rs`). A single rigid rod about its centre of mass takes the same
+//! equations in closed form (`rigid_rod.rs`).
+
+use nalgebra::{SVector, Vector2};
+
+use super::{
+    raw_sign, terms_on, Contact, ContactEval, ContactMode, DragStiffness, Eval, Model, Modes,
+    Shape, SignModel, Slip, MAX_CONTACTS,
+};
+use crate::body::mechanism::Pose;
+use crate::body::rod::ApplyAt;
+use crate::body::SoleModel;
+use crate::forces::ContactState;
+
+/// The immersed geometry of one contact, as the force law needs it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Geometry {
+    /// Depth of the force law [m].
+    pub(super) depth: f64,
+    /// Local coordinates of the immersed centroid E.
+    pub(super) centroid: Vector2<f64>,
+    /// Immersed volume [m^3].
+    pub(super) volume: f64,
+    /// Width w of the horizontal static term [m].
+    pub(super) width: f64,
+    /// Reference length of the depth factor [m].
+    pub(super) l_ref: f64,
+    /// Margin to full immersion [m].
+    pub(super) margin: f64,
+    /// Lowest point of the shape [m].
+    pub(super) lowest: f64,
+    /// The axis whose cross product with v_E sets a rod's (or the thesis sole's) drag area.
+    pub(super) cross_axis: Vector2<f64>,
+    /// Drag factor along `cross_axis`: `A_r |v_E| = factor * |cross_axis x v_E|`, or for the
+    /// box `A_r |v_E|` comes from the polygon (`sole`).
+    pub(super) factor: f64,
+    /// The sole's polygon, for the box drag.
+    pub(super) sole: Option<crate::body::SoleGeometry>,
+}
+
+impl<const N: usize> Model<N> {
+    /// The geometry of contact `c` at `pose` (depth zero when out of the sand).
+    pub(super) fn geometry(&self, c: &Contact, pose: &Pose<N>) -> Geometry {
+        let link = c.link();
+        let axis = pose.axis[link];
+        match &c.shape {
+            Shape::Rod(rod) => {
+                let tip = self.mechanism.point(pose, link, rod.tip);
+                let g = rod.geometry(tip.y, axis);
+                Geometry {
+                    depth: g.depth,
+                    centroid: Vector2::new(g.centroid_s, rod.tip.y),
+                    volume: rod.immersed_volume(&g),
+                    width: rod.diameter,
+                    l_ref: rod.length,
+                    margin: rod.length * axis.y - g.depth,
+                    lowest: tip.y,
+                    cross_axis: axis,
+                    factor: rod.diameter * g.immersed_length,
+                    sole: None,
+                }
+            }
+            Shape::Sole(sole) => {
+                let joint = pose.joint[link];
+                let normal = pose.normal[link];
+                let g = sole.geometry(joint, axis, normal);
+                let rel = g.centroid - joint;
+                let centroid = Vector2::new(rel.dot(&axis), rel.dot(&normal));
+                let (volume, factor, cross_axis) = match sole.model {
+                    SoleModel::Box => (sole.volume(&g), 0.0, axis),
+                    SoleModel::Thesis => {
+                        // Eqs. 5.5-5.7 with q the shank's angle from the vertical: infinite
+                        // at q = 0 (V) and |q| = 90 deg (A_r); NaN there stops the run.
+                        let e = pose.axis[sole.angle_link];
+                        let (sin_q, cos_q) = (e.x.abs(), e.y);
+                        let ok = sin_q > 1e-9 && cos_q > 1e-9;
+                        let nan = f64::NAN;
+                        (
+                            if ok {
+                                sole.length * sole.width * g.depth / sin_q
+                            } else {
+                                nan
+                            },
+                            if ok {
+                                sole.length * g.depth / cos_q
+                            } else {
+                                nan
+                            },
+                            e,
+                        )
+                    }
+                };
+                Geometry {
+                    depth: g.depth,
+                    centroid,
+                    volume,
+                    width: sole.length,
+                    l_ref: sole.l_ref,
+                    margin: g.highest,
+                    lowest: g.lowest,
+                    cross_axis,
+                    factor,
+                    sole: if sole.model == SoleModel::Box {
+                        Some(g)
+                    } else {
+                        None
+                    },
+                }
+            }
+        }
+    }
+
+    /// Rate of change of E's local coordinates on its link (E moves over the body as the
+    /// immersed part grows).
+    pub(super) fn centroid_local_rate(
+        &self,
+        c: &Contact,
+        pose: &Pose<N>,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        geom: &Geometry,
+    ) -> Vector2<f64> {
+        let link = c.link();
+        match &c.shape {
+            Shape::Rod(rod) => {
+                let axis = pose.axis[link];
+                let v_tip = self.mechanism.point_velocity(pose, link, rod.tip, qd);
+                let omega = qd[2 + link];
+                let g = rod.geometry(-geom.depth, axis);
+                let l_rate = rod.immersed_length_rate(&g, axis, -v_tip.y, -axis.x * omega);
+                Vector2::new(0.5 * l_rate, 0.0)
+            }
+            Shape::Sole(_) => {
+                // Central difference along the motion (the polygon's centroid has no simple
+                // closed-form rate).
+                let h = 1e-7;
+                let at = |sign: f64| {
+                    let qh = q + (sign * h) * qd;
+                    self.geometry(c, &self.mechanism.pose(&qh)).centroid
+                };
+                (at(1.0) - at(-1.0)) / (2.0 * h)
+            }
+        }
+    }
+
+    /// The local (s, n) coordinates of the point where contact `c`'s force acts.
+    #[inline]
+    pub(super) fn application_point(&self, c: &Contact, centroid: Vector2<f64>) -> Vector2<f64> {
+        match self.apply_at {
+            ApplyAt::Tip => c.reference_point(),
+            ApplyAt::Centroid => centroid,
+        }
+    }
+
+    /// The acceleration of gravity on the body [m/s^2]: the medium's g while the `gravity`
+    /// term acts, else zero (the body then has no potential energy from gravity either).
+    #[inline(always)]
+    pub fn gravity(&self) -> f64 {
+        if self.forces.gravity {
+            self.medium.g
+        } else {
+            0.0
+        }
+    }
+
+    /// The signs of v_Ex and v_Ey that the static terms take in `mode`, by the sign model.
+    #[inline(always)]
+    pub(super) fn signs(&self, mode: &ContactMode, v_e: Vector2<f64>) -> [f64; 2] {
+        match self.sign_model {
+            SignModel::Modes => [mode.sx.sign(), mode.sy.sign()],
+            SignModel::Raw => [raw_sign(v_e.x), raw_sign(v_e.y)],
+            SignModel::Smooth { eps } => [(v_e.x / eps).tanh(), (v_e.y / eps).tanh()],
+        }
+    }
+
+    /// |e x v_E| as the drag reads it: with its sign held in `Modes` (the kink at zero is a
+    /// located event), plainly otherwise.
+    #[inline(always)]
+    pub(super) fn held_cross(&self, mode: &ContactMode, cross_signed: f64) -> f64 {
+        match self.sign_model {
+            SignModel::Modes if mode.cross == Slip::Neg => -cross_signed,
+            SignModel::Modes => cross_signed,
+            _ => cross_signed.abs(),
+        }
+    }
+
+    /// Evaluate the listed contact terms of contact `ci` on `state` into `out`: each term's
+    /// force, their sums by class, and the bounds of a sticking reaction. The one place the
+    /// force law is evaluated, for every body and for `granrs.resistance_force`.
+    #[inline(always)]
+    pub fn apply_terms(&self, ci: usize, state: &ContactState<f64>, out: &mut ContactEval) {
+        (out.force, out.bound) = terms_on(
+            &self.forces,
+            &self.forces.per_contact[ci],
+            state,
+            &self.medium,
+        );
+    }
+
+    /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
+    ///
+    /// A single rigid rod whose root is its centre of mass (the free link) has a constant,
+    /// diagonal mass matrix and no velocity products: it takes [`Model::eval_rigid_rod`],
+    /// the same equations in closed form.
+    #[inline]
+    pub fn eval(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>, modes: &Modes) -> Eval<N> {
+        match self.rigid_rod() {
+            Some(rod) => {
+                let mut contacts = [ContactEval::default(); MAX_CONTACTS];
+                let (qdd, power, joint_torque) =
+                    self.eval_rigid_rod(rod, q, qd, modes, &mut contacts[0]);
+                Eval {
+                    qdd,
+                    power,
+                    joint_power: 0.0,
+                    joint_torque,
+                    contacts,
+                }
+            }
+            None => self.eval_general(q, qd, modes),
+        }
+    }
+
+    /// [`Model::eval`] into `out`, in place (an `Eval` holds every contact's findings: the
+    /// solver keeps two and writes each step's end into one). Every field is overwritten
+    /// except the findings past the model's contacts, which stay as they were (the defaults,
+    /// when `out` came from this model).
+    #[inline]
+    pub fn eval_into(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+        out: &mut Eval<N>,
+    ) {
+        match self.rigid_rod() {
+            Some(rod) => {
+                out.contacts[0] = ContactEval::default();
+                let (qdd, power, joint_torque) =
+                    self.eval_rigid_rod(rod, q, qd, modes, &mut out.contacts[0]);
+                out.qdd = qdd;
+                out.power = power;
+                out.joint_power = 0.0;
+                out.joint_torque = joint_torque;
+            }
+            None => *out = self.eval_general(q, qd, modes),
+        }
+    }
+
+    /// What a Runge-Kutta stage needs of [`Model::eval`]: the accelerations, the power of
+    /// the sand's forces and that of the joints' dampers [W] (the free link skips the
+    /// per-contact findings).
+    #[inline]
+    pub fn rates(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> (SVector<f64, N>, f64, f64) {
+        let (qdd, power, joint_power, _) = self.rates_sampled(q, qd, modes);
+        (qdd, power, joint_power)
+    }
+
+    /// [`Model::rates`] and the drag's stiffest contact at the stage.
+    #[inline]
+    pub fn rates_sampled(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> (SVector<f64, N>, f64, f64, DragStiffness) {
+        match self.rigid_rod() {
+            Some(rod) => {
+                let mut contact = ContactEval::default();
+                let (qdd, power, _) = self.eval_rigid_rod(rod, q, qd, modes, &mut contact);
+                (qdd, power, 0.0, DragStiffness::of(0, &contact))
+            }
+            None => {
+                let e = self.eval_general(q, qd, modes);
+                let stiff = (0..self.contacts.len())
+                    .map(|ci| DragStiffness::of(ci, &e.contacts[ci]))
+                    .fold(
+                        DragStiffness::default(),
+                        |a, b| if b.beats(&a) { b } else { a },
+                    );
+                (e.qdd, e.power, e.joint_power, stiff)
+            }
+        }
+    }
+
+    /// [`Model::eval`] for any body: pose, bias forces, contact forces through the
+    /// Jacobians, mass matrix and its Cholesky factor, and the constraints in force.
+    pub fn eval_general(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+    ) -> Eval<N> {
+        let pose = self.mechanism.pose(q);
+        let g = self.gravity();
+        let mut rhs = self.mechanism.bias_forces(&pose, qd, g);
+        let mut joint_torque = [0.0; N];
+        let joint_power = if self.forces.joint_springs {
+            self.mechanism
+                .add_joint_torques(q, qd, &mut rhs, &mut joint_torque)
+        } else {
+            0.0
+        };
+        let mut contacts = [ContactEval::default(); MAX_CONTACTS];
+        for (ci, c) in self.contacts.iter().enumerate() {
+            let link = c.link();
+            let t_local = c.reference_point();
+            let tip = self.mechanism.point(&pose, link, t_local);
+            let v_tip = self.mechanism.point_velocity(&pose, link, t_local, qd);
+            let out = &mut contacts[ci];
+            out.tip = tip;
+            out.v_tip = v_tip;
+            // With nothing immersed, E is the reference point.
+            out.v_centroid = v_tip;
+            let geom = self.geometry(c, &pose);
+            out.lowest = geom.lowest;
+            let mode = &modes[ci];
+            if !mode.in_contact {
+                continue;
+            }
+            out.depth = geom.depth;
+            out.immersion_margin = geom.margin;
+            let is_rod = matches!(c.shape, Shape::Rod(_));
+            if geom.depth <= 0.0 && !is_rod {
+                continue;
+            }
+            // A rod's E and sign of e x v_E also at depth 0: entering, the drag's mode is
+            // chosen from them (a rod past horizontal enters with l = L, E its middle).
+            let v_e = self
+                .mechanism
+                .point_velocity(&pose, link, geom.centroid, qd);
+            out.v_centroid = v_e;
+            let e = geom.cross_axis;
+            let cross_signed = e.x * v_e.y - e.y * v_e.x;
+            out.cross = if geom.sole.is_some() {
+                1.0
+            } else {
+                cross_signed
+            };
+            if geom.depth <= 0.0 {
+                continue;
+            }
+            // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held (the
+            // kink at 0 is a located event).
+            let area_speed = match (&geom.sole, &c.shape) {
+                _ if !self.forces.reads_area_speed => 0.0,
+                (Some(sg), Shape::Sole(sole)) => sole.drag_area_speed(sg, v_e),
+                _ => geom.factor * self.held_cross(mode, cross_signed),
+            };
+            let state = ContactState {
+                depth: geom.depth,
+                volume: geom.volume,
+                width: geom.width,
+                l_ref: geom.l_ref,
+                v: [v_e.x, v_e.y],
+                area_speed,
+                sign: self.signs(mode, v_e),
+            };
+            self.apply_terms(ci, &state, out);
+            let p = self.application_point(c, geom.centroid);
+            self.mechanism
+                .add_point_force(&pose, link, p, out.force.total(), &mut rhs);
+        }
+        let mass = self.mechanism.mass_matrix(&pose);
+        // Positive masses give a positive definite M for any finite state; a state that has
+        // already blown up (NaN) does not: return NaN and let the solver report it.
+        let Some(chol) = mass.cholesky() else {
+            return Eval {
+                qdd: SVector::repeat(f64::NAN),
+                power: f64::NAN,
+                joint_power: f64::NAN,
+                joint_torque,
+                contacts,
+            };
+        };
+        let mut qdd = chol.solve(&rhs);
+        let has_locks = self.mechanism.locked_rows().next().is_some();
+        if has_locks || self.any_stuck(modes) {
+            self.solve_constraints(
+                &pose,
+                q,
+                qd,
+                modes,
+                &chol,
+                &mut qdd,
+                &mut contacts,
+                &mut joint_torque,
+            );
+        }
+        // Power of the sand's forces at their points of application.
+        let mut power = 0.0;
+        for (ci, ce) in contacts.iter().enumerate().take(self.contacts.len()) {
+            if ce.depth <= 0.0 || !modes[ci].in_contact {
+                continue;
+            }
+            let p = match self.apply_at {
+                ApplyAt::Tip => ce.v_tip,
+                ApplyAt::Centroid => ce.v_centroid,
+            };
+            power += ce.force.total().dot(&p);
+        }
+        Eval {
+            qdd,
+            power,
+            joint_power,
+            joint_torque,
+            contacts,
+        }
+    }
+
+    /// Force each link receives at its joint from its parent (or the root) [N], from the
+    /// accelerations of an evaluation (see
+    /// [`Mechanism::joint_forces`](crate::body::Mechanism::joint_forces)).
+    pub fn joint_forces(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) -> [Vector2<f64>; N] {
+        let pose = self.mechanism.pose(q);
+        let mut external = [Vector2::zeros(); N];
+        for (ci, c) in self.contacts.iter().enumerate() {
+            if modes[ci].in_contact {
+                external[c.link()] += e.contacts[ci].force.total();
+            }
+        }
+        let g = self.gravity();
+        self.mechanism.joint_forces(&pose, qd, &e.qdd, g, &external)
+    }
+
+    /// Kinetic and potential energy at `(q, qd)` [J]; the potential energy is gravity's
+    /// (while the `gravity` term acts) plus the joints' springs' (while `joint_springs`
+    /// acts).
+    pub fn energies(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> (f64, f64) {
+        let pose = self.mechanism.pose(q);
+        let springs = if self.forces.joint_springs {
+            self.mechanism.spring_energy(q)
+        } else {
+            0.0
+        };
+        (
+            self.mechanism.kinetic_energy(&pose, qd),
+            self.mechanism.potential_energy(&pose, self.gravity()) + springs,
+        )
+    }
+}

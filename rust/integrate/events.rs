@@ -1,0 +1,560 @@
+//! Events (diffrax's `Event`): the switching functions of the force law's discontinuities
+//! (surface entry and exit, full immersion, the held signs, the end of a stick) and the
+//! stops; their detection at a step's end, their location on the step's cubic Hermite
+//! interpolant (Illinois), the polishing of the kinks no mode holds on the step map itself,
+//! and the mode changes an event makes (`choose_slip`, `enter_contact`).
+
+use super::observe::Observer;
+use super::outcome::Stats;
+use super::solve::EndCondition;
+use super::stepper::{deriv_of, step, Deriv, Hermite, State};
+use crate::dynamics::{ContactMode, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
+use crate::forces::Switch;
+
+/// Relative tolerance of event location, in units of the step.
+const ROOT_TOL: f64 = 1e-13;
+/// Events closer than this (in units of the step) to the earliest are handled with it.
+const SIMULTANEOUS: f64 = 1e-9;
+/// A velocity component above this [m/s] at a mode decision is moving, not at rest.
+const SLIP_SPEED: f64 = 1e-9;
+/// At most this many events within one grid step before the step is taken as it is.
+pub const MAX_EVENTS_PER_STEP: usize = 32;
+
+/// Kind of a switching function.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kind {
+    Entry,
+    Exit,
+    SlipX,
+    SlipY,
+    StickX,
+    StickY,
+    Stop,
+    Immersion,
+    Cross,
+}
+
+/// The value of a switching function: non-negative while the mode holds; the event is
+/// where it turns negative (the stop: where -v_Ty reaches zero).
+fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) -> f64 {
+    let c = &e.contacts[ci];
+    match kind {
+        Kind::Entry => c.lowest,
+        Kind::Exit => -c.lowest,
+        Kind::SlipX => modes[ci].sx.sign() * c.v_centroid.x,
+        Kind::SlipY => modes[ci].sy.sign() * c.v_centroid.y,
+        Kind::StickX => c.bound[0] - c.force.statics.x.abs(),
+        Kind::StickY => c.bound[1] - c.force.statics.y.abs(),
+        Kind::Stop => -c.v_tip.y,
+        Kind::Cross => modes[ci].cross.sign() * c.cross,
+        Kind::Immersion => {
+            if modes[ci].full {
+                -c.immersion_margin
+            } else {
+                c.immersion_margin
+            }
+        }
+    }
+}
+
+/// The switching functions active under `modes`.
+fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, usize)>) {
+    out.clear();
+    let with_modes = model.sign_model == SignModel::Modes;
+    for (ci, m) in modes.iter().enumerate().take(model.contacts.len()) {
+        if !m.in_contact {
+            out.push((Kind::Entry, ci));
+            continue;
+        }
+        out.push((Kind::Exit, ci));
+        out.push((Kind::Immersion, ci));
+        if !m.stopped {
+            out.push((Kind::Stop, ci));
+        }
+        if with_modes {
+            // A contact held in both directions has v_E = 0: no drag, and e x v_E is
+            // round-off whose sign would flip back and forth (Zeno events).
+            let (own_x, own_y) = (
+                model.forces.owns(Switch::SlipX),
+                model.forces.owns(Switch::SlipY),
+            );
+            let held = own_x && own_y && m.sx == Slip::Stick && m.sy == Slip::Stick;
+            if model.forces.owns(Switch::Cross) && !held {
+                out.push((Kind::Cross, ci));
+            }
+            if own_x {
+                out.push((
+                    if m.sx == Slip::Stick {
+                        Kind::StickX
+                    } else {
+                        Kind::SlipX
+                    },
+                    ci,
+                ));
+            }
+            if own_y {
+                out.push((
+                    if m.sy == Slip::Stick {
+                        Kind::StickY
+                    } else {
+                        Kind::SlipY
+                    },
+                    ci,
+                ));
+            }
+        }
+    }
+}
+
+/// Whether the function has crossed (the event happened by the end of the step).
+#[inline]
+fn crossed(kind: Kind, g1: f64) -> bool {
+    if kind == Kind::Stop {
+        g1 <= 0.0
+    } else {
+        g1 < 0.0
+    }
+}
+
+/// Choose the mode of the static term along `axis` of contact `ci` at the state `at`,
+/// where its velocity component is (about) zero. Karnopp: stick if the reaction that holds
+/// the component is within the static bound, else slip the way the other forces push. A
+/// component that already moves decidedly keeps its direction. At the surface the bound and
+/// the reaction are both zero; there the decision is taken at `lookahead` (the end of the
+/// step that found the event), where they have grown.
+pub(super) fn choose_slip<const N: usize>(
+    model: &Model<N>,
+    modes: &mut Modes,
+    ci: usize,
+    axis: usize,
+    at: &State<N>,
+    lookahead: &State<N>,
+    stats: &mut Stats,
+) {
+    let mut trial = *modes;
+    if axis == 0 {
+        trial[ci].sx = Slip::Stick;
+    } else {
+        trial[ci].sy = Slip::Stick;
+    }
+    let judge = |s: &State<N>, stats: &mut Stats| {
+        let e = model.eval(&s.q, &s.qd, &trial);
+        stats.rhs_evals += 1;
+        let c = e.contacts[ci];
+        if axis == 0 {
+            (c.force.statics.x, c.bound[0], c.v_centroid.x)
+        } else {
+            (c.force.statics.y, c.bound[1], c.v_centroid.y)
+        }
+    };
+    let (mut reaction, mut bound, v) = judge(at, stats);
+    if v.abs() <= SLIP_SPEED && bound == 0.0 {
+        (reaction, bound, _) = judge(lookahead, stats);
+    }
+    let slip = if v.abs() > SLIP_SPEED {
+        if v < 0.0 {
+            Slip::Neg
+        } else {
+            Slip::Pos
+        }
+    } else if reaction.abs() <= bound {
+        Slip::Stick
+    } else if reaction > 0.0 {
+        Slip::Neg
+    } else {
+        Slip::Pos
+    };
+    if axis == 0 {
+        modes[ci].sx = slip;
+    } else {
+        modes[ci].sy = slip;
+    }
+}
+
+/// The modes at a state where contact `ci` has just entered the sand (or starts in it).
+pub(super) fn enter_contact<const N: usize>(
+    model: &Model<N>,
+    modes: &mut Modes,
+    ci: usize,
+    y: &State<N>,
+    probe: &State<N>,
+    stats: &mut Stats,
+) {
+    modes[ci].in_contact = true;
+    if model.sign_model != SignModel::Modes {
+        return;
+    }
+    let e = model.eval(&y.q, &y.qd, modes);
+    stats.rhs_evals += 1;
+    let v = e.contacts[ci].v_centroid;
+    // The drag's kink: the sign of e x v_E now, or where it is going.
+    let mut cross = e.contacts[ci].cross;
+    if cross == 0.0 {
+        cross = model.eval(&probe.q, &probe.qd, modes).contacts[ci].cross;
+        stats.rhs_evals += 1;
+    }
+    modes[ci].cross = if cross < 0.0 { Slip::Neg } else { Slip::Pos };
+    for axis in 0..2 {
+        let vk = if axis == 0 { v.x } else { v.y };
+        let slip = if vk < 0.0 {
+            Some(Slip::Neg)
+        } else if vk > 0.0 {
+            Some(Slip::Pos)
+        } else {
+            None
+        };
+        match slip {
+            Some(s) if axis == 0 => modes[ci].sx = s,
+            Some(s) => modes[ci].sy = s,
+            None => choose_slip(model, modes, ci, axis, y, probe, stats),
+        }
+    }
+}
+
+/// The modes at the start of a run from `y`: a contact whose tip is below the surface, or
+/// at it and moving down, is in contact. A zero velocity component is judged a little
+/// later, at the end of a probe step of size `dt` free of the static terms' signs (they are
+/// zero at the surface).
+pub(super) fn initial_modes<const N: usize>(
+    model: &Model<N>,
+    y: &State<N>,
+    dt: f64,
+    stats: &mut Stats,
+) -> Modes {
+    let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
+    let e_free = model.eval(&y.q, &y.qd, &modes);
+    stats.rhs_evals += 1;
+    for ci in 0..model.contacts.len() {
+        let c = &e_free.contacts[ci];
+        if c.lowest < 0.0 || (c.lowest == 0.0 && c.v_tip.y < 0.0) {
+            let k1 = deriv_of(y, &e_free);
+            let probe = y.add(dt, &k1);
+            enter_contact(model, &mut modes, ci, y, &probe, stats);
+        }
+    }
+    modes
+}
+
+/// One switching function's crossing within a step.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Hit {
+    /// Which function.
+    kind: Kind,
+    /// Of which contact.
+    contact: usize,
+    /// Where in the step, as a fraction of it.
+    theta: f64,
+    /// The function at the step's start (at least 0) and at its end.
+    g0: f64,
+    /// See `g0`.
+    g1: f64,
+}
+
+/// A step as the events see it: its start (state, first stage, evaluation), its end (state,
+/// evaluation) and its size [s].
+pub(super) struct Span<'a, const N: usize> {
+    /// The state at the start.
+    pub y0: &'a State<N>,
+    /// Its derivative (the step's first stage).
+    pub k1: &'a Deriv<N>,
+    /// Its evaluation.
+    pub e0: &'a Eval<N>,
+    /// The state at the end.
+    pub y1: &'a State<N>,
+    /// Its evaluation.
+    pub e1: &'a Eval<N>,
+    /// The step's size [s].
+    pub h: f64,
+}
+
+/// Where the run lands on the earliest event: time, state and its evaluation, the state at
+/// which an event at the very start of the step is judged (`probe`), and the step's end
+/// (`lookahead`, where a slip mode is decided when the surface gives no reaction yet).
+pub(super) struct Landing<'a, const N: usize> {
+    /// Time [s].
+    pub t: f64,
+    /// The state.
+    pub y: &'a State<N>,
+    /// Its evaluation in the modes before the event.
+    pub e: &'a Eval<N>,
+    /// See the struct.
+    pub probe: &'a State<N>,
+    /// See the struct.
+    pub lookahead: &'a State<N>,
+}
+
+/// The events' state through a run.
+pub(super) struct Events {
+    /// The switching functions active under `listed_for`.
+    funcs: Vec<(Kind, usize)>,
+    /// The modes `funcs` was listed for (the list changes only with the modes).
+    listed_for: Option<Modes>,
+    /// Events handled within the current grid step.
+    in_step: usize,
+    /// The crossings found in the current step.
+    hits: Vec<Hit>,
+}
+
+impl Events {
+    /// No events yet.
+    pub(super) fn new() -> Self {
+        Events {
+            funcs: Vec::with_capacity(4 * MAX_CONTACTS),
+            listed_for: None,
+            in_step: 0,
+            hits: Vec::new(),
+        }
+    }
+
+    /// The run moves on to the next grid step.
+    #[inline]
+    pub(super) fn next_step(&mut self) {
+        self.in_step = 0;
+    }
+
+    /// Find the switching functions that crossed within `span` (in `modes`), each located
+    /// on the step's Hermite interpolant; returns the earliest crossing as a fraction of
+    /// the step (infinite without one). After [`MAX_EVENTS_PER_STEP`] events within one grid
+    /// step none are looked for, and the step counts as unresolved.
+    pub(super) fn detect<const N: usize>(
+        &mut self,
+        model: &Model<N>,
+        modes: &Modes,
+        span: &Span<N>,
+        stats: &mut Stats,
+    ) -> f64 {
+        if self.listed_for != Some(*modes) {
+            active(model, modes, &mut self.funcs);
+            self.listed_for = Some(*modes);
+        }
+        self.hits.clear();
+        let mut earliest = f64::INFINITY;
+        if self.in_step >= MAX_EVENTS_PER_STEP {
+            stats.unresolved += 1;
+            return earliest;
+        }
+        for &(kind, ci) in &self.funcs {
+            let g1 = switching(kind, ci, span.e1, modes);
+            if !crossed(kind, g1) {
+                continue;
+            }
+            let g0 = switching(kind, ci, span.e0, modes).max(0.0);
+            let theta = if g1 == 0.0 {
+                1.0
+            } else if g0 == 0.0 {
+                0.0
+            } else {
+                let dense = Hermite {
+                    y0: *span.y0,
+                    f0: *span.k1,
+                    y1: *span.y1,
+                    f1: deriv_of(span.y1, span.e1),
+                    h: span.h,
+                };
+                let (theta, evals) = locate(
+                    |th| {
+                        let s = dense.at(th);
+                        let e = model.eval(&s.q, &s.qd, modes);
+                        switching(kind, ci, &e, modes)
+                    },
+                    g0,
+                    g1,
+                    ROOT_TOL,
+                );
+                stats.root_evals += evals;
+                stats.rhs_evals += evals;
+                theta
+            };
+            earliest = earliest.min(theta);
+            self.hits.push(Hit {
+                kind,
+                contact: ci,
+                theta,
+                g0,
+                g1,
+            });
+        }
+        earliest
+    }
+
+    /// Whether the last [`Events::detect`] found no crossing.
+    #[inline]
+    pub(super) fn none(&self) -> bool {
+        self.hits.is_empty()
+    }
+
+    /// Polish the crossings of an RK4 step whose earliest is inside it; returns the new
+    /// earliest.
+    ///
+    /// The interpolant's root is the step map's only to the interpolant's error: O(h^4)
+    /// where the held modes keep the right-hand side smooth through the step, but first
+    /// order where the step straddles a kink no mode holds: the cap of the immersed
+    /// length (l <= L, a sole box under the surface) and the exit, where the static
+    /// term's d^lambda has an unbounded derivative. Polish those events on the map
+    /// itself, h' -> g(step(y, h')), which is what the run will follow; its bracket [0, 1]
+    /// is the step's own ends. Every such hit is polished, so that mirror-image events
+    /// stay simultaneous.
+    pub(super) fn polish<const N: usize>(
+        &mut self,
+        model: &Model<N>,
+        modes: &Modes,
+        span: &Span<N>,
+        earliest: f64,
+        stats: &mut Stats,
+    ) -> f64 {
+        if !(earliest > 0.0 && earliest < 1.0) {
+            return earliest;
+        }
+        for hit in self.hits.iter_mut() {
+            let Hit {
+                kind,
+                contact: ci,
+                theta: guess,
+                g0,
+                g1,
+            } = *hit;
+            if !matches!(kind, Kind::Immersion | Kind::Exit) || guess <= 0.0 || guess >= 1.0 {
+                continue;
+            }
+            let mut map = |th: f64| {
+                let s = step(model, modes, span.y0, span.k1, th * span.h);
+                let e = model.eval(&s.q, &s.qd, modes);
+                switching(kind, ci, &e, modes)
+            };
+            let at = map(guess);
+            let (theta, evals) = if at < 0.0 {
+                locate_in(&mut map, (0.0, g0), (guess, at), ROOT_TOL)
+            } else {
+                locate_in(&mut map, (guess, at), (1.0, g1), ROOT_TOL)
+            };
+            stats.root_evals += evals + 1;
+            stats.rhs_evals += 4 * (evals + 1);
+            hit.theta = theta;
+        }
+        self.hits
+            .iter()
+            .fold(f64::INFINITY, |m, hit| m.min(hit.theta))
+    }
+
+    /// Handle the crossings simultaneous with the `earliest` where the run has landed
+    /// (`at`): change the modes, and tell `obs` of entries and stops. Returns whether the
+    /// run ends here (the stop that the end condition `end` waits for).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn handle<const N: usize>(
+        &mut self,
+        model: &Model<N>,
+        modes: &mut Modes,
+        earliest: f64,
+        at: &Landing<N>,
+        end: EndCondition,
+        obs: &mut Observer<N>,
+        stats: &mut Stats,
+    ) -> bool {
+        let nc = model.contacts.len();
+        let mut terminal = false;
+        for hit in &self.hits {
+            if hit.theta > earliest + SIMULTANEOUS {
+                continue;
+            }
+            let ci = hit.contact;
+            stats.events += 1;
+            match hit.kind {
+                Kind::Entry => {
+                    obs.entered(ci, at.t);
+                    enter_contact(model, modes, ci, at.y, at.probe, stats);
+                }
+                Kind::Exit => {
+                    modes[ci].in_contact = false;
+                    modes[ci].sx = Slip::Stick;
+                    modes[ci].sy = Slip::Stick;
+                }
+                Kind::Immersion => modes[ci].full = !modes[ci].full,
+                Kind::Cross => {
+                    modes[ci].cross = if modes[ci].cross == Slip::Pos {
+                        Slip::Neg
+                    } else {
+                        Slip::Pos
+                    }
+                }
+                Kind::SlipX | Kind::StickX => {
+                    choose_slip(model, modes, ci, 0, at.y, at.lookahead, stats)
+                }
+                Kind::SlipY | Kind::StickY => {
+                    choose_slip(model, modes, ci, 1, at.y, at.lookahead, stats)
+                }
+                Kind::Stop => {
+                    modes[ci].stopped = true;
+                    obs.stopped(model, ci, at.t, at.y, at.e);
+                    terminal |= match end {
+                        EndCondition::FirstStop => true,
+                        EndCondition::AllStops => modes[..nc].iter().all(|m| m.stopped),
+                        EndCondition::Time => false,
+                    };
+                }
+            }
+        }
+        self.in_step += 1;
+        terminal
+    }
+}
+
+/// Find a root of `g` in [0, 1] given `g(0) = g0 >= 0` and `g(1) = g1 < 0` (a sign change),
+/// by the Illinois variant of regula falsi. Returns `(theta, evaluations)`; `theta` is the
+/// right end of the final bracket, so that `g(theta) <= 0` (the event has happened there).
+pub fn locate(g: impl FnMut(f64) -> f64, g0: f64, g1: f64, tol: f64) -> (f64, usize) {
+    locate_in(g, (0.0, g0), (1.0, g1), tol)
+}
+
+/// [`locate`] on the bracket `[a, b]` with `g(a) = fa >= 0` and `g(b) = fb < 0`.
+pub fn locate_in(
+    mut g: impl FnMut(f64) -> f64,
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    tol: f64,
+) -> (f64, usize) {
+    let mut side = 0i8;
+    let mut evals = 0usize;
+    while b - a > tol && evals < 200 {
+        let mut x = if fa == fb {
+            0.5 * (a + b)
+        } else {
+            (a * fb - b * fa) / (fb - fa)
+        };
+        if !(x > a && x < b) {
+            x = 0.5 * (a + b);
+        }
+        let fx = g(x);
+        evals += 1;
+        if fx < 0.0 {
+            b = x;
+            fb = fx;
+            if side == -1 {
+                fa *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = x;
+            fa = fx;
+            if side == 1 {
+                fb *= 0.5;
+            }
+            side = 1;
+        }
+        if fx == 0.0 {
+            return (x, evals);
+        }
+    }
+    (b, evals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn locates_a_simple_root() {
+        let (x, n) = locate(|t| 0.3 - t * t, 0.3, -0.7, 1e-14);
+        assert!((x - 0.3f64.sqrt()).abs() < 1e-13, "{x}");
+        assert!(n < 60);
+    }
+}

@@ -1,0 +1,531 @@
+//! Observing a run: its summaries as it goes (the largest drag, the joints' loads, each
+//! contact's results at its stop or at the end), the drag's stiffest moment (`h_lambda`),
+//! the recorder of time series, and the check that a finished run is a physical answer.
+//!
+//! Each contact's results are written in one place (`Observer::settle`), at its stop or,
+//! without one, at the end of the run.
+
+use nalgebra::{SVector, Vector2};
+
+use super::outcome::{
+    ContactSummary, JointSummary, Outcome, Series, Stats, Status, OUTCOME_FIELDS,
+};
+use super::solve::SolveOptions;
+use super::stepper::{Method, State};
+use crate::dynamics::{ContactEval, DragStiffness, Eval, Model, Modes, Shape, SignModel, Slip};
+use crate::error::{GranrsError, Result};
+use crate::forces::{ForceSet, Switch};
+
+/// What to record as time series. Nothing is stored for a field that is off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Record {
+    /// Generalized coordinates and rates, and the work of the sand.
+    pub state: bool,
+    /// Per contact: tip position and velocity, depth, and the four force components.
+    pub forces: bool,
+    /// Kinetic and potential energy.
+    pub energy: bool,
+    /// Record every `stride`-th grid step (events are always recorded). 0 means 1.
+    pub stride: usize,
+}
+
+impl Record {
+    /// Whether anything is recorded.
+    pub fn any(&self) -> bool {
+        self.state || self.forces || self.energy
+    }
+}
+
+/// `h lambda` beyond which the classical RK4 is unstable for a real, negative rate.
+pub const RK4_STABILITY_LIMIT: f64 = 2.785;
+
+/// The fastest rate [1/s] of a quadratic drag `F = -c |v| v` on a point of inverse effective
+/// mass `w`, with `k = |F| / |v|` and `dir` the unit velocity: the largest eigenvalue of
+/// `w K`, `K = dF/dv = -k (I + dir dir^T)` (twice as stiff along the motion as across).
+/// A rod's drag `-c |e x v| v` has the same stiffness broadside and less otherwise.
+fn drag_rate(w: &nalgebra::Matrix2<f64>, k: f64, dir: Vector2<f64>) -> f64 {
+    let stiffness = k * (nalgebra::Matrix2::identity() + dir * dir.transpose());
+    let p = w * stiffness;
+    let (tr, det) = (p.trace(), p.determinant());
+    // Both factors are symmetric positive semi-definite: the eigenvalues are real, >= 0.
+    0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
+}
+
+/// The drag's stiffest moment of a run so far, and the coordinates where it was.
+struct Stiffest<const N: usize> {
+    best: DragStiffness,
+    q: SVector<f64, N>,
+}
+
+impl<const N: usize> Stiffest<N> {
+    #[inline]
+    fn offer(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
+        if s.beats(&self.best) {
+            self.best = *s;
+            self.q = *q;
+        }
+    }
+}
+
+/// What a run keeps of itself as it goes: each contact's and joint's summary, the drag's
+/// stiffest moment, the recorded series, and the start's energies the summaries compare to.
+pub(super) struct Observer<const N: usize> {
+    summaries: Vec<ContactSummary>,
+    joints: Vec<JointSummary>,
+    /// The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E), over
+    /// the step ends, the events and the RK4 stages (within a step that does not resolve the
+    /// contact, the stages meet a stiffness the ends do not). Squared norms: a square root
+    /// only when a maximum is beaten.
+    stiffest: Stiffest<N>,
+    recorder: Recorder,
+    /// Record every `stride`-th grid step.
+    stride: u64,
+    /// The start: coordinates, kinetic and potential energy, and each link's.
+    q0: SVector<f64, N>,
+    ke0: f64,
+    pe0: f64,
+    link_e0: Vec<(f64, f64)>,
+}
+
+/// Kinetic and potential energy of link `i` at `y` [J].
+fn link_energy<const N: usize>(model: &Model<N>, y: &State<N>, i: usize) -> (f64, f64) {
+    let pose = model.mechanism.pose(&y.q);
+    model
+        .mechanism
+        .link_energy(&pose, &y.qd, model.gravity(), i)
+}
+
+impl<const N: usize> Observer<N> {
+    /// Start observing a run from `y` in `modes` (a contact in the sand at the start
+    /// entered it at t = 0).
+    pub(super) fn new(model: &Model<N>, y: &State<N>, modes: &Modes, record: Record) -> Self {
+        let nc = model.contacts.len();
+        let (ke0, pe0) = model.energies(&y.q, &y.qd);
+        let summaries = (0..nc)
+            .map(|ci| ContactSummary {
+                stopped: false,
+                t_s: f64::NAN,
+                depth: 0.0,
+                dq: 0.0,
+                omega_end: 0.0,
+                f_d_max: 0.0,
+                f_s_end: f64::NAN,
+                f_r_end: f64::NAN,
+                d_ke: f64::NAN,
+                d_pe: f64::NAN,
+                d_e: f64::NAN,
+                work_sand: f64::NAN,
+                tip_end: Vector2::zeros(),
+                t_entry: if modes[ci].in_contact { 0.0 } else { f64::NAN },
+                link_d_ke: f64::NAN,
+                link_d_pe: f64::NAN,
+            })
+            .collect();
+        let n_links = model.mechanism.n_links();
+        Observer {
+            summaries,
+            joints: vec![JointSummary::default(); n_links],
+            stiffest: Stiffest {
+                best: DragStiffness::default(),
+                q: y.q,
+            },
+            recorder: Recorder::new(record, &model.forces, N, nc, n_links),
+            stride: record.stride.max(1) as u64,
+            q0: y.q,
+            ke0,
+            pe0,
+            link_e0: (0..n_links).map(|i| link_energy(model, y, i)).collect(),
+        }
+    }
+
+    /// Show the drag's stiffness at an RK4 stage with coordinates `q`.
+    #[inline]
+    pub(super) fn offer(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
+        self.stiffest.offer(q, s);
+    }
+
+    /// A step ended at `y` (its evaluation `e`): the largest drag of each contact not yet
+    /// stopped, the drag's stiffness there, and the joints' largest loads.
+    pub(super) fn step_end(&mut self, model: &Model<N>, y: &State<N>, e: &Eval<N>, modes: &Modes) {
+        for (ci, s) in self.summaries.iter_mut().enumerate() {
+            if !modes[ci].stopped {
+                let c = &e.contacts[ci];
+                let drag2 = c.force.dynamic.norm_squared();
+                if drag2 > s.f_d_max * s.f_d_max {
+                    s.f_d_max = drag2.sqrt();
+                }
+                self.stiffest.offer(&y.q, &DragStiffness::of(ci, c));
+            }
+        }
+        if self.joints.len() < 2 {
+            return;
+        }
+        let f = model.joint_forces(&y.q, &y.qd, e, modes);
+        for (i, j) in self.joints.iter_mut().enumerate() {
+            j.f_max = j.f_max.max(f[i].norm());
+            j.torque_max = j.torque_max.max(e.joint_torque[i].abs());
+        }
+    }
+
+    /// Record the state at `t` (events and the run's ends are always recorded).
+    #[inline]
+    pub(super) fn record(
+        &mut self,
+        model: &Model<N>,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) {
+        self.recorder.push(model, t, y, e, modes);
+    }
+
+    /// Record the end of the `n`-th grid step, if it is one of every `stride`.
+    #[inline]
+    pub(super) fn record_step(
+        &mut self,
+        n: u64,
+        model: &Model<N>,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) {
+        if n.is_multiple_of(self.stride) {
+            self.recorder.push(model, t, y, e, modes);
+        }
+    }
+
+    /// Contact `ci` entered the sand at `t` (the first entry counts).
+    pub(super) fn entered(&mut self, ci: usize, t: f64) {
+        let s = &mut self.summaries[ci];
+        if s.t_entry.is_nan() {
+            s.t_entry = t;
+        }
+    }
+
+    /// Contact `ci` stopped at `t`, at the state `y` (its evaluation `e`).
+    pub(super) fn stopped(
+        &mut self,
+        model: &Model<N>,
+        ci: usize,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+    ) {
+        let energies = model.energies(&y.q, &y.qd);
+        let s = &mut self.summaries[ci];
+        s.stopped = true;
+        s.t_s = t;
+        self.settle(model, ci, y, &e.contacts[ci], energies);
+    }
+
+    /// Write contact `ci`'s results at the state `y` (`c` its findings there, `(ke, pe)` the
+    /// body's energies): at its stop, or at the end of a run without one.
+    fn settle(
+        &mut self,
+        model: &Model<N>,
+        ci: usize,
+        y: &State<N>,
+        c: &ContactEval,
+        (ke, pe): (f64, f64),
+    ) {
+        let link = model.contacts[ci].link();
+        let (lk, lp) = link_energy(model, y, link);
+        let s = &mut self.summaries[ci];
+        s.depth = (-c.tip.y).max(0.0);
+        s.dq = y.q[2 + link] - self.q0[2 + link];
+        s.omega_end = y.qd[2 + link];
+        s.f_s_end = c.force.static_magnitude();
+        s.f_r_end = c.force.total_magnitude();
+        s.d_ke = self.ke0 - ke;
+        s.d_pe = self.pe0 - pe;
+        s.d_e = s.d_ke + s.d_pe;
+        s.work_sand = y.work;
+        s.tip_end = c.tip;
+        s.link_d_ke = self.link_e0[link].0 - lk;
+        s.link_d_pe = self.link_e0[link].1 - lp;
+    }
+
+    /// The run ended at `t` in the state `y` with `status`: the results of the contacts that
+    /// did not stop, the last record, the drag's `h lambda`, and the outcome, checked.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn finish(
+        mut self,
+        model: &Model<N>,
+        status: Status,
+        t: f64,
+        y: &State<N>,
+        modes: &Modes,
+        stats: Stats,
+        options: &SolveOptions,
+    ) -> Result<Outcome> {
+        // Contacts without a stop report their state at the end.
+        let e_end = model.eval(&y.q, &y.qd, modes);
+        let energies = model.energies(&y.q, &y.qd);
+        for ci in 0..self.summaries.len() {
+            if !self.summaries[ci].stopped {
+                self.settle(model, ci, y, &e_end.contacts[ci], energies);
+            }
+        }
+        if status != Status::Stopped && options.record.any() && self.recorder.t.last() != Some(&t) {
+            self.recorder.push(model, t, y, &e_end, modes);
+        }
+        let best = &self.stiffest.best;
+        let h_lambda = if options.method != Method::Rk4 {
+            f64::NAN
+        } else if best.k2() > 0.0 {
+            let inverse_mass = model.centroid_inverse_mass(&self.stiffest.q, best.contact);
+            options.dt * drag_rate(&inverse_mass, best.k2().sqrt(), best.v.normalize())
+        } else {
+            0.0
+        };
+        let out = Outcome {
+            h_lambda,
+            status,
+            t_final: t,
+            stats,
+            contacts: self.summaries,
+            energy_start: self.ke0 + self.pe0,
+            energy_end: energies.0 + energies.1,
+            work_sand: y.work,
+            dissipated: y.dissipated,
+            joints: self.joints,
+            series: self.recorder.finish(),
+            terms: model.forces.names.clone(),
+        };
+        check_outcome(model, &out)?;
+        Ok(out)
+    }
+}
+
+/// How many times the body's energy scale a run may gain before it counts as diverged.
+/// With the force at the tip the sand can feed energy in; over the property tests' domain
+/// the gain stayed below 0.11 of that scale (docs/hard_cases.md), so this is 90x margin.
+pub const DIVERGENCE_FACTOR: f64 = 10.0;
+
+/// Refuse an outcome that is not a physical answer: a non-finite result (a field of [`OUTCOME_FIELDS`] marked `finite`), or a run whose
+/// mechanical energy grew past [`DIVERGENCE_FACTOR`] times the body's energy scale
+/// (|E(0)| + M g l, with M the total mass and l the links' size). Both happen only when the
+/// step is beyond RK4's stability limit for the scene's contact stiffness; the error says so
+/// instead of returning a "stopped" run with enormous numbers.
+fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> {
+    let fail = |message: String| {
+        Err(GranrsError::NonFinite {
+            t: out.t_final,
+            message,
+        })
+    };
+    for (i, c) in out.contacts.iter().enumerate() {
+        let bad = OUTCOME_FIELDS
+            .contact
+            .iter()
+            .filter(|f| f.finite)
+            .map(|f| (f.name, (f.read)(c).as_f64()))
+            .find(|(_, v)| !v.is_finite());
+        if let Some((name, v)) = bad {
+            return fail(format!(
+                "contact {i}: {name} = {v}; the step dt is too large for this scene's \
+                 contact stiffness (try a smaller dt, or method=\"dopri5\")"
+            ));
+        }
+    }
+    let links = &model.mechanism.links;
+    let mass: f64 = links.iter().map(|l| l.mass).sum::<f64>() + model.mechanism.root_mass;
+    // The body's size: its links' extents and its contacts' lengths (a free link's root is
+    // its centre of mass, so only the rod's length says how tall it is).
+    let size: f64 = links
+        .iter()
+        .map(|l| 2.0 * l.com.norm() + l.joint_on_parent.norm())
+        .sum::<f64>()
+        + model
+            .contacts
+            .iter()
+            .map(|c| match c.shape {
+                Shape::Rod(r) => r.length,
+                Shape::Sole(s) => s.length + s.height,
+            })
+            .sum::<f64>();
+    let scale = out.energy_start.abs() + mass * model.gravity() * size + 1e-12 * mass;
+    let gain = out.energy_end - out.energy_start;
+    if !out.energy_end.is_finite() || gain > DIVERGENCE_FACTOR * scale {
+        return fail(format!(
+            "the run diverged: its energy grew from {:.4e} J to {:.4e} J (more than {} times \
+             the body's energy scale {:.3e} J); the step dt is too large for this scene's \
+             contact stiffness (try a smaller dt, or method=\"dopri5\")",
+            out.energy_start, out.energy_end, DIVERGENCE_FACTOR, scale
+        ));
+    }
+    Ok(())
+}
+
+/// Recorder of time series.
+struct Recorder {
+    on: Record,
+    n_dof: usize,
+    n_contacts: usize,
+    n_links: usize,
+    t: Vec<f64>,
+    cols: Vec<Vec<f64>>,
+    names: Vec<String>,
+}
+
+impl Recorder {
+    fn new(on: Record, forces: &ForceSet, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
+        let mut names = Vec::new();
+        if on.state {
+            for i in 0..n_dof {
+                names.push(format!("q{i}"));
+            }
+            for i in 0..n_dof {
+                names.push(format!("qd{i}"));
+            }
+            names.push("work_sand".into());
+        }
+        if on.forces {
+            // A force term that is off is not stored, nor the mode of its sign.
+            let mut fields = vec![
+                "tip_x", "tip_y", "v_tip_x", "v_tip_y", "depth", "v_E_x", "v_E_y",
+            ];
+            for info in &forces.contact_info {
+                fields.extend(info.columns.iter().map(|(name, _)| *name));
+            }
+            if forces.owns(Switch::SlipX) {
+                fields.push("mode_x");
+            }
+            if forces.owns(Switch::SlipY) {
+                fields.push("mode_y");
+            }
+            for c in 0..n_contacts {
+                for f in &fields {
+                    names.push(format!("c{c}.{f}"));
+                }
+            }
+            if n_links > 1 {
+                for i in 0..n_links {
+                    for f in ["Fx", "Fy", "torque"] {
+                        names.push(format!("joint{i}.{f}"));
+                    }
+                }
+            }
+        }
+        if on.energy {
+            names.push("KE".into());
+            names.push("PE".into());
+            names.push("joint_loss".into());
+            if n_links > 1 {
+                for i in 0..n_links {
+                    names.push(format!("link{i}.KE"));
+                    names.push(format!("link{i}.PE"));
+                }
+            }
+        }
+        let cols = vec![Vec::new(); names.len()];
+        Recorder {
+            on,
+            n_dof,
+            n_contacts,
+            n_links,
+            t: Vec::new(),
+            cols,
+            names,
+        }
+    }
+
+    fn push<const N: usize>(
+        &mut self,
+        model: &Model<N>,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) {
+        if !self.on.any() {
+            return;
+        }
+        self.t.push(t);
+        let mut k = 0;
+        let mut put = |cols: &mut Vec<Vec<f64>>, v: f64| {
+            cols[k].push(v);
+            k += 1;
+        };
+        if self.on.state {
+            for i in 0..self.n_dof {
+                put(&mut self.cols, y.q[i]);
+            }
+            for i in 0..self.n_dof {
+                put(&mut self.cols, y.qd[i]);
+            }
+            put(&mut self.cols, y.work);
+        }
+        if self.on.forces {
+            for (c, m) in e.contacts[..self.n_contacts].iter().zip(modes) {
+                // The modes: -1, +1, 0 for stick; NaN out of the sand or without modes.
+                let mode = |s: Slip| {
+                    if m.in_contact && model.sign_model == SignModel::Modes {
+                        s.sign()
+                    } else {
+                        f64::NAN
+                    }
+                };
+                for v in [
+                    c.tip.x,
+                    c.tip.y,
+                    c.v_tip.x,
+                    c.v_tip.y,
+                    (-c.tip.y).max(0.0),
+                    c.v_centroid.x,
+                    c.v_centroid.y,
+                ] {
+                    put(&mut self.cols, v);
+                }
+                let forces = &model.forces;
+                for (k, info) in forces.contact_info.iter().enumerate() {
+                    for &(_, axis) in info.columns {
+                        put(&mut self.cols, c.force.terms[k][axis]);
+                    }
+                }
+                if forces.owns(Switch::SlipX) {
+                    put(&mut self.cols, mode(m.sx));
+                }
+                if forces.owns(Switch::SlipY) {
+                    put(&mut self.cols, mode(m.sy));
+                }
+            }
+            if self.n_links > 1 {
+                let f = model.joint_forces(&y.q, &y.qd, e, modes);
+                for (fi, ti) in f.iter().zip(&e.joint_torque).take(self.n_links) {
+                    put(&mut self.cols, fi.x);
+                    put(&mut self.cols, fi.y);
+                    put(&mut self.cols, *ti);
+                }
+            }
+        }
+        if self.on.energy {
+            let (ke, pe) = model.energies(&y.q, &y.qd);
+            put(&mut self.cols, ke);
+            put(&mut self.cols, pe);
+            put(&mut self.cols, y.dissipated);
+            if self.n_links > 1 {
+                let pose = model.mechanism.pose(&y.q);
+                for i in 0..self.n_links {
+                    let (k, p) = model
+                        .mechanism
+                        .link_energy(&pose, &y.qd, model.gravity(), i);
+                    put(&mut self.cols, k);
+                    put(&mut self.cols, p);
+                }
+            }
+        }
+    }
+
+    fn finish(self) -> Option<Series> {
+        if !self.on.any() {
+            return None;
+        }
+        Some(Series {
+            t: self.t,
+            columns: self.names.into_iter().zip(self.cols).collect(),
+        })
+    }
+}

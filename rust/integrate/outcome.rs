@@ -1,0 +1,311 @@
+//! What a run returns (diffrax's `_solution.py`): why it ended, its work counters, the
+//! results of each contact and joint, the recorded series, and [`OUTCOME_FIELDS`], the one
+//! table of the output fields that the Python summary dicts and the sweep columns read.
+
+use nalgebra::Vector2;
+
+/// Why a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// The end condition's stop(s) happened.
+    Stopped,
+    /// `t_end` was reached with the end condition `Time`.
+    EndTime,
+    /// `t_end` was reached before the stop(s) the end condition waits for.
+    NotStopped,
+}
+
+impl Status {
+    /// A short name for reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Status::Stopped => "stopped",
+            Status::EndTime => "end_time",
+            Status::NotStopped => "not_stopped",
+        }
+    }
+
+    /// Its code in a table of numbers (a sweep's `status` column): 0 stopped, 1 end time,
+    /// 2 not stopped.
+    pub const fn code(self) -> f64 {
+        match self {
+            Status::Stopped => 0.0,
+            Status::EndTime => 1.0,
+            Status::NotStopped => 2.0,
+        }
+    }
+}
+
+/// Work counters of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Stats {
+    /// Accepted steps (full and shortened).
+    pub steps: usize,
+    /// Right-hand-side evaluations, root finding included.
+    pub rhs_evals: usize,
+    /// Right-hand-side evaluations spent locating events.
+    pub root_evals: usize,
+    /// Events handled (entries, exits, sign switches, sticks, stops).
+    pub events: usize,
+    /// Steps rejected by the adaptive method's error control.
+    pub rejected: usize,
+    /// Steps taken as they were after [`MAX_EVENTS_PER_STEP`] events within them: the
+    /// sign modes chattered, the step does not resolve the contact.
+    ///
+    /// [`MAX_EVENTS_PER_STEP`]: super::events::MAX_EVENTS_PER_STEP
+    pub unresolved: usize,
+}
+
+/// The results of one contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactSummary {
+    /// Whether the contact's stop happened.
+    pub stopped: bool,
+    /// Time of the stop (NaN without one) [s].
+    pub t_s: f64,
+    /// Depth of the tip at the stop, or at the end without one [m].
+    pub depth: f64,
+    /// Change of the contact link's angle from the start to the stop [rad].
+    pub dq: f64,
+    /// Angular velocity dq/dt of the contact link at the stop [rad/s].
+    pub omega_end: f64,
+    /// Largest |F_d| before the stop, over step ends and events [N] (eq. 3.23).
+    pub f_d_max: f64,
+    /// |F_s| at the stop, as the stop is approached [N] (eq. 3.22).
+    pub f_s_end: f64,
+    /// |F_r| at the stop [N] (eq. 3.24).
+    pub f_r_end: f64,
+    /// Kinetic energy lost from the start to the stop, KE(0) - KE(t_s) [J] (eq. 3.25).
+    pub d_ke: f64,
+    /// Potential energy lost, PE(0) - PE(t_s) [J] (eq. 3.26).
+    pub d_pe: f64,
+    /// Mechanical energy lost, dKE + dPE [J].
+    pub d_e: f64,
+    /// Work done by the sand on the body up to the stop (integrated power) [J].
+    pub work_sand: f64,
+    /// Tip position at the stop (or end) [m].
+    pub tip_end: Vector2<f64>,
+    /// Time the tip entered the sand (NaN if it never did) [s].
+    pub t_entry: f64,
+    /// Kinetic energy lost by the contact's own link, start to stop [J] (thesis eq. 4.9).
+    pub link_d_ke: f64,
+    /// Potential energy lost by the contact's own link, start to stop [J] (eq. 4.10).
+    pub link_d_pe: f64,
+}
+
+/// The results of one joint (the force and torque a link receives from its parent, or
+/// from the root for a root link).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct JointSummary {
+    /// Largest |F| over the run [N].
+    pub f_max: f64,
+    /// Largest |torque| over the run [N m].
+    pub torque_max: f64,
+}
+
+/// Recorded time series, column by column (each the same length as `t`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// Time [s].
+    pub t: Vec<f64>,
+    /// Named columns.
+    pub columns: Vec<(String, Vec<f64>)>,
+}
+
+/// What a run returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// Why it ended.
+    pub status: Status,
+    /// Time it ended [s].
+    pub t_final: f64,
+    /// Work counters.
+    pub stats: Stats,
+    /// Per contact.
+    pub contacts: Vec<ContactSummary>,
+    /// Mechanical energy KE + PE (gravity and springs) at the start and the end [J].
+    pub energy_start: f64,
+    /// See `energy_start`.
+    pub energy_end: f64,
+    /// Work done by the sand over the whole run [J].
+    pub work_sand: f64,
+    /// Energy dissipated by the joints' dampers over the whole run [J].
+    pub dissipated: f64,
+    /// Per link: the joint that carries it.
+    pub joints: Vec<JointSummary>,
+    /// Largest `dt * lambda` of the drag over the run: the step times the drag's fastest
+    /// rate, `2 |F_d| / |v_E|` times E's inverse effective mass (see
+    /// [`Model::centroid_inverse_mass`]), at the state where the drag was stiffest (step
+    /// ends, events and RK4 stages: see [`crate::integrate::stepper::step_sampling`]). Above
+    /// [`RK4_STABILITY_LIMIT`] the fixed step does not resolve the impact. NaN with the
+    /// adaptive method, 0 without drag.
+    ///
+    /// [`Model::centroid_inverse_mass`]: crate::dynamics::Model::centroid_inverse_mass
+    /// [`RK4_STABILITY_LIMIT`]: super::observe::RK4_STABILITY_LIMIT
+    pub h_lambda: f64,
+    /// Time series, if any were asked for.
+    pub series: Option<Series>,
+    /// The terms that acted, in the scene's order.
+    pub terms: Vec<&'static str>,
+}
+
+/// The value of one output field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FieldValue {
+    /// A real number (NaN where the run has none).
+    Real(f64),
+    /// A count.
+    Count(usize),
+    /// Yes or no.
+    Flag(bool),
+    /// Why the run ended.
+    Status(Status),
+}
+
+impl FieldValue {
+    /// The value as a number: a count as itself, a flag as 0 or 1, a status by its
+    /// [`Status::code`].
+    #[inline]
+    pub fn as_f64(self) -> f64 {
+        match self {
+            FieldValue::Real(x) => x,
+            FieldValue::Count(n) => n as f64,
+            FieldValue::Flag(b) => {
+                if b {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            FieldValue::Status(s) => s.code(),
+        }
+    }
+}
+
+/// One output field: its name (a key of `granrs.Result.summary` and of its contacts' and
+/// joints' summaries, a sweep column), its unit, and how to read it from `T`.
+#[derive(Clone, Copy)]
+pub struct Field<T> {
+    /// The name.
+    pub name: &'static str,
+    /// Its unit ("-" for a count, a flag or a status).
+    pub unit: &'static str,
+    /// Whether a run that ends with it non-finite is refused (see
+    /// `observe::check_outcome`); the others may be NaN (no stop, no entry).
+    pub finite: bool,
+    /// Its value in `T`.
+    pub read: fn(&T) -> FieldValue,
+}
+
+/// The output fields of a run, by what they belong to, each in its order.
+#[derive(Clone, Copy)]
+pub struct OutcomeFields {
+    /// The run's (`Result.summary`'s run-level keys; a sweep's first columns).
+    pub run: &'static [Field<Outcome>],
+    /// Each contact's (`ContactResult.summary`; a sweep's `c{i}.` columns).
+    pub contact: &'static [Field<ContactSummary>],
+    /// Each joint's (`Result.joints`; a sweep's `joint{i}.` columns).
+    pub joint: &'static [Field<JointSummary>],
+}
+
+/// A real field of `T`.
+const fn real<T>(name: &'static str, unit: &'static str, read: fn(&T) -> FieldValue) -> Field<T> {
+    Field {
+        name,
+        unit,
+        finite: false,
+        read,
+    }
+}
+
+/// A real field of `T` that a run must end with finite.
+const fn finite<T>(name: &'static str, unit: &'static str, read: fn(&T) -> FieldValue) -> Field<T> {
+    Field {
+        name,
+        unit,
+        finite: true,
+        read,
+    }
+}
+
+/// A count of `T`.
+const fn count<T>(name: &'static str, read: fn(&T) -> FieldValue) -> Field<T> {
+    Field {
+        name,
+        unit: "-",
+        finite: false,
+        read,
+    }
+}
+
+use FieldValue::{Count, Flag, Real};
+
+/// Every output field of a run: the one list the bindings' summary dicts, the sweep's
+/// columns and the check of a finished run read.
+pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
+    run: &[
+        Field {
+            name: "status",
+            unit: "-",
+            finite: false,
+            read: |o| FieldValue::Status(o.status),
+        },
+        real("t_final", "s", |o| Real(o.t_final)),
+        count("steps", |o| Count(o.stats.steps)),
+        count("rhs_evals", |o| Count(o.stats.rhs_evals)),
+        count("root_evals", |o| Count(o.stats.root_evals)),
+        count("events", |o| Count(o.stats.events)),
+        count("rejected", |o| Count(o.stats.rejected)),
+        count("unresolved", |o| Count(o.stats.unresolved)),
+        real("energy_start", "J", |o| Real(o.energy_start)),
+        real("energy_end", "J", |o| Real(o.energy_end)),
+        real("dissipated", "J", |o| Real(o.dissipated)),
+        real("h_lambda", "-", |o| Real(o.h_lambda)),
+    ],
+    contact: &[
+        Field {
+            name: "stopped",
+            unit: "-",
+            finite: false,
+            read: |c| Flag(c.stopped),
+        },
+        real("t_s", "s", |c| Real(c.t_s)),
+        finite("depth", "m", |c| Real(c.depth)),
+        finite("dq", "rad", |c| Real(c.dq)),
+        finite("omega_end", "rad/s", |c| Real(c.omega_end)),
+        finite("F_d_max", "N", |c| Real(c.f_d_max)),
+        finite("F_s_end", "N", |c| Real(c.f_s_end)),
+        finite("F_r_end", "N", |c| Real(c.f_r_end)),
+        finite("dKE", "J", |c| Real(c.d_ke)),
+        finite("dPE", "J", |c| Real(c.d_pe)),
+        real("dE", "J", |c| Real(c.d_e)),
+        finite("work_sand", "J", |c| Real(c.work_sand)),
+        finite("x_tip_end", "m", |c| Real(c.tip_end.x)),
+        real("t_entry", "s", |c| Real(c.t_entry)),
+        real("link_dKE", "J", |c| Real(c.link_d_ke)),
+        real("link_dPE", "J", |c| Real(c.link_d_pe)),
+        real("link_dE", "J", |c| Real(c.link_d_ke + c.link_d_pe)),
+    ],
+    joint: &[
+        real("F_max", "N", |j| Real(j.f_max)),
+        real("torque_max", "N m", |j| Real(j.torque_max)),
+    ],
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn field_names_are_unique_within_each_part() {
+        fn unique(names: Vec<&str>) {
+            let mut sorted = names.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            assert_eq!(sorted.len(), names.len(), "{names:?}");
+        }
+        unique(OUTCOME_FIELDS.run.iter().map(|f| f.name).collect());
+        unique(OUTCOME_FIELDS.contact.iter().map(|f| f.name).collect());
+        unique(OUTCOME_FIELDS.joint.iter().map(|f| f.name).collect());
+    }
+}

@@ -1,0 +1,149 @@
+//! Batches from Python: `sweep` (run on a rayon pool with the GIL released, with progress
+//! and Ctrl-C) and `validate_sweep`.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use super::convert::{spec_from_dict, value_from_py};
+use super::errors::to_pyerr;
+use crate::batch::{self, Source};
+use crate::error::GranrsError;
+use crate::spec::Value;
+
+/// The batch a `sweep` call describes.
+fn source_from_py(
+    base: Option<Bound<'_, PyDict>>,
+    axes: Option<Vec<(String, Bound<'_, PyAny>)>>,
+    scenes: Option<Vec<Bound<'_, PyDict>>>,
+) -> PyResult<Source> {
+    match (base, scenes) {
+        (Some(base), None) => {
+            let mut converted = Vec::new();
+            for (field, values) in axes.unwrap_or_default() {
+                let values: Vec<Value> = values
+                    .try_iter()?
+                    .map(|v| v.map(|v| value_from_py(&v)))
+                    .collect::<PyResult<_>>()?;
+                converted.push((field, values));
+            }
+            Ok(Source::Product {
+                base: spec_from_dict(&base),
+                axes: converted,
+            })
+        }
+        (None, Some(scenes)) => Ok(Source::List(scenes.iter().map(spec_from_dict).collect())),
+        _ => Err(PyValueError::new_err(
+            "sweep() takes either base (with axes) or scenes",
+        )),
+    }
+}
+
+/// Validate every run of a batch (as `sweep` describes it) without running any; raises the
+/// typed error of the first bad run, naming the field and the run.
+#[pyfunction]
+#[pyo3(signature = (base=None, axes=None, scenes=None, threads=0))]
+pub(super) fn validate_sweep<'py>(
+    py: Python<'py>,
+    base: Option<Bound<'py, PyDict>>,
+    axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
+    scenes: Option<Vec<Bound<'py, PyDict>>>,
+    threads: usize,
+) -> PyResult<usize> {
+    let err = |e: GranrsError| to_pyerr(py, e);
+    let src = source_from_py(base, axes, scenes)?;
+    src.body().map_err(err)?;
+    let pool = batch::pool(threads).map_err(err)?;
+    let n = src.len();
+    py.detach(|| pool.install(|| batch::validate(&src, 0..n)))
+        .map_err(err)?;
+    Ok(n)
+}
+
+/// Run a batch: the Cartesian product of `axes` (a list of `(field, values)`) over the scene
+/// dict `base`, or a list of scene dicts `scenes`; runs `start..stop` of it (default: all)
+/// on `threads` threads (0: one per core) with the GIL released.
+///
+/// Every run is validated before any starts. `progress(done)` is called about ten times a
+/// second from the calling thread; Ctrl-C (or an exception in `progress`) cancels the batch
+/// after the runs in flight and raises. Returns a dict: `columns` (names), `data` (a
+/// rows x columns float array, input order), `failures` (list of (run, message)), `body`.
+#[pyfunction]
+#[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn sweep<'py>(
+    py: Python<'py>,
+    base: Option<Bound<'py, PyDict>>,
+    axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
+    scenes: Option<Vec<Bound<'py, PyDict>>>,
+    start: usize,
+    stop: Option<usize>,
+    threads: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let err = |e: GranrsError| to_pyerr(py, e);
+    let src = source_from_py(base, axes, scenes)?;
+    let n = src.len();
+    let stop = stop.unwrap_or(n).min(n);
+    let range = start.min(stop)..stop;
+    let body = src.body().map_err(err)?;
+    let pool = batch::pool(threads).map_err(err)?;
+    py.detach(|| pool.install(|| batch::validate(&src, range.clone())))
+        .map_err(err)?;
+    let done = AtomicUsize::new(0);
+    let cancel = AtomicBool::new(false);
+    let finished = AtomicBool::new(false);
+    let caller = std::thread::current();
+    let (out, interrupted) = std::thread::scope(|s| {
+        let worker = s.spawn(|| {
+            let out = pool.install(|| batch::run(&src, range.clone(), &body, &done, &cancel));
+            finished.store(true, Ordering::Release);
+            caller.unpark();
+            out
+        });
+        let mut interrupted: Option<PyErr> = None;
+        let mut reported = usize::MAX;
+        loop {
+            py.detach(|| {
+                if !finished.load(Ordering::Acquire) {
+                    std::thread::park_timeout(std::time::Duration::from_millis(100));
+                }
+            });
+            let now = done.load(Ordering::Relaxed);
+            if let Some(cb) = &progress {
+                if now != reported {
+                    reported = now;
+                    if let Err(e) = cb.call1((now,)) {
+                        interrupted.get_or_insert(e);
+                    }
+                }
+            }
+            if let Err(e) = py.check_signals() {
+                interrupted.get_or_insert(e);
+            }
+            if interrupted.is_some() {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            if finished.load(Ordering::Acquire) || interrupted.is_some() {
+                break;
+            }
+        }
+        let out = py.detach(|| worker.join());
+        (out, interrupted)
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let out = out.map_err(|_| PyRuntimeError::new_err("a sweep worker panicked"))?;
+    let rows = range.len();
+    let width = out.columns.len();
+    let d = PyDict::new(py);
+    d.set_item("columns", out.columns)?;
+    d.set_item("data", out.data.into_pyarray(py).reshape([rows, width])?)?;
+    d.set_item("failures", out.failures)?;
+    d.set_item("body", body)?;
+    Ok(d)
+}
