@@ -65,7 +65,22 @@ fn out_of_range(field: &str, value: f64, min: f64, strict: bool) -> GranrsError 
     GranrsError::InvalidParameter {
         field: field.to_string(),
         value,
-        allowed: format!("finite, {} {}", if strict { ">" } else { ">=" }, min),
+        allowed: format!(
+            "finite, {} {}{}",
+            if strict { ">" } else { ">=" },
+            min,
+            unit_of(field)
+        ),
+    }
+}
+
+/// ` [unit]` of a scene field from the field table (empty for a field without a unit).
+fn unit_of(field: &str) -> String {
+    match crate::spec::fields::info(field) {
+        Some(f) if !f.unit.is_empty() && f.unit != "-" && !field.contains('.') => {
+            format!(" [{}]", f.unit)
+        }
+        _ => String::new(),
     }
 }
 
@@ -85,7 +100,7 @@ fn not_finite(field: &str, value: f64) -> GranrsError {
     GranrsError::InvalidParameter {
         field: field.to_string(),
         value,
-        allowed: "finite".to_string(),
+        allowed: format!("finite{}", unit_of(field)),
     }
 }
 

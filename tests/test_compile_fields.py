@@ -64,9 +64,14 @@ SCENES = [
 
 
 def test_the_core_keeps_every_field_name() -> None:
-    """Every field a Scene sends has a slot of its own in the core's spec."""
+    """Every field a Scene sends has a slot of its own in the core's spec; the only fields
+    it does not send are the notes (provenance the run does not read)."""
+    from granrs.scene import FIELD_INFO
+
     sent = set(itertools.chain.from_iterable(_CORE_FIELDS.values()))
-    assert sent == set(_granrs.SCENE_FIELDS)
+    notes = {n for n, f in FIELD_INFO.items() if f["part"] == "notes"}
+    assert notes == {"coefficients_source"}
+    assert sent == set(_granrs.SCENE_FIELDS) - notes
 
 
 @pytest.mark.parametrize("scene", SCENES, ids=lambda s: s.body)
@@ -139,3 +144,21 @@ def test_bad_fields_raise_the_same_error(change: dict[str, Any]) -> None:
     with pytest.raises(type(a)) as info:
         granrs.simulate(scene)
     assert info.value.field == a.field
+
+
+def test_one_field_table_describes_every_scene_field() -> None:
+    """Issue 16: the core's field table (rust/spec/fields.rs) names exactly the Scene's
+    fields, and drives BODY_FIELDS, the TOML notes, the docstring and the errors' units."""
+    from granrs import scenefile
+    from granrs.scene import BODY_FIELDS, FIELD_INFO
+
+    assert set(FIELD_INFO) == {f.name for f in dataclasses.fields(Scene)}
+    assert set(FIELD_INFO) == set(_granrs.SCENE_FIELDS)
+    assert BODY_FIELDS["q2_deg"] == ("chain",) and "v0" not in BODY_FIELDS
+    for name, f in FIELD_INFO.items():
+        assert f["part"] in ("body", "medium", "forces", "start", "solver", "outputs", "notes")
+        assert f["doc"] and f["note"], name
+        assert f"        {name}: " in (Scene.__doc__ or ""), name
+        assert f["note"] in scenefile._NOTES[name]
+    with pytest.raises(granrs.InvalidParameterError, match=r"> 0 \[kg/m\^3\]"):
+        granrs.simulate(Scene(rho_g=-1.0))

@@ -20,6 +20,7 @@ __all__ = [
     "resistance_force",
     "run",
     "run_scene",
+    "scene_fields",
     "sweep",
     "term_infos",
     "validate",
@@ -104,6 +105,9 @@ def resistance_force(
 ) -> Any:
     """The rod force over n states: nine contiguous float64 arrays (FORCE_INPUTS order) in,
     an n x 10 array (FORCE_OUTPUTS order) out."""
+
+def scene_fields() -> list[dict[str, Any]]:
+    """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""
 
 def term_infos() -> list[dict[str, Any]]:
     """Every registered force term's description (name, equation, params, ...)."""

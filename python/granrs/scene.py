@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import textwrap
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -30,7 +31,7 @@ from . import _granrs
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from .forces import Term, as_terms, thesis
 
-__all__ = ["BODIES", "BODY_FIELDS", "JOINTS", "RECORDS", "JointSpec", "Scene"]
+__all__ = ["BODIES", "BODY_FIELDS", "FIELD_INFO", "JOINTS", "RECORDS", "JointSpec", "Scene"]
 
 #: The body models.
 BODIES: tuple[str, ...] = ("free_link", "chain", "leg")
@@ -103,103 +104,21 @@ def _joint(value: Any, field_name: str) -> str | dict[str, float]:
     )
 
 
-#: Fields that only one or two bodies use (any other field applies to every body).
+#: The one table of a scene's fields (the core's, ``rust/spec/fields.rs``): name, part,
+#: bodies, unit, note and doc of each, by name.
+FIELD_INFO: dict[str, dict[str, Any]] = {f["name"]: f for f in _granrs.scene_fields()}
+
+#: Fields that only one or two bodies use (any other field applies to every body), from
+#: :data:`FIELD_INFO`.
 BODY_FIELDS: dict[str, tuple[str, ...]] = {
-    "length": ("free_link", "chain"),
-    "diameter": ("free_link", "chain"),
-    "mass": ("free_link", "chain"),
-    "inertia": ("free_link", "chain"),
-    "q_deg": ("free_link", "chain"),
-    "omega0": ("free_link", "chain"),
-    "q2_deg": ("chain",),
-    "pin_mass": ("chain",),
-    "pin_joint": ("chain",),
-    "body_mass": ("leg",),
-    "height": ("leg",),
-    "foot_length": ("leg",),
-    "shoe_width": ("leg",),
-    "tibia_length": ("leg",),
-    "sole_height": ("leg",),
-    "ankle": ("leg",),
-    "knee": ("leg",),
-    "hip": ("leg",),
-    "knee_deg": ("leg",),
-    "hip_deg": ("leg",),
-    "trunk_deg": ("leg",),
-    "foot_deg": ("leg",),
-    "sole_model": ("leg",),
+    name: tuple(f["bodies"]) for name, f in FIELD_INFO.items() if f["bodies"]
 }
 
 
 @dataclass(frozen=True)
 class Scene:
-    """One impact of a body with sand.
-
-    Attributes:
-        body: the body model: ``"free_link"`` (a round rod, 3 degrees of freedom),
-            ``"chain"`` (two rods pinned at their top ends, 4) or ``"leg"`` (foot, shank,
-            thigh, half trunk, 6).
-        length: rod length L [m] (thesis sec. 3.2.1: 0.190); each chain link's.
-        diameter: rod diameter d_c [m] (thesis sec. 3.2.1: 0.0127); each chain link's.
-        mass: body mass m [kg] (thesis sec. 3.2.1: 0.184); each chain link's.
-        inertia: moment of inertia about the centre of mass [kg m^2]; ``None`` for a solid
-            cylinder, m (L^2/12 + d_c^2/16).
-        rho_g: bulk density of the sand, packing included [kg/m^3] (thesis sec. 3.3.1: 1650).
-        g: gravitational acceleration [m/s^2] (9.81).
-        coefficients_source: where the force terms' parameters come from (for reports; not
-            used by the run).
-        q_deg: initial angle of the rod (chain: link 1) from the vertical [deg],
-            -90 < q_deg < 90.
-        v0: initial downward speed [m/s], >= 0.
-        depth0: initial depth of the tip [m], >= 0 (0: at the surface, as in the thesis).
-        vx0: initial horizontal velocity of the tip [m/s].
-        omega0: initial angular velocity dq/dt [rad/s].
-        apply_at: ``"tip"`` (default; the thesis's CAD runs, sec. 3.3.2) or ``"centroid"``
-            (the immersed centroid E, sec. 3.3.1; strictly dissipative).
-        sign_model: ``"modes"`` (default: each sign held through a step, switches located
-            exactly, sticking handled), ``"raw"`` (the thesis's plain sign) or ``"smooth"``
-            (tanh(v / smooth_eps)).
-        smooth_eps: velocity scale of the ``"smooth"`` sign model [m/s].
-        forces: the force terms that act, a list of :mod:`granrs.forces` terms, each with
-            its parameters (one value for every contact or one per contact). Default: the
-            thesis's law (gravity, drag, static_h, static_v, joint_springs) with each term's
-            defaults, Table 3.4 at q = 0. A term not listed is neither computed nor stored,
-            and a spring-damper joint is free without ``joint_springs``; ``[]``: nothing acts.
-        dt: step of the fixed-step RK4 [s] (thesis sec. 3.3.2: 10 kHz, 1e-4); the first
-            step of ``"dopri5"``.
-        method: ``"rk4"`` (default: classical RK4 on the grid n dt) or ``"dopri5"``
-            (adaptive Dormand-Prince 5(4) with tolerances ``rtol`` and ``atol``).
-        rtol: relative tolerance of ``"dopri5"``.
-        atol: absolute tolerance of ``"dopri5"`` [SI units of each coordinate].
-        t_end: latest end time [s].
-        end: ``"first_stop"`` (the thesis's end of the penetration phase), ``"all_stops"``
-            or ``"time"``.
-        record: time series to record, from ``RECORDS`` (none by default).
-        record_stride: record every n-th step (events are always recorded).
-
-    Chain only (thesis chapter 4):
-        q2_deg: link 2's angle from the vertical [deg]; ``None``: -q_deg (mirror image).
-        pin_mass: mass of the pin, a point mass at the joint [kg] (0).
-        pin_joint: the pin: ``"free"`` (the thesis's frictionless joint, sec. 4.1),
-            ``"locked"`` or ``{"k": .., "c": ..}`` (rest angle: the initial one).
-
-    Leg only (thesis chapter 5; segment data from Winter 2009, Table 4.1 and Fig. 4.1,
-    after Dempster 1955; see :func:`granrs.cases.leg`):
-        body_mass: body mass [kg] (sec. 5.2.1: 75.35); the leg carries half of it.
-        height: body height H [m] (sec. 5.2.1: 1.78).
-        foot_length: foot size f_s [m] (sec. 5.3.2: 0.254).
-        shoe_width: shoe width w_s [m] (sec. 5.3.2: 0.086).
-        tibia_length: tibia l_l [m] (sec. 5.3.2: 0.432): the shank and L_ref of eq. 5.4.
-        sole_height: height of the contact box above the sole [m]; ``None``: the tibia
-            length (the sole's footprint carried up the leg, so V keeps growing as
-            f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count.
-        ankle, knee, hip: each ``"locked"`` (default), ``"free"`` or a spring-damper
-            ``{"k": N m/rad, "c": N m s/rad}`` relaxed at the touchdown posture.
-        knee_deg, hip_deg: flexion at touchdown [deg] (granrs assumption: 20, 20).
-        trunk_deg: trunk lean forward [deg] (granrs assumption: 10).
-        foot_deg: sole pitch, toe up [deg] (0: flat landing).
-        sole_model: ``"box"`` (the geometric box of MODEL.md) or ``"thesis"`` (eqs.
-            5.5-5.7 with the shank's angle; finite only for 1 <= |shank angle| <= 89 deg).
+    """One impact of a body with sand (its fields are described below, from the one field
+    table of the core: ``granrs.scene.FIELD_INFO``).
     """
 
     body: str = "free_link"
@@ -350,15 +269,52 @@ class Scene:
         return scenefile.dumps(self) if path is None else scenefile.dump(self, path)
 
 
+def _field_doc(name: str) -> str:
+    f = FIELD_INFO[name]
+    unit = f" [{f['unit']}]" if f["unit"] not in ("", "-") else ""
+    text = f"{name}: {f['doc']}{unit}."
+    return textwrap.fill(
+        text, width=92, initial_indent=" " * 8, subsequent_indent=" " * 12, break_on_hyphens=False
+    )
+
+
+def _scene_doc() -> str:
+    names = [f.name for f in dataclasses.fields(Scene)]
+    missing = set(names) ^ set(FIELD_INFO)
+    if missing:  # the dataclass and the core's table name the same fields (tested)
+        raise ImportError(f"granrs.Scene and the core's field table differ: {sorted(missing)}")
+    groups = [
+        ("    Attributes:", [n for n in names if FIELD_INFO[n]["bodies"] in ([], RODS)]),
+        (
+            "    Chain only (thesis chapter 4):",
+            [n for n in names if FIELD_INFO[n]["bodies"] == ["chain"]],
+        ),
+        (
+            "    Leg only (thesis chapter 5; segment data from Winter 2009, Table 4.1 and Fig. "
+            "4.1, after\n    Dempster 1955; see :func:`granrs.cases.leg`):",
+            [n for n in names if FIELD_INFO[n]["bodies"] == ["leg"]],
+        ),
+    ]
+    parts = [(Scene.__doc__ or "").rstrip(), ""]
+    for title, group in groups:
+        parts.append(title)
+        parts.extend(_field_doc(n) for n in group)
+        parts.append("")
+    return "\n".join(parts) + "    "
+
+
+RODS = ["free_link", "chain"]
+Scene.__doc__ = _scene_doc()
+
 _DEFAULTS: dict[str, Any] = {
     f.name: f.default for f in dataclasses.fields(Scene) if f.default is not dataclasses.MISSING
 }
-#: Per body, the fields the Rust core reads (those of the body; not coefficients_source).
+#: Per body, the fields the Rust core reads (those of the body; not the notes).
 _CORE_FIELDS: dict[str, tuple[str, ...]] = {
     body: tuple(
         f.name
         for f in dataclasses.fields(Scene)
-        if body in BODY_FIELDS.get(f.name, (body,)) and f.name != "coefficients_source"
+        if body in BODY_FIELDS.get(f.name, (body,)) and FIELD_INFO[f.name]["part"] != "notes"
     )
     for body in BODIES
 }

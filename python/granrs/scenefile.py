@@ -48,7 +48,7 @@ from typing import Any
 
 from . import _granrs, forces
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
-from .scene import BODY_FIELDS, RECORDS, Scene
+from .scene import BODY_FIELDS, FIELD_INFO, Scene
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -83,50 +83,11 @@ _TOML_REPLACED: dict[str, str] = {
     "effects": 'the terms that act must be listed as [[forces]] tables (term = "gravity", ...)',
 }
 
-#: One short note per field (unit first), written as a trailing comment.
+#: One short note per field (unit first), written as a trailing comment: from the core's
+#: field table (:data:`granrs.scene.FIELD_INFO`).
 _NOTES: dict[str, str] = {
-    "body": "free_link, chain or leg",
-    "length": "m, rod length (each chain link's)",
-    "diameter": "m, rod diameter",
-    "mass": "kg (each chain link's)",
-    "inertia": "kg m^2 about the centre of mass; left out: solid cylinder",
-    "rho_g": "kg/m^3, bulk density of the sand",
-    "g": "m/s^2",
-    "coefficients_source": "where the terms' parameters come from (not used by the run)",
-    "q_deg": "deg from the vertical, -90 < q_deg < 90",
-    "v0": "m/s downward, >= 0",
-    "depth0": "m, initial depth of the tip, >= 0",
-    "vx0": "m/s, horizontal velocity of the tip",
-    "omega0": "rad/s",
-    "apply_at": "tip or centroid",
-    "sign_model": "modes, raw or smooth",
-    "smooth_eps": "m/s, velocity scale of the smooth sign model",
-    "dt": "s, RK4 step (first step of dopri5)",
-    "method": "rk4 or dopri5",
-    "rtol": "dopri5 relative tolerance",
-    "atol": "dopri5 absolute tolerance",
-    "t_end": "s, latest end time",
-    "end": "first_stop, all_stops or time",
-    "record": f"series to record, from {', '.join(RECORDS)}",
-    "record_stride": "record every n-th step",
-    "q2_deg": "deg, link 2's angle; left out: -q_deg (mirror image)",
-    "forces": "the force terms: [[forces]] tables, each term = name and its parameters",
-    "pin_mass": "kg, point mass at the pin",
-    "pin_joint": "free, locked or { k = N m/rad, c = N m s/rad }",
-    "body_mass": "kg, the leg carries half",
-    "height": "m, body height",
-    "foot_length": "m",
-    "shoe_width": "m",
-    "tibia_length": "m",
-    "sole_height": "m, contact box height; left out: the tibia length",
-    "ankle": "locked, free or { k = N m/rad, c = N m s/rad }",
-    "knee": "locked, free or { k = N m/rad, c = N m s/rad }",
-    "hip": "locked, free or { k = N m/rad, c = N m s/rad }",
-    "knee_deg": "deg flexion at touchdown, 0..150",
-    "hip_deg": "deg flexion at touchdown, -30..150",
-    "trunk_deg": "deg forward lean, -60..60",
-    "foot_deg": "deg sole pitch, toe up, -60..60",
-    "sole_model": "box or thesis",
+    name: ", ".join(x for x in (f["unit"] if f["unit"] != "-" else "", f["note"]) if x)
+    for name, f in FIELD_INFO.items()
 }
 
 

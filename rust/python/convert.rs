@@ -167,3 +167,21 @@ thread_local! {
     /// spec slot of each name, so that a scene's fields are read without matching names.
     static SLOTS: std::cell::RefCell<Vec<NamesSlots>> = const { std::cell::RefCell::new(Vec::new()) };
 }
+
+/// The table of a scene's fields ([`crate::spec::FIELDS`]): name, part, bodies, unit, note
+/// and doc of each, for `granrs.scene`, the TOML notes and the docs.
+#[pyfunction]
+pub fn scene_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let out = PyList::empty(py);
+    for f in crate::spec::FIELDS.iter() {
+        let d = PyDict::new(py);
+        d.set_item("name", f.name)?;
+        d.set_item("part", f.part)?;
+        d.set_item("bodies", f.bodies.to_vec())?;
+        d.set_item("unit", f.unit)?;
+        d.set_item("note", f.note)?;
+        d.set_item("doc", f.doc)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}

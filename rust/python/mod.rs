@@ -41,6 +41,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SCENE_FIELDS", SCENE_FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(run::leg_segments, m)?)?;
     m.add_function(wrap_pyfunction!(terms::term_infos, m)?)?;
+    m.add_function(wrap_pyfunction!(convert::scene_fields, m)?)?;
     m.add_function(wrap_pyfunction!(terms::check_term, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -16,9 +16,13 @@ use crate::error::{GranrsError, Result};
 use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
 use crate::integrate::{EndCondition, Method, Record, SolveOptions};
 
+pub mod fields;
 #[cfg(test)]
 mod tests;
 mod value;
+
+use fields::field_slot;
+pub use fields::{FieldInfo, FIELDS, SCENE_FIELDS};
 
 #[cfg(test)]
 pub(crate) use tests::free_link_spec;
@@ -30,88 +34,6 @@ pub const EFFECTS: [&str; 5] = ["gravity", "drag", "static_h", "static_v", "join
 pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
 /// Names of the bodies.
 pub const BODIES: [&str; 3] = ["free_link", "chain", "leg"];
-
-/// The fields of a scene, in a table and a list: every field a `granrs.Scene` hands the
-/// core ([`SCENE_FIELDS`]) has a slot of the table, found by a `match` on its name (a switch
-/// on the length and an inlined comparison, no search); any other name goes to the list.
-macro_rules! scene_fields {
-    ($($name:literal,)*) => {
-        /// Every field a `granrs.Scene` hands the core, sorted.
-        pub const SCENE_FIELDS: [&str; [$($name,)*].len()] = [$($name,)*];
-
-        /// The slot of a field of [`SCENE_FIELDS`].
-        #[inline]
-        fn field_slot(name: &str) -> Option<usize> {
-            match name {
-                $($name => Some(const { position($name) }),)*
-                _ => None,
-            }
-        }
-    };
-}
-
-scene_fields! {
-    "ankle",
-    "apply_at",
-    "atol",
-    "body",
-    "body_mass",
-    "depth0",
-    "diameter",
-    "dt",
-    "end",
-    "foot_deg",
-    "foot_length",
-    "forces",
-    "g",
-    "height",
-    "hip",
-    "hip_deg",
-    "inertia",
-    "knee",
-    "knee_deg",
-    "length",
-    "mass",
-    "method",
-    "omega0",
-    "pin_joint",
-    "pin_mass",
-    "q2_deg",
-    "q_deg",
-    "record",
-    "record_stride",
-    "rho_g",
-    "rtol",
-    "shoe_width",
-    "sign_model",
-    "smooth_eps",
-    "sole_height",
-    "sole_model",
-    "t_end",
-    "tibia_length",
-    "trunk_deg",
-    "v0",
-    "vx0",
-}
-
-/// Where `name` is in [`SCENE_FIELDS`] (at compile time).
-const fn position(name: &str) -> usize {
-    let mut i = 0;
-    while i < SCENE_FIELDS.len() {
-        let (a, b) = (SCENE_FIELDS[i].as_bytes(), name.as_bytes());
-        if a.len() == b.len() {
-            let mut j = 0;
-            while j < a.len() && a[j] == b[j] {
-                j += 1;
-            }
-            if j == a.len() {
-                return i;
-            }
-        }
-        i += 1;
-    }
-    panic!("not a scene field")
-}
 
 /// A scene as named fields. Fields that a body does not use are ignored.
 #[derive(Debug, Clone, PartialEq)]

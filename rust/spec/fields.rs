@@ -1,0 +1,172 @@
+//! The one table of a scene's fields: name, the part of the scene it belongs to, the bodies
+//! that use it, its unit, a short note and its description with the default's source.
+//!
+//! Everything that describes a field reads this table: the spec's slots (the core's
+//! conversion and validation), the error messages (a field's unit and note follow the
+//! allowed range), `granrs.Scene`'s documentation, `granrs.scene.BODY_FIELDS`, the notes of
+//! a TOML scene file and the docs site's field tables (through `_granrs.scene_fields()`).
+//! Defaults live with their values: the `granrs.Scene` dataclass, whose fields a test holds
+//! to this table. Sorted by name.
+
+/// One field of a scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FieldInfo {
+    /// The field's name (`granrs.Scene` attribute, TOML key, error `field`).
+    pub name: &'static str,
+    /// The part of the scene it belongs to: `body`, `medium`, `forces`, `start`, `solver`,
+    /// `outputs`, or `notes` (provenance the run does not read).
+    pub part: &'static str,
+    /// The bodies that use it (empty: every body).
+    pub bodies: &'static [&'static str],
+    /// Its unit (`-`: none; a name field: empty).
+    pub unit: &'static str,
+    /// A short note: the allowed values or range (TOML comments, error messages).
+    pub note: &'static str,
+    /// What it is, with the default's source.
+    pub doc: &'static str,
+}
+
+const CHAIN: &[&str] = &["chain"];
+const LEG: &[&str] = &["leg"];
+const RODS: &[&str] = &["free_link", "chain"];
+const ALL: &[&str] = &[];
+
+macro_rules! scene_fields {
+    ($($name:literal: $part:literal, $bodies:expr, $unit:literal, $note:literal, $doc:literal;)*) => {
+        /// Every field of a scene, sorted by name (the core's slots).
+        pub const SCENE_FIELDS: [&str; [$($name,)*].len()] = [$($name,)*];
+
+        /// Every field's description, in the order of [`SCENE_FIELDS`].
+        pub static FIELDS: [FieldInfo; SCENE_FIELDS.len()] = [$(FieldInfo {
+            name: $name,
+            part: $part,
+            bodies: $bodies,
+            unit: $unit,
+            note: $note,
+            doc: $doc,
+        },)*];
+
+        /// The slot of a field of [`SCENE_FIELDS`]: a `match` on its name (a switch on the
+        /// length and an inlined comparison, no search).
+        #[inline]
+        pub(crate) fn field_slot(name: &str) -> Option<usize> {
+            match name {
+                $($name => Some(const { position($name) }),)*
+                _ => None,
+            }
+        }
+    };
+}
+
+scene_fields! {
+    "ankle": "body", LEG, "", "locked, free or { k = N m/rad, c = N m s/rad }",
+        "the ankle: \"locked\" (default), \"free\" or a spring-damper {\"k\": N m/rad, \"c\": N m s/rad} relaxed at the touchdown posture (the thesis's CAD model does not say)";
+    "apply_at": "forces", ALL, "", "tip or centroid",
+        "where the contact terms act: \"tip\" (default; the thesis's CAD runs, sec. 3.3.2) or \"centroid\" (the immersed centroid E, sec. 3.3.1; strictly dissipative)";
+    "atol": "solver", ALL, "-", "> 0",
+        "absolute tolerance of \"dopri5\" [SI units of each coordinate]";
+    "body": "body", ALL, "", "free_link, chain or leg",
+        "the body model: \"free_link\" (a round rod, 3 degrees of freedom), \"chain\" (two rods pinned at their top ends, 4) or \"leg\" (foot, shank, thigh, half trunk, 6)";
+    "body_mass": "body", LEG, "kg", "> 0; the leg carries half",
+        "body mass (thesis sec. 5.2.1: 75.35); the leg carries half of it";
+    "coefficients_source": "notes", ALL, "", "text",
+        "where the force terms' parameters come from (for reports; not used by the run)";
+    "depth0": "start", ALL, "m", ">= 0",
+        "initial depth of the tip (0: at the surface, as in the thesis)";
+    "diameter": "body", RODS, "m", "> 0",
+        "rod diameter d_c (thesis sec. 3.2.1: 0.0127); each chain link's";
+    "dt": "solver", ALL, "s", "> 0",
+        "step of the fixed-step RK4 (thesis sec. 3.3.2: 10 kHz, 1e-4); the first step of \"dopri5\"";
+    "end": "solver", ALL, "", "first_stop, all_stops or time",
+        "when the run ends: \"first_stop\" (the thesis's end of the penetration phase), \"all_stops\" or \"time\"";
+    "foot_deg": "start", LEG, "deg", "-60..60",
+        "sole pitch at touchdown, toe up (0: flat landing)";
+    "foot_length": "body", LEG, "m", "> 0",
+        "foot size f_s (thesis sec. 5.3.2: 0.254)";
+    "forces": "forces", ALL, "", "[[forces]] tables: term = name and its parameters",
+        "the force terms that act (granrs.forces), each with its parameters: one value for every contact or one per contact. Default: the thesis's law (gravity, drag, static_h, static_v, joint_springs) with each term's defaults, Table 3.4 at q = 0. A term not listed is neither computed nor stored, and a spring-damper joint is free without joint_springs; []: nothing acts";
+    "g": "medium", ALL, "m/s^2", ">= 0",
+        "gravitational acceleration (9.81, as in the thesis); the static terms scale with it, and the gravity term pulls with it";
+    "height": "body", LEG, "m", "> 0",
+        "body height H (thesis sec. 5.2.1: 1.78)";
+    "hip": "body", LEG, "", "locked, free or { k = N m/rad, c = N m s/rad }",
+        "the hip: as the ankle";
+    "hip_deg": "start", LEG, "deg", "-30..150",
+        "hip flexion at touchdown (granrs assumption: 20)";
+    "inertia": "body", RODS, "kg m^2", "> 0; left out: solid cylinder",
+        "moment of inertia about the centre of mass; None for a solid cylinder, m (L^2/12 + d_c^2/16)";
+    "knee": "body", LEG, "", "locked, free or { k = N m/rad, c = N m s/rad }",
+        "the knee: as the ankle";
+    "knee_deg": "start", LEG, "deg", "0..150",
+        "knee flexion at touchdown (granrs assumption: 20)";
+    "length": "body", RODS, "m", "> 0",
+        "rod length L (thesis sec. 3.2.1: 0.190); each chain link's";
+    "mass": "body", RODS, "kg", "> 0",
+        "body mass m (thesis sec. 3.2.1: 0.184); each chain link's (not in the thesis: 0.0341, a solid steel link)";
+    "method": "solver", ALL, "", "rk4 or dopri5",
+        "the integrator: \"rk4\" (default: classical RK4 on the grid n dt) or \"dopri5\" (adaptive Dormand-Prince 5(4) with rtol and atol)";
+    "omega0": "start", RODS, "rad/s", "finite",
+        "initial angular velocity dq/dt";
+    "pin_joint": "body", CHAIN, "", "free, locked or { k = N m/rad, c = N m s/rad }",
+        "the pin: \"free\" (the thesis's frictionless joint, sec. 4.1), \"locked\" or a spring-damper (rest angle: the initial one)";
+    "pin_mass": "body", CHAIN, "kg", ">= 0",
+        "mass of the pin, a point mass at the joint (0)";
+    "q2_deg": "start", CHAIN, "deg", "-90 < q2_deg < 90; left out: -q_deg",
+        "link 2's angle from the vertical; None: -q_deg (mirror image)";
+    "q_deg": "start", RODS, "deg", "-90 < q_deg < 90",
+        "initial angle of the rod (chain: link 1) from the vertical";
+    "record": "outputs", ALL, "", "from state, forces, energy",
+        "time series to record, from RECORDS (none by default)";
+    "record_stride": "outputs", ALL, "-", "a whole number >= 1",
+        "record every n-th step (events are always recorded)";
+    "rho_g": "medium", ALL, "kg/m^3", "> 0",
+        "bulk density of the sand, packing included (thesis sec. 3.3.1: 1650; the leg's sand, sec. 5.3.2: 1600)";
+    "rtol": "solver", ALL, "-", "> 0",
+        "relative tolerance of \"dopri5\"";
+    "shoe_width": "body", LEG, "m", "> 0",
+        "shoe width w_s (thesis sec. 5.3.2: 0.086)";
+    "sign_model": "forces", ALL, "", "modes, raw or smooth",
+        "how the static terms take the sign of the velocity: \"modes\" (default: each sign held through a step, switches located exactly, sticking handled), \"raw\" (the thesis's plain sign) or \"smooth\" (tanh(v / smooth_eps))";
+    "smooth_eps": "forces", ALL, "m/s", "> 0",
+        "velocity scale of the \"smooth\" sign model";
+    "sole_height": "body", LEG, "m", "> 0; left out: the tibia length",
+        "height of the contact box above the sole; None: the tibia length (the sole's footprint carried up the leg, so V keeps growing as f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count";
+    "sole_model": "body", LEG, "", "box or thesis",
+        "the sole's contact: \"box\" (the geometric box of MODEL.md) or \"thesis\" (eqs. 5.5-5.7 with the shank's angle; finite only for 1 <= shank angle <= 89 deg)";
+    "t_end": "solver", ALL, "s", "> 0",
+        "latest end time";
+    "tibia_length": "body", LEG, "m", "> 0",
+        "tibia l_l (thesis sec. 5.3.2: 0.432): the shank and L_ref of eq. 5.4";
+    "trunk_deg": "start", LEG, "deg", "-60..60",
+        "trunk lean forward at touchdown (granrs assumption: 10)";
+    "v0": "start", ALL, "m/s", ">= 0",
+        "initial downward speed";
+    "vx0": "start", ALL, "m/s", "finite",
+        "initial horizontal velocity of the tip";
+}
+
+/// Where `name` is in [`SCENE_FIELDS`] (at compile time).
+const fn position(name: &str) -> usize {
+    let mut i = 0;
+    while i < SCENE_FIELDS.len() {
+        let (a, b) = (SCENE_FIELDS[i].as_bytes(), name.as_bytes());
+        if a.len() == b.len() {
+            let mut j = 0;
+            while j < a.len() && a[j] == b[j] {
+                j += 1;
+            }
+            if j == a.len() {
+                return i;
+            }
+        }
+        i += 1;
+    }
+    panic!("not a scene field")
+}
+
+/// The description of the scene field `name` (or of the field `name.sub` belongs to, e.g.
+/// `knee` for `knee.k`), if it is one.
+pub fn info(name: &str) -> Option<&'static FieldInfo> {
+    let base = name.split('.').next().unwrap_or(name);
+    field_slot(base).map(|i| &FIELDS[i])
+}
