@@ -22,7 +22,7 @@ pub const MAX_EVENTS_PER_STEP: usize = 32;
 
 /// Kind of a switching function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Kind {
+enum Kind {
     Entry,
     Exit,
     SlipX,
@@ -36,6 +36,7 @@ pub(super) enum Kind {
 
 /// The value of a switching function: non-negative while the mode holds; the event is
 /// where it turns negative (the stop: where -v_Ty reaches zero).
+#[inline]
 fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) -> f64 {
     let c = &e.contacts[ci];
     match kind {
@@ -122,7 +123,7 @@ fn crossed(kind: Kind, g1: f64) -> bool {
 /// component that already moves decidedly keeps its direction. At the surface the bound and
 /// the reaction are both zero; there the decision is taken at `lookahead` (the end of the
 /// step that found the event), where they have grown.
-pub(super) fn choose_slip<const N: usize>(
+fn choose_slip<const N: usize>(
     model: &Model<N>,
     modes: &mut Modes,
     ci: usize,
@@ -172,7 +173,7 @@ pub(super) fn choose_slip<const N: usize>(
 }
 
 /// The modes at a state where contact `ci` has just entered the sand (or starts in it).
-pub(super) fn enter_contact<const N: usize>(
+fn enter_contact<const N: usize>(
     model: &Model<N>,
     modes: &mut Modes,
     ci: usize,
@@ -237,7 +238,7 @@ pub(super) fn initial_modes<const N: usize>(
 
 /// One switching function's crossing within a step.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Hit {
+struct Hit {
     /// Which function.
     kind: Kind,
     /// Of which contact.

@@ -146,6 +146,7 @@ impl<const N: usize> Observer<N> {
 
     /// A step ended at `y` (its evaluation `e`): the largest drag of each contact not yet
     /// stopped, the drag's stiffness there, and the joints' largest loads.
+    #[inline(always)]
     pub(super) fn step_end(&mut self, model: &Model<N>, y: &State<N>, e: &Eval<N>, modes: &Modes) {
         for (ci, s) in self.summaries.iter_mut().enumerate() {
             if !modes[ci].stopped {
@@ -304,11 +305,12 @@ impl<const N: usize> Observer<N> {
 /// the gain stayed below 0.11 of that scale (docs/hard_cases.md), so this is 90x margin.
 pub const DIVERGENCE_FACTOR: f64 = 10.0;
 
-/// Refuse an outcome that is not a physical answer: a non-finite result (a field of [`OUTCOME_FIELDS`] marked `finite`), or a run whose
-/// mechanical energy grew past [`DIVERGENCE_FACTOR`] times the body's energy scale
-/// (|E(0)| + M g l, with M the total mass and l the links' size). Both happen only when the
-/// step is beyond RK4's stability limit for the scene's contact stiffness; the error says so
-/// instead of returning a "stopped" run with enormous numbers.
+/// Refuse an outcome that is not a physical answer: a non-finite result (a contact field of
+/// [`OUTCOME_FIELDS`] marked `finite`), or a run whose mechanical energy grew past
+/// [`DIVERGENCE_FACTOR`] times the body's energy scale (|E(0)| + M g l, with M the total
+/// mass and l the links' size). Both happen only when the step is beyond RK4's stability
+/// limit for the scene's contact stiffness; the error says so instead of returning a
+/// "stopped" run with enormous numbers.
 fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> {
     let fail = |message: String| {
         Err(GranrsError::NonFinite {

@@ -245,7 +245,7 @@ pub fn dopri5_step<const N: usize>(
 /// RK4, which has none). RK4 shows `sample` each stage's coordinates and the drag's stiffest
 /// contact there (see [`step_sampling`]). Counts the evaluations in `stats`.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 pub fn full_step<const N: usize>(
     model: &Model<N>,
     method: Method,
