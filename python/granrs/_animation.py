@@ -186,7 +186,7 @@ def _pose(result: Result, frames: np.ndarray) -> _Pose:
 
 
 def _leg_pose(result: Result, frames: np.ndarray) -> _Pose:
-    """The leg (``rust/scene.rs`` LegScene::model): the ankle is the root; the foot's axis
+    """The leg (``rust/bodies/leg.rs`` LegScene::model): the ankle is the root; the foot's axis
     runs heel to toe with the sole at n = h (the ankle height) below it; the shank, thigh and
     trunk rise from the ankle, the knee and the hip along their axes."""
     scene, series = result.scene, result.series

@@ -5,7 +5,7 @@ the caller's input also derive from :class:`ValueError`, so ``except ValueError`
 working for code that does not know granrs.
 
 The Rust core raises the same classes: its one error enum is converted exhaustively in
-``rust/python/mod.rs``.
+``rust/python/errors.rs``.
 """
 
 from __future__ import annotations
