@@ -204,7 +204,23 @@ impl ContactForce {
 
     /// Put a sticking reaction `reaction` along `axis` in place of the static terms that own
     /// that component's slip switch, and sum again.
+    #[inline]
     fn set_reaction(&mut self, forces: &ForceSet, axis: usize, reaction: f64) {
+        // One static term writes this axis (the thesis's law: static_h in x, static_v in y):
+        // the other static terms' components along it are exactly zero (a term writes only
+        // the axes its columns name), so the reaction is the axis's static sum too.
+        if let Some(k) = forces.sole_static_owner[axis] {
+            self.terms[k][axis] = reaction;
+            self.statics[axis] = reaction;
+            return;
+        }
+        self.set_reaction_shared(forces, axis, reaction);
+    }
+
+    /// [`ContactForce::set_reaction`] where several static terms share an axis: the
+    /// reaction is split among the owners of its switch in proportion to their magnitudes.
+    #[cold]
+    fn set_reaction_shared(&mut self, forces: &ForceSet, axis: usize, reaction: f64) {
         let switch = if axis == 0 {
             Switch::SlipX
         } else {

@@ -206,7 +206,8 @@ pub struct TermInfo {
     /// The switches it owns.
     pub switches: &'static [Switch],
     /// Its per-contact series columns (`c{i}.{column}` with `record=("forces",)`) and the
-    /// force component each holds (0 = x, 1 = y).
+    /// force component each holds (0 = x, 1 = y). A term writes only the components its
+    /// columns name: the others of its force are exactly zero (the engine relies on it).
     pub columns: &'static [(&'static str, usize)],
 }
 

@@ -233,6 +233,10 @@ pub struct ForceSet {
     pub owns: [bool; 3],
     /// Whether a listed term reads A_r |v_E|.
     pub reads_area_speed: bool,
+    /// Per axis, the one static term that writes that axis (by its columns) when it also
+    /// owns the axis's slip switch: a sticking reaction then simply replaces its component
+    /// and the static sum's (see `ContactForce::set_reaction`).
+    pub sole_static_owner: [Option<usize>; 2],
 }
 
 impl ForceSet {
@@ -247,6 +251,7 @@ impl ForceSet {
             contact_info: Vec::new(),
             owns: [false; 3],
             reads_area_speed: false,
+            sole_static_owner: [None; 2],
         };
         for spec in specs {
             let (info, values) = spec.resolve(n_contacts)?;
@@ -279,6 +284,19 @@ impl ForceSet {
                         set.owns[*s as usize] = true;
                     }
                     set.reads_area_speed |= info.reads_area_speed;
+                }
+            }
+        }
+        for (axis, switch) in [(0, Switch::SlipX), (1, Switch::SlipY)] {
+            let writers: Vec<usize> = (0..set.contact_info.len())
+                .filter(|&k| {
+                    let info = set.contact_info[k];
+                    info.class == Class::Static && info.columns.iter().any(|&(_, a)| a == axis)
+                })
+                .collect();
+            if let [k] = writers[..] {
+                if set.contact_info[k].switches.contains(&switch) {
+                    set.sole_static_owner[axis] = Some(k);
                 }
             }
         }
@@ -394,6 +412,24 @@ mod tests {
         assert!(
             matches!(&err, GranrsError::InvalidParameter { field, .. } if field == "static_v.lam")
         );
+    }
+
+    #[test]
+    fn a_sticking_reaction_replaces_the_one_static_term_of_its_axis() {
+        let thesis = ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]);
+        // gravity is a body term: drag 0, static_h 1, static_v 2 among the contact terms.
+        assert_eq!(thesis.sole_static_owner, [Some(1), Some(2)]);
+        // A second static term writing x (the test fixture, both axes): shared.
+        let shared = ForceSet::build(
+            &[
+                TermSpec::new("static_h", &[]),
+                TermSpec::new("static_v", &[]),
+                TermSpec::new("constant", &[("fx", 1.0)]),
+            ],
+            1,
+        )
+        .unwrap();
+        assert_eq!(shared.sole_static_owner, [None, None]);
     }
 
     #[test]
