@@ -250,6 +250,357 @@ def _bounds_for(
     return out
 
 
+def _check_body(cases: Any) -> str:
+    """The body named by ``cases`` (one of :data:`BODIES`), with a did-you-mean if not."""
+    if not isinstance(cases, str) or cases not in BODIES:
+        hint = difflib.get_close_matches(str(cases), BODIES, n=1)
+        more = f"; did you mean {hint[0]!r}?" if hint else ""
+        raise UnknownNameError(
+            f"unknown cases {cases!r}{more}; calibrate fits {', '.join(BODIES)}", field="cases"
+        )
+    return cases
+
+
+def _parse_params(
+    params: Sequence[str], body: str, m: Measurements, per_angle: bool
+) -> list[_Param]:
+    """The parameters to fit, parsed, with ``per_angle`` expanded into one node per
+    measured angle; each name once, and no coefficient both plain and per node."""
+    if isinstance(params, str):
+        params = [params]
+    if not params:
+        raise InvalidParameterError("no parameter to fit", field="params")
+    parsed = [_parse_param(p, body) for p in params]
+    if per_angle:
+        if body != "free_link":
+            raise InvalidParameterError("per_angle is for the free link", field="per_angle")
+        angles = sorted({abs(float(q)) for q in m.rows["q_deg"]})
+        expanded = []
+        for p in parsed:
+            if p.kind == "coef":
+                expanded += [_Param(f"{p.target}@{q:g}", "node", p.target, q) for q in angles]
+            else:
+                expanded.append(p)
+        parsed = expanded
+    names = [p.name for p in parsed]
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        raise InvalidParameterError(f"parameter {dupes[0]!r} is given twice", field=dupes[0])
+    kinds = {p.target: p.kind for p in parsed if p.kind in ("coef", "node")}
+    for p in parsed:
+        if p.kind in ("coef", "node") and kinds[p.target] != p.kind:
+            raise InvalidParameterError(
+                f"{p.target} is fitted both as one value and per angle node; choose one",
+                field=p.name,
+            )
+    return parsed
+
+
+def _check_quantities(quantities: Sequence[str] | str) -> list[str]:
+    """The quantities to fit, as a list of names from :data:`QUANTITIES`."""
+    qs = [quantities] if isinstance(quantities, str) else list(quantities)
+    if not qs or any(q not in QUANTITIES for q in qs):
+        raise UnknownNameError(
+            f"quantities must be among {', '.join(QUANTITIES)}; got {quantities!r}",
+            field="quantities",
+        )
+    return qs
+
+
+def _check_base(base: str | Coefficients | None, body: str) -> str | Coefficients:
+    """The base coefficients' name (the body's default for None) or the Coefficients."""
+    if base is None:
+        base = "table_3_4" if body == "free_link" else "thesis"
+    if isinstance(base, str):
+        allowed = {
+            "free_link": ("table_3_4", "table_3_2"),
+            "chain": ("thesis", "table_4_4"),
+            "leg": ("thesis",),
+        }[body]
+        if base not in allowed:
+            raise UnknownNameError(
+                f"unknown base {base!r} for the {body}; use {', '.join(allowed)} or a "
+                "granrs.Coefficients",
+                field="base",
+            )
+    elif not isinstance(base, Coefficients):
+        raise InvalidParameterError(
+            f"base must be a name or a granrs.Coefficients; got {type(base).__name__}",
+            field="base",
+        )
+    return base
+
+
+def _check_options(dt: Any, rel_step: Any, starts: Any, max_nfev: Any, error_scale: Any) -> None:
+    """Reject an invalid ``dt``, ``rel_step``, ``starts``, ``max_nfev`` or ``error_scale``
+    (``field`` names it)."""
+    for name, value, ok in (
+        ("dt", dt, _is_number(dt) and math.isfinite(dt) and dt > 0),
+        ("rel_step", rel_step, _is_number(rel_step) and 1e-8 <= rel_step <= 0.1),
+        (
+            "starts",
+            starts,
+            isinstance(starts, int) and not isinstance(starts, bool) and starts >= 1,
+        ),
+        (
+            "max_nfev",
+            max_nfev,
+            isinstance(max_nfev, int) and not isinstance(max_nfev, bool) and max_nfev >= 1,
+        ),
+        ("error_scale", error_scale, error_scale in ("auto", "none")),
+    ):
+        if not ok:
+            raise InvalidParameterError(f"invalid {name}: {value!r}", field=name)
+
+
+def _check_joints(joints: Mapping[str, float] | None, body: str) -> dict[str, float]:
+    """The leg's fixed joint settings (``k``, ``c``: finite, >= 0) as a new dict."""
+    fixed = dict(joints or {})
+    for key, value in fixed.items():
+        if body != "leg" or key not in _JOINTS:
+            raise InvalidParameterError(
+                f"joints takes 'k' and 'c' for the leg; got {key!r}", field=f"joints.{key}"
+            )
+        if not _is_number(value) or not math.isfinite(value) or value < 0:
+            raise InvalidParameterError(
+                f"joints.{key} must be a finite number >= 0; got {value!r}", field=f"joints.{key}"
+            )
+    return fixed
+
+
+def _start_values(
+    parsed: Sequence[_Param],
+    box: Sequence[tuple[float, float]],
+    start: Mapping[str, float] | None,
+    model: _Model,
+    m: Measurements,
+    fixed: Mapping[str, float],
+) -> list[float]:
+    """The start of every parameter in natural units, clipped to its bounds: the given
+    one, else 1 for a scale factor, the fixed or default joint setting, or the base value
+    (at the row nearest the node for a node)."""
+    names = [p.name for p in parsed]
+    given_start = {k.replace("lambda", "lam"): v for k, v in dict(start or {}).items()}
+    for key in given_start:
+        if key not in names:
+            hint = difflib.get_close_matches(key, names, n=1)
+            more = f"; did you mean {hint[0]!r}?" if hint else ""
+            raise UnknownNameError(
+                f"start given for {key!r}, which is not a fitted parameter{more}",
+                field=f"start.{key}",
+            )
+    records = m.rows.to_dict("records")
+    x_start = []
+    for p, (lo, hi) in zip(parsed, box, strict=True):
+        if p.name in given_start:
+            v = given_start[p.name]
+            if not _is_number(v) or not lo <= v <= hi:
+                raise InvalidParameterError(
+                    f"start of {p.name!r} must be a number within its bounds [{lo}, {hi}]; "
+                    f"got {v!r}",
+                    field=f"start.{p.name}",
+                )
+            v = float(v)
+        elif p.kind == "scale":
+            v = 1.0
+        elif p.kind == "joint":
+            v = fixed.get(p.target, _JOINT_START[p.target])
+        else:
+            if p.kind == "node":
+                row = min(records, key=lambda r: abs(abs(float(r["q_deg"])) - p.node))
+                row = {**row, "q_deg": p.node}
+            else:
+                row = records[0]
+            v = getattr(model.base_coefficients(row), p.target)
+        x_start.append(min(max(v, lo), hi))
+    return x_start
+
+
+class _Objective:
+    """The weighted residuals of the fit as a function of the fitted (internal) parameter
+    vector, and their forward-difference Jacobian, both run as one sweep; counts the
+    simulations, failed and unresolved runs as it goes (``counters``)."""
+
+    def __init__(
+        self,
+        model: _Model,
+        m: Measurements,
+        qs: Sequence[str],
+        n_runs: int,
+        rel_step: float,
+        hi_x: np.ndarray,
+        threads: int | None,
+    ) -> None:
+        self.model, self.m, self.qs, self.n_runs = model, m, qs, n_runs
+        self.rel_step, self.hi_x, self.threads = rel_step, hi_x, threads
+        self.sd = {q: m.sd_fit(q) for q in qs}
+        self.means = {q: m.rows[f"{q}_mean"].to_numpy(dtype=float) for q in qs}
+        self.counters = {"sims": 0, "failed": 0, "unresolved": 0}
+        self.cache: dict[bytes, np.ndarray] = {}
+
+    def weighted(self, depth: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+        """Residuals over sd_fit, one row per parameter vector; a failed run's are large."""
+        sims = {"depth": depth, "t_s": t_s}
+        parts = [(sims[q] - self.means[q][None, :]) / self.sd[q][None, :] for q in self.qs]
+        r = np.concatenate(parts, axis=1)
+        return np.where(np.isfinite(r), r, _FAILED_RESIDUAL)
+
+    def evaluate(self, xs: Sequence[np.ndarray]) -> np.ndarray:
+        """The weighted residuals of every vector of ``xs``, all in one sweep."""
+        vectors = [self.model.to_natural(x) for x in xs]
+        depth, t_s, ok = self.model.simulate(self.m.rows, vectors, self.threads)
+        self.counters["sims"] += self.n_runs * len(xs)  # refused vectors count as attempted
+        self.counters["failed"] += int(np.sum(~ok))
+        self.counters["unresolved"] += int(np.sum(self.model.last_unresolved))
+        return self.weighted(depth, t_s)
+
+    def fun(self, x: np.ndarray) -> np.ndarray:
+        """The residuals at ``x`` (the last point is cached: the Jacobian has it)."""
+        key = np.asarray(x, dtype=float).tobytes()
+        if key not in self.cache:
+            self.cache.clear()
+            self.cache[key] = self.evaluate([x])[0]
+        return self.cache[key]
+
+    def steps(self, x: np.ndarray) -> np.ndarray:
+        """The forward-difference step of each parameter at ``x``."""
+        rel_step = self.rel_step
+        h = np.array(
+            [
+                rel_step if p.log else rel_step * max(abs(u), 0.1)
+                for p, u in zip(self.model.params, x, strict=True)
+            ]
+        )
+        # Step inwards where the forward step would leave the box.
+        return np.where(x + h > self.hi_x, -h, h)
+
+    def jac(self, x: np.ndarray) -> np.ndarray:
+        """The forward-difference Jacobian at ``x``: the point and one step per parameter
+        in one sweep (the point's residuals are cached for :meth:`fun`)."""
+        h = self.steps(x)
+        xs = [np.asarray(x, dtype=float)] + [x + h[i] * np.eye(len(x))[i] for i in range(len(x))]
+        r = self.evaluate(xs)
+        self.cache.clear()
+        self.cache[np.asarray(x, dtype=float).tobytes()] = r[0]
+        return ((r[1:] - r[0]) / h[:, None]).T
+
+
+def _fit_starts(
+    objective: _Objective,
+    x0: np.ndarray,
+    lo_x: np.ndarray,
+    hi_x: np.ndarray,
+    starts: int,
+    seed: int,
+    max_nfev: int,
+) -> tuple[Any, int, int]:
+    """Least squares from ``x0`` and ``starts - 1`` seeded random starts; the best fit (the
+    lowest cost) and the residual and Jacobian evaluations of all of them."""
+    from scipy.optimize import least_squares
+
+    rng = np.random.default_rng(seed)
+    candidates = [x0]
+    for _ in range(starts - 1):
+        lo_s = np.maximum(lo_x, x0 - 2.3)
+        hi_s = np.minimum(hi_x, x0 + 2.3)
+        candidates.append(rng.uniform(lo_s, hi_s))
+    best = None
+    nfev = njev = 0
+    for cand in candidates:
+        try:
+            fit = least_squares(
+                objective.fun,
+                cand,
+                jac=objective.jac,
+                bounds=(lo_x, hi_x),
+                method="trf",
+                x_scale="jac",
+                max_nfev=max_nfev,
+            )
+        except SimulationError:  # pragma: no cover - runs fail into residuals, not raise
+            raise
+        nfev += fit.nfev
+        njev += fit.njev or 0
+        if best is None or fit.cost < best.cost:
+            best = fit
+    assert best is not None
+    return best, nfev, njev
+
+
+def _covariance(
+    jmat: np.ndarray, r: np.ndarray, n_res: int, error_scale: str
+) -> tuple[float, int, float, np.ndarray, np.ndarray, np.ndarray]:
+    """From the Jacobian and residuals at the optimum: chi2, dof, the error scale, the
+    covariance and standard errors of the fitted (internal) parameters (infinite along
+    directions the data do not determine), and their correlation matrix."""
+    n = jmat.shape[1]
+    chi2 = float(r @ r)
+    dof = n_res - n
+    scale = 1.0
+    if error_scale == "auto" and dof > 0 and chi2 / dof > 1.0:
+        scale = math.sqrt(chi2 / dof)
+    jtj = jmat.T @ jmat
+    try:
+        cov = np.linalg.pinv(jtj, rcond=1e-12, hermitian=True) * scale**2
+        se_x = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    except np.linalg.LinAlgError:  # pragma: no cover
+        cov = np.full((n, n), np.nan)
+        se_x = np.full(n, np.nan)
+    rank = np.linalg.matrix_rank(jtj) if np.all(np.isfinite(jtj)) else 0
+    if rank < n:
+        # Directions the data do not determine: their errors are not finite.
+        w, v = np.linalg.eigh(jtj)
+        null = v[:, w <= w.max() * 1e-12]
+        for i in range(n):
+            if np.any(np.abs(null[i]) > 1e-6):
+                se_x[i] = math.inf
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = np.sqrt(np.diag(cov))
+        corr = cov / np.outer(d, d)
+    return chi2, dof, scale, cov, se_x, corr
+
+
+def _natural_estimates(
+    parsed: Sequence[_Param],
+    natural: np.ndarray,
+    x: np.ndarray,
+    se_x: np.ndarray,
+    lo_x: np.ndarray,
+    hi_x: np.ndarray,
+) -> tuple[dict[str, float], dict[str, float], dict[str, tuple[float, float]], list[str]]:
+    """Values, standard errors and ~95 % intervals in natural units (mapped back from the
+    fitted space), and the parameters that ended on a bound."""
+    values, se, intervals = {}, {}, {}
+    span = hi_x - lo_x
+    at_bound = []
+    for i, p in enumerate(parsed):
+        values[p.name] = float(natural[i])
+        lo_i, hi_i = x[i] - 1.96 * se_x[i], x[i] + 1.96 * se_x[i]
+        if p.log:
+            se[p.name] = float(natural[i] * se_x[i])
+            intervals[p.name] = (_exp(lo_i), _exp(hi_i))
+        else:
+            se[p.name] = float(se_x[i])
+            intervals[p.name] = (float(lo_i), float(hi_i))
+        if min(x[i] - lo_x[i], hi_x[i] - x[i]) <= 1e-6 * max(span[i], 1.0):
+            at_bound.append(p.name)
+    return values, se, intervals, at_bound
+
+
+def _final_residuals(objective: _Objective, natural: np.ndarray, x0: np.ndarray) -> pd.DataFrame:
+    """The residual table at the optimum, with the start's z columns (one sweep)."""
+    model, m = objective.model, objective.m
+    depth, t_s, _ = model.simulate(m.rows, [natural, model.to_natural(x0)], objective.threads)
+    objective.counters["sims"] += 2 * objective.n_runs
+    flags = model.last_unresolved
+    frame = _residual_frame(m, depth[0], t_s[0])
+    frame["unresolved"] = flags[0] if flags.size else False
+    start_frame = _residual_frame(m, depth[1], t_s[1])
+    for q in QUANTITIES:
+        frame[f"{q}_z_start"] = start_frame[f"{q}_z"]
+    return frame
+
+
 def calibrate(
     cases: str,
     measurements: Measurements | str | os.PathLike[str],
@@ -321,139 +672,28 @@ def calibrate(
             ordered, a start outside the bounds, a bad option (``field`` names it).
         MeasurementError: a measurements CSV that cannot be read (before any simulation).
     """
-    from scipy.optimize import least_squares
+
+    # scipy first, as before the split: without it, calibrate fails before any check.
+    from scipy.optimize import least_squares  # noqa: F401
 
     t0 = time.perf_counter()
-    if not isinstance(cases, str) or cases not in BODIES:
-        hint = difflib.get_close_matches(str(cases), BODIES, n=1)
-        more = f"; did you mean {hint[0]!r}?" if hint else ""
-        raise UnknownNameError(
-            f"unknown cases {cases!r}{more}; calibrate fits {', '.join(BODIES)}", field="cases"
-        )
-    body = cases
+    body = _check_body(cases)
     m = _check_measurements(measurements, body)
-    if isinstance(params, str):
-        params = [params]
-    if not params:
-        raise InvalidParameterError("no parameter to fit", field="params")
-    parsed = [_parse_param(p, body) for p in params]
-    if per_angle:
-        if body != "free_link":
-            raise InvalidParameterError("per_angle is for the free link", field="per_angle")
-        angles = sorted({abs(float(q)) for q in m.rows["q_deg"]})
-        expanded = []
-        for p in parsed:
-            if p.kind == "coef":
-                expanded += [_Param(f"{p.target}@{q:g}", "node", p.target, q) for q in angles]
-            else:
-                expanded.append(p)
-        parsed = expanded
+    parsed = _parse_params(params, body, m, per_angle)
     names = [p.name for p in parsed]
-    dupes = sorted({n for n in names if names.count(n) > 1})
-    if dupes:
-        raise InvalidParameterError(f"parameter {dupes[0]!r} is given twice", field=dupes[0])
-    kinds = {p.target: p.kind for p in parsed if p.kind in ("coef", "node")}
-    for p in parsed:
-        if p.kind in ("coef", "node") and kinds[p.target] != p.kind:
-            raise InvalidParameterError(
-                f"{p.target} is fitted both as one value and per angle node; choose one",
-                field=p.name,
-            )
-    qs = [quantities] if isinstance(quantities, str) else list(quantities)
-    if not qs or any(q not in QUANTITIES for q in qs):
-        raise UnknownNameError(
-            f"quantities must be among {', '.join(QUANTITIES)}; got {quantities!r}",
-            field="quantities",
-        )
+    qs = _check_quantities(quantities)
     n_res = len(m) * len(qs)
     if n_res < len(parsed):
         raise InvalidParameterError(
             f"{len(parsed)} parameters cannot be fitted to {n_res} measured values",
             field="params",
         )
-    if base is None:
-        base = "table_3_4" if body == "free_link" else "thesis"
-    if isinstance(base, str):
-        allowed = {
-            "free_link": ("table_3_4", "table_3_2"),
-            "chain": ("thesis", "table_4_4"),
-            "leg": ("thesis",),
-        }[body]
-        if base not in allowed:
-            raise UnknownNameError(
-                f"unknown base {base!r} for the {body}; use {', '.join(allowed)} or a "
-                "granrs.Coefficients",
-                field="base",
-            )
-    elif not isinstance(base, Coefficients):
-        raise InvalidParameterError(
-            f"base must be a name or a granrs.Coefficients; got {type(base).__name__}",
-            field="base",
-        )
-    for name, value, ok in (
-        ("dt", dt, _is_number(dt) and math.isfinite(dt) and dt > 0),
-        ("rel_step", rel_step, _is_number(rel_step) and 1e-8 <= rel_step <= 0.1),
-        (
-            "starts",
-            starts,
-            isinstance(starts, int) and not isinstance(starts, bool) and starts >= 1,
-        ),
-        (
-            "max_nfev",
-            max_nfev,
-            isinstance(max_nfev, int) and not isinstance(max_nfev, bool) and max_nfev >= 1,
-        ),
-        ("error_scale", error_scale, error_scale in ("auto", "none")),
-    ):
-        if not ok:
-            raise InvalidParameterError(f"invalid {name}: {value!r}", field=name)
-    fixed = dict(joints or {})
-    for key, value in fixed.items():
-        if body != "leg" or key not in _JOINTS:
-            raise InvalidParameterError(
-                f"joints takes 'k' and 'c' for the leg; got {key!r}", field=f"joints.{key}"
-            )
-        if not _is_number(value) or not math.isfinite(value) or value < 0:
-            raise InvalidParameterError(
-                f"joints.{key} must be a finite number >= 0; got {value!r}", field=f"joints.{key}"
-            )
+    base = _check_base(base, body)
+    _check_options(dt, rel_step, starts, max_nfev, error_scale)
+    fixed = _check_joints(joints, body)
     box = _bounds_for(parsed, bounds)
     model = _Model(body, tuple(parsed), base, float(dt), dict(overrides), fixed)
-
-    # Start values.
-    given_start = {k.replace("lambda", "lam"): v for k, v in dict(start or {}).items()}
-    for key in given_start:
-        if key not in names:
-            hint = difflib.get_close_matches(key, names, n=1)
-            more = f"; did you mean {hint[0]!r}?" if hint else ""
-            raise UnknownNameError(
-                f"start given for {key!r}, which is not a fitted parameter{more}",
-                field=f"start.{key}",
-            )
-    records = m.rows.to_dict("records")
-    x_start = []
-    for p, (lo, hi) in zip(parsed, box, strict=True):
-        if p.name in given_start:
-            v = given_start[p.name]
-            if not _is_number(v) or not lo <= v <= hi:
-                raise InvalidParameterError(
-                    f"start of {p.name!r} must be a number within its bounds [{lo}, {hi}]; "
-                    f"got {v!r}",
-                    field=f"start.{p.name}",
-                )
-            v = float(v)
-        elif p.kind == "scale":
-            v = 1.0
-        elif p.kind == "joint":
-            v = fixed.get(p.target, _JOINT_START[p.target])
-        else:
-            if p.kind == "node":
-                row = min(records, key=lambda r: abs(abs(float(r["q_deg"])) - p.node))
-                row = {**row, "q_deg": p.node}
-            else:
-                row = records[0]
-            v = getattr(model.base_coefficients(row), p.target)
-        x_start.append(min(max(v, lo), hi))
+    x_start = _start_values(parsed, box, start, model, m, fixed)
     # Build every scene once up front: bad overrides or values fail here, before any run.
     model.scenes(m.rows, x_start)
 
@@ -461,131 +701,21 @@ def calibrate(
     hi_x = model.to_internal([b[1] for b in box])
     x0 = model.to_internal(x_start)
     x0 = np.clip(x0, lo_x, hi_x)
-    sd = {q: m.sd_fit(q) for q in qs}
-    means = {q: m.rows[f"{q}_mean"].to_numpy(dtype=float) for q in qs}
-    counters = {"sims": 0, "failed": 0, "unresolved": 0}
     n_runs = len(model.scenes(m.rows, x_start))
-
-    def weighted(depth: np.ndarray, t_s: np.ndarray) -> np.ndarray:
-        sims = {"depth": depth, "t_s": t_s}
-        parts = [(sims[q] - means[q][None, :]) / sd[q][None, :] for q in qs]
-        r = np.concatenate(parts, axis=1)
-        return np.where(np.isfinite(r), r, _FAILED_RESIDUAL)
-
-    def evaluate(xs: Sequence[np.ndarray]) -> np.ndarray:
-        vectors = [model.to_natural(x) for x in xs]
-        depth, t_s, ok = model.simulate(m.rows, vectors, threads)
-        counters["sims"] += n_runs * len(xs)  # refused vectors count as attempted
-        counters["failed"] += int(np.sum(~ok))
-        counters["unresolved"] += int(np.sum(model.last_unresolved))
-        return weighted(depth, t_s)
-
-    cache: dict[bytes, np.ndarray] = {}
-
-    def fun(x: np.ndarray) -> np.ndarray:
-        key = np.asarray(x, dtype=float).tobytes()
-        if key not in cache:
-            cache.clear()
-            cache[key] = evaluate([x])[0]
-        return cache[key]
-
-    def steps(x: np.ndarray) -> np.ndarray:
-        h = np.array(
-            [
-                rel_step if p.log else rel_step * max(abs(u), 0.1)
-                for p, u in zip(parsed, x, strict=True)
-            ]
-        )
-        # Step inwards where the forward step would leave the box.
-        return np.where(x + h > hi_x, -h, h)
-
-    def jac(x: np.ndarray) -> np.ndarray:
-        h = steps(x)
-        xs = [np.asarray(x, dtype=float)] + [x + h[i] * np.eye(len(x))[i] for i in range(len(x))]
-        r = evaluate(xs)
-        cache.clear()
-        cache[np.asarray(x, dtype=float).tobytes()] = r[0]
-        return ((r[1:] - r[0]) / h[:, None]).T
-
-    rng = np.random.default_rng(seed)
-    candidates = [x0]
-    for _ in range(starts - 1):
-        lo_s = np.maximum(lo_x, x0 - 2.3)
-        hi_s = np.minimum(hi_x, x0 + 2.3)
-        candidates.append(rng.uniform(lo_s, hi_s))
-    best = None
-    nfev = njev = 0
-    for cand in candidates:
-        try:
-            fit = least_squares(
-                fun,
-                cand,
-                jac=jac,
-                bounds=(lo_x, hi_x),
-                method="trf",
-                x_scale="jac",
-                max_nfev=max_nfev,
-            )
-        except SimulationError:  # pragma: no cover - runs fail into residuals, not raise
-            raise
-        nfev += fit.nfev
-        njev += fit.njev or 0
-        if best is None or fit.cost < best.cost:
-            best = fit
-    assert best is not None
+    objective = _Objective(model, m, qs, n_runs, rel_step, hi_x, threads)
+    best, nfev, njev = _fit_starts(objective, x0, lo_x, hi_x, starts, seed, max_nfev)
 
     # Uncertainty from the Jacobian at the optimum.
     x = best.x
-    jmat = jac(x)
-    r = fun(x)
-    chi2 = float(r @ r)
-    dof = n_res - len(x)
-    scale = 1.0
-    if error_scale == "auto" and dof > 0 and chi2 / dof > 1.0:
-        scale = math.sqrt(chi2 / dof)
-    jtj = jmat.T @ jmat
-    try:
-        cov = np.linalg.pinv(jtj, rcond=1e-12, hermitian=True) * scale**2
-        se_x = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    except np.linalg.LinAlgError:  # pragma: no cover
-        cov = np.full((len(x), len(x)), np.nan)
-        se_x = np.full(len(x), np.nan)
-    rank = np.linalg.matrix_rank(jtj) if np.all(np.isfinite(jtj)) else 0
-    if rank < len(x):
-        # Directions the data do not determine: their errors are not finite.
-        w, v = np.linalg.eigh(jtj)
-        null = v[:, w <= w.max() * 1e-12]
-        for i in range(len(x)):
-            if np.any(np.abs(null[i]) > 1e-6):
-                se_x[i] = math.inf
-    with np.errstate(invalid="ignore", divide="ignore"):
-        d = np.sqrt(np.diag(cov))
-        corr = cov / np.outer(d, d)
+    jmat = objective.jac(x)
+    r = objective.fun(x)
+    chi2, dof, scale, _cov, se_x, corr = _covariance(jmat, r, n_res, error_scale)
     natural = model.to_natural(x)
-    values, se, intervals = {}, {}, {}
-    span = hi_x - lo_x
-    at_bound = []
-    for i, p in enumerate(parsed):
-        values[p.name] = float(natural[i])
-        lo_i, hi_i = x[i] - 1.96 * se_x[i], x[i] + 1.96 * se_x[i]
-        if p.log:
-            se[p.name] = float(natural[i] * se_x[i])
-            intervals[p.name] = (_exp(lo_i), _exp(hi_i))
-        else:
-            se[p.name] = float(se_x[i])
-            intervals[p.name] = (float(lo_i), float(hi_i))
-        if min(x[i] - lo_x[i], hi_x[i] - x[i]) <= 1e-6 * max(span[i], 1.0):
-            at_bound.append(p.name)
+    values, se, intervals, at_bound = _natural_estimates(parsed, natural, x, se_x, lo_x, hi_x)
 
     # Residual tables at the optimum and at the start (one sweep).
-    depth, t_s, _ = model.simulate(m.rows, [natural, model.to_natural(x0)], threads)
-    counters["sims"] += 2 * n_runs
-    flags = model.last_unresolved
-    frame = _residual_frame(m, depth[0], t_s[0])
-    frame["unresolved"] = flags[0] if flags.size else False
-    start_frame = _residual_frame(m, depth[1], t_s[1])
-    for q in QUANTITIES:
-        frame[f"{q}_z_start"] = start_frame[f"{q}_z"]
+    frame = _final_residuals(objective, natural, x0)
+    counters = objective.counters
     return CalibrationResult(
         body=body,
         params=tuple(names),
