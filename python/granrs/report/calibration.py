@@ -29,8 +29,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .calibrate import CalibrationResult, Measurements, calibrate, evaluate, within
-from .report import ReportContext, _fmt, md_table, register_chapter
+from ..calibrate import CalibrationResult, Measurements, calibrate, evaluate, within
+from .format import _fmt, md_table
+from .framework import ReportContext, register_chapter
 
 __all__ = ["FREE_LINK_VARIANTS", "chapter_calibration", "vertical_drop"]
 
@@ -102,7 +103,7 @@ def vertical_drop(
     """
     from scipy.integrate import solve_ivp
 
-    from .cases import FREE_LINK
+    from ..cases import FREE_LINK
 
     m, length, dc = FREE_LINK["mass"], FREE_LINK["length"], FREE_LINK["diameter"]
     k = eta_v * g * rho_g * math.pi * dc**2 / 4.0
@@ -172,7 +173,7 @@ def _residual_rows(
 def _figure(ctx: ReportContext, thesis: pd.DataFrame, fitted: pd.DataFrame, label: str) -> str:
     from matplotlib.figure import Figure
 
-    from . import plots
+    from .. import plots
 
     fig = Figure(figsize=(12.0, 4.6))
     axes = fig.subplots(1, 2)

@@ -1,0 +1,318 @@
+"""The report's framework: the chapter registry (:data:`CHAPTERS`,
+:func:`register_chapter`), what a chapter works with (:class:`ReportContext`), and
+:func:`reproduce`, which runs the chapters asked for and writes the report.
+
+It never imports a chapter: the chapters import it and register themselves, and the
+package (:mod:`granrs.report`) imports them in report order.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import __version__, cases
+from ..api import simulate
+from ..errors import InvalidParameterError, UnknownNameError
+from ..result import Result
+from ..scene import Scene
+
+__all__ = [
+    "CHAPTERS",
+    "FIGURES_DIR",
+    "REPORT_NAME",
+    "Chapter",
+    "ChapterBuilder",
+    "ReportContext",
+    "register_chapter",
+    "reproduce",
+]
+
+#: The file name of the report inside the output directory.
+REPORT_NAME = "README.md"
+#: The folder of the figures inside the output directory.
+FIGURES_DIR = "figures"
+
+ChapterBuilder = Callable[["ReportContext"], str]
+
+
+@dataclass(frozen=True)
+class Chapter:
+    """A chapter of the report.
+
+    Attributes:
+        key: the name used to ask for it (``"3"``).
+        title: its heading, e.g. ``"Chapter 3: the free link"``.
+        build: the function that runs it and returns its Markdown (headings from ``##``).
+    """
+
+    key: str
+    title: str
+    build: ChapterBuilder
+
+
+#: The chapters :func:`reproduce` knows, by key, in registration order.
+CHAPTERS: dict[str, Chapter] = {}
+
+
+def register_chapter(key: str, title: str) -> Callable[[ChapterBuilder], ChapterBuilder]:
+    """Decorator: register ``build`` as the chapter ``key`` of the report."""
+
+    def decorator(build: ChapterBuilder) -> ChapterBuilder:
+        """Register ``build`` and return it unchanged."""
+        if key in CHAPTERS:
+            raise ValueError(f"chapter {key!r} is already registered")
+        CHAPTERS[key] = Chapter(key=key, title=title, build=build)
+        return build
+
+    return decorator
+
+
+@dataclass
+class ReportContext:
+    """What a chapter works with: the run settings, and where its outputs go.
+
+    Attributes:
+        dt: the integration step of every scene [s].
+        progress: whether to print progress lines (to stderr).
+        figures: PNG bytes by file name (relative to ``figures/``), filled by
+            :meth:`add_figure`.
+        headlines: one-line findings for the report's summary, filled by
+            :meth:`add_headline`.
+        runs: the number of simulations run so far.
+        sim_seconds: wall time spent in :func:`granrs.simulate` [s].
+        settings: every (sign model, point of application) pair that was run.
+    """
+
+    dt: float
+    progress: bool = True
+    figures: dict[str, bytes] = field(default_factory=dict)
+    headlines: list[str] = field(default_factory=list)
+    runs: int = 0
+    sim_seconds: float = 0.0
+    settings: set[tuple[str, str]] = field(default_factory=set)
+
+    def log(self, message: str) -> None:
+        """Print one progress line to stderr (nothing when ``progress`` is False)."""
+        if self.progress:
+            print(f"granrs reproduce: {message}", file=sys.stderr, flush=True)
+
+    @contextmanager
+    def step(self, label: str) -> Iterator[None]:
+        """Time a step of a chapter and log ``label`` with its run count and duration."""
+        runs, start = self.runs, time.perf_counter()
+        yield
+        n = self.runs - runs
+        what = f"{n} run{'s' if n != 1 else ''}, " if n else ""
+        self.log(f"{label} ({what}{time.perf_counter() - start:.2f} s)")
+
+    def run(self, scene: Scene) -> Result:
+        """Simulate ``scene`` and count it."""
+        start = time.perf_counter()
+        result = simulate(scene)
+        self.sim_seconds += time.perf_counter() - start
+        self.runs += 1
+        self.settings.add((scene.sign_model, scene.apply_at))
+        return result
+
+    def free_link(self, q_deg: float, v0: float, **kwargs: Any) -> Result:
+        """Run :func:`granrs.cases.free_link` at the context's ``dt``."""
+        return self.run(cases.free_link(q_deg=q_deg, v0=v0, dt=self.dt, **kwargs))
+
+    def chain(self, case: int, **kwargs: Any) -> Result:
+        """Run :func:`granrs.cases.chain` case ``case`` at the context's ``dt``, until both
+        links have stopped (``end="all_stops"`` unless ``kwargs`` says otherwise)."""
+        kwargs.setdefault("end", "all_stops")
+        return self.run(cases.chain(case=case, dt=self.dt, **kwargs))
+
+    def leg(self, v0: float, **kwargs: Any) -> Result:
+        """Run :func:`granrs.cases.leg` at ``v0`` [m/s] and the context's ``dt``."""
+        return self.run(cases.leg(v0=v0, dt=self.dt, **kwargs))
+
+    def add_figure(self, name: str, png: bytes, alt: str) -> str:
+        """Keep the PNG ``png`` as ``figures/name``; return its Markdown image link."""
+        if name in self.figures:
+            raise ValueError(f"figure {name!r} was added twice")
+        self.figures[name] = png
+        self.log(f"figure {FIGURES_DIR}/{name}")
+        return f"![{alt}]({FIGURES_DIR}/{name})"
+
+    def add_headline(self, text: str) -> None:
+        """Add a one-line finding to the report's summary."""
+        self.headlines.append(text)
+
+
+# --------------------------------------------------------------------------------------
+# The report
+# --------------------------------------------------------------------------------------
+
+
+def _anchor(title: str) -> str:
+    """The GitHub heading anchor of ``title``."""
+    kept = "".join(c for c in title.lower() if c.isalnum() or c in " -_")
+    return kept.replace(" ", "-")
+
+
+def _header(ctx: ReportContext, chapters: Sequence[Chapter], dt: float, seconds: float) -> str:
+    """The report's header: what was run, how to reproduce, summary, contents."""
+    settings = sorted(ctx.settings)
+    sign_models = ", ".join(sorted({s for s, _ in settings})) or "n/a"
+    apply_at = ", ".join(sorted({a for _, a in settings})) or "n/a"
+    date = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    chapter_args = "".join(f" --chapter {c.key}" for c in chapters)
+    chapter_keys = repr(tuple(c.key for c in chapters)).replace("'", '"')
+    contents = "\n".join(f"- [{c.title}](#{_anchor(c.title)})" for c in chapters)
+    headlines = "\n".join(f"- {h}" for h in ctx.headlines) or "- (no findings)"
+    return f"""# granrs reproduction report
+
+granrs reproduces the simulations of the thesis "Bipedal impact with granular matter": a
+resistance force of dynamic drag plus static depth-dependent terms acting on rods sinking
+into sand. This report runs the thesis's cases and sets the results beside its tables.
+
+## What was run
+
+- granrs {__version__} (Python {platform.python_version()}, numpy {np.__version__},
+  {platform.system()} {platform.machine()}), generated {date}
+- chapters: {", ".join(c.key for c in chapters)}
+- integrator: fixed-step RK4 with located events, dt = {dt:g} s ({1.0 / dt:g} Hz; the
+  thesis ran at 10 kHz)
+- sign model of the static terms: {sign_models}
+- point of application of the resistance force: {apply_at} (the thesis's CAD runs, sec.
+  3.3.2)
+- {ctx.runs} simulations in {ctx.sim_seconds:.2f} s ({seconds:.1f} s with figures)
+- reference numbers: the thesis's tables as shipped in `granrs.data` (see
+  `granrs.data.provenance(name)`), and a few values the thesis gives only in its text
+  (cited where used); nothing is edited to fit
+- relative errors: the thesis's eq. 3.21, ε = |reference - granrs| / |reference|
+
+## How to reproduce
+
+```sh
+granrs reproduce --out DIR --dt {dt:g}{chapter_args}
+```
+
+or, from Python, `granrs.report.reproduce("DIR", chapters={chapter_keys}, dt={dt:g})`.
+
+## Summary and known gaps
+
+{headlines}
+
+## Contents
+
+{contents}
+"""
+
+
+def _validate_out_dir(out_dir: Path) -> None:
+    """Reject an output path that exists and is not a directory (field ``out_dir``)."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InvalidParameterError(
+            f"the output directory {str(out_dir)!r} exists and is not a directory",
+            field="out_dir",
+        )
+
+
+def _write(out_dir: Path, report: str, figures: Mapping[str, bytes]) -> Path:
+    """Write the report and figures to a temporary directory, then move them into place.
+
+    A new ``out_dir`` is created by one rename. In an existing ``out_dir`` the report file
+    and the ``figures`` folder are replaced (the old folder is removed); other files are
+    left alone.
+    """
+    out_dir = out_dir.absolute()
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    try:
+        # mkdtemp's folder is private (0700); the report folder gets the usual umask.
+        new = staging / "report"
+        (new / FIGURES_DIR).mkdir(parents=True)
+        for name, png in figures.items():
+            (new / FIGURES_DIR / name).write_bytes(png)
+        (new / REPORT_NAME).write_text(report, encoding="utf-8")
+        if not out_dir.exists():
+            os.replace(new, out_dir)
+            return out_dir / REPORT_NAME
+        _validate_out_dir(out_dir)
+        old_figures = out_dir / FIGURES_DIR
+        if old_figures.exists():
+            os.replace(old_figures, staging / "old-figures")
+        os.replace(new / FIGURES_DIR, old_figures)
+        os.replace(new / REPORT_NAME, out_dir / REPORT_NAME)
+        return out_dir / REPORT_NAME
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def reproduce(
+    out_dir: str | os.PathLike[str],
+    *,
+    chapters: Sequence[str] | None = None,
+    dt: float = 1e-4,
+    progress: bool = True,
+) -> Path:
+    """Run the thesis's cases and write the reproduction report; return its path.
+
+    Writes ``out_dir/README.md`` (Markdown) and its PNG figures in ``out_dir/figures/``.
+    Everything is computed in memory before anything is written, and the files are moved
+    into place at the end, so an error leaves ``out_dir`` as it was (a new ``out_dir`` is
+    not created). In an existing ``out_dir`` the report and the ``figures`` folder are
+    replaced.
+
+    Args:
+        out_dir: the output directory (created if missing).
+        chapters: the keys of the chapters to run, from :data:`CHAPTERS` (``"3"``: the free
+            link, ``"4"``: the two-link chain, ``"5"``: the leg); None (the default) runs
+            every chapter, as the command line does.
+        dt: the integration step of every scene [s]; an invalid one raises the scene's
+            :class:`~granrs.errors.InvalidParameterError` (``field="dt"``).
+        progress: print one line per table and figure to stderr.
+
+    Returns:
+        The path of the report, ``out_dir/README.md``.
+
+    Raises:
+        UnknownNameError: an unknown chapter (``field="chapters"``).
+        InvalidParameterError: an invalid ``dt`` (``field="dt"``) or an ``out_dir`` that is
+            a file (``field="out_dir"``).
+    """
+    out_path = Path(out_dir)
+    if chapters is None:
+        chapters = tuple(CHAPTERS)
+    elif isinstance(chapters, str):
+        chapters = (chapters,)
+    selected = []
+    for key in chapters:
+        if key not in CHAPTERS:
+            raise UnknownNameError(
+                f"unknown chapter {key!r}; available: {', '.join(CHAPTERS)}", field="chapters"
+            )
+        selected.append(CHAPTERS[key])
+    if not selected:
+        raise InvalidParameterError("no chapter selected", field="chapters")
+    # The step is checked by a scene, the same rule every run uses (field "dt").
+    cases.free_link(q_deg=0.0, v0=1.0, dt=dt)
+    _validate_out_dir(out_path)
+
+    start = time.perf_counter()
+    ctx = ReportContext(dt=dt, progress=progress)
+    bodies = []
+    for chapter in selected:
+        ctx.log(f"{chapter.title}")
+        bodies.append(f"## {chapter.title}\n\n{chapter.build(ctx).strip()}\n")
+    seconds = time.perf_counter() - start
+    report = _header(ctx, selected, dt, seconds) + "\n" + "\n".join(bodies)
+    path = _write(out_path, report, ctx.figures)
+    ctx.log(f"wrote {path} and {len(ctx.figures)} figures in {seconds:.1f} s")
+    return path
