@@ -219,13 +219,18 @@ fn force(c: &mut Criterion) {
         });
     }
     g.bench_function("thesis_set", |b| {
+        let mut out = Default::default();
+        let mut bound = [0.0; 2];
         b.iter(|| {
             terms_on(
                 black_box(&set),
                 black_box(&set.per_contact[0]),
                 black_box(&state),
                 black_box(&medium),
-            )
+                &mut out,
+                &mut bound,
+            );
+            black_box(&out);
         })
     });
     g.finish();

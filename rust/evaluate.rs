@@ -89,11 +89,17 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
         area_speed: setup.diameter * l * cross,
         sign,
     };
-    let (f, _) = if depth > 0.0 {
-        terms_on(&setup.forces, &terms, &state, &setup.medium)
-    } else {
-        Default::default()
-    };
+    let mut f = crate::dynamics::ContactForce::default();
+    if depth > 0.0 {
+        terms_on(
+            &setup.forces,
+            &terms,
+            &state,
+            &setup.medium,
+            &mut f,
+            &mut [0.0; 2],
+        );
+    }
     let total = f.total();
     let values = [
         total.x,

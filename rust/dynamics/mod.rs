@@ -253,8 +253,8 @@ impl ContactForce {
 }
 
 /// The contact terms `terms` (a contact's instances of `forces`' contact terms, in their
-/// order) on one contact's `state`: each term's force, their sums by class, and the bounds
-/// of a sticking reaction along x and y. The one evaluation of the force law, for a run of
+/// order) on one contact's `state`, written into `out` and `bound`: each term's force, their
+/// sums by class, and the bounds of a sticking reaction along x and y. The one evaluation of the force law, for a run of
 /// any body and for `granrs.resistance_force`.
 #[inline(always)]
 pub fn terms_on(
@@ -262,22 +262,24 @@ pub fn terms_on(
     terms: &[AnyTerm],
     state: &ContactState<f64>,
     medium: &Medium,
-) -> (ContactForce, [f64; 2]) {
-    let mut f = ContactForce::default();
-    let mut bound = [0.0; 2];
+    out: &mut ContactForce,
+    bound: &mut [f64; 2],
+) {
+    out.dynamic = Vector2::zeros();
+    out.statics = Vector2::zeros();
+    *bound = [0.0; 2];
     for (k, t) in terms.iter().enumerate() {
         let tf = t.contact_force(state, medium);
         let v = Vector2::new(tf.force[0], tf.force[1]);
-        f.terms[k] = v;
-        if forces.is_dynamic(k) {
-            f.dynamic += v;
+        out.terms[k] = v;
+        if forces.dynamic[k] {
+            out.dynamic += v;
         } else {
-            f.statics += v;
+            out.statics += v;
         }
         bound[0] += tf.bound[0];
         bound[1] += tf.bound[1];
     }
-    (f, bound)
 }
 
 /// The thesis's plain sign: -1, 0 or +1.

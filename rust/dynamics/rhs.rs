@@ -195,11 +195,13 @@ impl<const N: usize> Model<N> {
     /// force law is evaluated, for every body and for `granrs.resistance_force`.
     #[inline(always)]
     pub fn apply_terms(&self, ci: usize, state: &ContactState<f64>, out: &mut ContactEval) {
-        (out.force, out.bound) = terms_on(
+        terms_on(
             &self.forces,
             &self.forces.per_contact[ci],
             state,
             &self.medium,
+            &mut out.force,
+            &mut out.bound,
         );
     }
 

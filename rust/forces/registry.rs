@@ -229,6 +229,8 @@ pub struct ForceSet {
     pub per_contact: Vec<Vec<AnyTerm>>,
     /// The contact terms' descriptions, in the same order.
     pub contact_info: Vec<&'static TermInfo>,
+    /// Whether the k-th contact term adds to the dynamic force F_d (its class), by index.
+    pub dynamic: [bool; MAX_TERMS],
     /// Whether some listed term owns each switch ([`Switch::Cross`], `SlipX`, `SlipY`).
     pub owns: [bool; 3],
     /// Whether a listed term reads A_r |v_E|.
@@ -250,6 +252,7 @@ impl ForceSet {
             per_contact: vec![Vec::new(); n_contacts],
             contact_info: Vec::new(),
             owns: [false; 3],
+            dynamic: [false; MAX_TERMS],
             reads_area_speed: false,
             sole_static_owner: [None; 2],
         };
@@ -274,6 +277,7 @@ impl ForceSet {
                             message: format!("at most {MAX_TERMS} contact terms"),
                         });
                     }
+                    set.dynamic[set.contact_info.len()] = info.class == Class::Dynamic;
                     set.contact_info.push(info);
                     for (ci, row) in set.per_contact.iter_mut().enumerate() {
                         let term =
@@ -312,7 +316,7 @@ impl ForceSet {
     /// Whether the k-th contact term adds to the dynamic force F_d.
     #[inline(always)]
     pub fn is_dynamic(&self, k: usize) -> bool {
-        self.contact_info[k].class == Class::Dynamic
+        self.dynamic[k]
     }
 
     /// The listed terms as specs (per-contact values collapsed where all contacts agree).

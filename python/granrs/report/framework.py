@@ -149,6 +149,21 @@ class ReportContext:
         self.log(f"figure {FIGURES_DIR}/{name}")
         return f"![{alt}]({FIGURES_DIR}/{name})"
 
+    def add_animation(self, name: str, scene: Scene, alt: str, frame_dt: float) -> str:
+        """Run ``scene`` recording its state and forces, keep its animation
+        (:func:`granrs.animate`, one frame per ``frame_dt`` of simulated time) as the GIF
+        ``figures/name``, and return its Markdown image link."""
+        import tempfile
+
+        from ..animate import animate
+
+        result = self.run(scene.replace(record=("state", "forces")))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / name
+            animate(result, frame_dt=frame_dt, fps=10.0, dpi=60.0, out=path)
+            gif = path.read_bytes()
+        return self.add_figure(name, gif, alt)
+
     def add_headline(self, text: str) -> None:
         """Add a one-line finding to the report's summary."""
         self.headlines.append(text)
