@@ -207,7 +207,9 @@ def test_figures_are_png(built: tuple[Path, str]) -> None:
         assert png.is_file(), link
         content = png.read_bytes()
         assert len(content) > 1000
-        assert content.startswith(PNG_MAGIC)
+        # Figures are PNG; each chapter's animation (issue 20) is a GIF.
+        magic = b"GIF89a" if link.endswith(".gif") else PNG_MAGIC
+        assert content.startswith(magic), link
     for number in ("3.15", "3.16", "3.17", "3.18", "3.19", "3.20", "3.22", "3.23"):
         assert f"Fig. {number}" in text or f"Figs. {number}" in text
     # Nothing else in the folder but the referenced figures.
@@ -478,13 +480,26 @@ def test_links_stop_times_are_compared(built: tuple[Path, str]) -> None:
         assert _float(r[i_pair + 1]) == pytest.approx((t2 - t1) * 1e3, abs=0.11)
 
 
+def test_each_chapter_embeds_an_animation(built: tuple[Path, str]) -> None:
+    """Issue 20: the report embeds one animated GIF of an impact per chapter."""
+    _, text = built
+    starts = [m.start() for m in re.finditer(r"^## ", text, re.M)]
+    chapters = [text[a:b] for a, b in zip(starts, [*starts[1:], len(text)], strict=True)]
+    chapters = [c for c in chapters if c.startswith(("## Chapter", "## Calibration"))]
+    assert chapters
+    for chapter in chapters:
+        gifs = re.findall(r"!\[[^\]]*\]\(([^)]+\.gif)\)", chapter)
+        assert len(gifs) == 1, chapter.splitlines()[0]
+
+
 def test_chapter_4_figures_are_cited(built: tuple[Path, str]) -> None:
     """Figs. 4.7-4.16 analogues, the pin force and the link-mass figure are in the report."""
     path, text = built
     section = text[text.index("## Chapter 4") : text.index("## Chapter 5")]
     links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", section)
     assert len(links) >= 5
-    assert all((path.parent / link).read_bytes().startswith(PNG_MAGIC) for link in links)
+    pngs = [link for link in links if not link.endswith(".gif")]
+    assert all((path.parent / link).read_bytes().startswith(PNG_MAGIC) for link in pngs)
     for number in ("4.7", "4.8", "4.9", "4.12", "4.13", "4.16"):
         assert f"Fig. {number}" in section or f"Figs. {number}" in section
 
