@@ -65,7 +65,7 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
     };
     let half = 0.5 * l;
     let v_e = Vector2::new(vx + half * omega * c, vy - half * omega * s);
-    let mut terms = setup.forces.per_contact[0].clone();
+    let mut terms = setup.forces.per_contact[0];
     for t in terms.iter_mut() {
         *t = match *t {
             AnyTerm::Drag(_) => AnyTerm::Drag(Drag { eta_d }),

@@ -217,6 +217,46 @@ fn unknown_param(info: &TermInfo, name: &str) -> GranrsError {
     }
 }
 
+/// One contact's terms in a fixed-size array (the hot path loops over it without a heap
+/// indirection); it reads as a slice of its `len` terms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TermList {
+    terms: [AnyTerm; MAX_TERMS],
+    len: usize,
+}
+
+impl Default for TermList {
+    fn default() -> Self {
+        TermList {
+            terms: [AnyTerm::Gravity(gravity::Gravity); MAX_TERMS],
+            len: 0,
+        }
+    }
+}
+
+impl TermList {
+    /// Append `term` (the caller checks [`MAX_TERMS`]).
+    pub fn push(&mut self, term: AnyTerm) {
+        self.terms[self.len] = term;
+        self.len += 1;
+    }
+}
+
+impl std::ops::Deref for TermList {
+    type Target = [AnyTerm];
+    #[inline(always)]
+    fn deref(&self) -> &[AnyTerm] {
+        &self.terms[..self.len]
+    }
+}
+
+impl std::ops::DerefMut for TermList {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [AnyTerm] {
+        &mut self.terms[..self.len]
+    }
+}
+
 /// The terms a scene lists, ready for the engine: which body terms act, and each contact
 /// term with its parameters per contact, in the scene's order.
 #[derive(Debug, Clone, PartialEq)]
@@ -228,7 +268,7 @@ pub struct ForceSet {
     /// Whether `joint_springs` acts.
     pub joint_springs: bool,
     /// The contact terms per contact, in the scene's order: `per_contact[c][k]`.
-    pub per_contact: Vec<Vec<AnyTerm>>,
+    pub per_contact: Vec<TermList>,
     /// The contact terms' descriptions, in the same order.
     pub contact_info: Vec<&'static TermInfo>,
     /// Whether the k-th contact term adds to the dynamic force F_d (its class), by index.
@@ -251,7 +291,7 @@ impl ForceSet {
             names: Vec::with_capacity(specs.len()),
             gravity: false,
             joint_springs: false,
-            per_contact: vec![Vec::new(); n_contacts],
+            per_contact: vec![TermList::default(); n_contacts],
             contact_info: Vec::new(),
             owns: [false; 3],
             dynamic: [false; MAX_TERMS],
