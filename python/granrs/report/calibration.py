@@ -641,14 +641,10 @@ def _watch(ctx: ReportContext) -> str:
     """The vertical drop the fits cannot match, as an animation (issue 20)."""
     from .. import cases
 
-    with ctx.step("calibration: the vertical drop as an animation"):
-        link = ctx.add_animation(
-            "calibration_vertical.gif",
-            cases.free_link(q_deg=0.0, v0=2.24, dt=ctx.dt),
-            "the vertical free link at 2.24 m/s: only the static vertical term acts",
-            frame_dt=1e-3,
-        )
-    return (
-        "### Watch it\n\nThe vertical drop (Table 3.1, q = 0, thesis coefficients), whose "
-        "stopping time no coefficients match: only static_v acts on it.\n\n" + link + "\n"
+    return ctx.watch(
+        "calibration_vertical.gif",
+        cases.free_link(q_deg=0.0, v0=2.24, dt=ctx.dt),
+        "The vertical drop (Table 3.1, q = 0, thesis coefficients), whose stopping time no "
+        "coefficients match: only static_v acts on it.",
+        frame_dt=1e-3,
     )

@@ -521,16 +521,10 @@ def chapter_3(ctx: ReportContext) -> str:
 
 def _watch(ctx: ReportContext) -> str:
     """The Table 3.1 drop at q = 45 deg, v0 = 2.27 m/s as an animation (issue 20)."""
-    with ctx.step("chapter 3: the q = 45 deg drop as an animation"):
-        link = ctx.add_animation(
-            "ch3_free_link_q45.gif",
-            cases.free_link(q_deg=45.0, v0=2.27, dt=ctx.dt),
-            "the free link at q = 45 deg, v0 = 2.27 m/s sinking into sand",
-            frame_dt=1e-3,
-        )
-    return (
-        "### Watch it\n\nThe q = 45°, v0 = 2.27 m/s drop, one frame per millisecond: the "
-        "rod to scale, the immersed part shaded, the force at the tip split by term.\n\n"
-        + link
-        + "\n"
+    return ctx.watch(
+        "ch3_free_link_q45.gif",
+        cases.free_link(q_deg=45.0, v0=2.27, dt=ctx.dt),
+        "The q = 45°, v0 = 2.27 m/s drop, one frame per millisecond: the rod to scale, the "
+        "immersed part shaded, the force at the tip split by term.",
+        frame_dt=1e-3,
     )

@@ -888,14 +888,9 @@ def chapter_4(ctx: ReportContext) -> str:
 
 def _watch(ctx: ReportContext) -> str:
     """Chain case 1 as an animation (issue 20)."""
-    with ctx.step("chapter 4: case 1 as an animation"):
-        link = ctx.add_animation(
-            "ch4_chain_case1.gif",
-            cases.chain(case=1, dt=ctx.dt, end="all_stops"),
-            "the two-link chain, case 1, sinking into sand",
-            frame_dt=2e-3,
-        )
-    return (
-        "### Watch it\n\nCase 1 until both links stop, one frame per 2 ms (solid-steel "
-        "link mass).\n\n" + link + "\n"
+    return ctx.watch(
+        "ch4_chain_case1.gif",
+        cases.chain(case=1, dt=ctx.dt, end="all_stops"),
+        "Case 1 until both links stop, one frame per 2 ms (solid-steel link mass).",
+        frame_dt=2e-3,
     )

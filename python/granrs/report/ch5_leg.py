@@ -524,14 +524,10 @@ def chapter_5(ctx: ReportContext) -> str:
 
 def _watch(ctx: ReportContext) -> str:
     """The leg at 3.28 m/s, joints locked, as an animation (issue 20)."""
-    with ctx.step("chapter 5: the 3.28 m/s landing as an animation"):
-        link = ctx.add_animation(
-            "ch5_leg_3_28.gif",
-            cases.leg(v0=3.28, dt=ctx.dt),
-            "one leg landing flat on sand at 3.28 m/s, joints locked",
-            frame_dt=2e-3,
-        )
-    return (
-        "### Watch it\n\nThe 3.28 m/s landing, joints locked, one frame per 2 ms (the "
-        "second panel zooms on the foot).\n\n" + link + "\n"
+    return ctx.watch(
+        "ch5_leg_3_28.gif",
+        cases.leg(v0=3.28, dt=ctx.dt),
+        "The 3.28 m/s landing, joints locked, one frame per 2 ms (the second panel zooms on "
+        "the foot).",
+        frame_dt=2e-3,
     )

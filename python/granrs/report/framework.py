@@ -149,20 +149,23 @@ class ReportContext:
         self.log(f"figure {FIGURES_DIR}/{name}")
         return f"![{alt}]({FIGURES_DIR}/{name})"
 
-    def add_animation(self, name: str, scene: Scene, alt: str, frame_dt: float) -> str:
-        """Run ``scene`` recording its state and forces, keep its animation
-        (:func:`granrs.animate`, one frame per ``frame_dt`` of simulated time) as the GIF
-        ``figures/name``, and return its Markdown image link."""
+    def watch(self, name: str, scene: Scene, caption: str, frame_dt: float) -> str:
+        """A chapter's "Watch it" section: run ``scene`` recording its state and forces,
+        keep its animation (:func:`granrs.animate`, one frame per ``frame_dt`` of simulated
+        time) as the GIF ``figures/name``, and return the section: a heading, ``caption``
+        and the image (issue 20: one animation per chapter)."""
         import tempfile
 
         from ..animate import animate
 
-        result = self.run(scene.replace(record=("state", "forces")))
-        with tempfile.TemporaryDirectory() as tmp:
-            path = Path(tmp) / name
-            animate(result, frame_dt=frame_dt, fps=10.0, dpi=60.0, out=path)
-            gif = path.read_bytes()
-        return self.add_figure(name, gif, alt)
+        with self.step(f"{name}: an animation"):
+            result = self.run(scene.replace(record=("state", "forces")))
+            with tempfile.TemporaryDirectory() as tmp:
+                path = Path(tmp) / name
+                animate(result, frame_dt=frame_dt, fps=10.0, dpi=60.0, out=path)
+                gif = path.read_bytes()
+        link = self.add_figure(name, gif, caption)
+        return f"### Watch it\n\n{caption}\n\n{link}\n"
 
     def add_headline(self, text: str) -> None:
         """Add a one-line finding to the report's summary."""
