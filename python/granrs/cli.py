@@ -303,6 +303,36 @@ SERIES_RECORD: tuple[str, ...] = ("state", "forces", "energy")
 SERIES_FORMATS: tuple[str, ...] = (".csv", ".parquet")
 
 
+def _add_scene_file(parser: argparse.ArgumentParser) -> None:
+    """The arguments of a command that runs a scene file: the file and its ``--set``s."""
+    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="FIELD=VALUE",
+        help=(
+            "override a field, repeatable; VALUE is TOML (q_deg=30, 'record=[\"state\"]', "
+            "'knee={k=300.0, c=5.0}'); TERM.PARAM sets a force term's parameter "
+            "(static_v.eta_v=300); a bare word is a string (body=chain)"
+        ),
+    )
+
+
+def _read_scene(path: str, overrides: dict[str, Any]) -> Any:
+    """The scene in the file ``path`` with ``overrides`` applied; an unreadable file is an
+    :class:`InvalidSceneError` naming it."""
+    from . import scenefile
+
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise InvalidSceneError(f"cannot read scene file {path}: {reason}") from None
+    return scenefile.loads(text, source=path, overrides=overrides)
+
+
 def _add_run(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Declare ``granrs run``."""
     parser = sub.add_parser(
@@ -314,19 +344,7 @@ def _add_run(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
             "contact's results with units."
         ),
     )
-    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="FIELD=VALUE",
-        help=(
-            "override a field, repeatable; VALUE is TOML (q_deg=30, 'record=[\"state\"]', "
-            "'knee={k=300.0, c=5.0}', coefficients.eta_h=7); a bare word is a string "
-            "(body=chain)"
-        ),
-    )
+    _add_scene_file(parser)
     parser.add_argument(
         "--series",
         metavar="OUT",
@@ -469,12 +487,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     overrides = dict(scenefile.parse_override(item) for item in args.overrides)
     suffix = _series_format(args.series) if args.series else None
-    try:
-        text = Path(args.scene).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise InvalidSceneError(f"cannot read scene file {args.scene}: {reason}") from None
-    scene = scenefile.loads(text, source=args.scene, overrides=overrides)
+    scene = _read_scene(args.scene, overrides)
     if suffix and not scene.record:
         scene = scene.replace(record=SERIES_RECORD)
         print(
@@ -519,7 +532,7 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
             "checked before the run."
         ),
     )
-    parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
+    _add_scene_file(parser)
     parser.add_argument(
         "--out",
         metavar="OUT",
@@ -554,14 +567,6 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     parser.add_argument(
         "--dpi", type=float, default=100.0, metavar="DPI", help="resolution (default: 100)"
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="FIELD=VALUE",
-        help="override a field, repeatable, as for 'granrs run'",
-    )
     parser.set_defaults(handler=_cmd_animate)
 
 
@@ -575,12 +580,7 @@ def _cmd_animate(args: argparse.Namespace) -> int:
     # Every argument is checked before the run: playback, the output path.
     frame_dt, speed, fps = playback(args.frame_dt, args.speed, args.fps)
     out = check_output(args.out)
-    try:
-        text = Path(args.scene).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise InvalidSceneError(f"cannot read scene file {args.scene}: {reason}") from None
-    scene = scenefile.loads(text, source=args.scene, overrides=overrides)
+    scene = _read_scene(args.scene, overrides)
     record = tuple(dict.fromkeys((*scene.record, *ANIMATE_RECORD)))
     result = simulate(scene.replace(record=record))
     anim = animate(result, frame_dt, speed, fps, dpi=args.dpi)
