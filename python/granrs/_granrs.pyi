@@ -8,8 +8,11 @@ __all__ = [
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
     "RECORDS",
+    "ROD_GEOM_OUTPUTS",
+    "ROD_GEOM_STATE",
     "SCENE_FIELDS",
     "Compiled",
+    "RodGeoms",
     "RunOutcome",
     "__version__",
     "check_term",
@@ -105,6 +108,31 @@ def resistance_force(
 ) -> Any:
     """The rod force over n states: nine contiguous float64 arrays (FORCE_INPUTS order) in,
     an n x 10 array (FORCE_OUTPUTS order) out."""
+
+ROD_GEOM_STATE: list[str]
+ROD_GEOM_OUTPUTS: list[str]
+
+@final
+class RodGeoms:
+    """N rod geoms of another engine under contact terms, through the free link's
+    right-hand side (granrs.mujoco.Sand)."""
+
+    def __new__(
+        cls,
+        names: list[str],
+        diameter: list[float],
+        length: list[float],
+        forces: list[Any],
+        rho_g: float,
+        g: float,
+        apply_at: str = "tip",
+        sign_model: str = "raw",
+        smooth_eps: float = 1e-3,
+    ) -> RodGeoms: ...
+    def __len__(self) -> int: ...
+    def evaluate(self, states: Any, out: Any) -> None:
+        """Every geom's force: states n x 7 (ROD_GEOM_STATE order) in, out n x 16
+        (ROD_GEOM_OUTPUTS order) written."""
 
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""

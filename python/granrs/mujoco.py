@@ -1,0 +1,518 @@
+"""Sand under a MuJoCo model: granrs's force terms on the geoms of a planar MuJoCo robot.
+
+``pip install 'granrs[mujoco]'`` (the ``mujoco`` package from PyPI). MuJoCo has no granular
+ground; :class:`Sand` gives the named capsule and cylinder geoms of a model that moves in the
+x-z plane (the hopper and walker2d pattern: slide x, slide z and hinge y at the root) the
+resistance force of granrs's terms, evaluated by the same Rust code as
+:func:`granrs.simulate` (each geom is the free link's rod; one call for all geoms)::
+
+    import mujoco
+    from granrs import forces
+    from granrs.mujoco import Sand
+
+    model = mujoco.MjModel.from_xml_path("hopper.xml")
+    data = mujoco.MjData(model)
+    sand = Sand(model, geoms=["foot"], forces=[forces.drag(), forces.static_h(), forces.static_v()])
+    for _ in range(1000):
+        sand.step(data)          # before mujoco.mj_step
+        mujoco.mj_step(model, data)
+
+or ``sand.install()`` once, to run as MuJoCo's passive-force callback inside every
+``mj_step`` (``sand.uninstall()`` to stop). See ``docs/mujoco.md`` for the frame, the geoms'
+contact geometry, where the force is applied, the static terms at rest and the stability
+limit (:class:`granrs.StepSizeWarning`).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+try:
+    import mujoco
+except ImportError as exc:  # pragma: no cover - exercised in a venv without mujoco
+    raise ImportError(
+        "granrs.mujoco needs the `mujoco` package: pip install 'granrs[mujoco]' "
+        "(or pip install 'mujoco>=3')"
+    ) from exc
+
+from . import _granrs
+from .api import RK4_STABILITY_LIMIT
+from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
+from .forces import as_terms
+
+__all__ = [
+    "EULER_STABILITY_LIMIT",
+    "GEOM_OUTPUTS",
+    "STATICS",
+    "Sand",
+]
+
+#: ``h lambda`` beyond which explicit Euler is unstable for a real, negative rate (|1 - h
+#: lambda| > 1). MuJoCo's Euler, implicit and implicitfast integrators all take the sand's
+#: force explicitly, as a constant through the step.
+EULER_STABILITY_LIMIT = 2.0
+
+#: The columns of :attr:`Sand.output`, one row per geom (the core's ``ROD_GEOM_OUTPUTS``).
+GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.ROD_GEOM_OUTPUTS)
+
+#: How :class:`Sand` treats the static terms (those with a sticking bound: ``static_h``,
+#: ``static_v``): ``"stick"`` solves each step for the reaction that brings the immersed
+#: centroid's velocity to zero at the step's end, within the terms' bounds (the default);
+#: ``"raw"`` applies the terms as evaluated (the thesis's plain sign, which chatters at rest).
+STATICS = ("stick", "raw")
+
+_SUPPORTED = {
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder",
+}
+_COL = {name: k for k, name in enumerate(GEOM_OUTPUTS)}
+_PLANE_TOL = 1e-9
+
+
+def _number(value: Any, name: str) -> float:
+    if isinstance(value, bool):
+        raise InvalidParameterError(f"`{name}` must be a number, got {value!r}", field=name)
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"`{name}` must be a number, got {value!r}", field=name
+        ) from None
+    if not math.isfinite(x):
+        raise InvalidParameterError(f"`{name}` must be finite, got {x}", field=name)
+    return x
+
+
+class Sand:
+    """granrs's force terms on named rod geoms of a planar MuJoCo model.
+
+    Args:
+        model: a ``mujoco.MjModel`` that moves in the x-z plane (gravity along -z).
+        geoms: names of capsule or cylinder geoms. Each is the free link's rod: its tip T is
+            the lower end of its axis, its diameter d_c twice its radius, its length L (also
+            L_ref) the cylinder's length; a capsule's caps count (T is the bottom of the
+            lower cap, L the capsule's whole length, as the thesis's round-ended rod).
+        forces: the medium's contact terms (``granrs.forces``: ``drag``, ``static_h``,
+            ``static_v``, ...). MuJoCo applies gravity and the joints: a ``gravity`` or
+            ``joint_springs`` term is an error naming it. A parameter is one value for every
+            geom or a tuple with one per geom.
+        surface: height z of the sand's surface [m].
+        rho_g: the sand's bulk density [kg/m^3] (the thesis's 1650). The static terms use
+            g = |``model.opt.gravity``|.
+        apply_at: ``"tip"`` (as :func:`granrs.simulate`'s default) or ``"centroid"``.
+        patch: the sand's extent in x, ``(x_min, x_max)`` [m]; a geom whose tip is outside
+            feels nothing from the sand. Geoms not listed keep MuJoCo's own contacts.
+        statics: ``"stick"`` (default) or ``"raw"``: see :data:`STATICS` and docs/mujoco.md.
+        sign_model: ``"raw"`` (the thesis's sign) or ``"smooth"`` (``tanh(v / smooth_eps)``).
+        smooth_eps: the smooth sign's velocity scale [m/s].
+
+    Every argument is checked here, before the first step; each error is a
+    :class:`granrs.GranrsError` (a ``ValueError``) naming the geom or parameter.
+
+    After each step, :attr:`output` holds each geom's evaluation (columns
+    :data:`GEOM_OUTPUTS`), :attr:`applied` the force (x, z) [N] and moment about y [N m]
+    applied at its tip, and :attr:`h_lambda` each geom's timestep times the drag's rate.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        geoms: Sequence[str],
+        forces: Sequence[Any],
+        surface: float = 0.0,
+        rho_g: float = 1650.0,
+        apply_at: str = "tip",
+        patch: tuple[float, float] = (-math.inf, math.inf),
+        statics: str = "stick",
+        sign_model: str = "raw",
+        smooth_eps: float = 1e-3,
+    ) -> None:
+        if not isinstance(model, mujoco.MjModel):
+            raise InvalidParameterError(
+                f"`model` must be a mujoco.MjModel, got {type(model).__name__}", field="model"
+            )
+        self.model = model
+        if isinstance(geoms, str) or not isinstance(geoms, Sequence) or len(geoms) == 0:
+            raise InvalidParameterError(
+                "`geoms` must be a non-empty list of geom names", field="geoms"
+            )
+        names = [str(g) for g in geoms]
+        if len(set(names)) != len(names):
+            raise InvalidSceneError("`geoms` lists a geom twice", field="geoms")
+        self.surface = _number(surface, "surface")
+        rho = _number(rho_g, "rho_g")
+        if rho <= 0.0:
+            raise InvalidParameterError(f"`rho_g` must be > 0, got {rho}", field="rho_g")
+        if statics not in STATICS:
+            raise UnknownNameError(
+                f"unknown statics `{statics}` (allowed: {', '.join(STATICS)})", field="statics"
+            )
+        self.statics = statics
+        try:
+            lo, hi = (float(x) for x in patch)
+        except (TypeError, ValueError):
+            raise InvalidParameterError(
+                f"`patch` must be (x_min, x_max), got {patch!r}", field="patch"
+            ) from None
+        if math.isnan(lo) or math.isnan(hi) or not lo < hi:
+            raise InvalidParameterError(
+                f"`patch` must be (x_min, x_max) with x_min < x_max, got {patch!r}",
+                field="patch",
+            )
+        self.patch = (lo, hi)
+        gravity = np.asarray(model.opt.gravity, dtype=float)
+        if not np.all(np.isfinite(gravity)) or abs(gravity[0]) > 0 or abs(gravity[1]) > 0:
+            raise InvalidSceneError(
+                f"the sand needs gravity along -z, got model.opt.gravity = {gravity.tolist()}",
+                field="model.opt.gravity",
+            )
+        self.g = float(np.linalg.norm(gravity))
+
+        ids, radius, half, lengths = [], [], [], []
+        for i, name in enumerate(names):
+            gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+            if gid < 0:
+                raise UnknownNameError(f"the model has no geom named `{name}`", field=f"geoms[{i}]")
+            kind = int(model.geom_type[gid])
+            if kind not in _SUPPORTED:
+                type_name = mujoco.mjtGeom(kind).name.removeprefix("mjGEOM_").lower()
+                raise InvalidSceneError(
+                    f"geom `{name}` is a {type_name}; the rod terms take "
+                    f"{' and '.join(_SUPPORTED.values())} geoms",
+                    field=f"geoms[{i}]",
+                )
+            r, h = float(model.geom_size[gid, 0]), float(model.geom_size[gid, 1])
+            ids.append(gid)
+            radius.append(r)
+            # A capsule's caps count: its tip is the bottom of the lower cap.
+            reach = h + r if _SUPPORTED[kind] == "capsule" else h
+            half.append(reach)
+            lengths.append(2.0 * reach)
+        self.geoms = tuple(names)
+        self._ids = np.asarray(ids, dtype=np.intp)
+        self._body = np.asarray(model.geom_bodyid[self._ids], dtype=np.intp)
+        self._root = np.asarray(model.body_rootid[self._body], dtype=np.intp)
+        self._half = np.asarray(half, dtype=float)
+        self._check_planar()
+        self._core = _granrs.RodGeoms(
+            list(names),
+            [2.0 * r for r in radius],
+            lengths,
+            list(as_terms(forces)),
+            rho,
+            self.g,
+            apply_at,
+            sign_model,
+            float(smooth_eps),
+        )
+        self.apply_at = apply_at
+        n = len(names)
+        self._states = np.zeros((n, len(_granrs.ROD_GEOM_STATE)))
+        #: Each geom's evaluation at the last step (columns :data:`GEOM_OUTPUTS`).
+        self.output = np.zeros((n, len(GEOM_OUTPUTS)))
+        #: The force (x, z) [N] and moment about +y [N m] applied at each tip, last step.
+        self.applied = np.zeros((n, 3))
+        #: Each geom's timestep times the drag's rate at the last step (0 out of the sand).
+        self.h_lambda = np.zeros(n)
+        #: The largest of :attr:`h_lambda` over every step so far.
+        self.max_h_lambda = 0.0
+        self._warned = False
+        self._statics_prev = np.zeros((n, 2))
+        self._contribution = np.zeros(model.nv)
+        self._data_ref: Any = None
+        self._before: np.ndarray | None = None
+        self._after: np.ndarray | None = None
+        self._jac = np.zeros((3, model.nv))
+
+    # -- checks -------------------------------------------------------------------------
+
+    def _check_planar(self) -> None:
+        """Every joint above each geom keeps it in the x-z plane: slides in x-z, hinges
+        about y; and each geom's axis lies in the plane (at the model's qpos0)."""
+        m = self.model
+        d = mujoco.MjData(m)
+        mujoco.mj_kinematics(m, d)
+        for i, (name, body) in enumerate(zip(self.geoms, self._body, strict=True)):
+            b = int(body)
+            while b > 0:
+                for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b]):
+                    kind = int(m.jnt_type[j])
+                    axis = d.xaxis[j]
+                    joint = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) or f"#{j}"
+                    if kind == mujoco.mjtJoint.mjJNT_SLIDE:
+                        ok = abs(axis[1]) <= _PLANE_TOL
+                    elif kind == mujoco.mjtJoint.mjJNT_HINGE:
+                        ok = abs(axis[0]) <= _PLANE_TOL and abs(axis[2]) <= _PLANE_TOL
+                    else:
+                        ok = False
+                    if not ok:
+                        raise InvalidSceneError(
+                            f"geom `{name}` is not planar: joint `{joint}` of body "
+                            f"`{mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)}` lets it "
+                            "leave the x-z plane (the rod terms need slides in x-z and "
+                            "hinges about y)",
+                            field=f"geoms[{i}]",
+                        )
+                b = int(m.body_parentid[b])
+            e = d.geom_xmat[self._ids[i]].reshape(3, 3)[:, 2]
+            if abs(e[1]) > 1e-6:
+                raise InvalidSceneError(
+                    f"geom `{name}` is not planar: its axis {e.round(6).tolist()} leaves the "
+                    "x-z plane",
+                    field=f"geoms[{i}]",
+                )
+
+    # -- the coupling -------------------------------------------------------------------
+
+    def step(self, data: Any) -> None:
+        """Compute each geom's force from ``data.qpos`` and ``data.qvel`` and put it in
+        ``data.qfrc_applied`` (call before ``mujoco.mj_step``). Replaces this Sand's own
+        previous contribution; an entry of ``qfrc_applied`` that changed since this Sand
+        last wrote it is taken as the user's and kept as it is."""
+        m = self.model
+        # Right after mj_step, xpos and cvel still hold the previous state: bring the
+        # kinematics to qpos and qvel (and M's factor for the static terms' reactions).
+        mujoco.mj_kinematics(m, data)
+        mujoco.mj_comPos(m, data)
+        mujoco.mj_comVel(m, data)
+        target = data.qfrc_applied
+        if data is not self._data_ref or self._after is None:
+            user = target.copy()
+            self._data_ref = data
+        else:
+            user = np.where(target == self._after, self._before, target)
+        contribution = self._evaluate(data, factor=True)
+        self._before = user
+        target[:] = user + contribution
+        self._after = target.copy()
+
+    def _callback(self, m: Any, data: Any) -> None:
+        """The passive-force callback: add the sand's force to ``qfrc_passive`` (MuJoCo
+        recomputes it at every evaluation, so there is nothing of ours to replace)."""
+        if m is not self.model:
+            return
+        data.qfrc_passive += self._evaluate(data, factor=False)
+
+    def install(self) -> None:
+        """Run as MuJoCo's passive-force callback (``mujoco.set_mjcb_passive``), inside
+        every ``mj_step`` and ``mj_forward`` of this Sand's model (at each RK4 stage, with
+        that stage's state). The callback is global to the process: every installed Sand is
+        called, each acting only on its own model (so two Sands on one model both act, and
+        their forces add), and a callback that was installed before the first Sand is
+        called first and restored when the last Sand is uninstalled."""
+        _Dispatch.add(self)
+
+    def uninstall(self) -> None:
+        """Stop acting as the passive-force callback (other installed Sands go on)."""
+        _Dispatch.remove(self)
+
+    def _evaluate(self, data: Any, factor: bool) -> np.ndarray:
+        """Every geom's force through the core in one call; the static terms' reactions;
+        the generalized force of all of it (returned) and the drag's h lambda."""
+        m = self.model
+        ids = self._ids
+        xmat = data.geom_xmat[ids]
+        axis = xmat[:, 2::3]  # each geom's local z axis in world coordinates
+        flip = axis[:, 2] < 0.0
+        axis = np.where(flip[:, None], -axis, axis)
+        tip = data.geom_xpos[ids] - self._half[:, None] * axis
+        cvel = data.cvel[self._body]
+        r = tip - data.subtree_com[self._root]
+        w = cvel[:, :3]
+        lin = cvel[:, 3:]
+        s = self._states
+        s[:, 0] = tip[:, 0]
+        s[:, 1] = tip[:, 2] - self.surface
+        norm = np.hypot(axis[:, 0], axis[:, 2])
+        s[:, 2] = axis[:, 0] / norm
+        s[:, 3] = axis[:, 2] / norm
+        s[:, 4] = lin[:, 0] + w[:, 1] * r[:, 2] - w[:, 2] * r[:, 1]
+        s[:, 5] = lin[:, 2] + w[:, 0] * r[:, 1] - w[:, 1] * r[:, 0]
+        s[:, 6] = w[:, 1]
+        out = self.output
+        self._core.evaluate(s, out)
+        inside = (tip[:, 0] >= self.patch[0]) & (tip[:, 0] <= self.patch[1])
+        active = inside & (out[:, _COL["depth"]] > 0.0)
+        applied = self.applied
+        applied[:] = 0.0
+        self.h_lambda[:] = 0.0
+        contribution = np.zeros(m.nv)
+        if not active.any():
+            self._statics_prev[:] = 0.0
+            self._contribution = contribution
+            return contribution
+        if factor:
+            # M's factor at this pose, for the reactions and the effective masses.
+            mujoco.mj_makeM(m, data)
+            mujoco.mj_factorM(m, data)
+        idx = np.flatnonzero(active)
+        rows = out[idx]
+        dynamic = rows[:, [_COL["F_dx"], _COL["F_dy"]]]
+        raw_static = rows[:, [_COL["F_sx"], _COL["F_sy"]]]
+        bound = rows[:, [_COL["bound_x"], _COL["bound_y"]]]
+        centroid = np.column_stack(
+            [rows[:, _COL["E_x"]], np.zeros(len(idx)), rows[:, _COL["E_y"]] + self.surface]
+        )
+        # Jacobians (x and z rows) of E and of the point of application P, per active geom.
+        jac_e = np.zeros((2 * len(idx), m.nv))
+        jac_p = np.zeros((2 * len(idx), m.nv))
+        for k, i in enumerate(idx):
+            mujoco.mj_jac(m, data, self._jac, None, centroid[k], int(self._body[i]))
+            jac_e[2 * k] = self._jac[0]
+            jac_e[2 * k + 1] = self._jac[2]
+            if self.apply_at == "tip":
+                mujoco.mj_jac(m, data, self._jac, None, tip[i], int(self._body[i]))
+                jac_p[2 * k] = self._jac[0]
+                jac_p[2 * k + 1] = self._jac[2]
+            else:
+                jac_p[2 * k : 2 * k + 2] = jac_e[2 * k : 2 * k + 2]
+        minv_jp = np.empty_like(jac_p)
+        mujoco.mj_solveM(m, data, minv_jp, jac_p)
+        # W = J_E M^-1 J_P^T: E's acceleration per unit force at P (both axes, all geoms).
+        wmat = jac_e @ minv_jp.T
+        # h lambda of the drag: timestep x 2 |F_d| / |v_E| x E's inverse effective mass
+        # along v_E (the rate of the drag's linearization; thesis law and granrs.simulate).
+        v_e = rows[:, [_COL["v_Ex"], _COL["v_Ey"]]]
+        speed = np.hypot(v_e[:, 0], v_e[:, 1])
+        for k, i in enumerate(idx):
+            if speed[k] > 0.0 and rows[k, _COL["k_drag"]] > 0.0:
+                u = v_e[k] / speed[k]
+                inv_mass = u @ wmat[2 * k : 2 * k + 2, 2 * k : 2 * k + 2] @ u
+                self.h_lambda[i] = m.opt.timestep * 2.0 * rows[k, _COL["k_drag"]] * inv_mass
+        statics = raw_static
+        if self.statics == "stick" and np.any(bound > 0.0):
+            statics = self._reactions(data, idx, dynamic, raw_static, bound, jac_e, wmat)
+        self._statics_prev[:] = 0.0
+        self._statics_prev[idx] = statics
+        # The core's moment about the tip holds the dynamic and the raw static force at P;
+        # a reaction in place of the static force acts at P too.
+        lever = np.zeros((len(idx), 2))
+        if self.apply_at == "centroid":
+            lever = centroid[:, [0, 2]] - tip[idx][:, [0, 2]]
+        delta = statics - raw_static
+        moment = rows[:, _COL["M"]] + lever[:, 1] * delta[:, 0] - lever[:, 0] * delta[:, 1]
+        total = dynamic + statics
+        applied[idx, 0] = total[:, 0]
+        applied[idx, 1] = total[:, 1]
+        applied[idx, 2] = moment
+        for k, i in enumerate(idx):
+            mujoco.mj_applyFT(
+                m,
+                data,
+                np.array([total[k, 0], 0.0, total[k, 1]]),
+                np.array([0.0, moment[k], 0.0]),
+                tip[i],
+                int(self._body[i]),
+                contribution,
+            )
+        self._contribution = contribution
+        self._warn_step_size()
+        return contribution
+
+    def _reactions(
+        self,
+        data: Any,
+        idx: np.ndarray,
+        dynamic: np.ndarray,
+        raw_static: np.ndarray,
+        bound: np.ndarray,
+        jac_e: np.ndarray,
+        wmat: np.ndarray,
+    ) -> np.ndarray:
+        """The static terms as reactions (docs/mujoco.md, "The static terms at rest"): the
+        forces R at P, |R| within the terms' bounds per axis, that bring E's velocity to zero
+        at the end of the step, as MuJoCo's (semi-implicit) Euler step will take it. The
+        acceleration from everything else (gravity, joints, actuators, contacts, the user's
+        forces) is last step's ``qacc`` less this Sand's own last contribution: exact while
+        those stay constant (a resting foot), an estimate otherwise."""
+        m = self.model
+        h = m.opt.timestep
+        v = jac_e @ data.qvel
+        # E's acceleration from everything but this step's sand force, plus the new drag.
+        own_prev = np.empty_like(self._contribution)
+        mujoco.mj_solveM(m, data, own_prev[None, :], self._contribution[None, :])
+        other = jac_e @ (data.qacc - own_prev)
+        b = v / h + other + wmat @ dynamic.reshape(-1)
+        limits = bound.reshape(-1)
+        fixed = limits <= 0.0
+        reaction = np.where(fixed, 0.0, raw_static.reshape(-1))
+        reaction[fixed] = 0.0
+        # Active set: solve the free rows, clamp the ones past their bound, repeat.
+        free = ~fixed
+        for _ in range(len(limits) + 1):
+            if not free.any():
+                break
+            f = np.flatnonzero(free)
+            rhs = -(b[f] + wmat[np.ix_(f, ~free)] @ reaction[~free])
+            try:
+                sol = np.linalg.solve(wmat[np.ix_(f, f)], rhs)
+            except np.linalg.LinAlgError:
+                sol = np.linalg.lstsq(wmat[np.ix_(f, f)], rhs, rcond=None)[0]
+            over = np.abs(sol) > limits[f]
+            reaction[f] = np.clip(sol, -limits[f], limits[f])
+            if not over.any():
+                break
+            free[f[over]] = False
+        # Axes whose terms have no bound keep their raw static force (none for the thesis).
+        reaction = np.where(limits > 0.0, reaction, raw_static.reshape(-1))
+        return reaction.reshape(-1, 2)
+
+    def _warn_step_size(self) -> None:
+        worst = int(np.argmax(self.h_lambda))
+        h_lambda = float(self.h_lambda[worst])
+        self.max_h_lambda = max(self.max_h_lambda, h_lambda)
+        limit = (
+            RK4_STABILITY_LIMIT
+            if self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
+            else EULER_STABILITY_LIMIT
+        )
+        if h_lambda > limit and not self._warned:
+            self._warned = True
+            h = self.model.opt.timestep
+            rate = h_lambda / h
+            warnings.warn(
+                StepSizeWarning(
+                    f"MuJoCo's timestep {h:g} s does not resolve the sand's drag on geom "
+                    f"`{self.geoms[worst]}`: timestep x rate = {h_lambda:.3g} (the integrator "
+                    f"is stable below {limit}); use timestep <= {0.5 / rate:.2g} s "
+                    "(timestep x rate <= 0.5)"
+                ),
+                stacklevel=3,
+            )
+
+
+class _Dispatch:
+    """The one passive-force callback of the process, calling every installed Sand."""
+
+    installed: list[Sand] = []  # noqa: RUF012
+    previous: Any = None
+
+    @classmethod
+    def add(cls, sand: Sand) -> None:
+        if sand in cls.installed:
+            return
+        if not cls.installed:
+            cls.previous = mujoco.get_mjcb_passive()
+            mujoco.set_mjcb_passive(cls.call)
+        cls.installed.append(sand)
+
+    @classmethod
+    def remove(cls, sand: Sand) -> None:
+        if sand not in cls.installed:
+            return
+        cls.installed.remove(sand)
+        if not cls.installed:
+            mujoco.set_mjcb_passive(cls.previous)
+            cls.previous = None
+
+    @classmethod
+    def call(cls, m: Any, d: Any) -> None:
+        if cls.previous is not None:
+            cls.previous(m, d)
+        for sand in cls.installed:
+            sand._callback(m, d)
