@@ -48,8 +48,11 @@ from .forces import as_terms
 __all__ = [
     "EULER_STABILITY_LIMIT",
     "GEOM_OUTPUTS",
+    "INTEGRATORS",
     "STATICS",
     "Sand",
+    "free_link_mjcf",
+    "rod_drop",
 ]
 
 #: ``h lambda`` beyond which explicit Euler is unstable for a real, negative rate (|1 - h
@@ -304,7 +307,11 @@ class Sand:
         that stage's state). The callback is global to the process: every installed Sand is
         called, each acting only on its own model (so two Sands on one model both act, and
         their forces add), and a callback that was installed before the first Sand is
-        called first and restored when the last Sand is uninstalled."""
+        called first and restored when the last Sand is uninstalled.
+
+        MuJoCo's compiler fails (``engine error: Python exception raised``) while any Python
+        passive callback is installed: compile every model before ``install()``, or use
+        :meth:`step`."""
         _Dispatch.add(self)
 
     def uninstall(self) -> None:
@@ -516,3 +523,138 @@ class _Dispatch:
             cls.previous(m, d)
         for sand in cls.installed:
             sand._callback(m, d)
+
+
+#: MuJoCo's integrators by their MJCF names.
+INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+
+
+def free_link_mjcf(scene: Any, timestep: float = 1e-4, integrator: str = "Euler") -> str:
+    """The MJCF of a free-link scene (:func:`granrs.cases.free_link`): its rod as a
+    cylinder geom ``rod`` of the scene's length, diameter and mass (MuJoCo's solid-cylinder
+    inertia, the scene's default) on a body with slide x, slide z and hinge y at its centre,
+    gravity ``scene.g`` along -z, no contacts."""
+    if integrator not in INTEGRATORS:
+        raise UnknownNameError(
+            f"unknown integrator `{integrator}` (allowed: {', '.join(INTEGRATORS)})",
+            field="integrator",
+        )
+    if scene.inertia is not None:
+        raise InvalidSceneError(
+            "free_link_mjcf builds MuJoCo's solid cylinder; the scene sets its own inertia",
+            field="inertia",
+        )
+    return f"""<mujoco model="granrs free link">
+  <option timestep="{_number(timestep, "timestep")!r}" integrator="{integrator}"
+          gravity="0 0 {-scene.g!r}"/>
+  <worldbody>
+    <body name="rod" pos="0 0 0">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <joint name="z" type="slide" axis="0 0 1"/>
+      <joint name="q" type="hinge" axis="0 1 0"/>
+      <geom name="rod" type="cylinder" size="{scene.diameter / 2!r} {scene.length / 2!r}"
+            mass="{scene.mass!r}" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def rod_drop(
+    scene: Any,
+    timestep: float = 1e-4,
+    integrator: str = "Euler",
+    mode: str = "step",
+    statics: str = "stick",
+    t_after: float = 0.0,
+) -> dict[str, Any]:
+    """Drop a free-link scene's rod in MuJoCo with :class:`Sand` under the scene's contact
+    terms, from the scene's initial state (tip at the surface, velocity (vx0, -v0), spin
+    omega0), until its stop, and ``t_after`` seconds on.
+
+    The stop is the first step at whose end the tip's vertical velocity is >= 0 (or within
+    1e-9 m/s of it: the stick brings it to zero to round-off), interpolated linearly inside
+    the step. Returns ``t_s`` [s], ``depth`` [m] (the tip's, at the stop), ``steps``, and
+    after the stop ``t``, ``tip`` (x, z) and ``energy`` (KE + gravitational PE [J]) per step.
+    ``mode`` is ``"step"`` (:meth:`Sand.step`) or ``"callback"`` (:meth:`Sand.install`).
+    """
+    from . import forces as _forces
+
+    if mode not in ("step", "callback"):
+        raise UnknownNameError(f"unknown mode `{mode}` (allowed: step, callback)", field="mode")
+    model = mujoco.MjModel.from_xml_string(free_link_mjcf(scene, timestep, integrator))
+    data = mujoco.MjData(model)
+    q = math.radians(scene.q_deg)
+    half = scene.length / 2
+    e = np.array([math.sin(q), math.cos(q)])
+    normal = np.array([math.cos(q), -math.sin(q)])
+    v_c = np.array([scene.vx0, -scene.v0]) + scene.omega0 * half * normal
+    data.qpos[:] = [half * e[0], half * e[1] - scene.depth0, q]
+    data.qvel[:] = [v_c[0], v_c[1], scene.omega0]
+    contact = [t for t in scene.forces if t.name not in ("gravity", "joint_springs")]
+    sand = Sand(
+        model,
+        ["rod"],
+        list(_forces.as_terms(contact)),
+        rho_g=scene.rho_g,
+        apply_at=scene.apply_at,
+        statics=statics,
+    )
+    mass = scene.mass
+    inertia = float(model.body_inertia[1, 1])
+    g = sand.g
+
+    def tip() -> tuple[float, float, float]:
+        angle = data.qpos[2]
+        s, c = math.sin(angle), math.cos(angle)
+        return (
+            data.qpos[0] - half * s,
+            data.qpos[1] - half * c,
+            data.qvel[1] + data.qvel[2] * half * s,
+        )
+
+    def energy() -> float:
+        v = data.qvel
+        return (
+            0.5 * mass * (v[0] ** 2 + v[1] ** 2)
+            + 0.5 * inertia * v[2] ** 2
+            + mass * g * (data.qpos[1])
+        )
+
+    if mode == "callback":
+        sand.install()
+    try:
+        t_prev, z_prev, v_prev = 0.0, tip()[1], tip()[2]
+        limit = math.ceil(max(scene.t_end, 1.0) / timestep)
+        for steps in range(1, limit + 1):  # noqa: B007
+            if mode == "step":
+                sand.step(data)
+            mujoco.mj_step(model, data)
+            _, z, v = tip()
+            if v >= -1e-9:
+                f = -v_prev / (v - v_prev) if v != v_prev else 1.0
+                t_s = t_prev + f * (data.time - t_prev)
+                depth = -(z_prev + f * (z - z_prev))
+                break
+            t_prev, z_prev, v_prev = data.time, z, v
+        else:
+            return {"t_s": math.nan, "depth": math.nan, "steps": limit, "sand": sand}
+        after_t, after_tip, after_e = [data.time], [tip()[:2]], [energy()]
+        for _ in range(round(t_after / timestep)):
+            if mode == "step":
+                sand.step(data)
+            mujoco.mj_step(model, data)
+            after_t.append(data.time)
+            after_tip.append(tip()[:2])
+            after_e.append(energy())
+    finally:
+        if mode == "callback":
+            sand.uninstall()
+    return {
+        "t_s": t_s,
+        "depth": depth,
+        "steps": steps,
+        "t": np.asarray(after_t),
+        "tip": np.asarray(after_tip),
+        "energy": np.asarray(after_e),
+        "sand": sand,
+    }
