@@ -365,6 +365,319 @@ pub mod geoms {
         }
     }
 
+    /// A geom's place in the other engine's model (MuJoCo's indices), fixed at setup.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct EnginePlace {
+        /// The geom's index (rows of `geom_xpos`, `geom_xmat`).
+        pub geom: usize,
+        /// Its body (rows of `cvel`).
+        pub body: usize,
+        /// The root of its body's tree (rows of `subtree_com`: `cvel` is taken about it).
+        pub root: usize,
+        /// From the geom's centre to its tip along its axis [m].
+        pub reach: f64,
+        /// The degrees of freedom that move it (the joints of its body and its ancestors).
+        pub dofs: Vec<usize>,
+    }
+
+    /// One evaluation's arrays of the other engine, row-major (MuJoCo's `mjData` fields, in
+    /// world coordinates; 3-d, with z up: the plane is x-z).
+    #[derive(Debug, Clone, Copy)]
+    pub struct EngineState<'a> {
+        /// `geom_xpos` (ngeom x 3).
+        pub geom_xpos: &'a [f64],
+        /// `geom_xmat` (ngeom x 9).
+        pub geom_xmat: &'a [f64],
+        /// `cvel` (nbody x 6: angular, linear velocity at the tree's `subtree_com`).
+        pub cvel: &'a [f64],
+        /// `subtree_com` (nbody x 3).
+        pub subtree_com: &'a [f64],
+        /// `cdof` (nv x 6: each dof's motion, angular then linear, about the same point).
+        pub cdof: &'a [f64],
+        /// The mass matrix, dense (nv x nv).
+        pub mass: &'a [f64],
+        /// `qvel` (nv).
+        pub qvel: &'a [f64],
+        /// `qacc` of the last evaluation (nv): the acceleration the static terms' reactions
+        /// take as the rest of the world's.
+        pub qacc: &'a [f64],
+    }
+
+    /// Where one step's results go: per geom the outputs ([`OUTPUTS`]), the applied force
+    /// and moment (x, z, about y), `h lambda`; and the generalized force (nv).
+    #[derive(Debug)]
+    pub struct EngineOut<'a> {
+        /// n x [`OUTPUTS`].
+        pub outputs: &'a mut [f64],
+        /// n x 3: force x, force z [N] at the tip, moment about +y [N m].
+        pub applied: &'a mut [f64],
+        /// n: the timestep times the drag's rate.
+        pub h_lambda: &'a mut [f64],
+        /// nv: the generalized force of every geom's force.
+        pub generalized: &'a mut [f64],
+    }
+
+    /// The coupling to another engine: [`RodGeoms`] placed on its bodies, with the sand's
+    /// surface and patch, and the static terms' treatment.
+    #[derive(Debug, Clone)]
+    pub struct Coupling {
+        /// The geoms' force law.
+        pub rods: RodGeoms,
+        /// Each geom's place.
+        pub places: Vec<EnginePlace>,
+        /// Number of degrees of freedom.
+        pub nv: usize,
+        /// Height of the sand's surface [m].
+        pub surface: f64,
+        /// The sand's extent in x [m].
+        pub patch: (f64, f64),
+        /// Whether the static terms act as reactions that bring E's velocity to zero within
+        /// their bounds (`true`), or as evaluated.
+        pub stick: bool,
+        /// Whether the force acts at the centroid E (else at the tip).
+        pub at_centroid: bool,
+        /// The last generalized force (nv), whose effect the last `qacc` holds.
+        pub previous: Vec<f64>,
+    }
+
+    /// The x and z rows of the Jacobian of world point `p` on the tree of `place`, and the
+    /// y row of its rotation.
+    fn jacobian(place: &EnginePlace, s: &EngineState, nv: usize, p: [f64; 3]) -> [Vec<f64>; 3] {
+        let c = &s.subtree_com[3 * place.root..3 * place.root + 3];
+        let o = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+        let mut rows = [vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]];
+        for &j in &place.dofs {
+            let d = &s.cdof[6 * j..6 * j + 6];
+            rows[0][j] = d[3] + d[1] * o[2] - d[2] * o[1];
+            rows[1][j] = d[5] + d[0] * o[1] - d[1] * o[0];
+            rows[2][j] = d[1];
+        }
+        rows
+    }
+
+    impl Coupling {
+        /// One evaluation: every geom's state from the engine's arrays, its force through
+        /// [`RodGeoms::evaluate`], the static terms' reactions (with `stick`), and the
+        /// generalized force of it all. `timestep` [s] sets the reactions and `h lambda`.
+        pub fn step(&mut self, s: &EngineState, timestep: f64, out: EngineOut) {
+            use nalgebra::{DMatrix, DVector};
+            let n = self.places.len();
+            let nv = self.nv;
+            let width = OUTPUTS.len();
+            let mut tips = vec![[0.0; 3]; n];
+            let mut active = Vec::with_capacity(n);
+            out.applied.fill(0.0);
+            out.h_lambda.fill(0.0);
+            out.generalized.fill(0.0);
+            for (i, place) in self.places.iter().enumerate() {
+                let m = &s.geom_xmat[9 * place.geom..9 * place.geom + 9];
+                let mut e = [m[2], m[5], m[8]];
+                if e[2] < 0.0 {
+                    e = [-e[0], -e[1], -e[2]];
+                }
+                let x = &s.geom_xpos[3 * place.geom..3 * place.geom + 3];
+                let tip = [
+                    x[0] - place.reach * e[0],
+                    x[1] - place.reach * e[1],
+                    x[2] - place.reach * e[2],
+                ];
+                let v = &s.cvel[6 * place.body..6 * place.body + 6];
+                let c = &s.subtree_com[3 * place.root..3 * place.root + 3];
+                let r = [tip[0] - c[0], tip[1] - c[1], tip[2] - c[2]];
+                let norm = e[0].hypot(e[2]);
+                let state = [
+                    tip[0],
+                    tip[2] - self.surface,
+                    e[0] / norm,
+                    e[2] / norm,
+                    v[3] + v[1] * r[2] - v[2] * r[1],
+                    v[5] + v[0] * r[1] - v[1] * r[0],
+                    v[1],
+                ];
+                let row = &mut out.outputs[i * width..(i + 1) * width];
+                self.rods.evaluate(i, &state, row);
+                tips[i] = tip;
+                if row[3] > 0.0 && tip[0] >= self.patch.0 && tip[0] <= self.patch.1 {
+                    active.push(i);
+                }
+            }
+            if active.is_empty() {
+                self.previous.fill(0.0);
+                return;
+            }
+            let k = active.len();
+            let col = |name: &str| OUTPUTS.iter().position(|c| *c == name).expect("a column");
+            let (c_fx, c_fy, c_m) = (col("F_x"), col("F_y"), col("M"));
+            let (c_ex, c_ey) = (col("E_x"), col("E_y"));
+            let (c_sx, c_sy, c_bx, c_by) =
+                (col("F_sx"), col("F_sy"), col("bound_x"), col("bound_y"));
+            let (c_vx, c_vy, c_k) = (col("v_Ex"), col("v_Ey"), col("k_drag"));
+            // Jacobians of the tip, of E and of P (x and z rows), and the rotation about y.
+            let mut j_tip = DMatrix::zeros(2 * k, nv);
+            let mut j_rot = DMatrix::zeros(k, nv);
+            let mut j_e = DMatrix::zeros(2 * k, nv);
+            let mut j_p = DMatrix::zeros(2 * k, nv);
+            let mut q_rest = DVector::zeros(nv);
+            let mut raw = vec![[0.0; 2]; k];
+            let mut levers = vec![[0.0; 2]; k];
+            for (a, &i) in active.iter().enumerate() {
+                let place = &self.places[i];
+                let row = &out.outputs[i * width..(i + 1) * width];
+                let centroid = [row[c_ex], 0.0, row[c_ey] + self.surface];
+                let [tx, tz, ry] = jacobian(place, s, nv, tips[i]);
+                let [ex, ez, _] = jacobian(place, s, nv, centroid);
+                for j in 0..nv {
+                    j_tip[(2 * a, j)] = tx[j];
+                    j_tip[(2 * a + 1, j)] = tz[j];
+                    j_rot[(a, j)] = ry[j];
+                    j_e[(2 * a, j)] = ex[j];
+                    j_e[(2 * a + 1, j)] = ez[j];
+                }
+                if self.at_centroid {
+                    levers[a] = [centroid[0] - tips[i][0], centroid[2] - tips[i][2]];
+                    let rows = j_e.rows(2 * a, 2).into_owned();
+                    j_p.rows_mut(2 * a, 2).copy_from(&rows);
+                } else {
+                    let rows = j_tip.rows(2 * a, 2).into_owned();
+                    j_p.rows_mut(2 * a, 2).copy_from(&rows);
+                }
+                raw[a] = [row[c_sx], row[c_sy]];
+                // Everything but the static terms: the force less the static sum, with its
+                // moment about the tip less that of the static sum at P.
+                let [lx, lz] = levers[a];
+                let f = [row[c_fx] - raw[a][0], row[c_fy] - raw[a][1]];
+                let moment = row[c_m] - (lz * raw[a][0] - lx * raw[a][1]);
+                for j in 0..nv {
+                    q_rest[j] += f[0] * tx[j] + f[1] * tz[j] + moment * ry[j];
+                }
+            }
+            let mass = DMatrix::from_row_slice(nv, nv, s.mass);
+            let Some(chol) = mass.cholesky() else {
+                // Not positive definite (a degenerate state): the forces as evaluated.
+                for (a, &i) in active.iter().enumerate() {
+                    self.finish(i, &raw[a], &raw[a], &levers[a], out.outputs, out.applied);
+                }
+                self.generalized(&active, &j_tip, &j_rot, out.applied, out.generalized);
+                return;
+            };
+            let minv_jp = chol.solve(&j_p.transpose());
+            let minv_je = chol.solve(&j_e.transpose());
+            let w = &j_e * &minv_jp;
+            let w_e = &j_e * &minv_je;
+            for (a, &i) in active.iter().enumerate() {
+                let row = &out.outputs[i * width..(i + 1) * width];
+                let speed = row[c_vx].hypot(row[c_vy]);
+                if speed > 0.0 && row[c_k] > 0.0 {
+                    let u = [row[c_vx] / speed, row[c_vy] / speed];
+                    let mut inv_mass = 0.0;
+                    for (p, up) in u.iter().enumerate() {
+                        for (q, uq) in u.iter().enumerate() {
+                            inv_mass += up * w_e[(2 * a + p, 2 * a + q)] * uq;
+                        }
+                    }
+                    out.h_lambda[i] = timestep * 2.0 * row[c_k] * inv_mass;
+                }
+            }
+            let mut reaction: Vec<f64> = raw.iter().flat_map(|r| r.iter().copied()).collect();
+            let bounds: Vec<f64> = active
+                .iter()
+                .flat_map(|&i| {
+                    let row = &out.outputs[i * width..(i + 1) * width];
+                    [row[c_bx], row[c_by]]
+                })
+                .collect();
+            if self.stick && bounds.iter().any(|&b| b > 0.0) {
+                // E's velocity at the step's end without reactions: v + h (a_rest), with the
+                // rest of the world's acceleration from the last qacc less our last force.
+                let qvel = DVector::from_column_slice(s.qvel);
+                let qacc = DVector::from_column_slice(s.qacc);
+                let previous = DVector::from_column_slice(&self.previous);
+                let accel = qacc + chol.solve(&(&q_rest - previous));
+                let b = &j_e * (qvel / timestep + accel);
+                solve_boxed(&w, &b, &bounds, &mut reaction);
+            }
+            for (a, &i) in active.iter().enumerate() {
+                let r = [reaction[2 * a], reaction[2 * a + 1]];
+                self.finish(i, &raw[a], &r, &levers[a], out.outputs, out.applied);
+            }
+            self.generalized(&active, &j_tip, &j_rot, out.applied, out.generalized);
+        }
+
+        /// Geom `i`'s applied force and moment (its static sum `raw` replaced by `r` at P).
+        fn finish(
+            &self,
+            i: usize,
+            raw: &[f64; 2],
+            r: &[f64; 2],
+            lever: &[f64; 2],
+            outputs: &[f64],
+            applied: &mut [f64],
+        ) {
+            let width = OUTPUTS.len();
+            let row = &outputs[i * width..(i + 1) * width];
+            let d = [r[0] - raw[0], r[1] - raw[1]];
+            applied[3 * i] = row[0] + d[0];
+            applied[3 * i + 1] = row[1] + d[1];
+            applied[3 * i + 2] = row[2] + lever[1] * d[0] - lever[0] * d[1];
+        }
+
+        /// The generalized force of the applied forces and moments, kept as `previous`.
+        fn generalized(
+            &mut self,
+            active: &[usize],
+            j_tip: &nalgebra::DMatrix<f64>,
+            j_rot: &nalgebra::DMatrix<f64>,
+            applied: &[f64],
+            generalized: &mut [f64],
+        ) {
+            for (a, &i) in active.iter().enumerate() {
+                let [fx, fz, m] = [applied[3 * i], applied[3 * i + 1], applied[3 * i + 2]];
+                for (j, g) in generalized.iter_mut().enumerate() {
+                    *g += fx * j_tip[(2 * a, j)] + fz * j_tip[(2 * a + 1, j)] + m * j_rot[(a, j)];
+                }
+            }
+            self.previous.copy_from_slice(generalized);
+        }
+    }
+
+    /// Solve `w r = -b` for the rows with a positive bound, each `|r_i| <= bound_i` (rows
+    /// without a bound keep their value): solve the free rows, clamp those past their bound
+    /// and hold them, until none is past (an active set; at most one pass per row).
+    fn solve_boxed(
+        w: &nalgebra::DMatrix<f64>,
+        b: &nalgebra::DVector<f64>,
+        bounds: &[f64],
+        r: &mut [f64],
+    ) {
+        use nalgebra::{DMatrix, DVector};
+        let mut free: Vec<bool> = bounds.iter().map(|&x| x > 0.0).collect();
+        for _ in 0..=bounds.len() {
+            let f: Vec<usize> = (0..bounds.len()).filter(|&i| free[i]).collect();
+            if f.is_empty() {
+                return;
+            }
+            let held: Vec<usize> = (0..bounds.len()).filter(|&i| !free[i]).collect();
+            let a = DMatrix::from_fn(f.len(), f.len(), |p, q| w[(f[p], f[q])]);
+            let rhs = DVector::from_fn(f.len(), |p, _| {
+                -(b[f[p]] + held.iter().map(|&h| w[(f[p], h)] * r[h]).sum::<f64>())
+            });
+            let Some(sol) = a.lu().solve(&rhs) else {
+                return;
+            };
+            let mut past = false;
+            for (p, &i) in f.iter().enumerate() {
+                r[i] = sol[p].clamp(-bounds[i], bounds[i]);
+                if sol[p].abs() > bounds[i] {
+                    free[i] = false;
+                    past = true;
+                }
+            }
+            if !past {
+                return;
+            }
+        }
+    }
+
     #[cfg(test)]
     mod tests {
         use super::*;

@@ -12,6 +12,7 @@ __all__ = [
     "ROD_GEOM_STATE",
     "SCENE_FIELDS",
     "Compiled",
+    "GeomCoupling",
     "RodGeoms",
     "RunOutcome",
     "__version__",
@@ -133,6 +134,46 @@ class RodGeoms:
     def evaluate(self, states: Any, out: Any) -> None:
         """Every geom's force: states n x 7 (ROD_GEOM_STATE order) in, out n x 16
         (ROD_GEOM_OUTPUTS order) written."""
+
+@final
+class GeomCoupling:
+    """RodGeoms placed on the bodies of a MuJoCo model (granrs.mujoco.Sand)."""
+
+    def __new__(
+        cls,
+        rods: RodGeoms,
+        geom: list[int],
+        body: list[int],
+        root: list[int],
+        reach: list[float],
+        dofs: list[list[int]],
+        nv: int,
+        surface: float,
+        patch: tuple[float, float],
+        stick: bool,
+        at_centroid: bool,
+    ) -> GeomCoupling: ...
+    def step(
+        self,
+        geom_xpos: Any,
+        geom_xmat: Any,
+        cvel: Any,
+        subtree_com: Any,
+        cdof: Any,
+        mass: Any,
+        qvel: Any,
+        qacc: Any,
+        timestep: float,
+        outputs: Any,
+        applied: Any,
+        h_lambda: Any,
+        generalized: Any,
+        target: Any,
+        kept: tuple[Any, Any] | None = None,
+        fresh: bool = False,
+    ) -> tuple[float, int]:
+        """One evaluation at MuJoCo's arrays; the generalized force into target. Returns the
+        largest h_lambda and its geom."""
 
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""

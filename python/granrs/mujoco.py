@@ -214,8 +214,29 @@ class Sand:
             float(smooth_eps),
         )
         self.apply_at = apply_at
+        dofs = []
+        for body in self._body:
+            chain, b = [], int(body)
+            while b > 0:
+                chain.extend(
+                    range(model.body_dofadr[b], model.body_dofadr[b] + model.body_dofnum[b])
+                )
+                b = int(model.body_parentid[b])
+            dofs.append(sorted(chain))
+        self._coupling = _granrs.GeomCoupling(
+            self._core,
+            [int(i) for i in self._ids],
+            [int(b) for b in self._body],
+            [int(r) for r in self._root],
+            [float(h) for h in self._half],
+            dofs,
+            model.nv,
+            self.surface,
+            self.patch,
+            statics == "stick",
+            apply_at == "centroid",
+        )
         n = len(names)
-        self._states = np.zeros((n, len(_granrs.ROD_GEOM_STATE)))
         #: Each geom's evaluation at the last step (columns :data:`GEOM_OUTPUTS`).
         self.output = np.zeros((n, len(GEOM_OUTPUTS)))
         #: The force (x, z) [N] and moment about +y [N m] applied at each tip, last step.
@@ -225,12 +246,11 @@ class Sand:
         #: The largest of :attr:`h_lambda` over every step so far.
         self.max_h_lambda = 0.0
         self._warned = False
-        self._statics_prev = np.zeros((n, 2))
-        self._contribution = np.zeros(model.nv)
+        self._mass = np.zeros((model.nv, model.nv))
+        self._generalized = np.zeros(model.nv)
         self._data_ref: Any = None
-        self._before: np.ndarray | None = None
-        self._after: np.ndarray | None = None
-        self._jac = np.zeros((3, model.nv))
+        self._before = np.zeros(model.nv)
+        self._after = np.zeros(model.nv)
 
     # -- checks -------------------------------------------------------------------------
 
@@ -279,27 +299,21 @@ class Sand:
         last wrote it is taken as the user's and kept as it is."""
         m = self.model
         # Right after mj_step, xpos and cvel still hold the previous state: bring the
-        # kinematics to qpos and qvel (and M's factor for the static terms' reactions).
+        # kinematics and the mass matrix to qpos and qvel.
         mujoco.mj_kinematics(m, data)
         mujoco.mj_comPos(m, data)
         mujoco.mj_comVel(m, data)
-        target = data.qfrc_applied
-        if data is not self._data_ref or self._after is None:
-            user = target.copy()
-            self._data_ref = data
-        else:
-            user = np.where(target == self._after, self._before, target)
-        contribution = self._evaluate(data, factor=True)
-        self._before = user
-        target[:] = user + contribution
-        self._after = target.copy()
+        mujoco.mj_makeM(m, data)
+        fresh = data is not self._data_ref
+        self._data_ref = data
+        self._evaluate(data, data.qfrc_applied, (self._before, self._after), fresh)
 
     def _callback(self, m: Any, data: Any) -> None:
         """The passive-force callback: add the sand's force to ``qfrc_passive`` (MuJoCo
         recomputes it at every evaluation, so there is nothing of ours to replace)."""
         if m is not self.model:
             return
-        data.qfrc_passive += self._evaluate(data, factor=False)
+        self._evaluate(data, data.qfrc_passive, None, False)
 
     def install(self) -> None:
         """Run as MuJoCo's passive-force callback (``mujoco.set_mjcb_passive``), inside
@@ -318,161 +332,36 @@ class Sand:
         """Stop acting as the passive-force callback (other installed Sands go on)."""
         _Dispatch.remove(self)
 
-    def _evaluate(self, data: Any, factor: bool) -> np.ndarray:
-        """Every geom's force through the core in one call; the static terms' reactions;
-        the generalized force of all of it (returned) and the drag's h lambda."""
+    def _evaluate(self, data: Any, target: np.ndarray, kept: Any, fresh: bool) -> None:
+        """One call of the core for every geom: each geom's state from MuJoCo's arrays, its
+        force through the free link's right-hand side, the static terms' reactions (with
+        ``statics="stick"``), the generalized force of it all into ``target``, and the
+        drag's h lambda."""
         m = self.model
-        ids = self._ids
-        xmat = data.geom_xmat[ids]
-        axis = xmat[:, 2::3]  # each geom's local z axis in world coordinates
-        flip = axis[:, 2] < 0.0
-        axis = np.where(flip[:, None], -axis, axis)
-        tip = data.geom_xpos[ids] - self._half[:, None] * axis
-        cvel = data.cvel[self._body]
-        r = tip - data.subtree_com[self._root]
-        w = cvel[:, :3]
-        lin = cvel[:, 3:]
-        s = self._states
-        s[:, 0] = tip[:, 0]
-        s[:, 1] = tip[:, 2] - self.surface
-        norm = np.hypot(axis[:, 0], axis[:, 2])
-        s[:, 2] = axis[:, 0] / norm
-        s[:, 3] = axis[:, 2] / norm
-        s[:, 4] = lin[:, 0] + w[:, 1] * r[:, 2] - w[:, 2] * r[:, 1]
-        s[:, 5] = lin[:, 2] + w[:, 0] * r[:, 1] - w[:, 1] * r[:, 0]
-        s[:, 6] = w[:, 1]
-        out = self.output
-        self._core.evaluate(s, out)
-        inside = (tip[:, 0] >= self.patch[0]) & (tip[:, 0] <= self.patch[1])
-        active = inside & (out[:, _COL["depth"]] > 0.0)
-        applied = self.applied
-        applied[:] = 0.0
-        self.h_lambda[:] = 0.0
-        contribution = np.zeros(m.nv)
-        if not active.any():
-            self._statics_prev[:] = 0.0
-            self._contribution = contribution
-            return contribution
-        if factor:
-            # M's factor at this pose, for the reactions and the effective masses.
-            mujoco.mj_makeM(m, data)
-            mujoco.mj_factorM(m, data)
-        idx = np.flatnonzero(active)
-        rows = out[idx]
-        dynamic = rows[:, [_COL["F_dx"], _COL["F_dy"]]]
-        raw_static = rows[:, [_COL["F_sx"], _COL["F_sy"]]]
-        bound = rows[:, [_COL["bound_x"], _COL["bound_y"]]]
-        centroid = np.column_stack(
-            [rows[:, _COL["E_x"]], np.zeros(len(idx)), rows[:, _COL["E_y"]] + self.surface]
+        mujoco.mj_fullM(m, data, self._mass)
+        worst, geom = self._coupling.step(
+            data.geom_xpos,
+            data.geom_xmat,
+            data.cvel,
+            data.subtree_com,
+            data.cdof,
+            self._mass,
+            data.qvel,
+            data.qacc,
+            m.opt.timestep,
+            self.output,
+            self.applied,
+            self.h_lambda,
+            self._generalized,
+            target,
+            kept,
+            fresh,
         )
-        # Jacobians (x and z rows) of E and of the point of application P, per active geom.
-        jac_e = np.zeros((2 * len(idx), m.nv))
-        jac_p = np.zeros((2 * len(idx), m.nv))
-        for k, i in enumerate(idx):
-            mujoco.mj_jac(m, data, self._jac, None, centroid[k], int(self._body[i]))
-            jac_e[2 * k] = self._jac[0]
-            jac_e[2 * k + 1] = self._jac[2]
-            if self.apply_at == "tip":
-                mujoco.mj_jac(m, data, self._jac, None, tip[i], int(self._body[i]))
-                jac_p[2 * k] = self._jac[0]
-                jac_p[2 * k + 1] = self._jac[2]
-            else:
-                jac_p[2 * k : 2 * k + 2] = jac_e[2 * k : 2 * k + 2]
-        minv_jp = np.empty_like(jac_p)
-        mujoco.mj_solveM(m, data, minv_jp, jac_p)
-        # W = J_E M^-1 J_P^T: E's acceleration per unit force at P (both axes, all geoms).
-        wmat = jac_e @ minv_jp.T
-        # h lambda of the drag: timestep x 2 |F_d| / |v_E| x E's inverse effective mass
-        # along v_E (the rate of the drag's linearization; thesis law and granrs.simulate).
-        v_e = rows[:, [_COL["v_Ex"], _COL["v_Ey"]]]
-        speed = np.hypot(v_e[:, 0], v_e[:, 1])
-        for k, i in enumerate(idx):
-            if speed[k] > 0.0 and rows[k, _COL["k_drag"]] > 0.0:
-                u = v_e[k] / speed[k]
-                inv_mass = u @ wmat[2 * k : 2 * k + 2, 2 * k : 2 * k + 2] @ u
-                self.h_lambda[i] = m.opt.timestep * 2.0 * rows[k, _COL["k_drag"]] * inv_mass
-        statics = raw_static
-        if self.statics == "stick" and np.any(bound > 0.0):
-            statics = self._reactions(data, idx, dynamic, raw_static, bound, jac_e, wmat)
-        self._statics_prev[:] = 0.0
-        self._statics_prev[idx] = statics
-        # The core's moment about the tip holds the dynamic and the raw static force at P;
-        # a reaction in place of the static force acts at P too.
-        lever = np.zeros((len(idx), 2))
-        if self.apply_at == "centroid":
-            lever = centroid[:, [0, 2]] - tip[idx][:, [0, 2]]
-        delta = statics - raw_static
-        moment = rows[:, _COL["M"]] + lever[:, 1] * delta[:, 0] - lever[:, 0] * delta[:, 1]
-        total = dynamic + statics
-        applied[idx, 0] = total[:, 0]
-        applied[idx, 1] = total[:, 1]
-        applied[idx, 2] = moment
-        for k, i in enumerate(idx):
-            mujoco.mj_applyFT(
-                m,
-                data,
-                np.array([total[k, 0], 0.0, total[k, 1]]),
-                np.array([0.0, moment[k], 0.0]),
-                tip[i],
-                int(self._body[i]),
-                contribution,
-            )
-        self._contribution = contribution
-        self._warn_step_size()
-        return contribution
+        if worst > self.max_h_lambda:
+            self.max_h_lambda = worst
+            self._warn_step_size(worst, geom)
 
-    def _reactions(
-        self,
-        data: Any,
-        idx: np.ndarray,
-        dynamic: np.ndarray,
-        raw_static: np.ndarray,
-        bound: np.ndarray,
-        jac_e: np.ndarray,
-        wmat: np.ndarray,
-    ) -> np.ndarray:
-        """The static terms as reactions (docs/mujoco.md, "The static terms at rest"): the
-        forces R at P, |R| within the terms' bounds per axis, that bring E's velocity to zero
-        at the end of the step, as MuJoCo's (semi-implicit) Euler step will take it. The
-        acceleration from everything else (gravity, joints, actuators, contacts, the user's
-        forces) is last step's ``qacc`` less this Sand's own last contribution: exact while
-        those stay constant (a resting foot), an estimate otherwise."""
-        m = self.model
-        h = m.opt.timestep
-        v = jac_e @ data.qvel
-        # E's acceleration from everything but this step's sand force, plus the new drag.
-        own_prev = np.empty_like(self._contribution)
-        mujoco.mj_solveM(m, data, own_prev[None, :], self._contribution[None, :])
-        other = jac_e @ (data.qacc - own_prev)
-        b = v / h + other + wmat @ dynamic.reshape(-1)
-        limits = bound.reshape(-1)
-        fixed = limits <= 0.0
-        reaction = np.where(fixed, 0.0, raw_static.reshape(-1))
-        reaction[fixed] = 0.0
-        # Active set: solve the free rows, clamp the ones past their bound, repeat.
-        free = ~fixed
-        for _ in range(len(limits) + 1):
-            if not free.any():
-                break
-            f = np.flatnonzero(free)
-            rhs = -(b[f] + wmat[np.ix_(f, ~free)] @ reaction[~free])
-            try:
-                sol = np.linalg.solve(wmat[np.ix_(f, f)], rhs)
-            except np.linalg.LinAlgError:
-                sol = np.linalg.lstsq(wmat[np.ix_(f, f)], rhs, rcond=None)[0]
-            over = np.abs(sol) > limits[f]
-            reaction[f] = np.clip(sol, -limits[f], limits[f])
-            if not over.any():
-                break
-            free[f[over]] = False
-        # Axes whose terms have no bound keep their raw static force (none for the thesis).
-        reaction = np.where(limits > 0.0, reaction, raw_static.reshape(-1))
-        return reaction.reshape(-1, 2)
-
-    def _warn_step_size(self) -> None:
-        worst = int(np.argmax(self.h_lambda))
-        h_lambda = float(self.h_lambda[worst])
-        self.max_h_lambda = max(self.max_h_lambda, h_lambda)
+    def _warn_step_size(self, h_lambda: float, geom: int) -> None:
         limit = (
             RK4_STABILITY_LIMIT
             if self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
@@ -485,11 +374,11 @@ class Sand:
             warnings.warn(
                 StepSizeWarning(
                     f"MuJoCo's timestep {h:g} s does not resolve the sand's drag on geom "
-                    f"`{self.geoms[worst]}`: timestep x rate = {h_lambda:.3g} (the integrator "
+                    f"`{self.geoms[geom]}`: timestep x rate = {h_lambda:.3g} (the integrator "
                     f"is stable below {limit}); use timestep <= {0.5 / rate:.2g} s "
                     "(timestep x rate <= 0.5)"
                 ),
-                stacklevel=3,
+                stacklevel=4,
             )
 
 

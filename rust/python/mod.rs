@@ -38,6 +38,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FORCE_INPUTS", crate::evaluate::INPUTS.to_vec())?;
     m.add("FORCE_OUTPUTS", crate::evaluate::OUTPUTS.to_vec())?;
     m.add_class::<mujoco::RodGeoms>()?;
+    m.add_class::<mujoco::GeomCoupling>()?;
     m.add("ROD_GEOM_STATE", crate::evaluate::geoms::STATE.to_vec())?;
     m.add("ROD_GEOM_OUTPUTS", crate::evaluate::geoms::OUTPUTS.to_vec())?;
     m.add("EFFECTS", EFFECTS.to_vec())?;

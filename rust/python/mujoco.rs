@@ -1,7 +1,9 @@
 //! `RodGeoms`: the force and moment on N rod geoms of another engine (`granrs.mujoco.Sand`)
 //! in one call, through the free link's right-hand side (see `rust/evaluate.rs`, `geoms`).
 
-use numpy::{PyReadonlyArray2, PyReadwriteArray2, PyUntypedArrayMethods};
+use numpy::{
+    PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray1, PyReadwriteArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
@@ -11,7 +13,7 @@ use super::terms::terms_from_py;
 use crate::body::rod::ApplyAt;
 use crate::dynamics::SignModel;
 use crate::error::GranrsError;
-use crate::evaluate::geoms::{self, STATE};
+use crate::evaluate::geoms::{self, Coupling, EngineOut, EnginePlace, EngineState, STATE};
 use crate::forces::{ForceSet, Medium};
 use crate::spec::Value;
 
@@ -131,5 +133,197 @@ impl RodGeoms {
             self.inner.evaluate(i, row, o);
         }
         Ok(())
+    }
+}
+
+/// [`RodGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
+/// model's arrays, evaluates every geom and returns the generalized force (see
+/// `granrs.mujoco.Sand`).
+#[pyclass(module = "granrs._granrs")]
+pub struct GeomCoupling {
+    inner: Coupling,
+}
+
+#[pymethods]
+impl GeomCoupling {
+    /// `rods` on MuJoCo's geoms `geom` (bodies `body`, tree roots `root`, tip `reach` from
+    /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
+    /// height and patch in x; `stick` for the static terms as reactions; `at_centroid`
+    /// where the force acts.
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        rods: PyRef<'_, RodGeoms>,
+        geom: Vec<usize>,
+        body: Vec<usize>,
+        root: Vec<usize>,
+        reach: Vec<f64>,
+        dofs: Vec<Vec<usize>>,
+        nv: usize,
+        surface: f64,
+        patch: (f64, f64),
+        stick: bool,
+        at_centroid: bool,
+    ) -> PyResult<Self> {
+        let n = rods.inner.len();
+        if [geom.len(), body.len(), root.len(), reach.len(), dofs.len()]
+            .iter()
+            .any(|&l| l != n)
+            || dofs.iter().flatten().any(|&j| j >= nv)
+        {
+            return Err(PyValueError::new_err("one place per geom, dofs below nv"));
+        }
+        let places = (0..n)
+            .map(|i| EnginePlace {
+                geom: geom[i],
+                body: body[i],
+                root: root[i],
+                reach: reach[i],
+                dofs: dofs[i].clone(),
+            })
+            .collect();
+        Ok(GeomCoupling {
+            inner: Coupling {
+                rods: rods.inner.clone(),
+                places,
+                nv,
+                surface,
+                patch,
+                stick,
+                at_centroid,
+                previous: vec![0.0; nv],
+            },
+        })
+    }
+
+    /// One evaluation at MuJoCo's arrays (`geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`,
+    /// `cdof`, the dense mass matrix, `qvel`, `qacc`): writes each geom's `outputs`
+    /// (ROD_GEOM_OUTPUTS), `applied` force and moment, `h_lambda`, and the generalized
+    /// force `generalized` (nv), and puts it into `target` (nv): added to it without
+    /// `kept` (the passive callback's `qfrc_passive`); with `kept = (before, after)` (the
+    /// user's `qfrc_applied` without and with the last contribution), an entry still equal
+    /// to `after` is restored to `before` and any other is the user's, then the new
+    /// contribution is added and `before` and `after` updated (`fresh`: no last step).
+    /// Returns the largest `h_lambda` and its geom.
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (geom_xpos, geom_xmat, cvel, subtree_com, cdof, mass, qvel, qacc, timestep, outputs, applied, h_lambda, generalized, target, kept=None, fresh=false))]
+    fn step(
+        &mut self,
+        geom_xpos: PyReadonlyArray2<'_, f64>,
+        geom_xmat: PyReadonlyArray2<'_, f64>,
+        cvel: PyReadonlyArray2<'_, f64>,
+        subtree_com: PyReadonlyArray2<'_, f64>,
+        cdof: PyReadonlyArray2<'_, f64>,
+        mass: PyReadonlyArray2<'_, f64>,
+        qvel: PyReadonlyArray1<'_, f64>,
+        qacc: PyReadonlyArray1<'_, f64>,
+        timestep: f64,
+        mut outputs: PyReadwriteArray2<'_, f64>,
+        mut applied: PyReadwriteArray2<'_, f64>,
+        mut h_lambda: PyReadwriteArray1<'_, f64>,
+        mut generalized: PyReadwriteArray1<'_, f64>,
+        mut target: PyReadwriteArray1<'_, f64>,
+        kept: Option<(PyReadwriteArray1<'_, f64>, PyReadwriteArray1<'_, f64>)>,
+        fresh: bool,
+    ) -> PyResult<(f64, usize)> {
+        let c = &self.inner;
+        let (n, nv) = (c.places.len(), c.nv);
+        let bad = |what: &str| PyValueError::new_err(format!("GeomCoupling.step: {what}"));
+        fn slice<'a>(
+            a: &'a PyReadonlyArray2<'_, f64>,
+            cols: usize,
+            rows: usize,
+        ) -> Option<&'a [f64]> {
+            let ok = a.shape()[1] == cols && a.shape()[0] >= rows;
+            a.as_slice().ok().filter(move |_| ok)
+        }
+        let max_geom = c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0);
+        let max_body = c
+            .places
+            .iter()
+            .map(|p| p.body.max(p.root) + 1)
+            .max()
+            .unwrap_or(0);
+        let state = EngineState {
+            geom_xpos: slice(&geom_xpos, 3, max_geom).ok_or_else(|| bad("geom_xpos"))?,
+            geom_xmat: slice(&geom_xmat, 9, max_geom).ok_or_else(|| bad("geom_xmat"))?,
+            cvel: slice(&cvel, 6, max_body).ok_or_else(|| bad("cvel"))?,
+            subtree_com: slice(&subtree_com, 3, max_body).ok_or_else(|| bad("subtree_com"))?,
+            cdof: slice(&cdof, 6, nv).ok_or_else(|| bad("cdof"))?,
+            mass: slice(&mass, nv, nv).ok_or_else(|| bad("mass"))?,
+            qvel: qvel
+                .as_slice()
+                .ok()
+                .filter(|s| s.len() == nv)
+                .ok_or_else(|| bad("qvel"))?,
+            qacc: qacc
+                .as_slice()
+                .ok()
+                .filter(|s| s.len() == nv)
+                .ok_or_else(|| bad("qacc"))?,
+        };
+        let width = crate::evaluate::geoms::OUTPUTS.len();
+        let out = EngineOut {
+            outputs: outputs
+                .as_slice_mut()
+                .ok()
+                .filter(|s| s.len() == n * width)
+                .ok_or_else(|| bad("outputs"))?,
+            applied: applied
+                .as_slice_mut()
+                .ok()
+                .filter(|s| s.len() == n * 3)
+                .ok_or_else(|| bad("applied"))?,
+            h_lambda: h_lambda
+                .as_slice_mut()
+                .ok()
+                .filter(|s| s.len() == n)
+                .ok_or_else(|| bad("h_lambda"))?,
+            generalized: generalized
+                .as_slice_mut()
+                .ok()
+                .filter(|s| s.len() == nv)
+                .ok_or_else(|| bad("generalized"))?,
+        };
+        self.inner.step(&state, timestep, out);
+        let gen = generalized.as_slice().map_err(|_| bad("generalized"))?;
+        let target = target
+            .as_slice_mut()
+            .ok()
+            .filter(|s| s.len() == nv)
+            .ok_or_else(|| bad("target"))?;
+        match kept {
+            None => target.iter_mut().zip(gen).for_each(|(t, g)| *t += g),
+            Some((mut before, mut after)) => {
+                let before = before
+                    .as_slice_mut()
+                    .ok()
+                    .filter(|s| s.len() == nv)
+                    .ok_or_else(|| bad("before"))?;
+                let after = after
+                    .as_slice_mut()
+                    .ok()
+                    .filter(|s| s.len() == nv)
+                    .ok_or_else(|| bad("after"))?;
+                for j in 0..nv {
+                    let user = if !fresh && target[j] == after[j] {
+                        before[j]
+                    } else {
+                        target[j]
+                    };
+                    before[j] = user;
+                    target[j] = user + gen[j];
+                    after[j] = target[j];
+                }
+            }
+        }
+        let worst = h_lambda.as_slice().map_err(|_| bad("h_lambda"))?;
+        let (mut k, mut top) = (0, 0.0);
+        for (i, &x) in worst.iter().enumerate() {
+            if x > top {
+                (k, top) = (i, x);
+            }
+        }
+        Ok((top, k))
     }
 }
