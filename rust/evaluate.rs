@@ -438,6 +438,10 @@ pub mod geoms {
         pub at_centroid: bool,
         /// The last generalized force (nv), whose effect the last `qacc` holds.
         pub previous: Vec<f64>,
+        /// The joints' damping that the engine's step takes implicitly, per dof [N s/m or
+        /// N m s/rad] (MuJoCo's Euler, implicit and implicitfast: the velocity update is
+        /// `(M + h B)^-1` times the force; zero for RK4).
+        pub implicit_damping: Vec<f64>,
     }
 
     /// The x and z rows of the Jacobian of world point `p` on the tree of `place`, and the
@@ -552,7 +556,13 @@ pub mod geoms {
                 }
             }
             let mass = DMatrix::from_row_slice(nv, nv, s.mass);
-            let Some(chol) = mass.cholesky() else {
+            // The matrix of the engine's velocity update, M + h B.
+            let mut step_matrix = mass.clone();
+            for (j, b) in self.implicit_damping.iter().enumerate() {
+                step_matrix[(j, j)] += timestep * b;
+            }
+            let (Some(chol), Some(step_chol)) = (mass.clone().cholesky(), step_matrix.cholesky())
+            else {
                 // Not positive definite (a degenerate state): the forces as evaluated.
                 for (a, &i) in active.iter().enumerate() {
                     self.finish(i, &raw[a], &raw[a], &levers[a], out.outputs, out.applied);
@@ -560,10 +570,10 @@ pub mod geoms {
                 self.generalized(&active, &j_tip, &j_rot, out.applied, out.generalized);
                 return;
             };
-            let minv_jp = chol.solve(&j_p.transpose());
-            let minv_je = chol.solve(&j_e.transpose());
-            let w = &j_e * &minv_jp;
-            let w_e = &j_e * &minv_je;
+            // E's response to a unit force at P over the engine's step, and its inverse
+            // effective mass (for the drag's rate).
+            let w = &j_e * step_chol.solve(&j_p.transpose());
+            let w_e = &j_e * chol.solve(&j_e.transpose());
             for (a, &i) in active.iter().enumerate() {
                 let row = &out.outputs[i * width..(i + 1) * width];
                 let speed = row[c_vx].hypot(row[c_vy]);
@@ -587,12 +597,13 @@ pub mod geoms {
                 })
                 .collect();
             if self.stick && bounds.iter().any(|&b| b > 0.0) {
-                // E's velocity at the step's end without reactions: v + h (a_rest), with the
-                // rest of the world's acceleration from the last qacc less our last force.
+                // E's velocity at the step's end without reactions: v + h (M + h B)^-1 f, with
+                // the rest of the world's force f from the last qacc (M qacc) less our last
+                // force, plus this step's non-static force.
                 let qvel = DVector::from_column_slice(s.qvel);
                 let qacc = DVector::from_column_slice(s.qacc);
                 let previous = DVector::from_column_slice(&self.previous);
-                let accel = qacc + chol.solve(&(&q_rest - previous));
+                let accel = step_chol.solve(&(&mass * qacc - previous + &q_rest));
                 let b = &j_e * (qvel / timestep + accel);
                 solve_boxed(&w, &b, &bounds, &mut reaction);
             }
@@ -641,8 +652,10 @@ pub mod geoms {
     }
 
     /// Solve `w r = -b` for the rows with a positive bound, each `|r_i| <= bound_i` (rows
-    /// without a bound keep their value): solve the free rows, clamp those past their bound
-    /// and hold them, until none is past (an active set; at most one pass per row).
+    /// without a bound keep their value): solve the free rows; if some are past their
+    /// bound, hold the one furthest past (relative to its bound) at its bound and solve the
+    /// rest again (an active set, one row at a time: a sliding row's large value must not
+    /// push the others past theirs).
     fn solve_boxed(
         w: &nalgebra::DMatrix<f64>,
         b: &nalgebra::DVector<f64>,
@@ -664,16 +677,20 @@ pub mod geoms {
             let Some(sol) = a.lu().solve(&rhs) else {
                 return;
             };
-            let mut past = false;
+            let mut worst: Option<(usize, f64)> = None;
             for (p, &i) in f.iter().enumerate() {
-                r[i] = sol[p].clamp(-bounds[i], bounds[i]);
-                if sol[p].abs() > bounds[i] {
-                    free[i] = false;
-                    past = true;
+                let past = sol[p].abs() / bounds[i];
+                if past > 1.0 && worst.is_none_or(|(_, x)| past > x) {
+                    worst = Some((i, past));
                 }
+                r[i] = sol[p];
             }
-            if !past {
-                return;
+            match worst {
+                None => return,
+                Some((i, _)) => {
+                    r[i] = r[i].clamp(-bounds[i], bounds[i]);
+                    free[i] = false;
+                }
             }
         }
     }

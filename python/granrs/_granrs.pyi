@@ -152,6 +152,7 @@ class GeomCoupling:
         patch: tuple[float, float],
         stick: bool,
         at_centroid: bool,
+        implicit_damping: list[float],
     ) -> GeomCoupling: ...
     def step(
         self,

@@ -235,6 +235,7 @@ class Sand:
             self.patch,
             statics == "stick",
             apply_at == "centroid",
+            self._implicit_damping(),
         )
         n = len(names)
         #: Each geom's evaluation at the last step (columns :data:`GEOM_OUTPUTS`).
@@ -251,6 +252,22 @@ class Sand:
         self._data_ref: Any = None
         self._before = np.zeros(model.nv)
         self._after = np.zeros(model.nv)
+
+    def _implicit_damping(self) -> list[float]:
+        """The dof damping that MuJoCo's step takes implicitly (its velocity update is
+        ``(M + h B)^-1`` times the force): Euler (unless ``eulerdamp`` is disabled), implicit
+        and implicitfast; none for RK4. Read when the Sand is built."""
+        m = self.model
+        kind = m.opt.integrator
+        euler = kind == mujoco.mjtIntegrator.mjINT_EULER
+        implicit = kind in (
+            mujoco.mjtIntegrator.mjINT_IMPLICIT,
+            mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+        )
+        off = m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_EULERDAMP
+        if implicit or (euler and not off):
+            return [float(b) for b in m.dof_damping]
+        return [0.0] * m.nv
 
     # -- checks -------------------------------------------------------------------------
 

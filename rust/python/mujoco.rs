@@ -149,7 +149,8 @@ impl GeomCoupling {
     /// `rods` on MuJoCo's geoms `geom` (bodies `body`, tree roots `root`, tip `reach` from
     /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
     /// height and patch in x; `stick` for the static terms as reactions; `at_centroid`
-    /// where the force acts.
+    /// where the force acts; `implicit_damping` the dof damping the engine's step takes
+    /// implicitly (nv).
     #[new]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -164,12 +165,14 @@ impl GeomCoupling {
         patch: (f64, f64),
         stick: bool,
         at_centroid: bool,
+        implicit_damping: Vec<f64>,
     ) -> PyResult<Self> {
         let n = rods.inner.len();
         if [geom.len(), body.len(), root.len(), reach.len(), dofs.len()]
             .iter()
             .any(|&l| l != n)
             || dofs.iter().flatten().any(|&j| j >= nv)
+            || implicit_damping.len() != nv
         {
             return Err(PyValueError::new_err("one place per geom, dofs below nv"));
         }
@@ -192,6 +195,7 @@ impl GeomCoupling {
                 stick,
                 at_centroid,
                 previous: vec![0.0; nv],
+                implicit_damping,
             },
         })
     }
