@@ -226,3 +226,59 @@ def test_bad_input_is_a_typed_error_naming_it_before_the_first_step(
         Sand(model, geoms, terms, **kwargs)
     assert isinstance(info.value, ValueError)
     assert named in str(info.value)
+
+
+@pytest.mark.parametrize("mode", ["step", "callback"])
+def test_a_walker_standing_in_sand_stays_put(mode):
+    """Two sand geoms on one tree, with MuJoCo's implicit joint damping: once the gallery's
+    walker has landed (0.3 s), for 1 s its shanks' tips stay within 0.1 mm and its energy
+    (MuJoCo's KE + PE, springs included) rises by no more than 1e-6 J/s x max(t, 1 s). Pins
+    the chatter of the first version, whose reactions drove each other to their bounds."""
+    from granrs.mujoco import WALKER_SAND_GEOMS, walker_mjcf
+
+    model = mujoco.MjModel.from_xml_string(walker_mjcf())
+    model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+    data = mujoco.MjData(model)
+    data.qvel[1] = -2.0
+    sand = Sand(model, list(WALKER_SAND_GEOMS), THESIS)
+    ids = [model.geom(name).id for name in WALKER_SAND_GEOMS]
+
+    def tips():
+        return np.array([data.geom_xpos[g] - data.geom_xmat[g, 2::3] * 0.26 for g in ids])
+
+    if mode == "callback":
+        sand.install()
+    try:
+        landed = round(0.3 / model.opt.timestep)
+        for k in range(landed + round(1.0 / model.opt.timestep)):
+            if mode == "step":
+                sand.step(data)
+            mujoco.mj_step(model, data)
+            if k == landed:
+                t0, e0, x0 = data.time, data.energy.sum(), tips()
+            elif k > landed:
+                assert np.abs(tips() - x0).max() < 1e-4
+                assert data.energy.sum() - e0 <= 1e-6 * max(data.time - t0, 1.0)
+    finally:
+        if mode == "callback":
+            sand.uninstall()
+
+
+def test_the_gallery_walker_runs():
+    """The gallery's walker example (docs) runs on its short horizon."""
+    import runpy
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    script = Path(__file__).resolve().parents[1] / "examples/gallery/plot_07_mujoco_walker.py"
+    namespace = runpy.run_path(str(script))
+    plt.close("all")
+    runs = namespace["runs"]
+    assert set(runs) == {"sand, thesis's law", "sand, static_v only", "rigid ground"}
+    for _, t, depth, force, _ in runs.values():
+        assert np.all(np.isfinite(depth)) and np.all(np.isfinite(force))
+        assert t[-1] == pytest.approx(namespace["T_END"], abs=1e-9)

@@ -7,8 +7,9 @@ planar MuJoCo model granrs's force terms, evaluated by the same Rust code as
 :func:`granrs.simulate` (each geom is the free link's rod), in one call per step for all
 geoms.
 
-A passive two-legged walker (a torso on slide x, slide z and hinge y; two legs of thigh and
-shank with stiff, damped hips and knees; no controller; its MJCF is below) is dropped at
+A passive two-legged walker (:func:`granrs.mujoco.walker_mjcf`, printed below: a torso on
+slide x, slide z and hinge y; two legs of thigh and shank with stiff, damped hips and knees;
+no controller) is dropped at
 2 m/s onto sand under the thesis's law, onto sand under a second law, and onto MuJoCo's
 rigid ground. The two shanks are the sand geoms and meet the sand tip first, as the thesis's
 rod does. The plot shows how deep the feet go and the ground's vertical reaction; the strip
@@ -21,47 +22,11 @@ import mujoco
 import numpy as np
 
 from granrs import forces
-from granrs.mujoco import Sand
+from granrs.mujoco import WALKER_SAND_GEOMS, Sand, walker_mjcf
 
-WALKER = """
-<mujoco model="granrs planar walker">
-  <option timestep="2e-4" integrator="Euler" gravity="0 0 -9.81"/>
-  <default>
-    <joint type="hinge" axis="0 1 0" stiffness="600" damping="10" armature="0.01"/>
-    <geom type="capsule" density="1000" friction="0.9"/>
-  </default>
-  <worldbody>
-    {floor}
-    <body name="torso" pos="0 0 {z0}">
-      <joint name="rootx" type="slide" axis="1 0 0" stiffness="0" damping="0" armature="0"/>
-      <joint name="rootz" type="slide" axis="0 0 1" stiffness="0" damping="0" armature="0"/>
-      <joint name="rooty" stiffness="0" damping="0" armature="0"/>
-      <geom name="torso" fromto="0 0 0.3 0 0 -0.05" size="0.06"/>
-      <body name="thigh_r" pos="0 0 -0.05">
-        <joint name="hip_r"/>
-        <geom name="thigh_r" fromto="0 0 0 0.12 0 -0.4" size="0.045"/>
-        <body name="shank_r" pos="0.12 0 -0.4">
-          <joint name="knee_r"/>
-          <geom name="shank_r" fromto="0 0 0 0.05 0 -0.45" size="0.035"/>
-        </body>
-      </body>
-      <body name="thigh_l" pos="0 0 -0.05">
-        <joint name="hip_l"/>
-        <geom name="thigh_l" fromto="0 0 0 -0.12 0 -0.4" size="0.045"/>
-        <body name="shank_l" pos="-0.12 0 -0.4">
-          <joint name="knee_l"/>
-          <geom name="shank_l" fromto="0 0 0 -0.05 0 -0.45" size="0.035"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-</mujoco>
-"""
-FLOOR = '<geom name="floor" type="plane" size="5 1 0.1" rgba="0.6 0.5 0.35 1"/>'
-# The shanks' tips (the bottoms of their caps) start at the surface; it falls at 2 m/s.
-Z0 = 0.05 + 0.4 + 0.45 + 0.035
+print(walker_mjcf(floor=True))
 T_END = 0.25  # short, so that the docs build (and CI) runs it in seconds
-GEOMS = ["shank_r", "shank_l"]
+GEOMS = list(WALKER_SAND_GEOMS)
 
 LAWS = {
     "sand, thesis's law": [forces.drag(), forces.static_h(), forces.static_v()],
@@ -73,7 +38,7 @@ LAWS = {
 def land(terms):
     """Drop the hopper; record the foot's depth, the vertical ground force and the poses."""
     rigid = terms is None
-    model = mujoco.MjModel.from_xml_string(WALKER.format(floor=FLOOR if rigid else "", z0=Z0))
+    model = mujoco.MjModel.from_xml_string(walker_mjcf(floor=rigid))
     data = mujoco.MjData(model)
     data.qvel[1] = -2.0
     sand = None if rigid else Sand(model, GEOMS, terms)

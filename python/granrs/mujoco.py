@@ -50,9 +50,11 @@ __all__ = [
     "GEOM_OUTPUTS",
     "INTEGRATORS",
     "STATICS",
+    "WALKER_SAND_GEOMS",
     "Sand",
     "free_link_mjcf",
     "rod_drop",
+    "walker_mjcf",
 ]
 
 #: ``h lambda`` beyond which explicit Euler is unstable for a real, negative rate (|1 - h
@@ -564,3 +566,60 @@ def rod_drop(
         "energy": np.asarray(after_e),
         "sand": sand,
     }
+
+
+#: The sand geoms of :func:`walker_mjcf`: its two shanks.
+WALKER_SAND_GEOMS = ("shank_r", "shank_l")
+
+
+def walker_mjcf(floor: bool = False, timestep: float = 2e-4, integrator: str = "Euler") -> str:
+    """The MJCF of the gallery's passive planar walker (written for granrs; SI units): a
+    torso on slide x, slide z and hinge y; two legs, each a thigh and a shank (capsules of
+    density 1000 kg/m^3, about 13 kg in all) with stiff, damped hinges about y at the hip
+    and knee (600 N m/rad, 10 N m s/rad), no actuators. The shanks' tips (the bottoms of
+    their caps) start at z = 0; ``floor`` adds MuJoCo's rigid ground there (a plane).
+    :data:`WALKER_SAND_GEOMS` are the shanks."""
+    if integrator not in INTEGRATORS:
+        raise UnknownNameError(
+            f"unknown integrator `{integrator}` (allowed: {', '.join(INTEGRATORS)})",
+            field="integrator",
+        )
+    ground = (
+        '<geom name="floor" type="plane" size="5 1 0.1" rgba="0.6 0.5 0.35 1"/>' if floor else ""
+    )
+    # The hip is 0.05 m below the torso's origin, the knee 0.4 m lower, the shank's end
+    # 0.45 m below the knee, and its cap reaches one radius (0.035 m) further.
+    z0 = 0.05 + 0.4 + 0.45 + 0.035
+    return f"""<mujoco model="granrs planar walker">
+  <option timestep="{_number(timestep, "timestep")!r}" integrator="{integrator}"
+          gravity="0 0 -9.81"/>
+  <default>
+    <joint type="hinge" axis="0 1 0" stiffness="600" damping="10" armature="0.01"/>
+    <geom type="capsule" density="1000" friction="0.9"/>
+  </default>
+  <worldbody>
+    {ground}
+    <body name="torso" pos="0 0 {z0!r}">
+      <joint name="rootx" type="slide" axis="1 0 0" stiffness="0" damping="0" armature="0"/>
+      <joint name="rootz" type="slide" axis="0 0 1" stiffness="0" damping="0" armature="0"/>
+      <joint name="rooty" stiffness="0" damping="0" armature="0"/>
+      <geom name="torso" fromto="0 0 0.3 0 0 -0.05" size="0.06"/>
+      <body name="thigh_r" pos="0 0 -0.05">
+        <joint name="hip_r"/>
+        <geom name="thigh_r" fromto="0 0 0 0.12 0 -0.4" size="0.045"/>
+        <body name="shank_r" pos="0.12 0 -0.4">
+          <joint name="knee_r"/>
+          <geom name="shank_r" fromto="0 0 0 0.05 0 -0.45" size="0.035"/>
+        </body>
+      </body>
+      <body name="thigh_l" pos="0 0 -0.05">
+        <joint name="hip_l"/>
+        <geom name="thigh_l" fromto="0 0 0 -0.12 0 -0.4" size="0.045"/>
+        <body name="shank_l" pos="-0.12 0 -0.4">
+          <joint name="knee_l"/>
+          <geom name="shank_l" fromto="0 0 0 -0.05 0 -0.45" size="0.035"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
