@@ -282,3 +282,37 @@ def test_the_gallery_walker_runs():
     for _, t, depth, force, _ in runs.values():
         assert np.all(np.isfinite(depth)) and np.all(np.isfinite(force))
         assert t[-1] == pytest.approx(namespace["T_END"], abs=1e-9)
+
+
+def test_the_generalized_force_is_mj_applyFT_of_each_geoms_force_at_its_tip():
+    """The core's generalized force (its own Jacobians from MuJoCo's cdof) equals MuJoCo's
+    mj_applyFT of each geom's applied force and moment at its tip, on the walker's two
+    shanks mid-impact (different angles, moving, apply_at centroid)."""
+    from granrs.mujoco import WALKER_SAND_GEOMS, walker_mjcf
+
+    model = mujoco.MjModel.from_xml_string(walker_mjcf())
+    data = mujoco.MjData(model)
+    data.qvel[:3] = [0.4, -2.0, 0.8]
+    sand = Sand(model, list(WALKER_SAND_GEOMS), THESIS, apply_at="centroid")
+    for _ in range(60):
+        sand.step(data)
+        mujoco.mj_step(model, data)
+    data.qfrc_applied[:] = 0.0
+    sand.step(data)
+    assert np.all(sand.output[:, 3] > 0.0)
+    expected = np.zeros(model.nv)
+    for i, name in enumerate(WALKER_SAND_GEOMS):
+        g = model.geom(name).id
+        axis = data.geom_xmat[g, 2::3] * np.sign(data.geom_xmat[g, 8])
+        tip = data.geom_xpos[g] - (model.geom_size[g, 1] + model.geom_size[g, 0]) * axis
+        fx, fz, m = sand.applied[i]
+        mujoco.mj_applyFT(
+            model,
+            data,
+            np.array([fx, 0.0, fz]),
+            np.array([0.0, m, 0.0]),
+            tip,
+            int(model.geom_bodyid[g]),
+            expected,
+        )
+    np.testing.assert_allclose(data.qfrc_applied, expected, rtol=1e-12, atol=1e-12)
