@@ -154,27 +154,29 @@ class GeomCoupling:
         at_centroid: bool,
         implicit_damping: list[float],
     ) -> GeomCoupling: ...
-    def step(
+    def bind(
         self,
         geom_xpos: Any,
         geom_xmat: Any,
         cvel: Any,
         subtree_com: Any,
         cdof: Any,
-        mass: Any,
         qvel: Any,
         qacc: Any,
-        timestep: float,
+        qfrc_applied: Any,
+        qfrc_passive: Any,
+        mass: Any,
         outputs: Any,
         applied: Any,
         h_lambda: Any,
         generalized: Any,
-        target: Any,
-        kept: tuple[Any, Any] | None = None,
-        fresh: bool = False,
-    ) -> tuple[float, int]:
-        """One evaluation at MuJoCo's arrays; the generalized force into target. Returns the
-        largest h_lambda and its geom."""
+        before: Any,
+        after: Any,
+    ) -> None:
+        """Bind one mjData's arrays and the caller's buffers (checked once)."""
+    def step(self, timestep: float, passive: bool, fresh: bool) -> tuple[float, int]:
+        """One evaluation at the bound arrays; the generalized force into qfrc_passive
+        (passive) or qfrc_applied. Returns the largest h_lambda and its geom."""
 
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""

@@ -323,16 +323,14 @@ class Sand:
         mujoco.mj_comPos(m, data)
         mujoco.mj_comVel(m, data)
         mujoco.mj_makeM(m, data)
-        fresh = data is not self._data_ref
-        self._data_ref = data
-        self._evaluate(data, data.qfrc_applied, (self._before, self._after), fresh)
+        self._evaluate(data, passive=False)
 
     def _callback(self, m: Any, data: Any) -> None:
         """The passive-force callback: add the sand's force to ``qfrc_passive`` (MuJoCo
         recomputes it at every evaluation, so there is nothing of ours to replace)."""
         if m is not self.model:
             return
-        self._evaluate(data, data.qfrc_passive, None, False)
+        self._evaluate(data, passive=True)
 
     def install(self) -> None:
         """Run as MuJoCo's passive-force callback (``mujoco.set_mjcb_passive``), inside
@@ -351,31 +349,36 @@ class Sand:
         """Stop acting as the passive-force callback (other installed Sands go on)."""
         _Dispatch.remove(self)
 
-    def _evaluate(self, data: Any, target: np.ndarray, kept: Any, fresh: bool) -> None:
+    def _evaluate(self, data: Any, passive: bool) -> None:
         """One call of the core for every geom: each geom's state from MuJoCo's arrays, its
         force through the free link's right-hand side, the static terms' reactions (with
-        ``statics="stick"``), the generalized force of it all into ``target``, and the
-        drag's h lambda."""
+        ``statics="stick"``), the generalized force of it all into ``qfrc_passive``
+        (``passive``) or ``qfrc_applied``, and the drag's h lambda."""
         m = self.model
+        fresh = data is not self._data_ref
+        if fresh:
+            # MuJoCo allocates an mjData's arrays once: the core binds their views once.
+            self._coupling.bind(
+                data.geom_xpos,
+                data.geom_xmat,
+                data.cvel,
+                data.subtree_com,
+                data.cdof,
+                data.qvel,
+                data.qacc,
+                data.qfrc_applied,
+                data.qfrc_passive,
+                self._mass,
+                self.output,
+                self.applied,
+                self.h_lambda,
+                self._generalized,
+                self._before,
+                self._after,
+            )
+            self._data_ref = data
         mujoco.mj_fullM(m, data, self._mass)
-        worst, geom = self._coupling.step(
-            data.geom_xpos,
-            data.geom_xmat,
-            data.cvel,
-            data.subtree_com,
-            data.cdof,
-            self._mass,
-            data.qvel,
-            data.qacc,
-            m.opt.timestep,
-            self.output,
-            self.applied,
-            self.h_lambda,
-            self._generalized,
-            target,
-            kept,
-            fresh,
-        )
+        worst, geom = self._coupling.step(m.opt.timestep, passive, fresh)
         if worst > self.max_h_lambda:
             self.max_h_lambda = worst
             self._warn_step_size(worst, geom)

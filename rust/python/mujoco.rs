@@ -2,7 +2,7 @@
 //! in one call, through the free link's right-hand side (see `rust/evaluate.rs`, `geoms`).
 
 use numpy::{
-    PyReadonlyArray1, PyReadonlyArray2, PyReadwriteArray1, PyReadwriteArray2, PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadwriteArray2, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -136,12 +136,35 @@ impl RodGeoms {
     }
 }
 
+/// The arrays one `GeomCoupling` reads and writes at every step, bound once per `mjData`
+/// (MuJoCo allocates them once, so their views stay valid while held): reading them then
+/// costs no conversion per step.
+struct Arrays {
+    geom_xpos: Py<PyArray2<f64>>,
+    geom_xmat: Py<PyArray2<f64>>,
+    cvel: Py<PyArray2<f64>>,
+    subtree_com: Py<PyArray2<f64>>,
+    cdof: Py<PyArray2<f64>>,
+    mass: Py<PyArray2<f64>>,
+    qvel: Py<PyArray1<f64>>,
+    qacc: Py<PyArray1<f64>>,
+    outputs: Py<PyArray2<f64>>,
+    applied: Py<PyArray2<f64>>,
+    h_lambda: Py<PyArray1<f64>>,
+    generalized: Py<PyArray1<f64>>,
+    qfrc_applied: Py<PyArray1<f64>>,
+    qfrc_passive: Py<PyArray1<f64>>,
+    before: Py<PyArray1<f64>>,
+    after: Py<PyArray1<f64>>,
+}
+
 /// [`RodGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
-/// model's arrays, evaluates every geom and returns the generalized force (see
+/// model's arrays, evaluates every geom and puts the generalized force into MuJoCo's (see
 /// `granrs.mujoco.Sand`).
-#[pyclass(module = "granrs._granrs")]
+#[pyclass(module = "granrs._granrs", unsendable)]
 pub struct GeomCoupling {
     inner: Coupling,
+    bound: Option<Arrays>,
 }
 
 #[pymethods]
@@ -197,118 +220,120 @@ impl GeomCoupling {
                 previous: vec![0.0; nv],
                 implicit_damping,
             },
+            bound: None,
         })
     }
 
-    /// One evaluation at MuJoCo's arrays (`geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`,
-    /// `cdof`, the dense mass matrix, `qvel`, `qacc`): writes each geom's `outputs`
-    /// (ROD_GEOM_OUTPUTS), `applied` force and moment, `h_lambda`, and the generalized
-    /// force `generalized` (nv), and puts it into `target` (nv): added to it without
-    /// `kept` (the passive callback's `qfrc_passive`); with `kept = (before, after)` (the
-    /// user's `qfrc_applied` without and with the last contribution), an entry still equal
-    /// to `after` is restored to `before` and any other is the user's, then the new
-    /// contribution is added and `before` and `after` updated (`fresh`: no last step).
-    /// Returns the largest `h_lambda` and its geom.
+    /// Bind the arrays of one `mjData` (`geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`,
+    /// `cdof`, `qvel`, `qacc`, `qfrc_applied`, `qfrc_passive`) and the caller's buffers (the
+    /// dense mass matrix it fills, `outputs` per geom in ROD_GEOM_OUTPUTS order, `applied`
+    /// force and moment, `h_lambda`, the generalized force, and `before` and `after`, the
+    /// bookkeeping of `qfrc_applied`), each checked for its shape once.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (geom_xpos, geom_xmat, cvel, subtree_com, cdof, mass, qvel, qacc, timestep, outputs, applied, h_lambda, generalized, target, kept=None, fresh=false))]
-    fn step(
+    fn bind(
         &mut self,
-        geom_xpos: PyReadonlyArray2<'_, f64>,
-        geom_xmat: PyReadonlyArray2<'_, f64>,
-        cvel: PyReadonlyArray2<'_, f64>,
-        subtree_com: PyReadonlyArray2<'_, f64>,
-        cdof: PyReadonlyArray2<'_, f64>,
-        mass: PyReadonlyArray2<'_, f64>,
-        qvel: PyReadonlyArray1<'_, f64>,
-        qacc: PyReadonlyArray1<'_, f64>,
-        timestep: f64,
-        mut outputs: PyReadwriteArray2<'_, f64>,
-        mut applied: PyReadwriteArray2<'_, f64>,
-        mut h_lambda: PyReadwriteArray1<'_, f64>,
-        mut generalized: PyReadwriteArray1<'_, f64>,
-        mut target: PyReadwriteArray1<'_, f64>,
-        kept: Option<(PyReadwriteArray1<'_, f64>, PyReadwriteArray1<'_, f64>)>,
-        fresh: bool,
-    ) -> PyResult<(f64, usize)> {
+        geom_xpos: Bound2<'_>,
+        geom_xmat: Bound2<'_>,
+        cvel: Bound2<'_>,
+        subtree_com: Bound2<'_>,
+        cdof: Bound2<'_>,
+        qvel: Bound1<'_>,
+        qacc: Bound1<'_>,
+        qfrc_applied: Bound1<'_>,
+        qfrc_passive: Bound1<'_>,
+        mass: Bound2<'_>,
+        outputs: Bound2<'_>,
+        applied: Bound2<'_>,
+        h_lambda: Bound1<'_>,
+        generalized: Bound1<'_>,
+        before: Bound1<'_>,
+        after: Bound1<'_>,
+    ) -> PyResult<()> {
         let c = &self.inner;
         let (n, nv) = (c.places.len(), c.nv);
-        let bad = |what: &str| PyValueError::new_err(format!("GeomCoupling.step: {what}"));
-        fn slice<'a>(
-            a: &'a PyReadonlyArray2<'_, f64>,
-            cols: usize,
-            rows: usize,
-        ) -> Option<&'a [f64]> {
-            let ok = a.shape()[1] == cols && a.shape()[0] >= rows;
-            a.as_slice().ok().filter(move |_| ok)
-        }
         let max_geom = c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0);
-        let max_body = c
-            .places
-            .iter()
-            .map(|p| p.body.max(p.root) + 1)
-            .max()
-            .unwrap_or(0);
-        let state = EngineState {
-            geom_xpos: slice(&geom_xpos, 3, max_geom).ok_or_else(|| bad("geom_xpos"))?,
-            geom_xmat: slice(&geom_xmat, 9, max_geom).ok_or_else(|| bad("geom_xmat"))?,
-            cvel: slice(&cvel, 6, max_body).ok_or_else(|| bad("cvel"))?,
-            subtree_com: slice(&subtree_com, 3, max_body).ok_or_else(|| bad("subtree_com"))?,
-            cdof: slice(&cdof, 6, nv).ok_or_else(|| bad("cdof"))?,
-            mass: slice(&mass, nv, nv).ok_or_else(|| bad("mass"))?,
-            qvel: qvel
-                .as_slice()
-                .ok()
-                .filter(|s| s.len() == nv)
-                .ok_or_else(|| bad("qvel"))?,
-            qacc: qacc
-                .as_slice()
-                .ok()
-                .filter(|s| s.len() == nv)
-                .ok_or_else(|| bad("qacc"))?,
-        };
+        let max_body = c.places.iter().map(|p| p.body.max(p.root) + 1).max().unwrap_or(0);
         let width = crate::evaluate::geoms::OUTPUTS.len();
-        let out = EngineOut {
-            outputs: outputs
-                .as_slice_mut()
-                .ok()
-                .filter(|s| s.len() == n * width)
-                .ok_or_else(|| bad("outputs"))?,
-            applied: applied
-                .as_slice_mut()
-                .ok()
-                .filter(|s| s.len() == n * 3)
-                .ok_or_else(|| bad("applied"))?,
-            h_lambda: h_lambda
-                .as_slice_mut()
-                .ok()
-                .filter(|s| s.len() == n)
-                .ok_or_else(|| bad("h_lambda"))?,
-            generalized: generalized
-                .as_slice_mut()
-                .ok()
-                .filter(|s| s.len() == nv)
-                .ok_or_else(|| bad("generalized"))?,
+        let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
+            let [r, k] = [a.shape()[0], a.shape()[1]];
+            let ok = k == cols && if exact { r == rows } else { r >= rows };
+            if ok && a.is_c_contiguous() {
+                Ok(a.clone().unbind())
+            } else {
+                Err(PyValueError::new_err(format!("GeomCoupling.bind: {name}")))
+            }
         };
-        self.inner.step(&state, timestep, out);
-        let gen = generalized.as_slice().map_err(|_| bad("generalized"))?;
-        let target = target
-            .as_slice_mut()
-            .ok()
-            .filter(|s| s.len() == nv)
-            .ok_or_else(|| bad("target"))?;
-        match kept {
-            None => target.iter_mut().zip(gen).for_each(|(t, g)| *t += g),
-            Some((mut before, mut after)) => {
-                let before = before
-                    .as_slice_mut()
-                    .ok()
-                    .filter(|s| s.len() == nv)
-                    .ok_or_else(|| bad("before"))?;
-                let after = after
-                    .as_slice_mut()
-                    .ok()
-                    .filter(|s| s.len() == nv)
-                    .ok_or_else(|| bad("after"))?;
+        let one = |a: &Bound1<'_>, name: &str, len: usize| {
+            if a.len() == len && a.is_c_contiguous() {
+                Ok(a.clone().unbind())
+            } else {
+                Err(PyValueError::new_err(format!("GeomCoupling.bind: {name}")))
+            }
+        };
+        self.bound = Some(Arrays {
+            geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
+            geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
+            cvel: two(&cvel, "cvel", max_body, 6, false)?,
+            subtree_com: two(&subtree_com, "subtree_com", max_body, 3, false)?,
+            cdof: two(&cdof, "cdof", nv, 6, true)?,
+            mass: two(&mass, "mass", nv, nv, true)?,
+            qvel: one(&qvel, "qvel", nv)?,
+            qacc: one(&qacc, "qacc", nv)?,
+            outputs: two(&outputs, "outputs", n, width, true)?,
+            applied: two(&applied, "applied", n, 3, true)?,
+            h_lambda: one(&h_lambda, "h_lambda", n)?,
+            generalized: one(&generalized, "generalized", nv)?,
+            qfrc_applied: one(&qfrc_applied, "qfrc_applied", nv)?,
+            qfrc_passive: one(&qfrc_passive, "qfrc_passive", nv)?,
+            before: one(&before, "before", nv)?,
+            after: one(&after, "after", nv)?,
+        });
+        Ok(())
+    }
+
+    /// One evaluation at the bound arrays (the mass matrix filled by the caller): writes
+    /// each geom's outputs, applied force and moment and `h_lambda`, and the generalized
+    /// force, and puts it into MuJoCo's: with `passive`, added to `qfrc_passive` (the
+    /// callback); else into `qfrc_applied`, where an entry still equal to `after` (what
+    /// the last step left there) is restored to `before` (what it held before), any other
+    /// entry is the user's, the new contribution is added and `before` and `after` kept
+    /// (`fresh`: no last step, every entry is the user's). Returns the largest `h_lambda`
+    /// and its geom.
+    fn step(&mut self, py: Python<'_>, timestep: f64, passive: bool, fresh: bool) -> PyResult<(f64, usize)> {
+        let Some(b) = &self.bound else {
+            return Err(PyValueError::new_err("GeomCoupling.step before bind"));
+        };
+        let nv = self.inner.nv;
+        // SAFETY: the arrays were checked contiguous with their shapes at `bind`; MuJoCo
+        // never reallocates an mjData's arrays, the buffers are this Sand's own, and with
+        // the GIL held nothing else touches them during the call. Each is read or written
+        // through one slice at a time (no two slices alias: distinct arrays).
+        unsafe {
+            let state = EngineState {
+                geom_xpos: ro(py, &b.geom_xpos),
+                geom_xmat: ro(py, &b.geom_xmat),
+                cvel: ro(py, &b.cvel),
+                subtree_com: ro(py, &b.subtree_com),
+                cdof: ro(py, &b.cdof),
+                mass: ro(py, &b.mass),
+                qvel: ro(py, &b.qvel),
+                qacc: ro(py, &b.qacc),
+            };
+            let out = EngineOut {
+                outputs: rw(py, &b.outputs),
+                applied: rw(py, &b.applied),
+                h_lambda: rw(py, &b.h_lambda),
+                generalized: rw(py, &b.generalized),
+            };
+            self.inner.step(&state, timestep, out);
+            let gen = ro(py, &b.generalized);
+            if passive {
+                let target = rw(py, &b.qfrc_passive);
+                target.iter_mut().zip(gen).for_each(|(t, g)| *t += g);
+            } else {
+                let target = rw(py, &b.qfrc_applied);
+                let before = rw(py, &b.before);
+                let after = rw(py, &b.after);
                 for j in 0..nv {
                     let user = if !fresh && target[j] == after[j] {
                         before[j]
@@ -320,14 +345,41 @@ impl GeomCoupling {
                     after[j] = target[j];
                 }
             }
-        }
-        let worst = h_lambda.as_slice().map_err(|_| bad("h_lambda"))?;
-        let (mut k, mut top) = (0, 0.0);
-        for (i, &x) in worst.iter().enumerate() {
-            if x > top {
-                (k, top) = (i, x);
+            let h = ro(py, &b.h_lambda);
+            let (mut k, mut top) = (0, 0.0);
+            for (i, &x) in h.iter().enumerate() {
+                if x > top {
+                    (k, top) = (i, x);
+                }
             }
+            Ok((top, k))
         }
-        Ok((top, k))
     }
 }
+
+/// A bound array's data, read-only.
+///
+/// # Safety
+/// As [`PyArrayMethods::as_slice`]: nothing may write the array while the slice lives.
+unsafe fn ro<'a, D: numpy::ndarray::Dimension>(
+    py: Python<'a>,
+    a: &'a Py<numpy::PyArray<f64, D>>,
+) -> &'a [f64] {
+    a.bind(py).as_slice().expect("contiguous, checked at bind")
+}
+
+/// A bound array's data, writable.
+///
+/// # Safety
+/// As [`PyArrayMethods::as_slice_mut`]: nothing else may read or write the array while the
+/// slice lives.
+#[allow(clippy::mut_from_ref)]
+unsafe fn rw<'a, D: numpy::ndarray::Dimension>(
+    py: Python<'a>,
+    a: &'a Py<numpy::PyArray<f64, D>>,
+) -> &'a mut [f64] {
+    a.bind(py).as_slice_mut().expect("contiguous, checked at bind")
+}
+
+type Bound1<'py> = Bound<'py, PyArray1<f64>>;
+type Bound2<'py> = Bound<'py, PyArray2<f64>>;
