@@ -417,6 +417,44 @@ pub mod geoms {
         pub generalized: &'a mut [f64],
     }
 
+    /// Most geoms one [`Coupling`] takes.
+    pub const MAX_COUPLED: usize = 16;
+
+    /// A [`Coupling`]'s buffers, sized once (an evaluation allocates next to nothing).
+    #[derive(Debug, Clone, Default)]
+    pub struct Work {
+        j_tip: Vec<f64>,
+        j_e: Vec<f64>,
+        j_rot: Vec<f64>,
+        chol_m: Vec<f64>,
+        chol_h: Vec<f64>,
+        w: Vec<f64>,
+        tmp: Vec<f64>,
+        tmp2: Vec<f64>,
+        q_rest: Vec<f64>,
+        raw: Vec<[f64; 2]>,
+        levers: Vec<[f64; 2]>,
+    }
+
+    impl Work {
+        /// Buffers for `n` geoms and `nv` dofs.
+        pub fn new(n: usize, nv: usize) -> Work {
+            Work {
+                j_tip: vec![0.0; 2 * n * nv],
+                j_e: vec![0.0; 2 * n * nv],
+                j_rot: vec![0.0; n * nv],
+                chol_m: vec![0.0; nv * nv],
+                chol_h: vec![0.0; nv * nv],
+                w: vec![0.0; 4 * n * n],
+                tmp: vec![0.0; nv],
+                tmp2: vec![0.0; nv],
+                q_rest: vec![0.0; nv],
+                raw: vec![[0.0; 2]; n],
+                levers: vec![[0.0; 2]; n],
+            }
+        }
+    }
+
     /// The coupling to another engine: [`RodGeoms`] placed on its bodies, with the sand's
     /// surface and patch, and the static terms' treatment.
     #[derive(Debug, Clone)]
@@ -442,21 +480,31 @@ pub mod geoms {
         /// N m s/rad] (MuJoCo's Euler, implicit and implicitfast: the velocity update is
         /// `(M + h B)^-1` times the force; zero for RK4).
         pub implicit_damping: Vec<f64>,
+        /// Buffers ([`Work::new`] for the geoms and dofs).
+        pub work: Work,
     }
 
-    /// The x and z rows of the Jacobian of world point `p` on the tree of `place`, and the
-    /// y row of its rotation.
-    fn jacobian(place: &EnginePlace, s: &EngineState, nv: usize, p: [f64; 3]) -> [Vec<f64>; 3] {
+    /// The x and z rows of the Jacobian of world point `p` on the tree of `place` into
+    /// `rows` (2 x nv, zeroed), and the y row of its rotation into `rot`, from MuJoCo's
+    /// `cdof` (as `mj_jac` builds them).
+    fn jacobian(
+        place: &EnginePlace,
+        s: &EngineState,
+        nv: usize,
+        p: [f64; 3],
+        rows: &mut [f64],
+        mut rot: Option<&mut [f64]>,
+    ) {
         let c = &s.subtree_com[3 * place.root..3 * place.root + 3];
         let o = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
-        let mut rows = [vec![0.0; nv], vec![0.0; nv], vec![0.0; nv]];
         for &j in &place.dofs {
             let d = &s.cdof[6 * j..6 * j + 6];
-            rows[0][j] = d[3] + d[1] * o[2] - d[2] * o[1];
-            rows[1][j] = d[5] + d[0] * o[1] - d[1] * o[0];
-            rows[2][j] = d[1];
+            rows[j] = d[3] + d[1] * o[2] - d[2] * o[1];
+            rows[nv + j] = d[5] + d[0] * o[1] - d[1] * o[0];
+            if let Some(r) = rot.as_deref_mut() {
+                r[j] = d[1];
+            }
         }
-        rows
     }
 
     impl Coupling {
@@ -464,12 +512,11 @@ pub mod geoms {
         /// [`RodGeoms::evaluate`], the static terms' reactions (with `stick`), and the
         /// generalized force of it all. `timestep` [s] sets the reactions and `h lambda`.
         pub fn step(&mut self, s: &EngineState, timestep: f64, out: EngineOut) {
-            use nalgebra::{DMatrix, DVector};
-            let n = self.places.len();
             let nv = self.nv;
             let width = OUTPUTS.len();
-            let mut tips = vec![[0.0; 3]; n];
-            let mut active = Vec::with_capacity(n);
+            let mut tips = [[0.0; 3]; MAX_COUPLED];
+            let mut active_buf = [0usize; MAX_COUPLED];
+            let mut n_active = 0;
             out.applied.fill(0.0);
             out.h_lambda.fill(0.0);
             out.generalized.fill(0.0);
@@ -502,152 +549,220 @@ pub mod geoms {
                 self.rods.evaluate(i, &state, row);
                 tips[i] = tip;
                 if row[3] > 0.0 && tip[0] >= self.patch.0 && tip[0] <= self.patch.1 {
-                    active.push(i);
+                    active_buf[n_active] = i;
+                    n_active += 1;
                 }
             }
+            let active = &active_buf[..n_active];
             if active.is_empty() {
                 self.previous.fill(0.0);
                 return;
             }
             let k = active.len();
-            let col = |name: &str| OUTPUTS.iter().position(|c| *c == name).expect("a column");
-            let (c_fx, c_fy, c_m) = (col("F_x"), col("F_y"), col("M"));
-            let (c_ex, c_ey) = (col("E_x"), col("E_y"));
-            let (c_sx, c_sy, c_bx, c_by) =
-                (col("F_sx"), col("F_sy"), col("bound_x"), col("bound_y"));
-            let (c_vx, c_vy, c_k) = (col("v_Ex"), col("v_Ey"), col("k_drag"));
-            // Jacobians of the tip, of E and of P (x and z rows), and the rotation about y.
-            let mut j_tip = DMatrix::zeros(2 * k, nv);
-            let mut j_rot = DMatrix::zeros(k, nv);
-            let mut j_e = DMatrix::zeros(2 * k, nv);
-            let mut j_p = DMatrix::zeros(2 * k, nv);
-            let mut q_rest = DVector::zeros(nv);
-            let mut raw = vec![[0.0; 2]; k];
-            let mut levers = vec![[0.0; 2]; k];
+            let (c_fx, c_fy, c_m, c_ex, c_ey) = (0, 1, 2, 5, 6);
+            let (c_vx, c_vy, c_sx, c_sy, c_bx, c_by, c_k) = (7, 8, 11, 12, 13, 14, 15);
+            debug_assert_eq!(OUTPUTS[c_sx], "F_sx");
+            debug_assert_eq!(OUTPUTS[c_k], "k_drag");
+            let w_ = &mut self.work;
+            // Jacobians (rows of nv) of the tip and of E (x and z per geom), and the rotation
+            // about y; P is the tip or E.
+            w_.j_tip[..2 * k * nv].fill(0.0);
+            w_.j_e[..2 * k * nv].fill(0.0);
+            w_.j_rot[..k * nv].fill(0.0);
+            w_.q_rest.fill(0.0);
             for (a, &i) in active.iter().enumerate() {
                 let place = &self.places[i];
                 let row = &out.outputs[i * width..(i + 1) * width];
                 let centroid = [row[c_ex], 0.0, row[c_ey] + self.surface];
-                let [tx, tz, ry] = jacobian(place, s, nv, tips[i]);
-                let [ex, ez, _] = jacobian(place, s, nv, centroid);
-                for j in 0..nv {
-                    j_tip[(2 * a, j)] = tx[j];
-                    j_tip[(2 * a + 1, j)] = tz[j];
-                    j_rot[(a, j)] = ry[j];
-                    j_e[(2 * a, j)] = ex[j];
-                    j_e[(2 * a + 1, j)] = ez[j];
-                }
-                if self.at_centroid {
-                    levers[a] = [centroid[0] - tips[i][0], centroid[2] - tips[i][2]];
-                    let rows = j_e.rows(2 * a, 2).into_owned();
-                    j_p.rows_mut(2 * a, 2).copy_from(&rows);
+                let (tip_rows, rot) = (
+                    &mut w_.j_tip[2 * a * nv..(2 * a + 2) * nv],
+                    &mut w_.j_rot[a * nv..(a + 1) * nv],
+                );
+                jacobian(place, s, nv, tips[i], tip_rows, Some(rot));
+                jacobian(
+                    place,
+                    s,
+                    nv,
+                    centroid,
+                    &mut w_.j_e[2 * a * nv..(2 * a + 2) * nv],
+                    None,
+                );
+                w_.raw[a] = [row[c_sx], row[c_sy]];
+                w_.levers[a] = if self.at_centroid {
+                    [centroid[0] - tips[i][0], centroid[2] - tips[i][2]]
                 } else {
-                    let rows = j_tip.rows(2 * a, 2).into_owned();
-                    j_p.rows_mut(2 * a, 2).copy_from(&rows);
-                }
-                raw[a] = [row[c_sx], row[c_sy]];
+                    [0.0; 2]
+                };
                 // Everything but the static terms: the force less the static sum, with its
                 // moment about the tip less that of the static sum at P.
-                let [lx, lz] = levers[a];
-                let f = [row[c_fx] - raw[a][0], row[c_fy] - raw[a][1]];
-                let moment = row[c_m] - (lz * raw[a][0] - lx * raw[a][1]);
+                let [lx, lz] = w_.levers[a];
+                let raw = w_.raw[a];
+                let f = [row[c_fx] - raw[0], row[c_fy] - raw[1]];
+                let moment = row[c_m] - (lz * raw[0] - lx * raw[1]);
                 for j in 0..nv {
-                    q_rest[j] += f[0] * tx[j] + f[1] * tz[j] + moment * ry[j];
+                    w_.q_rest[j] += f[0] * w_.j_tip[2 * a * nv + j]
+                        + f[1] * w_.j_tip[(2 * a + 1) * nv + j]
+                        + moment * w_.j_rot[a * nv + j];
                 }
             }
-            let mass = DMatrix::from_row_slice(nv, nv, s.mass);
-            // The matrix of the engine's velocity update, M + h B.
-            let mut step_matrix = mass.clone();
+            // M and the matrix of the engine's velocity update, M + h B, factored.
+            w_.chol_m.copy_from_slice(s.mass);
+            w_.chol_h.copy_from_slice(s.mass);
             for (j, b) in self.implicit_damping.iter().enumerate() {
-                step_matrix[(j, j)] += timestep * b;
+                w_.chol_h[j * nv + j] += timestep * b;
             }
-            let (Some(chol), Some(step_chol)) = (mass.clone().cholesky(), step_matrix.cholesky())
-            else {
+            if !(cholesky(&mut w_.chol_m, nv) && cholesky(&mut w_.chol_h, nv)) {
                 // Not positive definite (a degenerate state): the forces as evaluated.
                 for (a, &i) in active.iter().enumerate() {
-                    self.finish(i, &raw[a], &raw[a], &levers[a], out.outputs, out.applied);
+                    finish(
+                        i,
+                        &w_.raw[a],
+                        &w_.raw[a],
+                        &w_.levers[a],
+                        out.outputs,
+                        out.applied,
+                    );
                 }
-                self.generalized(&active, &j_tip, &j_rot, out.applied, out.generalized);
+                self.generalized(active, out.applied, out.generalized);
                 return;
-            };
-            // E's response to a unit force at P over the engine's step, and its inverse
-            // effective mass (for the drag's rate).
-            let w = &j_e * step_chol.solve(&j_p.transpose());
-            let w_e = &j_e * chol.solve(&j_e.transpose());
+            }
+            let rows = 2 * k;
+            let j_p = if self.at_centroid { &w_.j_e } else { &w_.j_tip };
+            // W = J_E H^-1 J_P^T: E's response to a unit force at P over the engine's step.
+            for c in 0..rows {
+                w_.tmp.copy_from_slice(&j_p[c * nv..(c + 1) * nv]);
+                chol_solve(&w_.chol_h, nv, &mut w_.tmp);
+                for r in 0..rows {
+                    w_.w[r * rows + c] = dot(&w_.j_e[r * nv..(r + 1) * nv], &w_.tmp);
+                }
+            }
+            // The drag's rate: 2 |F_d| / |v_E| times E's inverse effective mass along v_E.
             for (a, &i) in active.iter().enumerate() {
                 let row = &out.outputs[i * width..(i + 1) * width];
                 let speed = row[c_vx].hypot(row[c_vy]);
                 if speed > 0.0 && row[c_k] > 0.0 {
                     let u = [row[c_vx] / speed, row[c_vy] / speed];
-                    let mut inv_mass = 0.0;
-                    for (p, up) in u.iter().enumerate() {
-                        for (q, uq) in u.iter().enumerate() {
-                            inv_mass += up * w_e[(2 * a + p, 2 * a + q)] * uq;
-                        }
+                    for j in 0..nv {
+                        let ju =
+                            u[0] * w_.j_e[2 * a * nv + j] + u[1] * w_.j_e[(2 * a + 1) * nv + j];
+                        w_.tmp[j] = ju;
+                        w_.tmp2[j] = ju;
                     }
+                    chol_solve(&w_.chol_m, nv, &mut w_.tmp);
+                    let inv_mass = dot(&w_.tmp2, &w_.tmp);
                     out.h_lambda[i] = timestep * 2.0 * row[c_k] * inv_mass;
                 }
             }
-            let mut reaction: Vec<f64> = raw.iter().flat_map(|r| r.iter().copied()).collect();
-            let bounds: Vec<f64> = active
-                .iter()
-                .flat_map(|&i| {
-                    let row = &out.outputs[i * width..(i + 1) * width];
-                    [row[c_bx], row[c_by]]
-                })
-                .collect();
-            if self.stick && bounds.iter().any(|&b| b > 0.0) {
+            let mut reaction = [0.0; 2 * MAX_COUPLED];
+            let mut bounds = [0.0; 2 * MAX_COUPLED];
+            for (a, &i) in active.iter().enumerate() {
+                let row = &out.outputs[i * width..(i + 1) * width];
+                reaction[2 * a..2 * a + 2].copy_from_slice(&w_.raw[a]);
+                bounds[2 * a] = row[c_bx];
+                bounds[2 * a + 1] = row[c_by];
+            }
+            if self.stick && bounds[..rows].iter().any(|&b| b > 0.0) {
                 // E's velocity at the step's end without reactions: v + h (M + h B)^-1 f, with
                 // the rest of the world's force f from the last qacc (M qacc) less our last
                 // force, plus this step's non-static force.
-                let qvel = DVector::from_column_slice(s.qvel);
-                let qacc = DVector::from_column_slice(s.qacc);
-                let previous = DVector::from_column_slice(&self.previous);
-                let accel = step_chol.solve(&(&mass * qacc - previous + &q_rest));
-                let b = &j_e * (qvel / timestep + accel);
-                solve_boxed(&w, &b, &bounds, &mut reaction);
+                for r in 0..nv {
+                    w_.tmp[r] = dot(&s.mass[r * nv..(r + 1) * nv], s.qacc) - self.previous[r]
+                        + w_.q_rest[r];
+                }
+                chol_solve(&w_.chol_h, nv, &mut w_.tmp);
+                let b = nalgebra::DVector::from_fn(rows, |r, _| {
+                    let je = &w_.j_e[r * nv..(r + 1) * nv];
+                    dot(je, s.qvel) / timestep + dot(je, &w_.tmp)
+                });
+                let w = nalgebra::DMatrix::from_row_slice(rows, rows, &w_.w[..rows * rows]);
+                solve_boxed(&w, &b, &bounds[..rows], &mut reaction[..rows]);
             }
             for (a, &i) in active.iter().enumerate() {
                 let r = [reaction[2 * a], reaction[2 * a + 1]];
-                self.finish(i, &raw[a], &r, &levers[a], out.outputs, out.applied);
+                finish(i, &w_.raw[a], &r, &w_.levers[a], out.outputs, out.applied);
             }
-            self.generalized(&active, &j_tip, &j_rot, out.applied, out.generalized);
+            self.generalized(active, out.applied, out.generalized);
         }
 
-        /// Geom `i`'s applied force and moment (its static sum `raw` replaced by `r` at P).
-        fn finish(
-            &self,
-            i: usize,
-            raw: &[f64; 2],
-            r: &[f64; 2],
-            lever: &[f64; 2],
-            outputs: &[f64],
-            applied: &mut [f64],
-        ) {
-            let width = OUTPUTS.len();
-            let row = &outputs[i * width..(i + 1) * width];
-            let d = [r[0] - raw[0], r[1] - raw[1]];
-            applied[3 * i] = row[0] + d[0];
-            applied[3 * i + 1] = row[1] + d[1];
-            applied[3 * i + 2] = row[2] + lever[1] * d[0] - lever[0] * d[1];
-        }
-
-        /// The generalized force of the applied forces and moments, kept as `previous`.
-        fn generalized(
-            &mut self,
-            active: &[usize],
-            j_tip: &nalgebra::DMatrix<f64>,
-            j_rot: &nalgebra::DMatrix<f64>,
-            applied: &[f64],
-            generalized: &mut [f64],
-        ) {
+        /// The generalized force of the applied forces and moments (at the tip, through the
+        /// Jacobians of the last evaluation), kept as `previous`.
+        fn generalized(&mut self, active: &[usize], applied: &[f64], generalized: &mut [f64]) {
+            let nv = self.nv;
+            let w_ = &self.work;
             for (a, &i) in active.iter().enumerate() {
                 let [fx, fz, m] = [applied[3 * i], applied[3 * i + 1], applied[3 * i + 2]];
                 for (j, g) in generalized.iter_mut().enumerate() {
-                    *g += fx * j_tip[(2 * a, j)] + fz * j_tip[(2 * a + 1, j)] + m * j_rot[(a, j)];
+                    *g += fx * w_.j_tip[2 * a * nv + j]
+                        + fz * w_.j_tip[(2 * a + 1) * nv + j]
+                        + m * w_.j_rot[a * nv + j];
                 }
             }
             self.previous.copy_from_slice(generalized);
+        }
+    }
+
+    /// Geom `i`'s applied force and moment (its static sum `raw` replaced by `r` at P).
+    fn finish(
+        i: usize,
+        raw: &[f64; 2],
+        r: &[f64; 2],
+        lever: &[f64; 2],
+        outputs: &[f64],
+        applied: &mut [f64],
+    ) {
+        let width = OUTPUTS.len();
+        let row = &outputs[i * width..(i + 1) * width];
+        let d = [r[0] - raw[0], r[1] - raw[1]];
+        applied[3 * i] = row[0] + d[0];
+        applied[3 * i + 1] = row[1] + d[1];
+        applied[3 * i + 2] = row[2] + lever[1] * d[0] - lever[0] * d[1];
+    }
+
+    /// `a . b`.
+    #[inline]
+    fn dot(a: &[f64], b: &[f64]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| x * y).sum()
+    }
+
+    /// The Cholesky factor L of the symmetric `a` (n x n, row-major) in its lower triangle,
+    /// in place; `false` where `a` is not positive definite.
+    fn cholesky(a: &mut [f64], n: usize) -> bool {
+        for j in 0..n {
+            let mut d = a[j * n + j];
+            for k in 0..j {
+                d -= a[j * n + k] * a[j * n + k];
+            }
+            if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return false;
+            }
+            let d = d.sqrt();
+            a[j * n + j] = d;
+            for i in j + 1..n {
+                let mut v = a[i * n + j];
+                for k in 0..j {
+                    v -= a[i * n + k] * a[j * n + k];
+                }
+                a[i * n + j] = v / d;
+            }
+        }
+        true
+    }
+
+    /// Solve `L L^T x = b` in place (`x` holds b), L from [`cholesky`].
+    fn chol_solve(l: &[f64], n: usize, x: &mut [f64]) {
+        for i in 0..n {
+            let mut v = x[i];
+            for k in 0..i {
+                v -= l[i * n + k] * x[k];
+            }
+            x[i] = v / l[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let mut v = x[i];
+            for k in i + 1..n {
+                v -= l[k * n + i] * x[k];
+            }
+            x[i] = v / l[i * n + i];
         }
     }
 

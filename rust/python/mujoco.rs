@@ -13,7 +13,9 @@ use super::terms::terms_from_py;
 use crate::body::rod::ApplyAt;
 use crate::dynamics::SignModel;
 use crate::error::GranrsError;
-use crate::evaluate::geoms::{self, Coupling, EngineOut, EnginePlace, EngineState, STATE};
+use crate::evaluate::geoms::{
+    self, Coupling, EngineOut, EnginePlace, EngineState, Work, MAX_COUPLED, STATE,
+};
 use crate::forces::{ForceSet, Medium};
 use crate::spec::Value;
 
@@ -199,6 +201,11 @@ impl GeomCoupling {
         {
             return Err(PyValueError::new_err("one place per geom, dofs below nv"));
         }
+        if n > MAX_COUPLED {
+            return Err(PyValueError::new_err(format!(
+                "at most {MAX_COUPLED} geoms"
+            )));
+        }
         let places = (0..n)
             .map(|i| EnginePlace {
                 geom: geom[i],
@@ -219,6 +226,7 @@ impl GeomCoupling {
                 at_centroid,
                 previous: vec![0.0; nv],
                 implicit_damping,
+                work: Work::new(n, nv),
             },
             bound: None,
         })
@@ -252,7 +260,12 @@ impl GeomCoupling {
         let c = &self.inner;
         let (n, nv) = (c.places.len(), c.nv);
         let max_geom = c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0);
-        let max_body = c.places.iter().map(|p| p.body.max(p.root) + 1).max().unwrap_or(0);
+        let max_body = c
+            .places
+            .iter()
+            .map(|p| p.body.max(p.root) + 1)
+            .max()
+            .unwrap_or(0);
         let width = crate::evaluate::geoms::OUTPUTS.len();
         let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
             let [r, k] = [a.shape()[0], a.shape()[1]];
@@ -299,7 +312,13 @@ impl GeomCoupling {
     /// entry is the user's, the new contribution is added and `before` and `after` kept
     /// (`fresh`: no last step, every entry is the user's). Returns the largest `h_lambda`
     /// and its geom.
-    fn step(&mut self, py: Python<'_>, timestep: f64, passive: bool, fresh: bool) -> PyResult<(f64, usize)> {
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        timestep: f64,
+        passive: bool,
+        fresh: bool,
+    ) -> PyResult<(f64, usize)> {
         let Some(b) = &self.bound else {
             return Err(PyValueError::new_err("GeomCoupling.step before bind"));
         };
@@ -378,7 +397,9 @@ unsafe fn rw<'a, D: numpy::ndarray::Dimension>(
     py: Python<'a>,
     a: &'a Py<numpy::PyArray<f64, D>>,
 ) -> &'a mut [f64] {
-    a.bind(py).as_slice_mut().expect("contiguous, checked at bind")
+    a.bind(py)
+        .as_slice_mut()
+        .expect("contiguous, checked at bind")
 }
 
 type Bound1<'py> = Bound<'py, PyArray1<f64>>;
