@@ -67,15 +67,12 @@ def test_step_and_callback_give_the_same_drop():
     assert b["t_s"] == pytest.approx(a["t_s"], rel=1e-9)
 
 
-@pytest.mark.parametrize(
-    ("t_after", "mode"),
-    [pytest.param(10.0, "callback", marks=pytest.mark.slow), (1.0, "callback"), (1.0, "step")],
-)
-def test_a_resting_rod_stays_put_and_gains_no_energy(t_after, mode):
+@pytest.mark.parametrize("mode", ["step", "callback"])
+def test_a_resting_rod_stays_put_and_gains_no_energy(mode):
     """Acceptance (rest): after the stop of the q = 0, v0 = 2 m/s drop, the tip stays within
     0.1 mm of where it stopped and E(t) - E(t_stop) <= 1e-6 J/s x max(t - t_stop, 1 s)."""
     scene = granrs.cases.free_link(q_deg=0, v0=2.0)
-    got = rod_drop(scene, timestep=1e-4, mode=mode, t_after=t_after)
+    got = rod_drop(scene, timestep=1e-4, mode=mode, t_after=10.0)
     moved = np.max(np.hypot(*(got["tip"] - got["tip"][0]).T))
     assert moved < 1e-4
     elapsed = got["t"] - got["t"][0]

@@ -62,7 +62,7 @@ __all__ = [
 #: force explicitly, as a constant through the step.
 EULER_STABILITY_LIMIT = 2.0
 
-#: The columns of :attr:`Sand.output`, one row per geom (the core's ``ROD_GEOM_OUTPUTS``).
+#: The columns of ``Sand.output``, one row per geom (the core's ``ROD_GEOM_OUTPUTS``).
 GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.ROD_GEOM_OUTPUTS)
 
 #: How :class:`Sand` treats the static terms (those with a sticking bound: ``static_h``,
@@ -119,9 +119,9 @@ class Sand:
     Every argument is checked here, before the first step; each error is a
     :class:`granrs.GranrsError` (a ``ValueError``) naming the geom or parameter.
 
-    After each step, :attr:`output` holds each geom's evaluation (columns
-    :data:`GEOM_OUTPUTS`), :attr:`applied` the force (x, z) [N] and moment about y [N m]
-    applied at its tip, and :attr:`h_lambda` each geom's timestep times the drag's rate.
+    After each step, ``output`` holds each geom's evaluation (columns
+    :data:`GEOM_OUTPUTS`), ``applied`` the force (x, z) [N] and moment about y [N m]
+    applied at its tip, and ``h_lambda`` each geom's timestep times the drag's rate.
     """
 
     def __init__(
@@ -246,7 +246,7 @@ class Sand:
         self.applied = np.zeros((n, 3))
         #: Each geom's timestep times the drag's rate at the last step (0 out of the sand).
         self.h_lambda = np.zeros(n)
-        #: The largest of :attr:`h_lambda` over every step so far.
+        #: The largest of ``h_lambda`` over every step so far.
         self.max_h_lambda = 0.0
         self._warned = False
         self._mass = np.zeros((model.nv, model.nv))
