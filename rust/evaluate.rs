@@ -482,6 +482,9 @@ pub mod geoms {
         pub implicit_damping: Vec<f64>,
         /// Buffers ([`Work::new`] for the geoms and dofs).
         pub work: Work,
+        /// Each geom's reactions as last solved (x, y) [N] and whether each was at its
+        /// bound (sliding); `None` out of the sand.
+        pub held: Vec<Option<([f64; 2], [bool; 2])>>,
     }
 
     /// The x and z rows of the Jacobian of world point `p` on the tree of `place` into
@@ -510,8 +513,11 @@ pub mod geoms {
     impl Coupling {
         /// One evaluation: every geom's state from the engine's arrays, its force through
         /// [`RodGeoms::evaluate`], the static terms' reactions (with `stick`), and the
-        /// generalized force of it all. `timestep` [s] sets the reactions and `h lambda`.
-        pub fn step(&mut self, s: &EngineState, timestep: f64, out: EngineOut) {
+        /// generalized force of it all. `timestep` [s] sets the reactions and `h lambda`;
+        /// `hold` (a later stage of a multi-stage step, RK4's) keeps the reactions of the
+        /// last evaluation that solved them, where every geom in the sand has one, so that
+        /// they act through the whole step as they were solved for.
+        pub fn step(&mut self, s: &EngineState, timestep: f64, hold: bool, out: EngineOut) {
             let nv = self.nv;
             let width = OUTPUTS.len();
             let mut tips = [[0.0; 3]; MAX_COUPLED];
@@ -661,7 +667,24 @@ pub mod geoms {
                 bounds[2 * a] = row[c_bx];
                 bounds[2 * a + 1] = row[c_by];
             }
-            if self.stick && bounds[..rows].iter().any(|&b| b > 0.0) {
+            let held = hold && active.iter().all(|&i| self.held[i].is_some());
+            if self.stick && held {
+                // A later stage of the engine's step: the reactions of its first stage.
+                // A sliding row (at its bound) takes this stage's bound, with its sign.
+                for (a, &i) in active.iter().enumerate() {
+                    let (r, sliding) = self.held[i].expect("held");
+                    for axis in 0..2 {
+                        let b = bounds[2 * a + axis];
+                        if b > 0.0 {
+                            reaction[2 * a + axis] = if sliding[axis] {
+                                b.copysign(r[axis])
+                            } else {
+                                r[axis].clamp(-b, b)
+                            };
+                        }
+                    }
+                }
+            } else if self.stick && bounds[..rows].iter().any(|&b| b > 0.0) {
                 // E's velocity at the step's end without reactions: v + h (M + h B)^-1 f, with
                 // the rest of the world's force f from the last qacc (M qacc) less our last
                 // force, plus this step's non-static force.
@@ -676,6 +699,14 @@ pub mod geoms {
                 });
                 let w = nalgebra::DMatrix::from_row_slice(rows, rows, &w_.w[..rows * rows]);
                 solve_boxed(&w, &b, &bounds[..rows], &mut reaction[..rows]);
+            }
+            if !held {
+                self.held.fill(None);
+                for (a, &i) in active.iter().enumerate() {
+                    let r = [reaction[2 * a], reaction[2 * a + 1]];
+                    let at = |k: usize| r[k].abs() >= bounds[2 * a + k] * (1.0 - 1e-12);
+                    self.held[i] = Some((r, [at(0), at(1)]));
+                }
             }
             for (a, &i) in active.iter().enumerate() {
                 let r = [reaction[2 * a], reaction[2 * a + 1]];

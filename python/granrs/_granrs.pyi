@@ -174,7 +174,7 @@ class GeomCoupling:
         after: Any,
     ) -> None:
         """Bind one mjData's arrays and the caller's buffers (checked once)."""
-    def step(self, timestep: float, passive: bool, fresh: bool) -> tuple[float, int]:
+    def step(self, timestep: float, passive: bool, fresh: bool, hold: bool) -> tuple[float, int]:
         """One evaluation at the bound arrays; the generalized force into qfrc_passive
         (passive) or qfrc_applied. Returns the largest h_lambda and its geom."""
 

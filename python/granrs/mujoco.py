@@ -250,6 +250,7 @@ class Sand:
         self.max_h_lambda = 0.0
         self._warned = False
         self._mass = np.zeros((model.nv, model.nv))
+        self._stage = (0, math.nan)
         self._generalized = np.zeros(model.nv)
         self._data_ref: Any = None
         self._before = np.zeros(model.nv)
@@ -330,7 +331,7 @@ class Sand:
         recomputes it at every evaluation, so there is nothing of ours to replace)."""
         if m is not self.model:
             return
-        self._evaluate(data, passive=True)
+        self._evaluate(data, passive=True, hold=self._later_stage(data))
 
     def install(self) -> None:
         """Run as MuJoCo's passive-force callback (``mujoco.set_mjcb_passive``), inside
@@ -349,7 +350,28 @@ class Sand:
         """Stop acting as the passive-force callback (other installed Sands go on)."""
         _Dispatch.remove(self)
 
-    def _evaluate(self, data: Any, passive: bool) -> None:
+    def _later_stage(self, data: Any) -> bool:
+        """Whether this callback is a later stage of MuJoCo's RK4 step (its four
+        evaluations are at t, t + h/2, t + h/2 and t + h): the static reactions solved at
+        its first stage then act through the whole step, as with :meth:`step`. Any other
+        call (Euler's one evaluation, an ``mj_forward``) solves them anew."""
+        if self.model.opt.integrator != mujoco.mjtIntegrator.mjINT_RK4:
+            return False
+        t, h = data.time, self.model.opt.timestep
+        stage, t0 = self._stage
+        same = math.isclose
+        if stage == 1 and same(t, t0 + 0.5 * h, rel_tol=1e-12, abs_tol=1e-15):
+            stage = 2
+        elif stage == 2 and same(t, t0 + 0.5 * h, rel_tol=1e-12, abs_tol=1e-15):
+            stage = 3
+        elif stage == 3 and same(t, t0 + h, rel_tol=1e-12, abs_tol=1e-15):
+            stage = 4
+        else:
+            stage, t0 = 1, t
+        self._stage = (stage, t0)
+        return stage > 1
+
+    def _evaluate(self, data: Any, passive: bool, hold: bool = False) -> None:
         """One call of the core for every geom: each geom's state from MuJoCo's arrays, its
         force through the free link's right-hand side, the static terms' reactions (with
         ``statics="stick"``), the generalized force of it all into ``qfrc_passive``
@@ -378,7 +400,7 @@ class Sand:
             )
             self._data_ref = data
         mujoco.mj_fullM(m, data, self._mass)
-        worst, geom = self._coupling.step(m.opt.timestep, passive, fresh)
+        worst, geom = self._coupling.step(m.opt.timestep, passive, fresh, hold)
         if worst > self.max_h_lambda:
             self.max_h_lambda = worst
             self._warn_step_size(worst, geom)

@@ -227,6 +227,7 @@ impl GeomCoupling {
                 previous: vec![0.0; nv],
                 implicit_damping,
                 work: Work::new(n, nv),
+                held: vec![None; n],
             },
             bound: None,
         })
@@ -310,7 +311,8 @@ impl GeomCoupling {
     /// callback); else into `qfrc_applied`, where an entry still equal to `after` (what
     /// the last step left there) is restored to `before` (what it held before), any other
     /// entry is the user's, the new contribution is added and `before` and `after` kept
-    /// (`fresh`: no last step, every entry is the user's). Returns the largest `h_lambda`
+    /// (`fresh`: no last step, every entry is the user's); `hold`: a later stage of RK4's
+    /// step, which keeps the static reactions of its first. Returns the largest `h_lambda`
     /// and its geom.
     fn step(
         &mut self,
@@ -318,6 +320,7 @@ impl GeomCoupling {
         timestep: f64,
         passive: bool,
         fresh: bool,
+        hold: bool,
     ) -> PyResult<(f64, usize)> {
         let Some(b) = &self.bound else {
             return Err(PyValueError::new_err("GeomCoupling.step before bind"));
@@ -344,7 +347,7 @@ impl GeomCoupling {
                 h_lambda: rw(py, &b.h_lambda),
                 generalized: rw(py, &b.generalized),
             };
-            self.inner.step(&state, timestep, out);
+            self.inner.step(&state, timestep, hold, out);
             let gen = ro(py, &b.generalized);
             if passive {
                 let target = rw(py, &b.qfrc_passive);
