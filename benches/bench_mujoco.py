@@ -15,15 +15,16 @@ elements=64)``. A row passes when the depth is within 2 % and t_s within 5 %.
 **Cost (``--part cost``).** The gallery's walker (:func:`granrs.mujoco.walker_mjcf`, 7 dofs,
 2 sand geoms), landed and standing in sand under the thesis's law (both geoms in the sand, the
 static terms as reactions): the time of ``mj_step`` alone, of ``Sand.step`` + ``mj_step``, and
-of ``mj_step`` with the Sand installed as the passive callback, each the minimum over
-``--repeats`` runs of ``--steps`` steps from the same state, timed in turn within each repeat.
-The coupling's cost is the difference to ``mj_step`` alone, quoted as a ratio to it. Build
+of ``mj_step`` with the Sand installed as the passive callback, each over ``--steps`` steps
+from the same state, timed in turn within each of ``--repeats`` repeats. The coupling's cost
+is the difference to ``mj_step`` alone, quoted as a ratio to it: of the minimum times, and
+the median (and range) of the ratios within each repeat (two times of the same stretch). Build
 the extension with ``maturin develop --release`` first (the dev build is several times
 slower); the machines are shared and noisy: read the ratios.
 
 Usage::
 
-    python benches/bench_mujoco.py [--part all|table|cost] [--repeats 7] [--steps 2000]
+    python benches/bench_mujoco.py [--part all|table|cost] [--repeats 15] [--steps 1000]
 """
 
 from __future__ import annotations
@@ -127,7 +128,9 @@ def cost(repeats: int, steps: int) -> dict[str, float]:
             mujoco.mj_step(model, data)
 
     best = {"mj_step": np.inf, "Sand.step + mj_step": np.inf, "mj_step, callback": np.inf}
+    ratios: dict[str, list[float]] = {"Sand.step + mj_step": [], "mj_step, callback": []}
     for _ in range(repeats):
+        this: dict[str, float] = {}
         for name, run in (
             ("mj_step", alone),
             ("Sand.step + mj_step", stepped),
@@ -142,16 +145,26 @@ def cost(repeats: int, steps: int) -> dict[str, float]:
             finally:
                 if name == "mj_step, callback":
                     sand.uninstall()
-            best[name] = min(best[name], (time.perf_counter() - t) / steps)
+            this[name] = (time.perf_counter() - t) / steps
+            best[name] = min(best[name], this[name])
+        for name, r in ratios.items():
+            r.append(this[name] / this["mj_step"] - 1.0)
     step = best["mj_step"]
-    print(f"walker, {model.nv} dofs, 2 sand geoms, {steps} steps, min of {repeats}:")
-    print("| run | us per step | coupling's cost [us] | cost / mj_step |")
-    print("|---|---|---|---|")
+    print(f"walker, {model.nv} dofs, 2 sand geoms, {steps} steps, {repeats} repeats:")
+    print(
+        "| run | us per step (min) | coupling's cost [us] | cost / mj_step (of the mins) | "
+        "cost / mj_step (median of the repeats, range) |"
+    )
+    print("|---|---|---|---|---|")
     for name, t in best.items():
         extra = t - step
+        if name == "mj_step":
+            print(f"| {name} | {t * 1e6:.2f} | | | |")
+            continue
+        r = np.array(ratios[name])
         print(
-            f"| {name} | {t * 1e6:.2f} | {extra * 1e6:.2f} | "
-            f"{'' if name == 'mj_step' else f'{extra / step:.2f}'} |"
+            f"| {name} | {t * 1e6:.2f} | {extra * 1e6:.2f} | {extra / step:.2f} | "
+            f"{np.median(r):.2f} ({r.min():.2f} to {r.max():.2f}) |"
         )
     return best
 
@@ -159,8 +172,8 @@ def cost(repeats: int, steps: int) -> dict[str, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--part", choices=("all", "table", "cost"), default="all")
-    parser.add_argument("--repeats", type=int, default=7)
-    parser.add_argument("--steps", type=int, default=2000)
+    parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--steps", type=int, default=1000)
     args = parser.parse_args()
     if args.part in ("all", "cost"):
         cost(args.repeats, args.steps)

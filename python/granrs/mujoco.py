@@ -251,6 +251,10 @@ class Sand:
         self._warned = False
         self._mass = np.zeros((model.nv, model.nv))
         self._stage = (0, math.nan)
+        # The model's options (a live view: the timestep is read at every step) and its
+        # integrator, read here as the implicit damping is.
+        self._opt = model.opt
+        self._rk4 = model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
         self._generalized = np.zeros(model.nv)
         self._data_ref: Any = None
         self._before = np.zeros(model.nv)
@@ -355,9 +359,9 @@ class Sand:
         evaluations are at t, t + h/2, t + h/2 and t + h): the static reactions solved at
         its first stage then act through the whole step, as with :meth:`step`. Any other
         call (Euler's one evaluation, an ``mj_forward``) solves them anew."""
-        if self.model.opt.integrator != mujoco.mjtIntegrator.mjINT_RK4:
+        if not self._rk4:
             return False
-        t, h = data.time, self.model.opt.timestep
+        t, h = data.time, self._opt.timestep
         stage, t0 = self._stage
         same = math.isclose
         if stage == 1 and same(t, t0 + 0.5 * h, rel_tol=1e-12, abs_tol=1e-15):
@@ -400,20 +404,16 @@ class Sand:
             )
             self._data_ref = data
         mujoco.mj_fullM(m, data, self._mass)
-        worst, geom = self._coupling.step(m.opt.timestep, passive, fresh, hold)
+        worst, geom = self._coupling.step(self._opt.timestep, passive, fresh, hold)
         if worst > self.max_h_lambda:
             self.max_h_lambda = worst
             self._warn_step_size(worst, geom)
 
     def _warn_step_size(self, h_lambda: float, geom: int) -> None:
-        limit = (
-            RK4_STABILITY_LIMIT
-            if self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
-            else EULER_STABILITY_LIMIT
-        )
+        limit = RK4_STABILITY_LIMIT if self._rk4 else EULER_STABILITY_LIMIT
         if h_lambda > limit and not self._warned:
             self._warned = True
-            h = self.model.opt.timestep
+            h = self._opt.timestep
             rate = h_lambda / h
             warnings.warn(
                 StepSizeWarning(
