@@ -75,7 +75,6 @@ _SUPPORTED = {
     int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
     int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder",
 }
-_COL = {name: k for k, name in enumerate(GEOM_OUTPUTS)}
 _PLANE_TOL = 1e-9
 
 
