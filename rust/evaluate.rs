@@ -183,53 +183,81 @@ pub mod geoms {
     use nalgebra::{SVector, Vector2};
 
     use crate::body::rod::ApplyAt;
-    use crate::body::{Joint, Link, Mechanism, RodContact};
+    use crate::body::{Joint, Link, Mechanism, RodContact, SoleContact, SoleModel};
     use crate::dynamics::{
         Contact, ContactMode, DragStiffness, Model, Shape, SignModel, MAX_CONTACTS,
     };
     use crate::error::{check_finite, check_range, GranrsError, Result};
     use crate::forces::{ForceSet, Medium};
 
-    /// The state of one geom, in this order: its tip T (the lower end of its axis) [m], its
-    /// unit axis e from the tip along the rod, the tip's velocity [m/s] and the angular
+    /// The state of one geom, in this order: its reference point R [m] (a rod's tip T, the
+    /// lower end of its axis; a sole box's centre), its unit axis e (a rod's, from the tip
+    /// along the rod; a box's x axis, from heel to toe), R's velocity [m/s] and the angular
     /// velocity [rad/s] (x right, y up; omega turns e towards +x, dq/dt of the free link).
-    pub const STATE: [&str; 7] = ["tip_x", "tip_y", "e_x", "e_y", "v_x", "v_y", "omega"];
+    pub const STATE: [&str; 7] = ["ref_x", "ref_y", "e_x", "e_y", "v_x", "v_y", "omega"];
 
-    /// What [`RodGeoms::evaluate`] writes per geom, in this order: the force (x, y) [N] and
-    /// its moment about the tip [N m] (positive turning e towards +x), the tip's depth and
-    /// the immersed length [m], the immersed centroid E [m] and its velocity [m/s], the
-    /// dynamic and static sums [N], the static terms' bounds along x and y [N] (the largest
-    /// reaction they supply while sticking) and the drag's stiffness |F_d| / |v_E| [kg/s].
-    pub const OUTPUTS: [&str; 16] = [
-        "F_x", "F_y", "M", "depth", "l", "E_x", "E_y", "v_Ex", "v_Ey", "F_dx", "F_dy", "F_sx",
-        "F_sy", "bound_x", "bound_y", "k_drag",
+    /// What [`SandGeoms::evaluate`] writes per geom, in this order: the force (x, y) [N] and
+    /// its moment about the reference point R [N m] (positive turning e towards +x), the
+    /// depth of the force law [m] (a rod's tip depth; a box's immersed area / length) and a
+    /// rod's immersed length [m] (0 for a box), the immersed centroid E [m], the point of
+    /// application P [m], E's velocity [m/s], the dynamic and static sums [N], the static
+    /// terms' bounds along x and y [N] (the largest reaction they supply while sticking) and
+    /// the drag's stiffness |F_d| / |v_E| [kg/s].
+    pub const OUTPUTS: [&str; 18] = [
+        "F_x", "F_y", "M", "depth", "l", "E_x", "E_y", "P_x", "P_y", "v_Ex", "v_Ey", "F_dx",
+        "F_dy", "F_sx", "F_sy", "bound_x", "bound_y", "k_drag",
     ];
 
-    /// N rod geoms, each the free link's rod with its own terms, in the same sand.
-    #[derive(Debug, Clone)]
-    pub struct RodGeoms {
-        models: Vec<Model<3>>,
-        contacts: Vec<RodContact>,
+    /// The shape of one geom.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    pub enum GeomShape {
+        /// The free link's rod (a capsule, a cylinder): diameter d_c and length L [m] (also
+        /// L_ref); R is its tip.
+        Rod {
+            /// d_c [m].
+            diameter: f64,
+            /// L [m].
+            length: f64,
+        },
+        /// The leg's sole box (`SoleModel::Box`) centred on R: its `length` f_s along e
+        /// (also the width of `static_h`), `height` across it in the plane, `width` w_s out
+        /// of the plane, and L_ref of the depth factor [m].
+        Sole {
+            /// f_s [m].
+            length: f64,
+            /// Height in the plane [m].
+            height: f64,
+            /// w_s [m].
+            width: f64,
+            /// L_ref [m].
+            l_ref: f64,
+        },
     }
 
-    impl RodGeoms {
-        /// Geoms named `names` with diameters d_c and lengths L (L is also L_ref, as for
-        /// the free link), under `forces` (built for `names.len()` contacts: a parameter
-        /// is one value for every geom or one per geom). Contact terms only: `gravity` and
-        /// `joint_springs` act through the other engine, and are an error naming them.
+    /// N geoms, each the free link's rod or the leg's sole box with its own terms, in the
+    /// same sand.
+    #[derive(Debug, Clone)]
+    pub struct SandGeoms {
+        models: Vec<Model<3>>,
+    }
+
+    impl SandGeoms {
+        /// Geoms named `names` of `shapes`, under `forces` (built for `names.len()`
+        /// contacts: a parameter is one value for every geom or one per geom). Contact terms
+        /// only: `gravity` and `joint_springs` act through the other engine, and are an
+        /// error naming them.
         pub fn new(
             names: &[String],
-            diameters: &[f64],
-            lengths: &[f64],
+            shapes: &[GeomShape],
             forces: &ForceSet,
             medium: Medium,
             apply_at: ApplyAt,
             sign_model: SignModel,
-        ) -> Result<RodGeoms> {
-            if diameters.len() != names.len() || lengths.len() != names.len() {
+        ) -> Result<SandGeoms> {
+            if shapes.len() != names.len() || forces.per_contact.len() != names.len() {
                 return Err(GranrsError::InvalidScene {
                     field: "geoms".into(),
-                    message: "one diameter and one length per geom".into(),
+                    message: "one shape and one set of terms per geom".into(),
                 });
             }
             for body in ["gravity", "joint_springs"] {
@@ -257,15 +285,41 @@ pub mod geoms {
                 });
             }
             let mut models = Vec::with_capacity(names.len());
-            let mut contacts = Vec::with_capacity(names.len());
             for (i, name) in names.iter().enumerate() {
-                check_range(&format!("{name}.diameter"), diameters[i], 0.0, true)?;
-                check_range(&format!("{name}.length"), lengths[i], 0.0, true)?;
-                let rod = RodContact {
-                    link: 0,
-                    tip: Vector2::zeros(),
-                    length: lengths[i],
-                    diameter: diameters[i],
+                let shape = match shapes[i] {
+                    GeomShape::Rod { diameter, length } => {
+                        check_range(&format!("{name}.diameter"), diameter, 0.0, true)?;
+                        check_range(&format!("{name}.length"), length, 0.0, true)?;
+                        Shape::Rod(RodContact {
+                            link: 0,
+                            tip: Vector2::zeros(),
+                            length,
+                            diameter,
+                        })
+                    }
+                    GeomShape::Sole {
+                        length,
+                        height,
+                        width,
+                        l_ref,
+                    } => {
+                        check_range(&format!("{name}.length"), length, 0.0, true)?;
+                        check_range(&format!("{name}.height"), height, 0.0, true)?;
+                        check_range(&format!("{name}.width"), width, 0.0, true)?;
+                        check_range(&format!("{name}.l_ref"), l_ref, 0.0, true)?;
+                        // Centred on the root: the sole (the face towards +n) from heel to
+                        // toe along e, the box rising towards -n.
+                        Shape::Sole(SoleContact {
+                            link: 0,
+                            angle_link: 0,
+                            heel: Vector2::new(-0.5 * length, 0.5 * height),
+                            length,
+                            height,
+                            width,
+                            l_ref,
+                            model: SoleModel::Box,
+                        })
+                    }
                 };
                 let mut own = forces.clone();
                 own.per_contact = vec![forces.per_contact[i]];
@@ -281,17 +335,14 @@ pub mod geoms {
                         }],
                         root_mass: 0.0,
                     },
-                    contacts: vec![Contact {
-                        shape: Shape::Rod(rod),
-                    }],
+                    contacts: vec![Contact { shape }],
                     medium,
                     apply_at,
                     sign_model,
                     forces: own,
                 });
-                contacts.push(rod);
             }
-            Ok(RodGeoms { models, contacts })
+            Ok(SandGeoms { models })
         }
 
         /// Number of geoms.
@@ -304,8 +355,14 @@ pub mod geoms {
             self.models.is_empty()
         }
 
-        /// Check one geom's state (finite, unit axis to 1e-6), naming the geom and field.
-        pub fn check_state(name: &str, state: &[f64; 7]) -> Result<()> {
+        /// Whether geom `i` is a sole box (else a rod).
+        pub fn is_sole(&self, i: usize) -> bool {
+            matches!(self.models[i].contacts[0].shape, Shape::Sole(_))
+        }
+
+        /// Check geom `i`'s state (finite, unit axis to 1e-6; a rod's axis pointing up
+        /// from its tip), naming the geom and field.
+        pub fn check_state(&self, i: usize, name: &str, state: &[f64; 7]) -> Result<()> {
             for (k, &x) in state.iter().enumerate() {
                 check_finite(&format!("{name}.{}", STATE[k]), x)?;
             }
@@ -317,31 +374,50 @@ pub mod geoms {
                     allowed: "a unit vector in the plane (|e| = 1)".into(),
                 });
             }
-            if state[3] < 0.0 {
+            if state[3] < 0.0 && !self.is_sole(i) {
                 return Err(GranrsError::InvalidParameter {
                     field: format!("{name}.e_y"),
                     value: state[3],
-                    allowed: ">= 0: the tip is the lower end of the axis".into(),
+                    allowed: ">= 0: a rod's tip is the lower end of its axis".into(),
                 });
             }
             Ok(())
         }
 
         /// Evaluate geom `i` at `state` (in the order of [`STATE`]) into `out` (in the
-        /// order of [`OUTPUTS`]), through the free link's right-hand side.
+        /// order of [`OUTPUTS`]), through the free link's right-hand side (the general
+        /// one for a sole box).
         pub fn evaluate(&self, i: usize, state: &[f64; 7], out: &mut [f64]) {
             let model = &self.models[i];
-            let [tip_x, tip_y, e_x, e_y, v_x, v_y, omega] = *state;
-            let q = SVector::<f64, 3>::new(tip_x, tip_y, e_x.atan2(e_y));
+            let [ref_x, ref_y, e_x, e_y, v_x, v_y, omega] = *state;
+            let q = SVector::<f64, 3>::new(ref_x, ref_y, e_x.atan2(e_y));
             let qd = SVector::<f64, 3>::new(v_x, v_y, omega);
             let mut modes = [ContactMode::default(); MAX_CONTACTS];
             modes[0].in_contact = true;
             let e = model.eval(&q, &qd, &modes);
             let c = &e.contacts[0];
             let axis = Vector2::new(e_x, e_y);
-            let l = self.contacts[i].geometry(tip_y, axis).immersed_length;
-            let l = if c.depth > 0.0 { l } else { 0.0 };
-            let centroid = Vector2::new(tip_x, tip_y) + (0.5 * l) * axis;
+            let root = Vector2::new(ref_x, ref_y);
+            let (l, centroid, reference) = match &model.contacts[0].shape {
+                Shape::Rod(rod) => {
+                    let l = if c.depth > 0.0 {
+                        rod.geometry(ref_y, axis).immersed_length
+                    } else {
+                        0.0
+                    };
+                    (l, root + (0.5 * l) * axis, root)
+                }
+                Shape::Sole(sole) => {
+                    let normal = Vector2::new(axis.y, -axis.x);
+                    let t = sole.reference_point();
+                    let centroid = sole.geometry(root, axis, normal).centroid;
+                    (0.0, centroid, root + t.x * axis + t.y * normal)
+                }
+            };
+            let apply = match model.apply_at {
+                ApplyAt::Tip => reference,
+                ApplyAt::Centroid => centroid,
+            };
             let k_drag = DragStiffness::of(0, c).k2().sqrt();
             let values = [
                 e.qdd[0],
@@ -351,6 +427,8 @@ pub mod geoms {
                 l,
                 centroid.x,
                 centroid.y,
+                apply.x,
+                apply.y,
                 c.v_centroid.x,
                 c.v_centroid.y,
                 c.force.dynamic.x,
@@ -374,7 +452,8 @@ pub mod geoms {
         pub body: usize,
         /// The root of its body's tree (rows of `subtree_com`: `cvel` is taken about it).
         pub root: usize,
-        /// From the geom's centre to its tip along its axis [m].
+        /// From the geom's centre to its reference point along its axis [m] (a rod's tip; 0
+        /// for a box).
         pub reach: f64,
         /// The degrees of freedom that move it (the joints of its body and its ancestors).
         pub dofs: Vec<usize>,
@@ -425,6 +504,7 @@ pub mod geoms {
     pub struct Work {
         j_tip: Vec<f64>,
         j_e: Vec<f64>,
+        j_p: Vec<f64>,
         j_rot: Vec<f64>,
         chol_m: Vec<f64>,
         chol_h: Vec<f64>,
@@ -442,6 +522,7 @@ pub mod geoms {
             Work {
                 j_tip: vec![0.0; 2 * n * nv],
                 j_e: vec![0.0; 2 * n * nv],
+                j_p: vec![0.0; 2 * n * nv],
                 j_rot: vec![0.0; n * nv],
                 chol_m: vec![0.0; nv * nv],
                 chol_h: vec![0.0; nv * nv],
@@ -455,12 +536,12 @@ pub mod geoms {
         }
     }
 
-    /// The coupling to another engine: [`RodGeoms`] placed on its bodies, with the sand's
+    /// The coupling to another engine: [`SandGeoms`] placed on its bodies, with the sand's
     /// surface and patch, and the static terms' treatment.
     #[derive(Debug, Clone)]
     pub struct Coupling {
         /// The geoms' force law.
-        pub rods: RodGeoms,
+        pub rods: SandGeoms,
         /// Each geom's place.
         pub places: Vec<EnginePlace>,
         /// Number of degrees of freedom.
@@ -472,8 +553,6 @@ pub mod geoms {
         /// Whether the static terms act as reactions that bring E's velocity to zero within
         /// their bounds (`true`), or as evaluated.
         pub stick: bool,
-        /// Whether the force acts at the centroid E (else at the tip).
-        pub at_centroid: bool,
         /// The last generalized force (nv), whose effect the last `qacc` holds.
         pub previous: Vec<f64>,
         /// The joints' damping that the engine's step takes implicitly, per dof [N s/m or
@@ -512,7 +591,7 @@ pub mod geoms {
 
     impl Coupling {
         /// One evaluation: every geom's state from the engine's arrays, its force through
-        /// [`RodGeoms::evaluate`], the static terms' reactions (with `stick`), and the
+        /// [`SandGeoms::evaluate`], the static terms' reactions (with `stick`), and the
         /// generalized force of it all. `timestep` [s] sets the reactions and `h lambda`;
         /// `hold` (a later stage of a multi-stage step, RK4's) keeps the reactions of the
         /// last evaluation that solved them, where every geom in the sand has one, so that
@@ -528,8 +607,13 @@ pub mod geoms {
             out.generalized.fill(0.0);
             for (i, place) in self.places.iter().enumerate() {
                 let m = &s.geom_xmat[9 * place.geom..9 * place.geom + 9];
-                let mut e = [m[2], m[5], m[8]];
-                if e[2] < 0.0 {
+                // A rod's axis is its local z, pointing up from its tip; a box's its local x.
+                let mut e = if self.rods.is_sole(i) {
+                    [m[0], m[3], m[6]]
+                } else {
+                    [m[2], m[5], m[8]]
+                };
+                if e[2] < 0.0 && !self.rods.is_sole(i) {
                     e = [-e[0], -e[1], -e[2]];
                 }
                 let x = &s.geom_xpos[3 * place.geom..3 * place.geom + 3];
@@ -565,15 +649,17 @@ pub mod geoms {
                 return;
             }
             let k = active.len();
-            let (c_fx, c_fy, c_m, c_ex, c_ey) = (0, 1, 2, 5, 6);
-            let (c_vx, c_vy, c_sx, c_sy, c_bx, c_by, c_k) = (7, 8, 11, 12, 13, 14, 15);
+            let (c_fx, c_fy, c_m, c_ex, c_ey, c_px, c_py) = (0, 1, 2, 5, 6, 7, 8);
+            let (c_vx, c_vy, c_sx, c_sy, c_bx, c_by, c_k) = (9, 10, 13, 14, 15, 16, 17);
+            debug_assert_eq!(OUTPUTS[c_px], "P_x");
             debug_assert_eq!(OUTPUTS[c_sx], "F_sx");
             debug_assert_eq!(OUTPUTS[c_k], "k_drag");
             let w_ = &mut self.work;
-            // Jacobians (rows of nv) of the tip and of E (x and z per geom), and the rotation
-            // about y; P is the tip or E.
+            // Jacobians (rows of nv) of the reference point R (`j_tip`), of E and of the point
+            // of application P (x and z per geom), and the rotation about y.
             w_.j_tip[..2 * k * nv].fill(0.0);
             w_.j_e[..2 * k * nv].fill(0.0);
+            w_.j_p[..2 * k * nv].fill(0.0);
             w_.j_rot[..k * nv].fill(0.0);
             w_.q_rest.fill(0.0);
             for (a, &i) in active.iter().enumerate() {
@@ -593,12 +679,17 @@ pub mod geoms {
                     &mut w_.j_e[2 * a * nv..(2 * a + 2) * nv],
                     None,
                 );
+                let apply = [row[c_px], 0.0, row[c_py] + self.surface];
+                jacobian(
+                    place,
+                    s,
+                    nv,
+                    apply,
+                    &mut w_.j_p[2 * a * nv..(2 * a + 2) * nv],
+                    None,
+                );
                 w_.raw[a] = [row[c_sx], row[c_sy]];
-                w_.levers[a] = if self.at_centroid {
-                    [centroid[0] - tips[i][0], centroid[2] - tips[i][2]]
-                } else {
-                    [0.0; 2]
-                };
+                w_.levers[a] = [apply[0] - tips[i][0], apply[2] - tips[i][2]];
                 // Everything but the static terms: the force less the static sum, with its
                 // moment about the tip less that of the static sum at P.
                 let [lx, lz] = w_.levers[a];
@@ -633,7 +724,7 @@ pub mod geoms {
                 return;
             }
             let rows = 2 * k;
-            let j_p = if self.at_centroid { &w_.j_e } else { &w_.j_tip };
+            let j_p = &w_.j_p;
             // W = J_E H^-1 J_P^T: E's response to a unit force at P over the engine's step.
             for c in 0..rows {
                 w_.tmp.copy_from_slice(&j_p[c * nv..(c + 1) * nv]);
@@ -846,6 +937,11 @@ pub mod geoms {
         use super::*;
         use crate::forces::{Coefficients, TermSpec};
 
+        const ROD: GeomShape = GeomShape::Rod {
+            diameter: 0.0127,
+            length: 0.19,
+        };
+
         fn thesis_contact_terms() -> ForceSet {
             let c = Coefficients::TABLE_3_4_VERTICAL;
             ForceSet::build(
@@ -861,17 +957,16 @@ pub mod geoms {
 
         #[test]
         fn a_sinking_vertical_rod_feels_the_free_links_force_at_its_tip() {
-            let geoms = RodGeoms::new(
+            let geoms = SandGeoms::new(
                 &["foot".into()],
-                &[0.0127],
-                &[0.19],
+                &[ROD],
                 &thesis_contact_terms(),
                 Medium::default(),
                 ApplyAt::Tip,
                 SignModel::Raw,
             )
             .unwrap();
-            let mut out = [0.0; 16];
+            let mut out = [0.0; 18];
             geoms.evaluate(0, &[0.0, -0.05, 0.0, 1.0, 0.0, -1.0, 0.0], &mut out);
             // By hand: F_sv = eta_v (d/L)^lam g rho V up, F_d = eta_d rho A_r |v| v with
             // A_r = 0 for axial motion; no moment about the tip.
@@ -885,17 +980,16 @@ pub mod geoms {
 
         #[test]
         fn the_centroid_carries_the_moment_and_a_body_term_is_refused() {
-            let geoms = RodGeoms::new(
+            let geoms = SandGeoms::new(
                 &["foot".into()],
-                &[0.0127],
-                &[0.19],
+                &[ROD],
                 &thesis_contact_terms(),
                 Medium::default(),
                 ApplyAt::Centroid,
                 SignModel::Raw,
             )
             .unwrap();
-            let mut out = [0.0; 16];
+            let mut out = [0.0; 18];
             let q = 0.5f64;
             geoms.evaluate(0, &[0.0, -0.02, q.sin(), q.cos(), 1.0, -1.0, 0.0], &mut out);
             // Moment about the tip of F at E = T + (l/2) e: r x F with r = (l/2) e.
@@ -904,10 +998,9 @@ pub mod geoms {
             assert!((out[2] - by_hand).abs() < 1e-12 * by_hand.abs(), "{out:?}");
             let mut with_gravity = thesis_contact_terms();
             with_gravity.names.push("gravity");
-            let err = RodGeoms::new(
+            let err = SandGeoms::new(
                 &["foot".into()],
-                &[0.0127],
-                &[0.19],
+                &[ROD],
                 &with_gravity,
                 Medium::default(),
                 ApplyAt::Tip,

@@ -7,14 +7,14 @@ __all__ = [
     "EFFECTS",
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
+    "GEOM_OUTPUTS",
+    "GEOM_STATE",
     "RECORDS",
-    "ROD_GEOM_OUTPUTS",
-    "ROD_GEOM_STATE",
     "SCENE_FIELDS",
     "Compiled",
     "GeomCoupling",
-    "RodGeoms",
     "RunOutcome",
+    "SandGeoms",
     "__version__",
     "check_term",
     "compile",
@@ -110,38 +110,37 @@ def resistance_force(
     """The rod force over n states: nine contiguous float64 arrays (FORCE_INPUTS order) in,
     an n x 10 array (FORCE_OUTPUTS order) out."""
 
-ROD_GEOM_STATE: list[str]
-ROD_GEOM_OUTPUTS: list[str]
+GEOM_STATE: list[str]
+GEOM_OUTPUTS: list[str]
 
 @final
-class RodGeoms:
-    """N rod geoms of another engine under contact terms, through the free link's
-    right-hand side (granrs.mujoco.Sand)."""
+class SandGeoms:
+    """N geoms (rods, sole boxes) of another engine under contact terms, through the free
+    link's right-hand side (granrs.mujoco.Sand)."""
 
     def __new__(
         cls,
         names: list[str],
-        diameter: list[float],
-        length: list[float],
+        shapes: list[tuple[str, list[float]]],
         forces: list[Any],
         rho_g: float,
         g: float,
         apply_at: str = "tip",
         sign_model: str = "raw",
         smooth_eps: float = 1e-3,
-    ) -> RodGeoms: ...
+    ) -> SandGeoms: ...
     def __len__(self) -> int: ...
     def evaluate(self, states: Any, out: Any) -> None:
-        """Every geom's force: states n x 7 (ROD_GEOM_STATE order) in, out n x 16
-        (ROD_GEOM_OUTPUTS order) written."""
+        """Every geom's force: states n x 7 (GEOM_STATE order) in, out n x 18
+        (GEOM_OUTPUTS order) written."""
 
 @final
 class GeomCoupling:
-    """RodGeoms placed on the bodies of a MuJoCo model (granrs.mujoco.Sand)."""
+    """SandGeoms placed on the bodies of a MuJoCo model (granrs.mujoco.Sand)."""
 
     def __new__(
         cls,
-        rods: RodGeoms,
+        rods: SandGeoms,
         geom: list[int],
         body: list[int],
         root: list[int],
@@ -151,7 +150,6 @@ class GeomCoupling:
         surface: float,
         patch: tuple[float, float],
         stick: bool,
-        at_centroid: bool,
         implicit_damping: list[float],
     ) -> GeomCoupling: ...
     def bind(

@@ -1,10 +1,11 @@
 """Sand under a MuJoCo model: granrs's force terms on the geoms of a planar MuJoCo robot.
 
 ``pip install 'granrs[mujoco]'`` (the ``mujoco`` package from PyPI). MuJoCo has no granular
-ground; :class:`Sand` gives the named capsule and cylinder geoms of a model that moves in the
-x-z plane (the hopper and walker2d pattern: slide x, slide z and hinge y at the root) the
-resistance force of granrs's terms, evaluated by the same Rust code as
-:func:`granrs.simulate` (each geom is the free link's rod; one call for all geoms)::
+ground; :class:`Sand` gives the named capsule, cylinder and box geoms of a model that moves
+in the x-z plane (the hopper and walker2d pattern: slide x, slide z and hinge y at the root)
+the resistance force of granrs's terms, evaluated by the same Rust code as
+:func:`granrs.simulate` (a rod geom is the free link's rod, a box the leg's sole; one call
+for all geoms)::
 
     import mujoco
     from granrs import forces
@@ -62,8 +63,8 @@ __all__ = [
 #: force explicitly, as a constant through the step.
 EULER_STABILITY_LIMIT = 2.0
 
-#: The columns of ``Sand.output``, one row per geom (the core's ``ROD_GEOM_OUTPUTS``).
-GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.ROD_GEOM_OUTPUTS)
+#: The columns of ``Sand.output``, one row per geom (the core's ``GEOM_OUTPUTS``).
+GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.GEOM_OUTPUTS)
 
 #: How :class:`Sand` treats the static terms (those with a sticking bound: ``static_h``,
 #: ``static_v``): ``"stick"`` solves each step for the reaction that brings the immersed
@@ -74,6 +75,7 @@ STATICS = ("stick", "raw")
 _SUPPORTED = {
     int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
     int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder",
+    int(mujoco.mjtGeom.mjGEOM_BOX): "box",
 }
 _PLANE_TOL = 1e-9
 
@@ -97,10 +99,13 @@ class Sand:
 
     Args:
         model: a ``mujoco.MjModel`` that moves in the x-z plane (gravity along -z).
-        geoms: names of capsule or cylinder geoms. Each is the free link's rod: its tip T is
-            the lower end of its axis, its diameter d_c twice its radius, its length L (also
-            L_ref) the cylinder's length; a capsule's caps count (T is the bottom of the
-            lower cap, L the capsule's whole length, as the thesis's round-ended rod).
+        geoms: names of capsule, cylinder or box geoms. A capsule or cylinder is the free
+            link's rod: its tip T is the lower end of its axis, its diameter d_c twice its
+            radius, its length L (also L_ref) the cylinder's length; a capsule's caps count
+            (T is the bottom of the lower cap, L the capsule's whole length, as the thesis's
+            round-ended rod). A box is the leg's sole box: f_s its length along x (also
+            L_ref), w_s its width along y; use ``apply_at="centroid"`` with boxes (see
+            docs/mujoco.md).
         forces: the medium's contact terms (``granrs.forces``: ``drag``, ``static_h``,
             ``static_v``, ...). MuJoCo applies gravity and the joints: a ``gravity`` or
             ``joint_springs`` term is an error naming it. A parameter is one value for every
@@ -108,7 +113,8 @@ class Sand:
         surface: height z of the sand's surface [m].
         rho_g: the sand's bulk density [kg/m^3] (the thesis's 1650). The static terms use
             g = |``model.opt.gravity``|.
-        apply_at: ``"tip"`` (as :func:`granrs.simulate`'s default) or ``"centroid"``.
+        apply_at: ``"tip"`` (as :func:`granrs.simulate`'s default; a box's sole middle) or
+            ``"centroid"``.
         patch: the sand's extent in x, ``(x_min, x_max)`` [m]; a geom whose tip is outside
             feels nothing from the sand. Geoms not listed keep MuJoCo's own contacts.
         statics: ``"stick"`` (default) or ``"raw"``: see :data:`STATICS` and docs/mujoco.md.
@@ -177,7 +183,7 @@ class Sand:
             )
         self.g = float(np.linalg.norm(gravity))
 
-        ids, radius, half, lengths = [], [], [], []
+        ids, half, shapes = [], [], []
         for i, name in enumerate(names):
             gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
             if gid < 0:
@@ -186,27 +192,32 @@ class Sand:
             if kind not in _SUPPORTED:
                 type_name = mujoco.mjtGeom(kind).name.removeprefix("mjGEOM_").lower()
                 raise InvalidSceneError(
-                    f"geom `{name}` is a {type_name}; the rod terms take "
-                    f"{' and '.join(_SUPPORTED.values())} geoms",
+                    f"geom `{name}` is a {type_name}; Sand takes "
+                    f"{', '.join(_SUPPORTED.values())} geoms",
                     field=f"geoms[{i}]",
                 )
-            r, h = float(model.geom_size[gid, 0]), float(model.geom_size[gid, 1])
             ids.append(gid)
-            radius.append(r)
+            size = [float(x) for x in model.geom_size[gid]]
+            if _SUPPORTED[kind] == "box":
+                # The leg's sole box, centred on the geom: f_s along its x, its height along
+                # z, w_s along y; L_ref its length.
+                half.append(0.0)
+                shapes.append(("sole", [2 * size[0], 2 * size[2], 2 * size[1], 2 * size[0]]))
+                continue
+            r, h = size[0], size[1]
             # A capsule's caps count: its tip is the bottom of the lower cap.
             reach = h + r if _SUPPORTED[kind] == "capsule" else h
             half.append(reach)
-            lengths.append(2.0 * reach)
+            shapes.append(("rod", [2.0 * r, 2.0 * reach]))
         self.geoms = tuple(names)
         self._ids = np.asarray(ids, dtype=np.intp)
         self._body = np.asarray(model.geom_bodyid[self._ids], dtype=np.intp)
         self._root = np.asarray(model.body_rootid[self._body], dtype=np.intp)
         self._half = np.asarray(half, dtype=float)
         self._check_planar()
-        self._core = _granrs.RodGeoms(
+        self._core = _granrs.SandGeoms(
             list(names),
-            [2.0 * r for r in radius],
-            lengths,
+            shapes,
             list(as_terms(forces)),
             rho,
             self.g,
@@ -235,7 +246,6 @@ class Sand:
             self.surface,
             self.patch,
             statics == "stick",
-            apply_at == "centroid",
             self._implicit_damping(),
         )
         n = len(names)
@@ -305,8 +315,13 @@ class Sand:
                             field=f"geoms[{i}]",
                         )
                 b = int(m.body_parentid[b])
-            e = d.geom_xmat[self._ids[i]].reshape(3, 3)[:, 2]
-            if abs(e[1]) > 1e-6:
+            frame = d.geom_xmat[self._ids[i]].reshape(3, 3)
+            # A rod's axis (local z) and a box's x and z lie in the plane: its local y is y.
+            e = frame[:, 2]
+            if abs(e[1]) > 1e-6 or (
+                int(m.geom_type[self._ids[i]]) == mujoco.mjtGeom.mjGEOM_BOX
+                and abs(frame[1, 1]) < 1 - 1e-6
+            ):
                 raise InvalidSceneError(
                     f"geom `{name}` is not planar: its axis {e.round(6).tolist()} leaves the "
                     "x-z plane",

@@ -1,4 +1,4 @@
-//! `RodGeoms`: the force and moment on N rod geoms of another engine (`granrs.mujoco.Sand`)
+//! `SandGeoms`: the force and moment on N rod geoms of another engine (`granrs.mujoco.Sand`)
 //! in one call, through the free link's right-hand side (see `rust/evaluate.rs`, `geoms`).
 
 use numpy::{
@@ -14,33 +14,33 @@ use crate::body::rod::ApplyAt;
 use crate::dynamics::SignModel;
 use crate::error::GranrsError;
 use crate::evaluate::geoms::{
-    self, Coupling, EngineOut, EnginePlace, EngineState, Work, MAX_COUPLED, STATE,
+    self, Coupling, EngineOut, EnginePlace, EngineState, GeomShape, Work, MAX_COUPLED, STATE,
 };
 use crate::forces::{ForceSet, Medium};
 use crate::spec::Value;
 
-/// N rod geoms under a list of contact terms in one sand, checked once; `evaluate` takes
-/// every geom's state and writes every geom's force, moment and findings.
+/// N geoms (rods and sole boxes) under a list of contact terms in one sand, checked once;
+/// `evaluate` takes every geom's state and writes every geom's force, moment and findings.
 #[pyclass(module = "granrs._granrs", frozen)]
-pub struct RodGeoms {
-    inner: geoms::RodGeoms,
+pub struct SandGeoms {
+    inner: geoms::SandGeoms,
     names: Vec<String>,
 }
 
 #[pymethods]
-impl RodGeoms {
-    /// `names`, `diameter` and `length` per geom; `forces` a sequence of
-    /// `granrs.forces.Term` (contact terms only); the sand's `rho_g` and `g`; `apply_at`
-    /// ("tip" or "centroid"); `sign_model` ("raw" or "smooth", with `smooth_eps` in m/s).
-    /// Every error names the geom, term or parameter.
+impl SandGeoms {
+    /// `names` and `shapes` per geom (`("rod", [d_c, L])` or `("sole", [length, height,
+    /// width, l_ref])`); `forces` a sequence of `granrs.forces.Term` (contact terms only);
+    /// the sand's `rho_g` and `g`; `apply_at` ("tip": a rod's tip, a sole's middle; or
+    /// "centroid"); `sign_model` ("raw" or "smooth", with `smooth_eps` in m/s). Every error
+    /// names the geom, term or parameter.
     #[new]
-    #[pyo3(signature = (names, diameter, length, forces, rho_g, g, apply_at="tip", sign_model="raw", smooth_eps=1e-3))]
+    #[pyo3(signature = (names, shapes, forces, rho_g, g, apply_at="tip", sign_model="raw", smooth_eps=1e-3))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         names: Vec<String>,
-        diameter: Vec<f64>,
-        length: Vec<f64>,
+        shapes: Vec<(String, Vec<f64>)>,
         forces: &Bound<'_, PyList>,
         rho_g: f64,
         g: f64,
@@ -83,17 +83,36 @@ impl RodGeoms {
                 }))
             }
         };
-        let inner = geoms::RodGeoms::new(
+        let mut kinds = Vec::with_capacity(shapes.len());
+        for (i, (kind, size)) in shapes.iter().enumerate() {
+            kinds.push(match (kind.as_str(), size.as_slice()) {
+                ("rod", &[diameter, length]) => GeomShape::Rod { diameter, length },
+                ("sole", &[length, height, width, l_ref]) => GeomShape::Sole {
+                    length,
+                    height,
+                    width,
+                    l_ref,
+                },
+                _ => {
+                    return Err(err(GranrsError::UnknownName {
+                        field: format!("shapes[{i}]"),
+                        value: kind.clone(),
+                        allowed: "(\"rod\", [d_c, L]), (\"sole\", [length, height, width, l_ref])"
+                            .into(),
+                    }))
+                }
+            });
+        }
+        let inner = geoms::SandGeoms::new(
             &names,
-            &diameter,
-            &length,
+            &kinds,
             &set,
             Medium { rho_g, g },
             apply_at,
             sign_model,
         )
         .map_err(err)?;
-        Ok(RodGeoms { inner, names })
+        Ok(SandGeoms { inner, names })
     }
 
     /// Number of geoms.
@@ -102,9 +121,9 @@ impl RodGeoms {
     }
 
     /// Every geom's force, moment and findings: `states` is `n x 7` in the order of
-    /// `ROD_GEOM_STATE`, `out` an `n x 16` float array written in the order of
-    /// `ROD_GEOM_OUTPUTS`. A non-finite state or an axis that is not a unit vector pointing
-    /// up from the tip is an error naming the geom, before any is evaluated.
+    /// `GEOM_STATE`, `out` an `n x 18` float array written in the order of `GEOM_OUTPUTS`.
+    /// A non-finite state, an axis that is not a unit vector, or a rod's axis pointing down
+    /// from its tip is an error naming the geom, before any is evaluated.
     fn evaluate(
         &self,
         py: Python<'_>,
@@ -128,7 +147,9 @@ impl RodGeoms {
         let mut rows = Vec::with_capacity(n);
         for (i, s) in states.chunks_exact(STATE.len()).enumerate() {
             let row: [f64; 7] = s.try_into().expect("seven columns");
-            geoms::RodGeoms::check_state(&self.names[i], &row).map_err(|e| to_pyerr(py, e))?;
+            self.inner
+                .check_state(i, &self.names[i], &row)
+                .map_err(|e| to_pyerr(py, e))?;
             rows.push(row);
         }
         for (i, (row, o)) in rows.iter().zip(out.chunks_exact_mut(width)).enumerate() {
@@ -160,7 +181,7 @@ struct Arrays {
     after: Py<PyArray1<f64>>,
 }
 
-/// [`RodGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
+/// [`SandGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
 /// model's arrays, evaluates every geom and puts the generalized force into MuJoCo's (see
 /// `granrs.mujoco.Sand`).
 #[pyclass(module = "granrs._granrs", unsendable)]
@@ -173,13 +194,12 @@ pub struct GeomCoupling {
 impl GeomCoupling {
     /// `rods` on MuJoCo's geoms `geom` (bodies `body`, tree roots `root`, tip `reach` from
     /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
-    /// height and patch in x; `stick` for the static terms as reactions; `at_centroid`
-    /// where the force acts; `implicit_damping` the dof damping the engine's step takes
-    /// implicitly (nv).
+    /// height and patch in x; `stick` for the static terms as reactions;
+    /// `implicit_damping` the dof damping the engine's step takes implicitly (nv).
     #[new]
     #[allow(clippy::too_many_arguments)]
     fn new(
-        rods: PyRef<'_, RodGeoms>,
+        rods: PyRef<'_, SandGeoms>,
         geom: Vec<usize>,
         body: Vec<usize>,
         root: Vec<usize>,
@@ -189,7 +209,6 @@ impl GeomCoupling {
         surface: f64,
         patch: (f64, f64),
         stick: bool,
-        at_centroid: bool,
         implicit_damping: Vec<f64>,
     ) -> PyResult<Self> {
         let n = rods.inner.len();
@@ -223,7 +242,6 @@ impl GeomCoupling {
                 surface,
                 patch,
                 stick,
-                at_centroid,
                 previous: vec![0.0; nv],
                 implicit_damping,
                 work: Work::new(n, nv),
@@ -235,7 +253,7 @@ impl GeomCoupling {
 
     /// Bind the arrays of one `mjData` (`geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`,
     /// `cdof`, `qvel`, `qacc`, `qfrc_applied`, `qfrc_passive`) and the caller's buffers (the
-    /// dense mass matrix it fills, `outputs` per geom in ROD_GEOM_OUTPUTS order, `applied`
+    /// dense mass matrix it fills, `outputs` per geom in GEOM_OUTPUTS order, `applied`
     /// force and moment, `h_lambda`, the generalized force, and `before` and `after`, the
     /// bookkeeping of `qfrc_applied`), each checked for its shape once.
     #[allow(clippy::too_many_arguments)]
