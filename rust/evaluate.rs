@@ -773,8 +773,12 @@ pub mod geoms {
             for (a, &i) in active.iter().enumerate() {
                 let row = &out.outputs[i * width..(i + 1) * width];
                 reaction[2 * a..2 * a + 2].copy_from_slice(&w_.raw[a]);
-                bounds[2 * a] = row[c_bx];
-                bounds[2 * a + 1] = row[c_by];
+                // The static (rate-independent) terms' reaction is bounded by the bounds
+                // they report (the thesis's terms: always; rft: only under the solver's held
+                // modes) and at least by their force's size along the axis, which they
+                // could supply as the velocity turns (rft's direction flips with it).
+                bounds[2 * a] = row[c_bx].max(row[c_sx].abs());
+                bounds[2 * a + 1] = row[c_by].max(row[c_sy].abs());
             }
             let held = hold && active.iter().all(|&i| self.held[i].is_some());
             if self.stick && held {

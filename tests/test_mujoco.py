@@ -46,11 +46,18 @@ def _rod(xml: str = ROD):
     return model, mujoco.MjData(model)
 
 
+RFT = forces.term("rft", zeta=1e6, elements=64)
+
+
+@pytest.mark.parametrize("law", ["thesis", "rft"])
 @pytest.mark.parametrize("q_deg", [0, 30, 60])
-def test_rod_drop_matches_simulate_at_1e_4(q_deg):
-    """Acceptance: the free link dropped in MuJoCo (Euler, 1e-4 s) with the thesis law stops
-    within 2 % of granrs.simulate's depth and 5 % of its t_s."""
+def test_rod_drop_matches_simulate_at_1e_4(q_deg, law):
+    """Acceptance: the free link dropped in MuJoCo (Euler, 1e-4 s) under the thesis's law
+    and under rft(zeta=1e6, elements=64) stops within 2 % of granrs.simulate's depth and 5 %
+    of its t_s."""
     scene = granrs.cases.free_link(q_deg=q_deg, v0=2.0)
+    if law == "rft":
+        scene = scene.replace(forces=(forces.gravity(), RFT))
     ref = granrs.simulate(scene)
     got = rod_drop(scene, timestep=1e-4, integrator="Euler")
     assert got["depth"] == pytest.approx(ref.depth, rel=0.02)
@@ -225,19 +232,23 @@ def test_bad_input_is_a_typed_error_naming_it_before_the_first_step(
     assert named in str(info.value)
 
 
+@pytest.mark.parametrize("law", ["thesis", "rft"])
 @pytest.mark.parametrize("mode", ["step", "callback"])
-def test_a_walker_standing_in_sand_stays_put(mode):
+def test_a_walker_standing_in_sand_stays_put(mode, law):
     """Two sand geoms on one tree, with MuJoCo's implicit joint damping: once the gallery's
     walker has landed (0.3 s), for 1 s its shanks' tips stay within 0.1 mm and its energy
-    (MuJoCo's KE + PE, springs included) rises by no more than 1e-6 J/s x max(t, 1 s). Pins
-    the chatter of the first version, whose reactions drove each other to their bounds."""
+    (MuJoCo's KE + PE, springs included) rises by no more than 1e-6 J/s x max(t, 1 s), under
+    the thesis's law and under rft. Pins the chatter of the first version, whose reactions
+    drove each other to their bounds, and that of rft, whose force turns with the velocity
+    and which reports no sticking bound outside the solver's held modes."""
     from granrs.mujoco import WALKER_SAND_GEOMS, walker_mjcf
 
     model = mujoco.MjModel.from_xml_string(walker_mjcf())
     model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     data = mujoco.MjData(model)
     data.qvel[1] = -2.0
-    sand = Sand(model, list(WALKER_SAND_GEOMS), THESIS)
+    terms = THESIS if law == "thesis" else [forces.term("rft", zeta=1e6, elements=16)]
+    sand = Sand(model, list(WALKER_SAND_GEOMS), terms)
     ids = [model.geom(name).id for name in WALKER_SAND_GEOMS]
 
     def tips():
@@ -275,7 +286,7 @@ def test_the_gallery_walker_runs():
     namespace = runpy.run_path(str(script))
     plt.close("all")
     runs = namespace["runs"]
-    assert set(runs) == {"sand, thesis's law", "sand, static_v only", "rigid ground"}
+    assert set(runs) == {"sand, rft", "sand, thesis's law", "rigid ground"}
     for _, t, depth, force, _ in runs.values():
         assert np.all(np.isfinite(depth)) and np.all(np.isfinite(force))
         assert t[-1] == pytest.approx(namespace["T_END"], abs=1e-9)
