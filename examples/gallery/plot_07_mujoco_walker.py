@@ -11,9 +11,10 @@ A passive two-legged walker (:func:`granrs.mujoco.walker_mjcf`, printed below: a
 slide x, slide z and hinge y; two legs of thigh and shank with stiff, damped hips and knees;
 no controller) is dropped at 2 m/s onto sand under ``rft`` (resistive force theory), then
 under the thesis's law, and onto MuJoCo's rigid ground. The two shanks are the sand geoms
-and meet the sand tip first, as the thesis's rod does. The plot shows how deep the feet go and the ground's vertical reaction; the strip
-below draws the three landings from the recorded poses (matplotlib: no offscreen rendering
-needed). ``pip install 'granrs[mujoco]'``.
+and meet the sand tip first, as the thesis's rod does. The plot shows how deep the feet go
+and the ground's vertical reaction; the strip below draws the three landings from the
+recorded poses (matplotlib: no offscreen rendering needed).
+``pip install 'granrs[mujoco]'``.
 """
 
 import matplotlib.pyplot as plt
