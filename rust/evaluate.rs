@@ -770,15 +770,20 @@ pub mod geoms {
             }
             let mut reaction = [0.0; 2 * MAX_COUPLED];
             let mut bounds = [0.0; 2 * MAX_COUPLED];
+            let mut soft = [false; 2 * MAX_COUPLED];
             for (a, &i) in active.iter().enumerate() {
                 let row = &out.outputs[i * width..(i + 1) * width];
                 reaction[2 * a..2 * a + 2].copy_from_slice(&w_.raw[a]);
                 // The static (rate-independent) terms' reaction is bounded by the bounds
                 // they report (the thesis's terms: always; rft: only under the solver's held
-                // modes) and at least by their force's size along the axis, which they
-                // could supply as the velocity turns (rft's direction flips with it).
-                bounds[2 * a] = row[c_bx].max(row[c_sx].abs());
-                bounds[2 * a + 1] = row[c_by].max(row[c_sy].abs());
+                // modes, so not here). Where they report none but push, their force's size
+                // along the axis bounds it (rft's force turns with the velocity), and a row
+                // past that bound keeps the force as evaluated (`soft`): rft's components
+                // need not oppose the motion axis by axis.
+                for (k, (c_b, c_s)) in [(c_bx, c_sx), (c_by, c_sy)].into_iter().enumerate() {
+                    soft[2 * a + k] = row[c_b] <= 0.0 && row[c_s] != 0.0;
+                    bounds[2 * a + k] = row[c_b].max(row[c_s].abs());
+                }
             }
             let held = hold && active.iter().all(|&i| self.held[i].is_some());
             if self.stick && held {
@@ -788,7 +793,13 @@ pub mod geoms {
                     let (r, sliding) = self.held[i].expect("held");
                     for axis in 0..2 {
                         let b = bounds[2 * a + axis];
-                        if b > 0.0 {
+                        // A soft row: sliding, the force as this stage evaluates it;
+                        // sticking, the reaction as solved (its bound is the first stage's).
+                        if soft[2 * a + axis] {
+                            if !sliding[axis] {
+                                reaction[2 * a + axis] = r[axis];
+                            }
+                        } else if b > 0.0 {
                             reaction[2 * a + axis] = if sliding[axis] {
                                 b.copysign(r[axis])
                             } else {
@@ -811,13 +822,22 @@ pub mod geoms {
                     dot(je, s.qvel) / timestep + dot(je, &w_.tmp)
                 });
                 let w = nalgebra::DMatrix::from_row_slice(rows, rows, &w_.w[..rows * rows]);
-                solve_boxed(&w, &b, &bounds[..rows], &mut reaction[..rows]);
+                solve_boxed(
+                    &w,
+                    &b,
+                    &bounds[..rows],
+                    &soft[..rows],
+                    &mut reaction[..rows],
+                );
             }
             if !held {
                 self.held.fill(None);
                 for (a, &i) in active.iter().enumerate() {
                     let r = [reaction[2 * a], reaction[2 * a + 1]];
-                    let at = |k: usize| r[k].abs() >= bounds[2 * a + k] * (1.0 - 1e-12);
+                    let at = |k: usize| {
+                        let (b, raw) = (bounds[2 * a + k], w_.raw[a][k]);
+                        r[k].abs() >= b * (1.0 - 1e-12) || (soft[2 * a + k] && r[k] == raw)
+                    };
                     self.held[i] = Some((r, [at(0), at(1)]));
                 }
             }
@@ -912,16 +932,19 @@ pub mod geoms {
 
     /// Solve `w r = -b` for the rows with a positive bound, each `|r_i| <= bound_i` (rows
     /// without a bound keep their value): solve the free rows; if some are past their
-    /// bound, hold the one furthest past (relative to its bound) at its bound and solve the
-    /// rest again (an active set, one row at a time: a sliding row's large value must not
+    /// bound, hold the one furthest past (relative to its bound) at its bound (a `soft` row
+    /// at its value on entry) and solve the rest again (an active set, one row at a time: a sliding row's large value must not
     /// push the others past theirs).
     fn solve_boxed(
         w: &nalgebra::DMatrix<f64>,
         b: &nalgebra::DVector<f64>,
         bounds: &[f64],
+        soft: &[bool],
         r: &mut [f64],
     ) {
         use nalgebra::{DMatrix, DVector};
+        // A soft row past its bound is held at its value on entry (the force as evaluated).
+        let entry: Vec<f64> = r.to_vec();
         let mut free: Vec<bool> = bounds.iter().map(|&x| x > 0.0).collect();
         for _ in 0..=bounds.len() {
             let f: Vec<usize> = (0..bounds.len()).filter(|&i| free[i]).collect();
@@ -947,7 +970,11 @@ pub mod geoms {
             match worst {
                 None => return,
                 Some((i, _)) => {
-                    r[i] = r[i].clamp(-bounds[i], bounds[i]);
+                    r[i] = if soft[i] {
+                        entry[i]
+                    } else {
+                        r[i].clamp(-bounds[i], bounds[i])
+                    };
                     free[i] = false;
                 }
             }
