@@ -219,6 +219,33 @@ def _parse_param(name: Any, body: str) -> _Param:
 LawSpec = Sequence[_forces.Term] | Callable[[Mapping[str, Any]], Sequence[_forces.Term]]
 
 
+def base_coefficients(
+    body: str, row: Mapping[str, Any], base: Any = None, rho_g: float = 1650.0
+) -> Coefficients:
+    """The thesis's published coefficients of one measurement row: free link Table 3.4's
+    nearest row (``base="table_3_2"``: the closed forms at the row's angle), chain Table 4.4
+    per link and case, leg the row of sec. 5.3.2 at the nearest speed; or ``base`` itself
+    if it is a :class:`~granrs.Coefficients`."""
+    if isinstance(base, Coefficients):
+        return base
+    if body == "free_link":
+        if base == "table_3_2":
+            return table_3_2(row["q_deg"], rho_g)
+        return table_3_4(row["q_deg"])[0]
+    if body == "chain":
+        case = int(row["v0_case"])
+        spec = _cases.chain_case(case if case in (1, 2, 3) else 1)
+        return spec["coefficients"][int(row["link"]) - 1]
+    table = data.load("human_coefficients", as_="numpy")
+    i = int(np.argmin(np.abs(table["v0"] - row["v0_mean"])))
+    return Coefficients(
+        eta_h=float(table["eta_h"][i]),
+        eta_d=float(table["eta_d"][i]),
+        eta_v=float(table["eta_v"][i]),
+        lam=float(table["lambda"][i]),
+    )
+
+
 def _contact(row: Mapping[str, Any]) -> int:
     """The contact a measurement row is (the chain's link 2 is contact 1)."""
     return int(row["link"]) - 1 if "link" in row else 0
@@ -272,24 +299,7 @@ class _Model:
 
     # base law ----------------------------------------------------------------------------
     def base_coefficients(self, row: Mapping[str, Any]) -> Coefficients:
-        if isinstance(self.base, Coefficients):
-            return self.base
-        if self.body == "free_link":
-            if self.base == "table_3_2":
-                return table_3_2(row["q_deg"], self.overrides.get("rho_g", 1650.0))
-            return table_3_4(row["q_deg"])[0]
-        if self.body == "chain":
-            case = int(row["v0_case"])
-            spec = _cases.chain_case(case if case in (1, 2, 3) else 1)
-            return spec["coefficients"][int(row["link"]) - 1]
-        table = data.load("human_coefficients", as_="numpy")
-        i = int(np.argmin(np.abs(table["v0"] - row["v0_mean"])))
-        return Coefficients(
-            eta_h=float(table["eta_h"][i]),
-            eta_d=float(table["eta_d"][i]),
-            eta_v=float(table["eta_v"][i]),
-            lam=float(table["lambda"][i]),
-        )
+        return base_coefficients(self.body, row, self.base, self.overrides.get("rho_g", 1650.0))
 
     def base_terms(self, row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
         """The law's terms for one row (one contact), before the fitted parameters."""
