@@ -24,6 +24,8 @@ The numbers, per dataset and law (columns of the frame, and keys of :func:`to_js
   as :func:`granrs.calibrate.within` counts);
 * ``oos_chi2``: out of sample, the sum of the squared residuals over the fit's sd: the
   score the laws are ranked by (``rank``, 1 the best);
+* ``stop_order`` (chain): in how many cases the two links stop in the measured order, out
+  of sample, and which link stops first per case, measured and predicted;
 * ``rows``: per row, the measured mean and sd and the out-of-sample prediction of depth and
   t_s, with z = (prediction - mean) / sd, and the group it was held out with;
 * ``folds``: per fold (``"all"`` the in-sample fit, then each held-out group), the fitted
@@ -61,6 +63,7 @@ __all__ = [
     "FitParam",
     "Law",
     "compare",
+    "scenes",
     "synthetic",
     "to_json",
 ]
@@ -184,8 +187,7 @@ LAWS: dict[str, Law] = {
         ),
         Law(
             "rft+rft_inertial",
-            "rft plus its inertial (rate-dependent) term, zeta and the inertial "
-            "coefficient fitted",
+            "rft plus its inertial (rate-dependent) term, zeta and the inertial coefficient fitted",
             terms=(("rft", {}), ("rft_inertial", {})),
             fit={"rft.zeta": (1e6, 1e3, 1e9), "rft_inertial.c": (1.0, 1e-3, 1e3)},
             fit_body={"leg": {"rft_inertial.c": None}},
@@ -461,6 +463,24 @@ def _count(rows: Sequence[Mapping[str, Any]], q: str, k: float) -> int:
     return int(sum(1 for r in rows if abs(r[f"{q}_z"]) <= k + 1e-12))
 
 
+def _stop_order(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The chain: in how many cases the links stop in the measured order (out of sample)."""
+    cases: dict[Any, dict[int, Mapping[str, Any]]] = {}
+    for r in rows:
+        cases.setdefault(r["v0_case"], {})[int(r["link"])] = r
+    per_case = {}
+    for case, links in cases.items():
+        if set(links) != {1, 2}:
+            continue
+        measured = links[1]["t_s_mean"] - links[2]["t_s_mean"]
+        predicted = links[1]["t_s_pred"] - links[2]["t_s_pred"]
+        first_m = 1 if measured < 0 else 2 if measured > 0 else 0
+        first_p = 1 if predicted < 0 else 2 if predicted > 0 else 0
+        per_case[str(_plain(case))] = {"measured_first": first_m, "predicted_first": first_p}
+    ok = sum(1 for v in per_case.values() if v["measured_first"] == v["predicted_first"])
+    return {"in_order": ok, "cases": len(per_case), "per_case": per_case}
+
+
 def _entry(
     name: str,
     job: _Job,
@@ -513,6 +533,7 @@ def _entry(
             oos.index = index
             oos = oos.sort_index()
     rows = _rows(m, oos.reset_index(drop=True), group)
+    stop_order = _stop_order(rows) if job.body == "chain" else None
     dof = n_res - k
     oos_chi2 = float(sum(r["depth_zfit"] ** 2 + r["t_s_zfit"] ** 2 for r in rows))
     return {
@@ -533,6 +554,7 @@ def _entry(
         "depth_within_1sd": _count(rows, "depth", 1.0),
         "ts_within_1sd": _count(rows, "t_s", 1.0),
         "ts_within_2sd": _count(rows, "t_s", 2.0),
+        "stop_order": stop_order,
         "group": group,
         "rows": rows,
         "folds": folds,
@@ -646,6 +668,7 @@ def _missing(name: str, law: Law, m: Measurements, reason: str) -> dict[str, Any
         "depth_within_1sd": nan,
         "ts_within_1sd": nan,
         "ts_within_2sd": nan,
+        "stop_order": None,
         "group": None,
         "rows": [],
         "folds": [],
@@ -671,6 +694,7 @@ JSON_KEYS: tuple[str, ...] = (
     "depth_within_1sd",
     "ts_within_1sd",
     "ts_within_2sd",
+    "stop_order",
     "group",
     "rows",
     "folds",
@@ -692,12 +716,28 @@ def _json_value(value: Any) -> Any:
     return value
 
 
+#: Keys that are counts (whole numbers, or None when the law did not run).
+_COUNT_KEYS = (
+    "n_params",
+    "n_rows",
+    "dof",
+    "rank",
+    "depth_within_1sd",
+    "ts_within_1sd",
+    "ts_within_2sd",
+    "simulations",
+)
+
+
 def to_json(frame: pd.DataFrame) -> dict[str, dict[str, dict[str, Any]]]:
     """The comparison as plain data, ``{dataset: {law: {...}}}`` (what ``laws.json`` and
     ``granrs compare --json`` hold): per law the keys of :data:`JSON_KEYS`; NaN as None."""
     out: dict[str, dict[str, dict[str, Any]]] = {}
     for rec in frame.to_dict("records"):
         entry = {k: _json_value(rec.get(k)) for k in JSON_KEYS}
+        for k in _COUNT_KEYS:
+            if isinstance(entry[k], float):
+                entry[k] = int(entry[k])
         out.setdefault(str(rec["dataset"]), {})[str(rec["law"])] = entry
     return out
 
@@ -750,13 +790,13 @@ def synthetic(
     )
 
 
-def _pinned(job: _Job, m: Measurements, dt: float, values: Sequence[float]) -> pd.DataFrame:
-    """The simulated rows of ``m`` with the job's parameters at ``values``."""
+def _model(job: _Job, dt: float) -> Any:
+    """The calibration model of a job (its parameters, law and settings)."""
     from .calibrate.fit import _check_law
     from .calibrate.model import _Model
 
     parsed = [_parse_param(p, job.body) for p in job.params]
-    model = _Model(
+    return _Model(
         job.body,
         tuple(parsed),
         None,
@@ -765,5 +805,32 @@ def _pinned(job: _Job, m: Measurements, dt: float, values: Sequence[float]) -> p
         dict(job.joints or {}),
         _check_law(job.law.terms_for(job.body)),
     )
-    depth, t_s, _ = model.simulate(m.rows, [values], None)
+
+
+def _pinned(job: _Job, m: Measurements, dt: float, values: Sequence[float]) -> pd.DataFrame:
+    """The simulated rows of ``m`` with the job's parameters at ``values``."""
+    depth, t_s, _ = _model(job, dt).simulate(m.rows, [values], None)
     return _residual_frame(m, depth[0], t_s[0])
+
+
+def scenes(
+    law: str | Law,
+    measurements: Measurements | str,
+    values: Mapping[str, float] | None = None,
+    *,
+    dataset: str | None = None,
+    dt: float = 1e-4,
+) -> list[Any]:
+    """The scenes :func:`compare` runs for the rows of ``measurements`` under ``law`` at
+    the parameter ``values`` (e.g. one fold's ``folds[i]["values"]``): one per row (one
+    per case for the chain), to rerun or record a prediction."""
+    (law_obj,) = _law_list([law])
+    m = measurements if isinstance(measurements, Measurements) else Measurements.load(measurements)
+    job = _job(law_obj, dataset or m.body, m)
+    given = dict(values or {})
+    if set(given) != set(job.params):
+        raise InvalidParameterError(
+            f"values must give exactly the law's parameters {list(job.params)}; got {list(given)}",
+            field="values",
+        )
+    return _model(job, dt).scenes(m.rows, [float(given[k]) for k in job.params])
