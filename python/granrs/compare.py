@@ -189,26 +189,32 @@ LAWS: dict[str, Law] = {
             "rft+rft_inertial",
             "rft plus its inertial (rate-dependent) term, zeta and the inertial coefficient fitted",
             terms=(("rft", {}), ("rft_inertial", {})),
-            fit={"rft.zeta": (1e6, 1e3, 1e9), "rft_inertial.c": (1.0, 1e-3, 1e3)},
-            fit_body={"leg": {"rft_inertial.c": None}},
+            fit={"rft.zeta": (1e6, 1e3, 1e9), "rft_inertial.lam": (1.0, 1e-3, 1e3)},
+            fit_body={"leg": {"rft_inertial.lam": None}},
         ),
         Law(
             "poncelet",
             "poncelet alone (Katsuragi & Durian 2007): c and k fitted",
             terms=(("poncelet", {}),),
-            fit={"poncelet.c": (1.0, 1e-3, 1e3), "poncelet.k": (1e3, 1.0, 1e7)},
-            fit_body={"leg": {"poncelet.c": None}},
+            fit={"poncelet.c": (1.0, 1e-3, 1e3), "poncelet.k": (300.0, 1.0, 1e7)},
+            # The leg: one parameter of the law (see _LEG_THESIS); the depth friction, at
+            # the order of the body weight over the measured depth.
+            fit_body={"leg": {"poncelet.c": None, "poncelet.k": (1e4, 1.0, 1e7)}},
         ),
     )
 }
 
-#: The body's unknowns fitted with every law that fits (``Law.body_unknowns``), by body:
-#: the chain's link mass is not in the thesis (between a steel tube of a quarter of the
-#: solid mass and solid steel, 0.0341 kg, the most a steel link of the stated size can
-#: weigh); the leg's joint stiffness within a physiological range (see :data:`DATASETS`).
+#: The body's unknowns fitted with every law that fits (``Law.body_unknowns``), by body.
+#: The leg's joint stiffness, within a physiological range (see :data:`DATASETS`). The
+#: chain's link mass is not in the thesis, but it cannot be fitted beside a law's force
+#: scale: every term of these laws is linear in its coefficient (eta_h, eta_d, eta_v, c, k,
+#: zeta), and gravity is linear in the mass, so a mass m' with those coefficients times
+#: m'/m gives the same motion (a = g + F/m). The chain keeps its solid-steel mass, and each
+#: law's coefficients are per that mass; :func:`granrs.calibrate` fits the mass itself
+#: (``"mass"``) where the law is held fixed.
 BODY_UNKNOWNS: dict[str, dict[str, FitParam]] = {
     "free_link": {},
-    "chain": {"mass": (0.0341, 0.0341 / 4.0, 0.0341)},
+    "chain": {},
     "leg": {"joints.k": (300.0, 100.0, 1000.0)},
 }
 
@@ -244,8 +250,9 @@ DATASETS: dict[str, Dataset] = {
         "table_4_chain",
         "v0_case",
         note="Tables 4.1-4.2, 3 cases x 2 links: leave one case out (3 folds of 2 rows). "
-        "The link mass is not in the thesis: the published model is solid steel (0.0341 kg); "
-        "the fitting laws fit it between a quarter of that and solid steel.",
+        "The link mass is not in the thesis: every law runs with solid steel (0.0341 kg). It "
+        "cannot be fitted beside a law's coefficients (a mass m' with the sand's force "
+        "scaled by m'/m moves the same), so each law's coefficients are per that mass.",
     ),
     "leg": Dataset(
         "table_5_1_means",
@@ -256,9 +263,13 @@ DATASETS: dict[str, Dataset] = {
         "across subjects): 2 rows, so leave one height out (2 folds of 1 row, each fit on 2 "
         "residuals: one parameter of the law and the joints' stiffness). The thesis's model "
         "has locked joints; the fitting laws put one spring-damper on ankle, knee and hip, "
-        "k fitted within 100-1000 N m/rad (the order of the knee's quasi-stiffness in the "
-        "loading phase of walking, Shamaei, Sawicki & Dollar, PLoS ONE 8 (2013) e59993; "
-        "an assumed range for a landing) and c = 5 N m s/rad.",
+        "k fitted within 100-1000 N m/rad and c = 5 N m s/rad. The range is an assumption "
+        "built on the knee's quasi-stiffness in walking (Shamaei, Sawicki & Dollar, PLoS ONE "
+        "8 (2013) e59993): a published regression of the knee's flexion quasi-stiffness in "
+        "the weight acceptance of walking (PMC4914409, Table II) gives about 3 N m/deg, "
+        "~170 N m/rad, for a 75 kg adult; a landing, with the muscles braced, is taken to be "
+        "stiffer, up to about 6 times that. No landing stiffness of these subjects was "
+        "measured.",
     ),
 }
 
