@@ -1,16 +1,18 @@
 """Which force law fits the experiments: a cross-validated comparison of laws (issue 18).
 
-:func:`compare` fits each law to each set of measurements (:func:`granrs.calibrate`), and
+:func:`granrs.compare` fits each law to each set of measurements (:func:`granrs.calibrate`), and
 checks every law out of sample by leave-one-group-out cross-validation: each group of rows
 (Table 3.1: one impact angle; the chain: one case; the leg: one drop height, or one
 subject) is predicted by the law fitted to the other groups. It returns a
 :class:`pandas.DataFrame` with one row per dataset and law.
 
-A law is data (:class:`Law`): the terms that act, and the parameters to fit with their
-starting values and bounds. :data:`LAWS` holds the named laws; a law whose term the core
-does not have (yet) is reported as unavailable, with the reason, instead of failing.
+A law is data (:class:`~granrs.compare.Law`): the terms that act, and the parameters to
+fit with their starting values and bounds. :data:`~granrs.compare.LAWS` holds the named
+laws; a law whose term the core does not have (yet) is reported as unavailable, with the
+reason, instead of failing.
 
-The numbers, per dataset and law (columns of the frame, and keys of :func:`to_json`):
+The numbers, per dataset and law (columns of the frame, and keys of
+:func:`~granrs.compare.to_json`):
 
 * ``n_params``: the parameters fitted (the law's and the body's unknowns);
 * ``n_rows``: measurement rows; ``n_residuals``: 2 per row (depth, t_s);
@@ -58,6 +60,7 @@ from .errors import GranrsError, InvalidParameterError, UnknownNameError
 __all__ = [
     "BODY_UNKNOWNS",
     "DATASETS",
+    "JSON_KEYS",
     "LAWS",
     "Dataset",
     "FitParam",
@@ -90,8 +93,9 @@ class Law:
             ``poncelet.c``, ...).
         fit_body: per body, parameters fitted on that body only (they replace those of
             ``fit`` of the same name; ``None`` as the value drops one).
-        body_unknowns: whether the body's unknowns (:data:`BODY_UNKNOWNS`) are fitted too;
-            if not, the body's published setting is used (:attr:`Dataset.published`).
+        body_unknowns: whether the body's unknowns
+            (:data:`~granrs.compare.BODY_UNKNOWNS`) are fitted too; if not, the body's
+            published setting is used (:attr:`~granrs.compare.Dataset.published`).
     """
 
     name: str
@@ -205,13 +209,13 @@ LAWS: dict[str, Law] = {
 }
 
 #: The body's unknowns fitted with every law that fits (``Law.body_unknowns``), by body.
-#: The leg's joint stiffness, within a physiological range (see :data:`DATASETS`). The
-#: chain's link mass is not in the thesis, but it cannot be fitted beside a law's force
-#: scale: every term of these laws is linear in its coefficient (eta_h, eta_d, eta_v, c, k,
-#: zeta), and gravity is linear in the mass, so a mass m' with those coefficients times
-#: m'/m gives the same motion (a = g + F/m). The chain keeps its solid-steel mass, and each
-#: law's coefficients are per that mass; :func:`granrs.calibrate` fits the mass itself
-#: (``"mass"``) where the law is held fixed.
+#: The leg's joint stiffness, within a physiological range (see
+#: :data:`~granrs.compare.DATASETS`). The chain's link mass is not in the thesis, but it
+#: cannot be fitted beside a law's force scale: every term of these laws is linear in its
+#: coefficient (eta_h, eta_d, eta_v, c, k, zeta), and gravity is linear in the mass, so a
+#: mass m' with those coefficients times m'/m gives the same motion (a = g + F/m). The
+#: chain keeps its solid-steel mass, and each law's coefficients are per that mass;
+#: :func:`granrs.calibrate` fits the mass itself (``"mass"``) where the law is held fixed.
 BODY_UNKNOWNS: dict[str, dict[str, FitParam]] = {
     "free_link": {},
     "chain": {},
@@ -224,7 +228,7 @@ class Dataset:
     """A dataset of the comparison: the thesis's measurements and how to cut them.
 
     Attributes:
-        measurements: the thesis's measurements' name (:meth:`Measurements.thesis`).
+        measurements: the thesis's measurements' name (:meth:`granrs.Measurements.thesis`).
         group: the column whose values are the cross-validation's groups.
         published: Scene settings of the thesis's model for what is not fitted
             (``joints``: the leg's; other keys: Scene fields).
@@ -587,12 +591,13 @@ def compare(
     """Fit every law to every dataset and cross-validate it; one row per dataset and law.
 
     Args:
-        laws: law names from :data:`LAWS` or :class:`Law` objects; None: every law of
-            :data:`LAWS`.
+        laws: law names from :data:`~granrs.compare.LAWS` or
+            :class:`~granrs.compare.Law` objects; None: every law of
+            :data:`~granrs.compare.LAWS`.
         measurements: a :class:`granrs.Measurements` (the dataset is named after its body),
             a thesis name (``"table_3_1"``), a mapping of dataset name to either, or None:
-            the thesis's three datasets (:data:`DATASETS`: ``"free_link"``, ``"chain"``,
-            ``"leg"``).
+            the thesis's three datasets (:data:`~granrs.compare.DATASETS`:
+            ``"free_link"``, ``"chain"``, ``"leg"``).
         folds: the column whose values are the groups left out one at a time; ``"auto"``
             (default): ``q_deg`` (free link), ``v0_case`` (chain), ``height_case`` or
             ``subject`` (leg: Table 5.1's means have only the heights, the per-subject table
@@ -688,7 +693,7 @@ def _missing(name: str, law: Law, m: Measurements, reason: str) -> dict[str, Any
     }
 
 
-#: The keys of each law's entry in :func:`to_json`.
+#: The keys of each law's entry in :func:`~granrs.compare.to_json`.
 JSON_KEYS: tuple[str, ...] = (
     "available",
     "reason",
@@ -742,7 +747,8 @@ _COUNT_KEYS = (
 
 def to_json(frame: pd.DataFrame) -> dict[str, dict[str, dict[str, Any]]]:
     """The comparison as plain data, ``{dataset: {law: {...}}}`` (what ``laws.json`` and
-    ``granrs compare --json`` hold): per law the keys of :data:`JSON_KEYS`; NaN as None."""
+    ``granrs compare --json`` hold): per law the keys of
+    :data:`~granrs.compare.JSON_KEYS`; NaN as None."""
     out: dict[str, dict[str, dict[str, Any]]] = {}
     for rec in frame.to_dict("records"):
         entry = {k: _json_value(rec.get(k)) for k in JSON_KEYS}
@@ -766,12 +772,12 @@ def synthetic(
     """Measurements made by granrs under ``law`` at the parameter ``values``, with noise:
     the rows of ``like`` (its angles, speeds, cases), each mean drawn from a normal
     distribution around the simulated value with sd ``rel_sd`` times that value, which is
-    also the row's sd. For checking that :func:`compare` picks the law that made the data
+    also the row's sd. For checking that :func:`granrs.compare` picks the law that made the data
     and recovers its parameters.
 
     ``values`` gives every fitted parameter of the law on that body (its own and the
-    body's unknowns, as :func:`compare` fits them; ``dataset`` names the settings of
-    :data:`DATASETS` to use, default the body's name)."""
+    body's unknowns, as :func:`granrs.compare` fits them; ``dataset`` names the settings of
+    :data:`~granrs.compare.DATASETS` to use, default the body's name)."""
     (law_obj,) = _law_list([law])
     m = like if isinstance(like, Measurements) else Measurements.load(like)
     if not (isinstance(rel_sd, (int, float)) and 0.0 < rel_sd < 1.0):
@@ -832,7 +838,7 @@ def scenes(
     dataset: str | None = None,
     dt: float = 1e-4,
 ) -> list[Any]:
-    """The scenes :func:`compare` runs for the rows of ``measurements`` under ``law`` at
+    """The scenes :func:`granrs.compare` runs for the rows of ``measurements`` under ``law`` at
     the parameter ``values`` (e.g. one fold's ``folds[i]["values"]``): one per row (one
     per case for the chain), to rerun or record a prediction."""
     (law_obj,) = _law_list([law])
