@@ -31,7 +31,8 @@ The numbers, per dataset and law (columns of the frame, and keys of
 * ``rows``: per row, the measured mean and sd and the out-of-sample prediction of depth and
   t_s, with z = (prediction - mean) / sd, and the group it was held out with;
 * ``folds``: per fold (``"all"`` the in-sample fit, then each held-out group), the fitted
-  values with their ~95 % intervals, chi2 and dof, and the parameters that ended on a bound;
+  values with their ~95 % intervals, chi2 and dof, the parameters that ended on a bound,
+  and the z of depth and t_s of the rows it was fitted to (in sample);
 * ``available``, ``reason``: whether the law could run, and why not;
 * ``simulations``, ``seconds``: what the comparison cost.
 
@@ -437,6 +438,7 @@ def _predict(
 
 
 def _fold_record(held_out: Any, fit: Any) -> dict[str, Any]:
+    res = fit.residuals
     return {
         "held_out": held_out,
         "values": dict(fit.values),
@@ -445,6 +447,9 @@ def _fold_record(held_out: Any, fit: Any) -> dict[str, Any]:
         "chi2": fit.chi2,
         "dof": fit.dof,
         "at_bound": list(fit.at_bound),
+        # In sample: the z of the rows this fold was fitted to, in their order.
+        "depth_z": [float(z) for z in res["depth_z"]],
+        "t_s_z": [float(z) for z in res["t_s_z"]],
     }
 
 

@@ -490,30 +490,44 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
         lo, hi = BODY_UNKNOWNS["leg"]["joints.k"][1:]
         good, notes = [], []
         for law in laws:
-            within = (
-                law["depth_within_1sd"] == law["n_rows"] and law["ts_within_1sd"] == law["n_rows"]
-            )
-            scales = [
-                v for f in law["folds"] for p, v in f["values"].items() if p.startswith("scale.")
-            ]
+            oos = law["depth_within_1sd"] == law["n_rows"] and law["ts_within_1sd"] == law["n_rows"]
+            folds = law["folds"]
+            full = next((f for f in folds if f["held_out"] == "all"), None)
+            if full is None:  # nothing fitted: in sample is out of sample
+                insample = oos
+            else:
+                insample = all(abs(z) <= 1.0 for z in full["depth_z"] + full["t_s_z"])
+            scales = [v for f in folds for p, v in f["values"].items() if p.startswith("scale.")]
             worst_scale = max((max(v, 1 / v) for v in scales), default=1.0)
-            ks = [f["values"]["joints.k"] for f in law["folds"] if "joints.k" in f["values"]]
-            ok = within and worst_scale <= _LEG_MAX_SCALE
-            if ok:
-                good.append(law["law"])
+            k_free = all(
+                "joints.k" not in f["at_bound"] for f in folds if "joints.k" in f["values"]
+            )
+            if (oos or insample) and worst_scale <= _LEG_MAX_SCALE and k_free:
+                good.append(law["law"] + (" (out of sample)" if oos else " (in sample only)"))
+            fits = "; ".join(
+                ("all rows" if f["held_out"] == "all" else f"without {f['held_out']}")
+                + ": "
+                + ", ".join(
+                    f"{p} {v:.3g}" + (" (at bound)" if p in f["at_bound"] else "")
+                    for p, v in f["values"].items()
+                )
+                for f in folds
+            )
             notes.append(
-                f"{law['law']}: depth {law['depth_within_1sd']}/{law['n_rows']}, t_s "
-                f"{law['ts_within_1sd']}/{law['n_rows']} within 1 sd"
-                + (f", largest scale factor {worst_scale:.2g}" if scales else "")
-                + (f", joint k {', '.join(f'{k:.0f}' for k in ks)} N m/rad" if ks else "")
+                f"{law['law']}: out of sample depth {law['depth_within_1sd']}/{law['n_rows']}, "
+                f"t_s {law['ts_within_1sd']}/{law['n_rows']} within 1 sd; in sample "
+                f"{'all' if insample else 'not all'} within 1 sd"
+                + (f"; largest scale factor {worst_scale:.2g}" if scales else "")
+                + (f" ({fits})" if fits else "")
             )
         out.append(
             "- **Leg** (Table 5.1's averages within 1 sd, joints in a physiological range, no "
             f"coefficient scaled by more than {_LEG_MAX_SCALE:g}x; out of sample, leave one "
-            "height out): "
+            "height out, or at least in sample): "
             + (f"**met** by {', '.join(good)}" if good else "**not met** by any law run")
-            + f". Joint stiffness fitted within {lo:g}-{hi:g} N m/rad, c = 5 N m s/rad: "
-            + "; ".join(notes)
+            + f". Joint stiffness k [N m/rad] fitted within {lo:g}-{hi:g} N m/rad (a joint "
+            "setting on a bound is outside the range the law would choose), c = 5 N m s/rad. "
+            + " | ".join(notes)
             + "."
         )
     return "\n".join(out)
