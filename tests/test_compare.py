@@ -251,6 +251,23 @@ def test_synthetic_recovery(maker, truth) -> None:
         assert 0 < lo and hi / lo < 20, (p, lo, hi)
 
 
+@pytest.mark.skipif("poncelet" not in forces.TERMS, reason="no poncelet term in this build")
+def test_synthetic_recovery_poncelet() -> None:
+    """Measurements made under poncelet alone: the comparison picks it over the thesis's
+    laws and recovers c and k within their intervals."""
+    truth = {"poncelet.c": 2.0, "poncelet.k": 400.0}
+    data = synthetic("poncelet", truth, TABLE_3_1, rel_sd=0.03, seed=1)
+    frame = compare(["thesis_published", "thesis_refit", "poncelet"], data, progress=False)
+    ranked = frame.sort_values("rank")
+    assert ranked["law"].iloc[0] == "poncelet", ranked[["law", "oos_chi2", "aic"]]
+    assert frame.set_index("law")["aic"].idxmin() == "poncelet"
+    full = to_json(frame)["free_link"]["poncelet"]["folds"][0]
+    for p, v in truth.items():
+        lo, hi = full["intervals"][p]
+        assert lo <= v <= hi, (p, v, lo, hi, full["values"][p])
+        assert 0 < lo and hi / lo < 20, (p, lo, hi)
+
+
 def test_synthetic_is_what_granrs_simulates() -> None:
     """With almost no noise the synthetic means are the law's runs at the given values."""
     data = synthetic(

@@ -94,6 +94,8 @@ class Law:
             ``poncelet.c``, ...).
         fit_body: per body, parameters fitted on that body only (they replace those of
             ``fit`` of the same name; ``None`` as the value drops one).
+        fixed_body: per body, parameters held at a value on that body (``{body:
+            {"poncelet.c": 0.0}}``): for a parameter with no default that is not fitted.
         body_unknowns: whether the body's unknowns
             (:data:`~granrs.compare.BODY_UNKNOWNS`) are fitted too; if not, the body's
             published setting is used (:attr:`~granrs.compare.Dataset.published`).
@@ -105,6 +107,7 @@ class Law:
     terms: tuple[tuple[str, Mapping[str, float]], ...] = ()
     fit: Mapping[str, FitParam] = field(default_factory=dict)
     fit_body: Mapping[str, Mapping[str, FitParam | None]] = field(default_factory=dict)
+    fixed_body: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     body_unknowns: bool = True
 
     def params_for(self, body: str) -> dict[str, FitParam]:
@@ -120,13 +123,15 @@ class Law:
     def terms_for(self, body: str) -> Callable[[Mapping[str, Any]], tuple[_forces.Term, ...]]:
         """The law's terms for one measurement row of ``body``, at the start values."""
         extra = []
+        fixed = self.fixed_body.get(body, {})
         for name, params in self.terms:
             starts = {
                 k.split(".", 1)[1]: v[0]
                 for k, v in self.params_for(body).items()
                 if k.startswith(name + ".") and "@" not in k
             }
-            extra.append(_forces.term(name, **{**params, **starts}))
+            held = {k.split(".", 1)[1]: v for k, v in fixed.items() if k.startswith(name + ".")}
+            extra.append(_forces.term(name, **{**params, **held, **starts}))
         listed = {t.name for t in extra}
 
         def law(row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
@@ -202,9 +207,10 @@ LAWS: dict[str, Law] = {
             "poncelet alone (Katsuragi & Durian 2007): c and k fitted",
             terms=(("poncelet", {}),),
             fit={"poncelet.c": (1.0, 1e-3, 1e3), "poncelet.k": (300.0, 1.0, 1e7)},
-            # The leg: one parameter of the law (see _LEG_THESIS); the depth friction, at
-            # the order of the body weight over the measured depth.
+            # The leg: one parameter of the law (see _LEG_THESIS): the depth friction, from
+            # the order of the body weight over the measured depth; no inertial drag.
             fit_body={"leg": {"poncelet.c": None, "poncelet.k": (1e4, 1.0, 1e7)}},
+            fixed_body={"leg": {"poncelet.c": 0.0}},
         ),
     )
 }

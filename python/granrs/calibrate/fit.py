@@ -226,7 +226,7 @@ def _bounds_for(
     given = {k.replace("lambda", "lam"): v for k, v in given.items()}
     out = []
     for p in params:
-        pair = given.get(p.name, p.default_bounds())
+        pair = given[p.name] if p.name in given else p.default_bounds()
         try:
             lo, hi = (float(pair[0]), float(pair[1]))
             if len(pair) != 2:
