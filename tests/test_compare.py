@@ -348,22 +348,43 @@ def test_leg_published_is_locked_thesis() -> None:
 # The report chapter
 
 
-@pytest.fixture(scope="module")
-def chapter(tmp_path_factory):
+#: The laws of the fast chapter run (the full run, every law, is marked slow).
+FAST_LAWS = ("thesis_published", "thesis_refit")
+
+
+def _build_chapter(tmp_path_factory, laws):
+    import sys
+
+    from granrs.report import laws as chapter_module
     from granrs.report import reproduce
 
-    out = tmp_path_factory.mktemp("laws") / "out"
-    path = reproduce(out, chapters=["laws"], progress=False)
-    return out, path.read_text(encoding="utf-8")
+    subset = {k: v for k, v in LAWS.items() if k in laws}
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(sys.modules["granrs.compare"], "LAWS", subset)
+        mp.setattr(chapter_module, "LAWS", subset)
+        out = tmp_path_factory.mktemp("laws") / "out"
+        path = reproduce(out, chapters=["laws"], progress=False)
+    return out, path.read_text(encoding="utf-8"), subset
+
+
+@pytest.fixture(
+    scope="module",
+    params=[
+        pytest.param(FAST_LAWS, id="two-laws"),
+        pytest.param(tuple(LAWS), id="every-law", marks=pytest.mark.slow),
+    ],
+)
+def chapter(request, tmp_path_factory):
+    return _build_chapter(tmp_path_factory, request.param)
 
 
 def test_chapter_writes_laws_json(chapter) -> None:
-    out, text = chapter
+    out, text, laws_run = chapter
     data = json.loads((out / "laws.json").read_text())
     assert set(data) == {"free_link", "chain", "leg"}
     sizes = {"free_link": 12, "chain": 6, "leg": 2}
     for dataset, laws in data.items():
-        assert set(laws) == set(LAWS)
+        assert set(laws) == set(laws_run)
         for name, entry in laws.items():
             assert ENTRY_KEYS <= set(entry), (dataset, name)
             if entry["available"]:
@@ -380,7 +401,7 @@ def test_chapter_writes_laws_json(chapter) -> None:
 
 
 def test_chapter_verdict_names_the_winner_of_laws_json(chapter) -> None:
-    out, text = chapter
+    out, text, _ = chapter
     data = json.loads((out / "laws.json").read_text())
     for dataset, laws in data.items():
         ran = {k: v for k, v in laws.items() if v["available"]}
