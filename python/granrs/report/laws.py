@@ -150,6 +150,13 @@ def _available(frame: pd.DataFrame, dataset: str) -> list[dict[str, Any]]:
     return out
 
 
+def _in_order(frame: pd.DataFrame, dataset: str) -> list[dict[str, Any]]:
+    """The laws that ran on ``dataset`` in the comparison's order (the figures' order, so
+    that a law keeps its place and colour in every panel)."""
+    ran = {r["law"]: r for r in _available(frame, dataset)}
+    return [ran[name] for name in frame.loc[frame["dataset"] == dataset, "law"] if name in ran]
+
+
 def _figure_predicted(ctx: ReportContext, frame: pd.DataFrame) -> str:
     from matplotlib.figure import Figure
 
@@ -159,7 +166,7 @@ def _figure_predicted(ctx: ReportContext, frame: pd.DataFrame) -> str:
     fig = Figure(figsize=(13.0, 3.6 * len(datasets)))
     axes = np.atleast_2d(fig.subplots(len(datasets), 2, squeeze=False))
     for i, d in enumerate(datasets):
-        laws = _available(frame, d)
+        laws = _in_order(frame, d)
         body = laws[0]["rows"]
         x = np.arange(len(body))
         labels = [_row_label(_body(d), r) for r in body]
@@ -212,13 +219,13 @@ def _figure_residuals(ctx: ReportContext, frame: pd.DataFrame) -> str:
     axes = np.atleast_2d(fig.subplots(len(datasets), 2, squeeze=False))
     clip = 10.0
     for i, d in enumerate(datasets):
-        laws = _available(frame, d)
+        laws = _in_order(frame, d)
         rows0 = laws[0]["rows"]
         x = np.arange(len(rows0))
         for j, q in enumerate(("depth", "t_s")):
             ax = axes[i, j]
-            ax.axhspan(-1, 1, color="0.85", zorder=0)
             ax.axhspan(-2, 2, color="0.93", zorder=0)
+            ax.axhspan(-1, 1, color="0.85", zorder=0)
             width = 0.6 / max(len(laws), 1)
             for k, law in enumerate(laws):
                 z = np.clip([r[f"{q}_z"] for r in law["rows"]], -clip, clip)
