@@ -375,7 +375,10 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             continue
         rows.append([_number(_plain(rec[c])) for c in _COMPARE_COLUMNS])
     print("\n".join(_table(list(_COMPARE_COLUMNS), rows)))
-    print("(counts out of sample; chi2/dof, AIC, BIC in sample; rank by out-of-sample chi2)")
+    if folds is None:
+        print("(no cross-validation: every number in sample; rank by chi2)")
+    else:
+        print("(counts out of sample; chi2/dof, AIC, BIC in sample; rank by out-of-sample chi2)")
     for note in notes:
         print(note)
     return 0
