@@ -124,6 +124,20 @@ def test_bad_term_parameters_are_typed_errors(params, kwargs, error, field) -> N
     assert info.value.field == field
 
 
+@pytest.mark.skipif("poncelet" not in forces.TERMS, reason="no poncelet term in this build")
+def test_a_parameter_without_default_needs_bounds() -> None:
+    """poncelet.c has no default: fitting it needs bounds (a typed error names them)."""
+    law = [forces.gravity(), forces.term("poncelet", c=1.0, k=100.0)]
+    rows = TABLE_3_1.subset(q_deg=45.0)
+    with pytest.raises(InvalidParameterError) as info:
+        calibrate("free_link", rows, ["poncelet.c"], forces=law)
+    assert info.value.field == "bounds.poncelet.c"
+    fit = calibrate(
+        "free_link", rows, ["poncelet.c"], forces=law, bounds={"poncelet.c": (0.01, 100)}
+    )
+    assert 0.01 <= fit.values["poncelet.c"] <= 100
+
+
 def test_joints_are_leg_only() -> None:
     with pytest.raises(UnknownNameError):
         calibrate("free_link", TABLE_3_1, ["joints.k"])
