@@ -363,3 +363,79 @@ impl Term for RftInertial {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::forces::{Frame, Outline};
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn alpha_is_normalised_mirrored_periodic_and_dissipative() {
+        let (ax, az) = alpha_at(&GENERIC, 0.0, FRAC_PI_2);
+        assert!(ax.abs() < 1e-12 && (az - 1.0).abs() < 1e-12, "{ax} {az}");
+        for i in 0..=36 {
+            for j in 0..=72 {
+                let beta = -PI + i as f64 * PI / 18.0;
+                let gamma = -PI + j as f64 * PI / 36.0;
+                let (ax, az) = alpha_at(&GENERIC, beta, gamma);
+                let (mx, mz) = alpha_at(&GENERIC, -beta, PI - gamma);
+                assert!((mx + ax).abs() < 1e-12 && (mz - az).abs() < 1e-12);
+                let (px, pz) = alpha_at(&GENERIC, beta + PI, gamma);
+                assert!((px - ax).abs() < 1e-12 && (pz - az).abs() < 1e-12);
+                // F = (-ax, az) against v = (cos g, -sin g).
+                assert!(
+                    -ax * gamma.cos() - az * gamma.sin() <= 1e-12,
+                    "{beta} {gamma}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_vertical_rod_sinking_feels_the_plates_stresses() {
+        let (d, d_c, zeta) = (0.03, 0.0127, 1e6);
+        let b = Boundary {
+            frame: Frame {
+                origin: [0.0, -d],
+                v: [0.0, -1.0],
+                omega: 0.0,
+                axis: [0.0, 1.0],
+            },
+            outline: Outline::Rod {
+                diameter: d_c,
+                immersed: d,
+            },
+            apply: [0.0, -d],
+            centroid: [0.0, -0.5 * d],
+            v_centroid: [0.0, -1.0],
+            held: [0.0; 2],
+        };
+        let state = ContactState {
+            depth: d,
+            volume: 0.0,
+            width: d_c,
+            l_ref: 0.19,
+            v: [0.0, -1.0],
+            area_speed: 0.0,
+            sign: [0.0, -1.0],
+            boundary: Some(&b),
+        };
+        // The shaft (beta = pi/2), the tip plate (beta = 0), both moving straight down.
+        let shaft = GENERIC[0] - GENERIC[1] - GENERIC[2] + GENERIC[3] - GENERIC[4];
+        let expected = zeta * d_c * (shaft * d * d / 2.0 + d_c * d);
+        for n in [1, 3, 8] {
+            let t = Rft {
+                zeta,
+                elements: n,
+                coefficients: GENERIC,
+            };
+            let f = t.contact_force(&state, &crate::forces::Medium::default());
+            assert!(
+                (f.force[1] - expected).abs() < 1e-12 * expected,
+                "{n}: {f:?}"
+            );
+            assert!(f.force[0].abs() < 1e-12 * expected && f.moment.abs() < 1e-12);
+        }
+    }
+}
