@@ -43,6 +43,9 @@ _STARTS = 2
 _FREE_LINK_TARGET = {"depth_within_1sd": 10, "ts_within_2sd": 10}
 #: Leg: no coefficient scaled by more than this factor from the thesis's.
 _LEG_MAX_SCALE = 3.0
+#: The order of zeta Li, Zhang & Goldman (2013) measured for their media [N/m^3] (1 N/cm^3;
+#: ``shared/LAWS.md``, the rft term's registry entry): the leg's scale check compares with it.
+_RFT_ZETA_REF = 1e6
 #: One colour per law, in the order of LAWS.
 _COLOURS = dict(
     zip(
@@ -545,6 +548,10 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
             else:
                 insample = all(abs(z) <= 1.0 for z in full["depth_z"] + full["t_s_z"])
             scales = [v for f in folds for p, v in f["values"].items() if p.startswith("scale.")]
+            # RFT's zeta against the order Li et al. measured: the same 3x rule.
+            scales += [
+                f["values"]["rft.zeta"] / _RFT_ZETA_REF for f in folds if "rft.zeta" in f["values"]
+            ]
             worst_scale = max((max(v, 1 / v) for v in scales), default=1.0)
             k_free = all(
                 "joints.k" not in f["at_bound"] for f in folds if "joints.k" in f["values"]
@@ -560,8 +567,16 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
                 )
                 for f in folds
             )
+            zetas = [f["values"]["rft.zeta"] for f in folds if "rft.zeta" in f["values"]]
             notes.append(
-                f"{law['law']}: out of sample depth {law['depth_within_1sd']}/{law['n_rows']}, "
+                (
+                    f"{law['law']}: zeta {min(zetas) / _RFT_ZETA_REF:.2g}-"
+                    f"{max(zetas) / _RFT_ZETA_REF:.2g} times the ~1e6 N/m^3 of Li et al.'s "
+                    "media (no value for this sand is published); "
+                    if zetas
+                    else f"{law['law']}: "
+                )
+                + f"out of sample depth {law['depth_within_1sd']}/{law['n_rows']}, "
                 f"t_s {law['ts_within_1sd']}/{law['n_rows']} within 1 sd; in sample "
                 f"{'all' if insample else 'not all'} within 1 sd"
                 + (f"; largest scale factor {worst_scale:.2g}" if scales else "")
