@@ -8,6 +8,8 @@ __all__ = [
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
     "RECORDS",
+    "RFT_COEFFICIENTS",
+    "RFT_GENERIC",
     "SCENE_FIELDS",
     "Compiled",
     "RunOutcome",
@@ -18,6 +20,7 @@ __all__ = [
     "compiled_scene",
     "leg_segments",
     "resistance_force",
+    "rft_alpha",
     "run",
     "run_scene",
     "scene_fields",
@@ -29,6 +32,8 @@ __all__ = [
 __version__: str
 EFFECTS: list[str]
 RECORDS: list[str]
+RFT_COEFFICIENTS: list[str]
+RFT_GENERIC: list[float]
 SCENE_FIELDS: list[str]
 
 @final
@@ -114,3 +119,6 @@ def term_infos() -> list[dict[str, Any]]:
 
 def check_term(name: str, params: dict[str, Any]) -> dict[str, float | tuple[float, ...]]:
     """Check one term's name and parameters; every parameter with defaults filled in."""
+
+def rft_alpha(beta: Any, gamma: Any, coefficients: list[float]) -> tuple[Any, Any]:
+    """RFT (alpha_x, alpha_z) at equal-length float64 arrays of angles [rad]."""

@@ -9,14 +9,17 @@ use nalgebra::{SVector, Vector2};
 
 use super::constraints::solve_upto2;
 use super::{
-    ContactEval, ContactForce, ContactMode, Model, Modes, Shape, SignModel, Slip, PROJECTION_LIMIT,
+    held_shift, ContactEval, ContactForce, ContactMode, Model, Modes, Shape, SignModel, Slip,
+    PROJECTION_LIMIT,
 };
 use crate::body::rod::ApplyAt;
 use crate::body::{RodContact, RodGeometry};
 use crate::forces::drag::Drag;
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
-use crate::forces::{AnyTerm, Class, ContactState, Switch, Term, TermForce, TermInfo};
+use crate::forces::{
+    AnyTerm, Boundary, Class, ContactState, Frame, Outline, Switch, Term, TermForce, TermInfo,
+};
 
 /// Position and velocity of a single rigid rod whose root is its centre of mass: what
 /// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation).
@@ -151,6 +154,7 @@ impl<const N: usize> Model<N> {
             let f = &mut out.force;
             f.dynamic = Vector2::zeros();
             f.statics = Vector2::zeros();
+            f.moment = 0.0;
             out.bound = [0.0; 2];
             add_term(0, dynamic(&Drag::INFO), fd, f, &mut out.bound);
             add_term(1, dynamic(&StaticH::INFO), fh, f, &mut out.bound);
@@ -201,7 +205,9 @@ impl<const N: usize> Model<N> {
         out.lowest = tip.y;
         let mode = &modes[0];
         let geom = rod.geometry(tip.y, fr.axis);
-        let forced = mode.in_contact && geom.depth > 0.0;
+        // Terms that read the frame are evaluated from the moment of entry: a `poncelet`
+        // drag or a plate's `rft_inertial` is finite at depth 0 (the entry is a jump).
+        let forced = mode.in_contact && (geom.depth > 0.0 || self.forces.reads_frame);
         let centroid = Vector2::new(geom.centroid_s, rod.tip.y);
         if mode.in_contact {
             out.depth = geom.depth;
@@ -218,6 +224,40 @@ impl<const N: usize> Model<N> {
             } else {
                 0.0
             };
+            let p_local = self.application_point(&self.contacts[0], centroid);
+            let sign = self.signs(mode, v_e);
+            let boundary = if self.forces.reads_frame {
+                let shift = held_shift(
+                    sign,
+                    v_e,
+                    [
+                        self.forces.owns(Switch::SlipX),
+                        self.forces.owns(Switch::SlipY),
+                    ],
+                );
+                let v_held = v_tip + shift;
+                let v_e_held = v_e + shift;
+                let (apply, e) = (fr.at(p_local), fr.at(centroid));
+                Some(Boundary {
+                    frame: Frame {
+                        origin: [tip.x, tip.y],
+                        v: [v_held.x, v_held.y],
+                        // q turns clockwise (e = (sin q, cos q)): omega = -dq/dt.
+                        omega: -fr.omega,
+                        axis: [fr.axis.x, fr.axis.y],
+                    },
+                    outline: Outline::Rod {
+                        diameter: rod.diameter,
+                        immersed: geom.immersed_length,
+                    },
+                    apply: [apply.x, apply.y],
+                    centroid: [e.x, e.y],
+                    v_centroid: [v_e_held.x, v_e_held.y],
+                    held: self.held_axes(mode),
+                })
+            } else {
+                None
+            };
             let state = ContactState {
                 depth: geom.depth,
                 volume: rod.immersed_volume(&geom),
@@ -225,13 +265,15 @@ impl<const N: usize> Model<N> {
                 l_ref: rod.length,
                 v: [v_e.x, v_e.y],
                 area_speed,
-                sign: self.signs(mode, v_e),
+                sign,
+                boundary: boundary.as_ref(),
             };
             self.rigid_rod_terms(&state, out);
             let total = out.force.total();
             gen[0] += total.x;
             gen[1] += total.y;
-            gen[2] += total.dot(&fr.lever(self.application_point(&self.contacts[0], centroid)));
+            // A counter-clockwise moment does work -M dq.
+            gen[2] += total.dot(&fr.lever(p_local)) - out.force.moment;
         }
         // M^-1 by multiplication: the divisions are off the force's path and overlap it.
         let (inv_m, inv_i) = self.rigid_rod_inverse_mass_parts();
@@ -257,7 +299,7 @@ impl<const N: usize> Model<N> {
                 ApplyAt::Tip => out.v_tip,
                 ApplyAt::Centroid => out.v_centroid,
             };
-            out.force.total().dot(&v_p)
+            out.force.total().dot(&v_p) - out.force.moment * fr.omega
         } else {
             0.0
         };

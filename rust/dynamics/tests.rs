@@ -50,6 +50,7 @@ proptest! {
             v: [vx, vy],
             area_speed,
             sign: [slip(sx).sign(), slip(sy).sign()],
+            boundary: None,
         };
         let mut model = FreeLinkScene::default().model();
         let terms = [
