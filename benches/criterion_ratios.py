@@ -1,4 +1,5 @@
-"""Print the medians of the last ``cargo bench --bench bodies`` run and their ratios.
+"""Print the medians of the last ``cargo bench --bench bodies`` run and their ratios, and
+the per-term table of ``cargo bench --bench free_link``.
 
 Reads criterion's ``<dir>/<group>/<body>/new/estimates.json`` for the groups of
 ``benches/bodies.rs`` (``rhs_by_body``, ``step_by_body``, ``impact_by_body``) and prints, per
@@ -6,9 +7,14 @@ group, each body's median time with its 95 % interval and its ratio to the free 
 in the same group. All the numbers come from one criterion run: the machines are shared and
 noisy, so read the ratios, not the absolute times.
 
+The free link's ``force`` group gives the cost of one evaluation of each force term and of
+the thesis's set as a whole (``terms_on`` over drag, static_h and static_v; issue 16), next
+to a whole right-hand-side evaluation (``rhs``), each with its ratio to the thesis's set.
+
 Usage::
 
     cargo bench --bench bodies -- --warm-up-time 1 --measurement-time 3
+    cargo bench --bench free_link -- "force|rhs" --warm-up-time 1 --measurement-time 3
     python benches/criterion_ratios.py [--dir target/criterion] [--baseline free_link_q45]
 """
 
@@ -31,6 +37,19 @@ BODIES = (
     "leg_spring",
     "leg_free",
 )
+
+
+#: The free link's per-term table (benches/free_link.rs): (group, bench) in report order, and
+#: the bench the ratios divide by.
+TERM_BENCHES = (
+    ("force", "term/drag"),
+    ("force", "term/static_h"),
+    ("force", "term/static_v"),
+    ("force", "thesis_set"),
+    ("rhs", "eval"),
+    ("rhs", "eval_vertical_stick"),
+)
+TERM_BASELINE = ("force", "thesis_set")
 
 
 def median_ns(path: Path) -> tuple[float, float, float]:
@@ -67,8 +86,23 @@ def report(root: Path, baseline: str) -> str:
             lines.append(
                 f"  {body:<14} {format_ns(med):>10} [{format_ns(lo)} - {format_ns(hi)}]  {ratio}"
             )
+    terms = {}
+    for group, bench in TERM_BENCHES:
+        # criterion writes a bench id's "/" as "_" in its directory name.
+        path = root / group / bench.replace("/", "_") / "new" / "estimates.json"
+        if path.exists():
+            terms[(group, bench)] = median_ns(path)
+    if terms:
+        base = terms.get(TERM_BASELINE)
+        lines.append("free link, one evaluation: median [95 % interval], ratio to force/thesis_set")
+        for (group, bench), (med, lo, hi) in terms.items():
+            ratio = f"{med / base[0]:6.2f}" if base else "     -"
+            name = f"{group}/{bench}"
+            lines.append(
+                f"  {name:<26} {format_ns(med):>10} [{format_ns(lo)} - {format_ns(hi)}]  {ratio}"
+            )
     if not lines:
-        return f"no estimates of benches/bodies.rs under {root}"
+        return f"no estimates of benches/bodies.rs or benches/free_link.rs under {root}"
     return "\n".join(lines)
 
 
