@@ -7,15 +7,19 @@ __all__ = [
     "EFFECTS",
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
+    "MAX_CONTACTS",
+    "MAX_LINKS",
     "RECORDS",
     "SCENE_FIELDS",
     "Compiled",
     "RunOutcome",
     "__version__",
+    "body_linkage",
     "check_term",
     "compile",
     "compile_fields",
     "compiled_scene",
+    "element_fields",
     "leg_segments",
     "resistance_force",
     "run",
@@ -30,6 +34,8 @@ __version__: str
 EFFECTS: list[str]
 RECORDS: list[str]
 SCENE_FIELDS: list[str]
+MAX_LINKS: int
+MAX_CONTACTS: int
 
 @final
 class Compiled:
@@ -108,6 +114,13 @@ def resistance_force(
 
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""
+
+def element_fields() -> list[dict[str, Any]]:
+    """The one table of a linkage's element fields (element, name, unit, note, doc)."""
+
+def body_linkage(scene: dict[str, Any], check: bool = False) -> dict[str, Any]:
+    """A scene's body as a linkage's plain parts (links, joints, contacts, root) and the
+    links' names in the engine's order; ``check`` validates the body's structure."""
 
 def term_infos() -> list[dict[str, Any]]:
     """Every registered force term's description (name, equation, params, ...)."""

@@ -14,7 +14,9 @@
 //! the relative angle `q_i - q_parent`. A locked joint is the linear constraint
 //! `qdot_i - qdot_parent = 0` ([`Mechanism::locked_rows`]), enforced with the contacts'
 //! sticking constraints by `dynamics`; since it is linear in `q`, RK4 keeps it exactly (to
-//! round-off).
+//! round-off). A joint driven at a constant rate is the same row with the rate as its target
+//! (`qdot_i - qdot_parent = rate`, zero relative acceleration), and a root whose motion is
+//! prescribed (pinned, or moved at a constant velocity) holds `xddot = yddot = 0`.
 
 use nalgebra::{SMatrix, SVector, Vector2};
 
@@ -34,6 +36,12 @@ pub enum Joint {
         c: f64,
         /// Relative angle at which the spring is relaxed [rad].
         rest: f64,
+    },
+    /// Driven: the relative angle `q_i - q_parent` follows `theta_0 + rate t` (its initial
+    /// value plus a constant rate), held by an unbounded torque that the run reports.
+    Driven {
+        /// Relative rate [rad/s].
+        rate: f64,
     },
 }
 
@@ -61,6 +69,9 @@ pub struct Mechanism<const N: usize> {
     pub links: Vec<Link>,
     /// A point mass at the root [kg] (the chain's pin; 0 for none).
     pub root_mass: f64,
+    /// Whether the root's motion is prescribed (pinned, or moved at its initial velocity):
+    /// its coordinates then have zero acceleration, held by a reaction.
+    pub root_fixed: bool,
 }
 
 /// Positions and axes of every link for one configuration.
@@ -100,16 +111,24 @@ impl<const N: usize> Mechanism<N> {
         self.root_mass + self.links.iter().map(|l| l.mass).sum::<f64>()
     }
 
-    /// The (link, parent) pairs of the locked joints; each is the constraint
-    /// `qdot_link - qdot_parent = 0`.
-    pub fn locked_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+    /// The (link, parent, rate) triples of the locked and driven joints; each is the
+    /// constraint `qdot_link - qdot_parent = rate` (0 for a locked joint).
+    pub fn locked_rows(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
         self.links
             .iter()
             .enumerate()
             .filter_map(|(i, l)| match (l.parent, l.joint) {
-                (Some(p), Joint::Locked) => Some((i, p)),
+                (Some(p), Joint::Locked) => Some((i, p, 0.0)),
+                (Some(p), Joint::Driven { rate }) => Some((i, p, rate)),
                 _ => None,
             })
+    }
+
+    /// Whether any constraint of the mechanism itself is in force: a locked or driven joint,
+    /// or a prescribed root.
+    #[inline]
+    pub fn has_constraints(&self) -> bool {
+        self.root_fixed || self.locked_rows().next().is_some()
     }
 
     /// Add the spring-damper torques of the joints to the generalized forces `out`; return
@@ -371,6 +390,7 @@ mod tests {
         Mechanism {
             links: vec![link.clone(), link],
             root_mass: 0.01,
+            root_fixed: false,
         }
     }
 

@@ -387,8 +387,7 @@ impl<const N: usize> Model<N> {
             };
         };
         let mut qdd = chol.solve(&rhs);
-        let has_locks = self.mechanism.locked_rows().next().is_some();
-        if has_locks || self.any_stuck(modes) {
+        if self.mechanism.has_constraints() || self.any_stuck(modes) {
             self.solve_constraints(
                 &pose,
                 q,
