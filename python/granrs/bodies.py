@@ -147,8 +147,11 @@ class Joint:
       relative angle ``theta = q_child - q_parent`` (``k`` N m/rad, ``c`` N m s/rad,
       ``rest_deg``; ``None``: the initial relative angle); acts while the
       ``joint_springs`` term does;
-    * ``"driven"``: the relative angle moves at the constant ``rate`` [rad/s] from its
-      initial value; the run reports the torque it takes (``Result.joints``).
+    * ``"driven"``: the relative angle follows its initial value plus ``rate t`` [rad/s]
+      plus a sinusoid ``amplitude_deg (sin(2 pi frequency t + phase) - sin(phase))``
+      (``frequency`` in Hz, ``phase_deg``); the run reports the torque it takes
+      (``Result.joints``). A sinusoid reads the time from a clock coordinate of its own
+      (the series ``clock``), so such a linkage has at most ``MAX_LINKS - 1`` links.
     """
 
     name: str
@@ -160,6 +163,9 @@ class Joint:
     c: float | None = None
     rest_deg: float | None = None
     rate: float | None = None
+    amplitude_deg: float | None = None
+    frequency: float | None = None
+    phase_deg: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "at", _point(self.at, f"joints.{self.name}.at"))

@@ -86,9 +86,16 @@ def _names(scene: Scene) -> dict[str, tuple[str, ...]]:
     body = scene.body
     order = body.order  # type: ignore[union-attr]
     carrier = {j.child: j.name for j in body.joints}  # type: ignore[union-attr]
+    # A sinusoidal drive reads the time from a clock coordinate after the links'.
+    clock = ("clock",) if any(j.amplitude_deg for j in body.joints) else ()  # type: ignore[union-attr]
     return {
-        "coords": ("x_root", "y_root", *(f"q_{n}" for n in order)),
-        "rates": ("vx_root", "vy_root", *(f"omega_{n}" for n in order)),
+        "coords": ("x_root", "y_root", *(f"q_{n}" for n in order), *clock),
+        "rates": (
+            "vx_root",
+            "vy_root",
+            *(f"omega_{n}" for n in order),
+            *(f"{c}_rate" for c in clock),
+        ),
         "links": order,
         "joints": tuple(carrier.get(n, "root") for n in order),
     }

@@ -291,12 +291,35 @@ impl LinkageScene {
                     check_range(&f("c"), c, 0.0, false)?;
                     check_finite(&f("rest_deg"), rest)?;
                 }
-                Joint::Driven { rate } => {
-                    if !rate.is_finite() {
+                Joint::Driven {
+                    rate,
+                    amplitude,
+                    omega,
+                    phase,
+                } => {
+                    for (k, v, what) in [
+                        ("rate", rate, "a finite rate [rad/s]"),
+                        ("amplitude_deg", amplitude, "a finite amplitude [deg]"),
+                        ("frequency", omega, "a finite frequency [Hz]"),
+                        ("phase_deg", phase, "a finite phase [deg]"),
+                    ] {
+                        if !v.is_finite() {
+                            return Err(GranrsError::InvalidParameter {
+                                field: f(k),
+                                value: v,
+                                allowed: format!("a finite trajectory: {what}"),
+                            });
+                        }
+                    }
+                    if amplitude != 0.0 && n >= MAX_LINKS {
                         return Err(GranrsError::InvalidParameter {
-                            field: f("rate"),
-                            value: rate,
-                            allowed: "a finite trajectory: a finite rate [rad/s]".into(),
+                            field: "links".into(),
+                            value: n as f64,
+                            allowed: format!(
+                                "at most {} links with a sinusoidal drive (its clock takes a \
+                                 coordinate)",
+                                MAX_LINKS - 1
+                            ),
                         });
                     }
                     locked += 1;
@@ -397,10 +420,21 @@ impl LinkageScene {
             })
             .collect();
         let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
-        with_size!(self.links.len(), N => {
+        with_size!(self.size(), N => {
             let model = self.model::<N>();
             validate_joint_stiffness(&model, &self.initial_state::<N>().0, &self.options, &names)
         })
+    }
+
+    /// Whether a joint reads the time (a sinusoidal drive): the mechanism then has a clock
+    /// coordinate after the links' ([`Mechanism::clock`]).
+    pub fn has_clock(&self) -> bool {
+        self.joints.iter().any(|j| j.joint.reads_clock())
+    }
+
+    /// The generalized coordinates beyond the root's: a link's angle each, and the clock.
+    pub fn size(&self) -> usize {
+        self.links.len() + usize::from(self.has_clock())
     }
 
     fn link_index(&self, name: &str) -> Option<usize> {
@@ -531,10 +565,19 @@ impl LinkageScene {
                 let pk = order.iter().position(|&o| o == p).unwrap_or(0);
                 match j.joint {
                     Joint::Locked => qd[2 + k] = qd[2 + pk],
-                    Joint::Driven { rate } => qd[2 + k] = qd[2 + pk] + rate,
+                    Joint::Driven {
+                        rate,
+                        amplitude,
+                        omega,
+                        phase,
+                    } => qd[2 + k] = qd[2 + pk] + rate + amplitude * omega * phase.cos(),
                     _ => {}
                 }
             }
+        }
+        if self.has_clock() {
+            // The clock: q = t = 0, qdot = 1.
+            qd[N - 1] = 1.0;
         }
         (q, qd)
     }
@@ -542,7 +585,7 @@ impl LinkageScene {
     /// Validate and run.
     pub fn run(&self) -> Result<Outcome> {
         self.validate()?;
-        with_size!(self.links.len(), N => {
+        with_size!(self.size(), N => {
             let (q0, qd0) = self.initial_state::<N>();
             solve(&self.model::<N>(), q0, qd0, &self.options)
         })
@@ -742,7 +785,7 @@ mod tests {
         s.joints.clear();
         let e = s.validate().unwrap_err();
         assert!(matches!(e, GranrsError::InvalidScene { ref field, .. } if field == "links.b"));
-        let s = pendulum(Joint::Driven { rate: f64::NAN });
+        let s = pendulum(Joint::driven(f64::NAN));
         let e = s.validate().unwrap_err();
         assert!(
             matches!(e, GranrsError::InvalidParameter { ref field, .. } if field == "joints.j.rate")

@@ -14,8 +14,8 @@ use crate::body::mechanism::Pose;
 use crate::forces::{ForceSet, Switch};
 
 /// Most constraint rows at once: two sticking components per contact, the locked (and
-/// driven) joints and a prescribed root's two.
-const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED + 2;
+/// driven) joints, a prescribed root's two and the clock's.
+const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED + 3;
 
 /// Unit vector of axis `k` (0 = x, 1 = y).
 #[inline]
@@ -274,17 +274,22 @@ impl<const N: usize> Model<N> {
         let locks: Vec<SVector<f64, N>> = self
             .mechanism
             .locked_rows()
-            .map(|(link, parent, _)| {
+            .map(|(link, parent)| {
                 let mut a = SVector::<f64, N>::zeros();
                 a[2 + link] = 1.0;
                 a[2 + parent] = -1.0;
                 a
             })
-            .chain((0..2).filter(|_| self.mechanism.root_fixed).map(|k| {
-                let mut a = SVector::<f64, N>::zeros();
-                a[k] = 1.0;
-                a
-            }))
+            .chain(
+                (0..2)
+                    .filter(|_| self.mechanism.root_fixed)
+                    .chain(self.mechanism.clock())
+                    .map(|k| {
+                        let mut a = SVector::<f64, N>::zeros();
+                        a[k] = 1.0;
+                        a
+                    }),
+            )
             .collect();
         let responses: Vec<SVector<f64, N>> = locks.iter().map(|a| chol.solve(a)).collect();
         let schur = nalgebra::DMatrix::from_fn(locks.len(), locks.len(), |i, j| {
@@ -339,20 +344,29 @@ impl<const N: usize> Model<N> {
         chol: &nalgebra::Cholesky<f64, nalgebra::Const<N>>,
     ) -> Rows<N, MAX_ROWS> {
         let mut rows = Rows::new();
-        for (link, parent, rate) in self.mechanism.locked_rows() {
+        let clock = self.mechanism.clock();
+        for r in self.mechanism.held_rows(q, qd) {
             let mut jac = SVector::<f64, N>::zeros();
-            jac[2 + link] = 1.0;
-            jac[2 + parent] = -1.0;
+            jac[2 + r.link] = 1.0;
+            jac[2 + r.parent] = -1.0;
+            if let Some(c) = clock {
+                jac[c] = r.clock_coef;
+            }
             rows.push(Row {
-                kind: RowKind::Lock { link },
+                kind: RowKind::Lock { link: r.link },
                 jac,
-                bias: 0.0,
+                bias: r.bias,
                 response: chol.solve(&jac),
-                target: rate,
+                target: r.target,
             });
         }
-        if self.mechanism.root_fixed {
-            for k in 0..2 {
+        if self.mechanism.root_fixed || clock.is_some() {
+            let root = if self.mechanism.root_fixed {
+                0..2
+            } else {
+                0..0
+            };
+            for k in root.chain(clock) {
                 let mut jac = SVector::<f64, N>::zeros();
                 jac[k] = 1.0;
                 rows.push(Row {

@@ -261,9 +261,19 @@ pub fn body_linkage<'py>(
                 d.set_item("c", c)?;
                 d.set_item("rest_deg", rest.to_degrees())?;
             }
-            Joint::Driven { rate } => {
+            Joint::Driven {
+                rate,
+                amplitude,
+                omega,
+                phase,
+            } => {
                 d.set_item("kind", "driven")?;
                 d.set_item("rate", rate)?;
+                if amplitude != 0.0 {
+                    d.set_item("amplitude_deg", amplitude.to_degrees())?;
+                    d.set_item("frequency", omega / (2.0 * std::f64::consts::PI))?;
+                    d.set_item("phase_deg", phase.to_degrees())?;
+                }
             }
         }
         joints.append(d)?;

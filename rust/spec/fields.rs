@@ -191,7 +191,7 @@ pub struct ElementField {
 
 /// Every field of a linkage's elements, by element (the one table: the core's parsing,
 /// `granrs.bodies`' dataclasses and docs, the TOML notes).
-pub static ELEMENT_FIELDS: [ElementField; 30] = {
+pub static ELEMENT_FIELDS: [ElementField; 33] = {
     const fn f(
         element: &'static str,
         name: &'static str,
@@ -223,7 +223,10 @@ pub static ELEMENT_FIELDS: [ElementField; 30] = {
         f("joint", "k", "N m/rad", ">= 0", "a spring's stiffness"),
         f("joint", "c", "N m s/rad", ">= 0", "a spring's damping"),
         f("joint", "rest_deg", "deg", "finite; left out: the initial angle", "a spring's rest angle, child relative to parent; None: the initial relative angle"),
-        f("joint", "rate", "rad/s", "finite", "a driven joint's constant relative rate (its angle: the initial one plus rate t); the run reports the torque it takes"),
+        f("joint", "rate", "rad/s", "finite; left out: 0", "a driven joint's constant relative rate; its angle is the initial one plus rate t plus the sinusoid; the run reports the torque it takes"),
+        f("joint", "amplitude_deg", "deg", "finite; left out: 0", "a driven joint's sinusoid: amplitude_deg (sin(2 pi frequency t + phase) - sin(phase)) added to its angle"),
+        f("joint", "frequency", "Hz", "finite; needed with an amplitude", "the sinusoid's frequency"),
+        f("joint", "phase_deg", "deg", "finite; left out: 0", "the sinusoid's phase at t = 0"),
         f("contact", "name", "", "text", "the contact's name"),
         f("contact", "shape", "", "rod or box", "\"rod\" (a round rod meeting the sand with its tip: tip and outline) or \"box\" (a sole, a plate)"),
         f("contact", "link", "", "a link's name", "the link the contact is fixed on"),

@@ -612,9 +612,19 @@ impl SceneSpec {
                         rest,
                     }
                 }
-                "driven" => Joint::Driven {
-                    rate: e.num("rate")?,
-                },
+                "driven" => {
+                    let amplitude = e.num_or("amplitude_deg", 0.0)?;
+                    Joint::Driven {
+                        rate: e.num_or("rate", 0.0)?,
+                        amplitude: amplitude.to_radians(),
+                        omega: if amplitude != 0.0 {
+                            2.0 * std::f64::consts::PI * e.num("frequency")?
+                        } else {
+                            e.num_or("frequency", 0.0)?
+                        },
+                        phase: e.num_or("phase_deg", 0.0)?.to_radians(),
+                    }
+                }
                 other => {
                     return Err(unknown(
                         &e.field("kind"),
