@@ -333,8 +333,14 @@ impl<const N: usize> Model<N> {
             }
             out.depth = geom.depth;
             out.immersion_margin = geom.margin;
+            if let Some(sg) = &geom.sole {
+                out.corners_y = sg.corners_y;
+            }
             let is_rod = matches!(c.shape, Shape::Rod(_));
-            if geom.depth <= 0.0 && !is_rod {
+            // A box in contact with an edge on the surface (a flat sole at touchdown) takes
+            // its forces' limit from inside: no area yet, but the drag's extent is the edge.
+            let on_surface = geom.sole.is_some_and(|sg| sg.n_vertices >= 3);
+            if geom.depth <= 0.0 && !is_rod && !on_surface {
                 continue;
             }
             // A rod's E and sign of e x v_E also at depth 0: entering, the drag's mode is
@@ -350,7 +356,7 @@ impl<const N: usize> Model<N> {
             } else {
                 cross_signed
             };
-            if geom.depth <= 0.0 {
+            if geom.depth <= 0.0 && !on_surface {
                 continue;
             }
             // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held (the
@@ -402,7 +408,8 @@ impl<const N: usize> Model<N> {
         // Power of the sand's forces at their points of application.
         let mut power = 0.0;
         for (ci, ce) in contacts.iter().enumerate().take(self.contacts.len()) {
-            if ce.depth <= 0.0 || !modes[ci].in_contact {
+            // (A contact whose force was not evaluated holds a zero force.)
+            if !modes[ci].in_contact {
                 continue;
             }
             let p = match self.apply_at {
