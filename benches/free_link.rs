@@ -209,6 +209,7 @@ fn force(c: &mut Criterion) {
         v: [v.x, v.y],
         area_speed: d_c * l * (axis.x * v.y - axis.y * v.x).abs(),
         sign: [1.0, -1.0],
+        boundary: None,
     };
     let medium = Medium::default();
     let set = ForceSet::thesis(&[TABLE_3_4_Q45]);

@@ -53,7 +53,8 @@ FIELDS = [
 JOINT_FIELDS = ("pin_joint", "ankle", "knee", "hip")
 NAMES = (
     "free_link chain leg tip centroid modes raw smooth rk4 dopri5 first_stop all_stops time "
-    "state forces energy gravity drag static_h static_v joint_springs free locked box thesis"
+    "state forces energy gravity drag static_h static_v joint_springs free locked box thesis "
+    "rft rft_inertial poncelet zeta elements c k A00 Bm11"
 ).split()
 
 
@@ -182,6 +183,13 @@ def base_scenes() -> list[Scene]:
             case=1, forces=[forces.gravity(), forces.drag(eta_d=(13.0, 10.0)), forces.static_h()]
         ),
         cases.leg(v0=3.28, forces=[]),
+        # The field's laws (issue 17), on each body.
+        cases.free_link(30.0, 2.0, forces=[forces.gravity(), forces.rft(zeta=1e6, elements=4)]),
+        cases.chain(case=2, forces=[forces.gravity(), forces.poncelet(c=1.0, k=100.0)]),
+        cases.leg(
+            v0=2.0,
+            forces=[forces.gravity(), forces.rft(zeta=1e6, elements=2), forces.rft_inertial()],
+        ),
     ]
 
 
@@ -215,6 +223,7 @@ def mutate_toml(rng: random.Random, text: str) -> str:
                     [
                         *("[coefficients]", "[coefficients2]", "[knee]", "[[q_deg]]", "[x.y]"),
                         *("[[forces]]", 'term = "drag"', 'term = "stati_v"', "eta_d = [1.0]"),
+                        *('term = "rft"', 'term = "poncelet"', "elements = 0", "zeta = -1"),
                     ]
                 ),
             )

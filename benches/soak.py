@@ -85,10 +85,27 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
 
 def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
     """The thesis's terms at 0..10x Table 3.4's q = 0 row; in a third of the scenes a random
-    subset of them (issue 16)."""
+    subset of them (issue 16); in a quarter, one of the field's laws (issue 17) with random
+    parameters: rft (zeta 0..1e7 N/m^3, 1..16 elements), rft + rft_inertial, or poncelet
+    (c 0..5, k 0..1000 N/m)."""
+    u = rng.random()
+    if u < 0.25:
+        zeta = 1e7 * f[0] / 10.0
+        n = int(rng.integers(1, 17))
+        law = rng.integers(0, 3)
+        if law == 0:
+            extra: tuple[forces.Term, ...] = (forces.rft(zeta=zeta, elements=n),)
+        elif law == 1:
+            extra = (
+                forces.rft(zeta=zeta, elements=n),
+                forces.rft_inertial(lam=float(f[1]) / 5.0, elements=n),
+            )
+        else:
+            extra = (forces.poncelet(c=float(f[2]) / 2.0, k=100.0 * float(f[3])),)
+        return {"forces": (forces.gravity(), *extra)}
     values = {k: SCALE[k] * x for k, x in zip(("eta_h", "eta_d", "eta_v", "lam"), f, strict=True)}
     terms = forces.thesis(Coefficients(**values))
-    if rng.random() < 1 / 3:
+    if u < 0.25 + 0.75 / 3:
         keep = rng.random(len(terms)) < 0.75
         terms = tuple(t for t, k in zip(terms, keep, strict=True) if k)
     return {"forces": terms}

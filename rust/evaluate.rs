@@ -15,7 +15,7 @@ use crate::dynamics::{raw_sign, terms_on};
 use crate::forces::drag::Drag;
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
-use crate::forces::{AnyTerm, ContactState, ForceSet, Medium};
+use crate::forces::{AnyTerm, Boundary, ContactState, ForceSet, Frame, Medium, Outline};
 
 /// Inputs per state, in this order.
 pub const INPUTS: [&str; 9] = [
@@ -80,6 +80,23 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
     };
     // A_r |v_E| = d_c l |e x v_E|: smooth at v_E = 0, no division.
     let cross = (s * v_e.y - c * v_e.x).abs();
+    // T at depth d; omega = dq/dt turns e clockwise.
+    let boundary = Boundary {
+        frame: Frame {
+            origin: [0.0, -depth],
+            v: [vx, vy],
+            omega: -omega,
+            axis: [s, c],
+        },
+        outline: Outline::Rod {
+            diameter: setup.diameter,
+            immersed: l,
+        },
+        apply: [0.0, -depth],
+        centroid: [half * s, -depth + half * c],
+        v_centroid: [v_e.x, v_e.y],
+        held: [0.0; 2],
+    };
     let state = ContactState {
         depth,
         volume: std::f64::consts::FRAC_PI_4 * setup.diameter * setup.diameter * l,
@@ -88,6 +105,7 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
         v: [v_e.x, v_e.y],
         area_speed: setup.diameter * l * cross,
         sign,
+        boundary: Some(&boundary),
     };
     let mut f = crate::dynamics::ContactForce::default();
     if depth > 0.0 {

@@ -78,14 +78,31 @@ def test_a_term_left_out_is_not_evaluated_nor_stored() -> None:
 
 
 def test_every_term_describes_itself_from_the_core() -> None:
-    assert forces.TERMS == ("gravity", "drag", "static_h", "static_v", "joint_springs")
+    assert forces.TERMS == (
+        "gravity",
+        "drag",
+        "static_h",
+        "static_v",
+        "joint_springs",
+        "poncelet",
+        "rft",
+        "rft_inertial",
+    )
     for name in forces.TERMS:
-        t = forces.term(name)
+        info = forces.info(name)
+        # A required parameter (no default) is given; the others take their defaults.
+        required = {p.name: 1.0 for p in info.params if p.required}
+        assert all(math.isnan(p.default) for p in info.params if p.required)
+        t = forces.term(name, **required)
         assert t.name == name and t.info.name == name
         assert t.info.equation and t.info.source
         # Each constructor's defaults are the registry's (one source of truth).
-        built = getattr(forces, name)()
-        assert dict(built.params) == {p.name: p.default for p in t.info.params}
+        built = getattr(forces, name)(**required)
+        expected = {p.name: required.get(p.name, p.default) for p in t.info.params}
+        assert dict(built.params) == expected
+        if required:
+            with pytest.raises(granrs.GranrsError, match="required"):
+                forces.term(name)
     sv = forces.static_v().info
     assert [p.name for p in sv.params] == ["eta_v", "lam"]
     assert sv.params[0].default == 248.0 and sv.params[0].unit == "-"

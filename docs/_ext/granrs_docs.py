@@ -190,10 +190,22 @@ def _number(value: float) -> str:
     return "-inf" if value == float("-inf") else repr(value)
 
 
+#: Example values of the parameters that have no default, by unit, for the pages' "Use"
+#: sections (each page says the value is an example).
+EXAMPLE_BY_UNIT = {"N/m^3": 1e6, "N/m": 100.0, "-": 1.0}
+
+
+def example_params(name: str) -> dict[str, float]:
+    """A value for each required parameter of the term ``name`` (none has a default)."""
+    return {
+        p.name: EXAMPLE_BY_UNIT.get(p.unit, 1.0) for p in forces.info(name).params if p.required
+    }
+
+
 def term_toml(name: str) -> str:
     """The term with its default parameters as a ``[[forces]]`` table, written by granrs's
     own scene writer (so it is what a scene file holds)."""
-    scene = granrs.Scene(forces=[forces.term(name)])
+    scene = granrs.Scene(forces=[forces.term(name, **example_params(name))])
     text = granrs.scenefile.dumps(scene, comments=False)
     return text[text.index("[[forces]]") :].strip()
 
@@ -202,12 +214,14 @@ def term_rst(name: str) -> str:
     """The page of one force term, from ``granrs.forces.info(name)``."""
     info = forces.info(name)
     constructor = getattr(forces, name, None)
+    example = example_params(name)
+    args = ", ".join(f"{k}={v!r}" for k, v in example.items())
     if callable(constructor):
         python = f":func:`granrs.forces.{name}`"
-        call = f"granrs.forces.{name}()"
+        call = f"granrs.forces.{name}({args})"
     else:
         python = f':func:`granrs.forces.term` (``granrs.forces.term("{name}")``)'
-        call = f'granrs.forces.term("{name}")'
+        call = f'granrs.forces.term("{name}"{", " + args if args else ""})'
     title = f"``{name}``"
     lines = [
         f".. _term-{name}:",
@@ -264,7 +278,7 @@ def term_rst(name: str) -> str:
             lines += [
                 f"   * - ``{p.name}``",
                 f"     - {'dimensionless' if p.unit == '-' else rst_escape(p.unit)}",
-                f"     - {_number(p.default)}",
+                f"     - {'required' if p.required else _number(p.default)}",
                 f"     - {_number(p.min)}",
                 f"     - {rst_escape(p.description)}",
                 f"     - {rst_escape(p.source)}",
@@ -286,7 +300,14 @@ def term_rst(name: str) -> str:
         "",
         f"   {call}",
         "",
-        "In a scene file (:doc:`/scenes_toml`), with every parameter at its default:",
+        "In a scene file (:doc:`/scenes_toml`), with every parameter at its default"
+        + (
+            f" ({', '.join(f'``{k}``' for k in example)}: an example value; it has no "
+            "default)"
+            if example
+            else ""
+        )
+        + ":",
         "",
         ".. code-block:: toml",
         "",

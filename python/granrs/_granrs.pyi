@@ -10,6 +10,8 @@ __all__ = [
     "MAX_CONTACTS",
     "MAX_LINKS",
     "RECORDS",
+    "RFT_COEFFICIENTS",
+    "RFT_GENERIC",
     "SCENE_FIELDS",
     "Compiled",
     "RunOutcome",
@@ -22,6 +24,7 @@ __all__ = [
     "element_fields",
     "leg_segments",
     "resistance_force",
+    "rft_alpha",
     "run",
     "run_scene",
     "scene_fields",
@@ -33,6 +36,8 @@ __all__ = [
 __version__: str
 EFFECTS: list[str]
 RECORDS: list[str]
+RFT_COEFFICIENTS: list[str]
+RFT_GENERIC: list[float]
 SCENE_FIELDS: list[str]
 MAX_LINKS: int
 MAX_CONTACTS: int
@@ -127,3 +132,6 @@ def term_infos() -> list[dict[str, Any]]:
 
 def check_term(name: str, params: dict[str, Any]) -> dict[str, float | tuple[float, ...]]:
     """Check one term's name and parameters; every parameter with defaults filled in."""
+
+def rft_alpha(beta: Any, gamma: Any, coefficients: list[float]) -> tuple[Any, Any]:
+    """RFT (alpha_x, alpha_z) at equal-length float64 arrays of angles [rad]."""

@@ -45,6 +45,10 @@ __all__ = [
     "gravity",
     "info",
     "joint_springs",
+    "poncelet",
+    "rft",
+    "rft_alpha",
+    "rft_inertial",
     "select",
     "static_h",
     "static_v",
@@ -68,6 +72,8 @@ class Param:
         source: where the default comes from.
         min: smallest allowed value (inclusive); every value must also be finite.
         description: what it is.
+        integer: whether it is a count (an integer >= ``min``).
+        required: whether a scene must give it (no default; ``default`` is NaN).
     """
 
     name: str
@@ -76,6 +82,8 @@ class Param:
     source: str
     min: float
     description: str
+    integer: bool = False
+    required: bool = False
 
 
 @dataclass(frozen=True)
@@ -166,8 +174,12 @@ class Term:
             raise InvalidParameterError(
                 f"{self.name}: params must be a mapping, got {self.params!r}", field=self.name
             )
-        checked = _granrs.check_term(self.name, dict(self.params))
-        object.__setattr__(self, "params", MappingProxyType(dict(checked)))
+        checked = dict(_granrs.check_term(self.name, dict(self.params)))
+        for p in _INFO[self.name].params:
+            v = checked[p.name]
+            if p.integer:
+                checked[p.name] = tuple(int(x) for x in v) if isinstance(v, tuple) else int(v)
+        object.__setattr__(self, "params", MappingProxyType(checked))
 
     @property
     def info(self) -> TermInfo:
@@ -254,6 +266,110 @@ def joint_springs() -> Term:
     c dtheta/dt, with k and c on each joint (``knee={"k": 300.0, "c": 5.0}``); without it a
     spring-damper joint is free."""
     return Term("joint_springs", {})
+
+
+#: Names of the nine RFT coefficients, in the order of :data:`RFT_GENERIC` (``m1`` is the
+#: paper's -1: ``Bm11`` is B_{-1,1}).
+RFT_COEFFICIENTS: tuple[str, ...] = tuple(_granrs.RFT_COEFFICIENTS)
+#: The generic coefficients of Li, Zhang & Goldman 2013 (supplementary Table S2).
+RFT_GENERIC: Mapping[str, float] = MappingProxyType(
+    dict(zip(RFT_COEFFICIENTS, _granrs.RFT_GENERIC, strict=True))
+)
+
+
+def rft(
+    zeta: ParamValue,
+    elements: int = 8,
+    coefficients: Mapping[str, float] | None = None,
+) -> Term:
+    """``rft``: planar resistive force theory (Li, Zhang & Goldman, Science 339 (2013) 1408).
+
+    Each element of the contact's boundary below the surface feels
+    ``dF = zeta |z| dA (-alpha_x(beta, gamma), alpha_z(beta, gamma))`` (:func:`rft_alpha`),
+    with ``z`` its depth, ``beta`` its line's angle and ``gamma`` its velocity's angle below
+    +x. A rod's boundary is its shaft (on the axis, from the tip along the immersed length)
+    and its tip end (``d_c`` across the axis), both ``d_c`` wide; a sole box's is its bottom
+    and the immersed parts of its front and back faces. Force and moment come from the
+    elements. At rest the force is a reaction bounded by the sand's resistance (the
+    engine's sticking). See ``docs/laws.md``.
+
+    Args:
+        zeta: the medium's scale [N/m^3]: alpha_z of a horizontal plate pushed straight down
+            per unit depth. Required (no default): Li et al. measured about 1e6 N/m^3
+            (1 N/cm^3) for their media; the docs tabulate values with sources.
+        elements: elements per boundary plate (default 8; the docs show the convergence).
+        coefficients: the nine Fourier coefficients of another medium, by name
+            (:data:`RFT_COEFFICIENTS`; the paper's ``B-11``, ``C-11`` are also accepted);
+            those left out keep the generic values (:data:`RFT_GENERIC`).
+    """
+    params: dict[str, ParamValue] = {"zeta": zeta, "elements": elements}
+    for k, v in (coefficients or {}).items():
+        params[str(k).replace("-1", "m1")] = v
+    return Term("rft", params)
+
+
+def rft_inertial(lam: ParamValue = 1.0, elements: int = 8) -> Term:
+    """``rft_inertial``: the rate-dependent term of dynamic RFT (Agarwal, Karsai, Goldman &
+    Kamrin, Science Advances 2021): on each immersed boundary element,
+    ``dF = -lam rho_g |v_n| v_n n dA`` with ``v_n`` the element's speed along its normal
+    ``n``: the momentum flux of the sand its leading face brings to its speed.
+
+    Args:
+        lam: scale of the momentum flux [-]; default 1 (the momentum-flux value).
+        elements: elements per boundary plate (default 8), as for :func:`rft`.
+    """
+    return Term("rft_inertial", {"lam": lam, "elements": elements})
+
+
+def poncelet(c: ParamValue, k: ParamValue) -> Term:
+    """``poncelet``: the Poncelet / Katsuragi-Durian impact law (Nature Physics 3 (2007)
+    420), at the contact's reference point T (a rod's tip):
+    ``F = -c rho_g A |v| v - k d v/|v|``, with ``A`` the immersed cross-section normal to
+    ``v`` (a rod: ``pi d_c^2/4 |e.v^| + d_c l |e x v^|``). The ``k d`` part is set-valued
+    at rest (``|F| <= k d`` per component): a body lighter than ``k d / g`` sticks, and is
+    never pushed back out.
+
+    Args:
+        c: inertial drag coefficient [-] (``m / d1 = c rho_g A`` in K&D's form). Required.
+        k: depth-friction coefficient [N/m]. Required.
+    """
+    return Term("poncelet", {"c": c, "k": k})
+
+
+def rft_alpha(beta: Any, gamma: Any, coefficients: Mapping[str, float] | None = None) -> Any:
+    """The RFT coefficients ``(alpha_x, alpha_z)`` (dimensionless) at the element angle
+    ``beta`` and the velocity angle ``gamma`` [rad], any real angles, numpy broadcasting.
+
+    Conventions (granrs's frame: x right, y up): ``gamma`` is the velocity's angle below +x
+    (``pi/2``: straight down), ``beta`` the element's line angle counter-clockwise from +x
+    (mod pi), and the force on an element is ``zeta |z| dA (-alpha_x, alpha_z)``. So
+    ``rft_alpha(0, pi/2) == (0, 1)``, and ``rft_alpha(-beta, pi - gamma) == (-alpha_x,
+    alpha_z)``. ``coefficients`` as for :func:`rft`.
+
+    >>> import numpy as np, granrs
+    >>> ax, az = granrs.forces.rft_alpha(0.0, np.pi / 2)
+    >>> round(float(ax), 12), round(float(az), 12)
+    (0.0, 1.0)
+    """
+    import numpy as np
+
+    k = dict(RFT_GENERIC)
+    for name, v in (coefficients or {}).items():
+        key = str(name).replace("-1", "m1")
+        if key not in k:
+            raise InvalidParameterError(
+                f"unknown parameter `rft.{key}` (an RFT coefficient); the coefficients are "
+                f"{', '.join(RFT_COEFFICIENTS)}",
+                field=f"rft.{key}",
+            )
+        k[key] = float(v)
+    b, g = np.broadcast_arrays(np.asarray(beta, dtype=float), np.asarray(gamma, dtype=float))
+    ax, az = _granrs.rft_alpha(
+        np.ascontiguousarray(b).ravel(),
+        np.ascontiguousarray(g).ravel(),
+        [k[n] for n in RFT_COEFFICIENTS],
+    )
+    return ax.reshape(b.shape), az.reshape(b.shape)
 
 
 def thesis(coefficients: Any = None, *more: Any) -> tuple[Term, ...]:

@@ -184,6 +184,9 @@ pub struct ContactForce {
     pub dynamic: Vector2<f64>,
     /// Sum of the static terms (or their reactions), F_s [N].
     pub statics: Vector2<f64>,
+    /// The terms' moment about the point of application P [N m] (terms that act over the
+    /// boundary or at T: `rft`, `rft_inertial`, `poncelet`).
+    pub moment: f64,
 }
 
 impl ContactForce {
@@ -271,11 +274,15 @@ pub fn terms_on(
     out: &mut ContactForce,
     bound: &mut [f64; 2],
 ) {
+    if forces.reads_frame {
+        return terms_on_boundary(forces, terms, state, medium, out, bound);
+    }
     out.dynamic = Vector2::zeros();
     out.statics = Vector2::zeros();
+    out.moment = 0.0;
     *bound = [0.0; 2];
     for (k, t) in terms.iter().enumerate() {
-        let tf = t.contact_force(state, medium);
+        let tf = t.contact_force_local(state, medium);
         let v = Vector2::new(tf.force[0], tf.force[1]);
         out.terms[k] = v;
         if forces.dynamic[k] {
@@ -286,6 +293,50 @@ pub fn terms_on(
         bound[0] += tf.bound[0];
         bound[1] += tf.bound[1];
     }
+}
+
+/// [`terms_on`] for a scene with a term that reads the contact's boundary (`rft`,
+/// `poncelet`, ...): every term through the full dispatch, and their moments.
+#[inline(never)]
+fn terms_on_boundary(
+    forces: &ForceSet,
+    terms: &[AnyTerm],
+    state: &ContactState<f64>,
+    medium: &Medium,
+    out: &mut ContactForce,
+    bound: &mut [f64; 2],
+) {
+    out.dynamic = Vector2::zeros();
+    out.statics = Vector2::zeros();
+    out.moment = 0.0;
+    *bound = [0.0; 2];
+    for (k, t) in terms.iter().enumerate() {
+        let tf = t.contact_force(state, medium);
+        let v = Vector2::new(tf.force[0], tf.force[1]);
+        out.terms[k] = v;
+        if forces.dynamic[k] {
+            out.dynamic += v;
+        } else {
+            out.statics += v;
+        }
+        out.moment += tf.moment;
+        bound[0] += tf.bound[0];
+        bound[1] += tf.bound[1];
+    }
+}
+
+/// The shift that holds E's velocity components on the side of their held signs `sign`
+/// through a step: a component whose sign disagrees with its held one (it has crossed zero
+/// inside the step, before the crossing is located) is mirrored, `-2 v_k`. Added to the
+/// contact frame's velocity, it makes the terms that read the frame (`rft`, `poncelet`)
+/// see the motion as the mode holds it, the way the static terms read a held sign; zero
+/// while the signs agree, so continuous at the crossing.
+/// Only a component whose slip switch a listed term owns is held (`owns`: x, y); the
+/// others' modes are not kept up to date.
+#[inline(always)]
+pub fn held_shift(sign: [f64; 2], v_e: Vector2<f64>, owns: [bool; 2]) -> Vector2<f64> {
+    let one = |own: bool, s: f64, v: f64| if own && s * v < 0.0 { -2.0 * v } else { 0.0 };
+    Vector2::new(one(owns[0], sign[0], v_e.x), one(owns[1], sign[1], v_e.y))
 }
 
 /// The thesis's plain sign: -1, 0 or +1.

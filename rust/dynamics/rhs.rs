@@ -10,13 +10,13 @@
 use nalgebra::{SVector, Vector2};
 
 use super::{
-    raw_sign, terms_on, Contact, ContactEval, ContactMode, DragStiffness, Eval, Model, Modes,
-    Shape, SignModel, Slip, MAX_CONTACTS,
+    held_shift, raw_sign, terms_on, Contact, ContactEval, ContactMode, DragStiffness, Eval, Model,
+    Modes, Shape, SignModel, Slip, MAX_CONTACTS,
 };
 use crate::body::mechanism::Pose;
 use crate::body::rod::ApplyAt;
 use crate::body::SoleModel;
-use crate::forces::ContactState;
+use crate::forces::{Boundary, ContactState, Frame, Outline, Switch};
 
 /// The immersed geometry of one contact, as the force law needs it.
 #[derive(Debug, Clone, Copy)]
@@ -114,6 +114,74 @@ impl<const N: usize> Model<N> {
                 }
             }
         }
+    }
+
+    /// What the terms that integrate over a contact's boundary read ([`Boundary`]): its
+    /// frame (T, v_T, the link's angular velocity, its axis), its outline, the point of
+    /// application `p` and the immersed centroid, in world coordinates.
+    pub(super) fn boundary(
+        &self,
+        c: &Contact,
+        pose: &Pose<N>,
+        qd: &SVector<f64, N>,
+        geom: &Geometry,
+        p: Vector2<f64>,
+    ) -> Boundary<f64> {
+        let link = c.link();
+        let e = pose.axis[link];
+        let t_local = c.reference_point();
+        let outline = match &c.shape {
+            Shape::Rod(rod) => Outline::Rod {
+                diameter: rod.diameter,
+                immersed: rod.geometry(-geom.depth, e).immersed_length,
+            },
+            Shape::Sole(sole) => Outline::Box {
+                corners: sole
+                    .corners_local()
+                    .map(|r| self.mechanism.point(pose, link, r))
+                    .map(|w| [w.x, w.y]),
+                width: sole.width,
+            },
+        };
+        let tip = self.mechanism.point(pose, link, t_local);
+        let v_tip = self.mechanism.point_velocity(pose, link, t_local, qd);
+        // The link's angular velocity from two of its points: v(T + e) - v(T) = omega x e.
+        let v_ahead =
+            self.mechanism
+                .point_velocity(pose, link, t_local + Vector2::new(1.0, 0.0), qd);
+        let dv = v_ahead - v_tip;
+        let w = self.mechanism.point(pose, link, p);
+        let centroid = self.mechanism.point(pose, link, geom.centroid);
+        Boundary {
+            frame: Frame {
+                origin: [tip.x, tip.y],
+                v: [v_tip.x, v_tip.y],
+                omega: e.x * dv.y - e.y * dv.x,
+                axis: [e.x, e.y],
+            },
+            outline,
+            apply: [w.x, w.y],
+            centroid: [centroid.x, centroid.y],
+            v_centroid: [0.0; 2],
+            held: [0.0; 2],
+        }
+    }
+
+    /// Per axis, 1.0 where a sticking reaction holds E's velocity component at zero in
+    /// `mode` (`Modes` sign model, a listed term owns the slip switch, the mode sticks).
+    #[inline]
+    pub(super) fn held_axes(&self, mode: &ContactMode) -> [f64; 2] {
+        let held = |switch: Switch, slip: Slip| {
+            if self.sign_model == SignModel::Modes
+                && self.forces.owns(switch)
+                && slip == Slip::Stick
+            {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        [held(Switch::SlipX, mode.sx), held(Switch::SlipY, mode.sy)]
     }
 
     /// Rate of change of E's local coordinates on its link (E moves over the body as the
@@ -315,6 +383,7 @@ impl<const N: usize> Model<N> {
             0.0
         };
         let mut contacts = [ContactEval::default(); MAX_CONTACTS];
+        let mut moment_power = 0.0;
         for (ci, c) in self.contacts.iter().enumerate() {
             let link = c.link();
             let t_local = c.reference_point();
@@ -340,7 +409,8 @@ impl<const N: usize> Model<N> {
             // A box in contact with an edge on the surface (a flat sole at touchdown) takes
             // its forces' limit from inside: no area yet, but the drag's extent is the edge.
             let on_surface = geom.sole.is_some_and(|sg| sg.n_vertices >= 3);
-            if geom.depth <= 0.0 && !is_rod && !on_surface {
+            let at_entry = geom.depth <= 0.0 && !self.forces.reads_frame && !on_surface;
+            if at_entry && !is_rod {
                 continue;
             }
             // A rod's E and sign of e x v_E also at depth 0: entering, the drag's mode is
@@ -356,7 +426,7 @@ impl<const N: usize> Model<N> {
             } else {
                 cross_signed
             };
-            if geom.depth <= 0.0 && !on_surface {
+            if at_entry {
                 continue;
             }
             // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held (the
@@ -366,6 +436,25 @@ impl<const N: usize> Model<N> {
                 (Some(sg), Shape::Sole(sole)) => sole.drag_area_speed(sg, v_e),
                 _ => geom.factor * self.held_cross(mode, cross_signed),
             };
+            let p = self.application_point(c, geom.centroid);
+            let sign = self.signs(mode, v_e);
+            let boundary = if self.forces.reads_frame {
+                let mut b = self.boundary(c, &pose, qd, &geom, p);
+                let shift = held_shift(
+                    sign,
+                    v_e,
+                    [
+                        self.forces.owns(Switch::SlipX),
+                        self.forces.owns(Switch::SlipY),
+                    ],
+                );
+                b.frame.v = [b.frame.v[0] + shift.x, b.frame.v[1] + shift.y];
+                b.v_centroid = [v_e.x + shift.x, v_e.y + shift.y];
+                b.held = self.held_axes(mode);
+                Some(b)
+            } else {
+                None
+            };
             let state = ContactState {
                 depth: geom.depth,
                 volume: geom.volume,
@@ -373,12 +462,26 @@ impl<const N: usize> Model<N> {
                 l_ref: geom.l_ref,
                 v: [v_e.x, v_e.y],
                 area_speed,
-                sign: self.signs(mode, v_e),
+                sign,
+                boundary: boundary.as_ref(),
             };
             self.apply_terms(ci, &state, out);
-            let p = self.application_point(c, geom.centroid);
             self.mechanism
                 .add_point_force(&pose, link, p, out.force.total(), &mut rhs);
+            if out.force.moment != 0.0 {
+                // The moment as a couple: f at P + e and -f at P, with e x f = M.
+                let e = pose.axis[link];
+                let f = out.force.moment * Vector2::new(-e.y, e.x);
+                self.mechanism.add_point_force(
+                    &pose,
+                    link,
+                    p + Vector2::new(1.0, 0.0),
+                    f,
+                    &mut rhs,
+                );
+                self.mechanism.add_point_force(&pose, link, p, -f, &mut rhs);
+                moment_power += out.force.moment * boundary.map_or(0.0, |b| b.frame.omega);
+            }
         }
         let mass = self.mechanism.mass_matrix(&pose);
         // Positive masses give a positive definite M for any finite state; a state that has
@@ -406,7 +509,7 @@ impl<const N: usize> Model<N> {
             );
         }
         // Power of the sand's forces at their points of application.
-        let mut power = 0.0;
+        let mut power = moment_power;
         for (ci, ce) in contacts.iter().enumerate().take(self.contacts.len()) {
             // (A contact whose force was not evaluated holds a zero force.)
             if !modes[ci].in_contact {

@@ -8,10 +8,12 @@
 use nalgebra::{SVector, Vector2};
 
 use super::constraints::solve_upto2;
-use super::{ContactEval, ContactMode, Model, Modes, Shape, SignModel, Slip, PROJECTION_LIMIT};
+use super::{
+    held_shift, ContactEval, ContactMode, Model, Modes, Shape, SignModel, Slip, PROJECTION_LIMIT,
+};
 use crate::body::rod::ApplyAt;
 use crate::body::{RodContact, RodGeometry};
-use crate::forces::{ContactState, Switch};
+use crate::forces::{Boundary, ContactState, Frame, Outline, Switch};
 
 /// Position and velocity of a single rigid rod whose root is its centre of mass: what
 /// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation).
@@ -142,7 +144,9 @@ impl<const N: usize> Model<N> {
         out.lowest = tip.y;
         let mode = &modes[0];
         let geom = rod.geometry(tip.y, fr.axis);
-        let forced = mode.in_contact && geom.depth > 0.0;
+        // Terms that read the frame are evaluated from the moment of entry: a `poncelet`
+        // drag or a plate's `rft_inertial` is finite at depth 0 (the entry is a jump).
+        let forced = mode.in_contact && (geom.depth > 0.0 || self.forces.reads_frame);
         let centroid = Vector2::new(geom.centroid_s, rod.tip.y);
         if mode.in_contact {
             out.depth = geom.depth;
@@ -159,6 +163,40 @@ impl<const N: usize> Model<N> {
             } else {
                 0.0
             };
+            let p_local = self.application_point(&self.contacts[0], centroid);
+            let sign = self.signs(mode, v_e);
+            let boundary = if self.forces.reads_frame {
+                let shift = held_shift(
+                    sign,
+                    v_e,
+                    [
+                        self.forces.owns(Switch::SlipX),
+                        self.forces.owns(Switch::SlipY),
+                    ],
+                );
+                let v_held = v_tip + shift;
+                let v_e_held = v_e + shift;
+                let (apply, e) = (fr.at(p_local), fr.at(centroid));
+                Some(Boundary {
+                    frame: Frame {
+                        origin: [tip.x, tip.y],
+                        v: [v_held.x, v_held.y],
+                        // q turns clockwise (e = (sin q, cos q)): omega = -dq/dt.
+                        omega: -fr.omega,
+                        axis: [fr.axis.x, fr.axis.y],
+                    },
+                    outline: Outline::Rod {
+                        diameter: rod.diameter,
+                        immersed: geom.immersed_length,
+                    },
+                    apply: [apply.x, apply.y],
+                    centroid: [e.x, e.y],
+                    v_centroid: [v_e_held.x, v_e_held.y],
+                    held: self.held_axes(mode),
+                })
+            } else {
+                None
+            };
             let state = ContactState {
                 depth: geom.depth,
                 volume: rod.immersed_volume(&geom),
@@ -166,13 +204,15 @@ impl<const N: usize> Model<N> {
                 l_ref: rod.length,
                 v: [v_e.x, v_e.y],
                 area_speed,
-                sign: self.signs(mode, v_e),
+                sign,
+                boundary: boundary.as_ref(),
             };
             self.apply_terms(0, &state, out);
             let total = out.force.total();
             gen[0] += total.x;
             gen[1] += total.y;
-            gen[2] += total.dot(&fr.lever(self.application_point(&self.contacts[0], centroid)));
+            // A counter-clockwise moment does work -M dq.
+            gen[2] += total.dot(&fr.lever(p_local)) - out.force.moment;
         }
         // M^-1 by multiplication: the divisions are off the force's path and overlap it.
         let (inv_m, inv_i) = self.rigid_rod_inverse_mass_parts();
@@ -189,7 +229,7 @@ impl<const N: usize> Model<N> {
                 ApplyAt::Tip => out.v_tip,
                 ApplyAt::Centroid => out.v_centroid,
             };
-            out.force.total().dot(&v_p)
+            out.force.total().dot(&v_p) - out.force.moment * fr.omega
         } else {
             0.0
         };

@@ -35,6 +35,7 @@ impl Term for Constant {
                 source: "-",
                 min: f64::NEG_INFINITY,
                 description: "x component",
+                integer: false,
             },
             Param {
                 name: "fy",
@@ -43,6 +44,7 @@ impl Term for Constant {
                 source: "-",
                 min: f64::NEG_INFINITY,
                 description: "y component",
+                integer: false,
             },
         ],
         acts: Acts::Contact,
@@ -50,6 +52,7 @@ impl Term for Constant {
         velocity_dependent: false,
         reads: "nothing",
         reads_area_speed: false,
+        reads_frame: false,
         switches: &[],
         columns: &[("F_cx", 0), ("F_cy", 1)],
     };
@@ -66,6 +69,7 @@ impl Term for Constant {
         TermForce {
             force: [F::splat(self.fx), F::splat(self.fy)],
             bound: [F::splat(0.0); 2],
+            moment: F::splat(0.0),
         }
     }
 }

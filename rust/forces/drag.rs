@@ -41,12 +41,14 @@ impl Term for Drag {
             source: "thesis Table 3.4, q = 0",
             min: 0.0,
             description: "dynamic scaling constant",
+            integer: false,
         }],
         acts: Acts::Contact,
         class: Class::Dynamic,
         velocity_dependent: true,
         reads: "rho_g; the contact's A_r |v_E| and v_E",
         reads_area_speed: true,
+        reads_frame: false,
         switches: &[Switch::Cross],
         columns: &[("F_dx", 0), ("F_dy", 1)],
     };
@@ -65,6 +67,7 @@ impl Term for Drag {
         TermForce {
             force: [k * c.v[0], k * c.v[1]],
             bound: [F::splat(0.0); 2],
+            moment: F::splat(0.0),
         }
     }
 }

@@ -30,6 +30,7 @@ impl Term for Gravity {
         velocity_dependent: false,
         reads: "each link's mass and centre of mass; g of the medium",
         reads_area_speed: false,
+        reads_frame: false,
         switches: &[],
         columns: &[],
     };

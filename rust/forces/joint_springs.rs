@@ -33,6 +33,7 @@ impl Term for JointSprings {
         velocity_dependent: true,
         reads: "each spring-damper joint's relative angle and rate",
         reads_area_speed: false,
+        reads_frame: false,
         switches: &[],
         columns: &[],
     };

@@ -31,7 +31,10 @@ pub mod constant;
 pub mod drag;
 pub mod gravity;
 pub mod joint_springs;
+pub mod outline;
+pub mod poncelet;
 pub mod registry;
+pub mod rft;
 pub mod static_h;
 pub mod static_v;
 
@@ -48,6 +51,18 @@ pub trait Real:
     fn powf(self, e: Self) -> Self;
     /// `1 / self`.
     fn recip(self) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// The larger of the two (per lane).
+    fn max(self, other: Self) -> Self;
+    /// The smaller of the two (per lane).
+    fn min(self, other: Self) -> Self;
+    /// `a` where `self > 0`, else `b` (per lane: a blend, no branch).
+    fn select_pos(self, a: Self, b: Self) -> Self;
+    /// Whether it is zero (in every lane).
+    fn all_zero(self) -> bool;
 }
 
 impl Real for f64 {
@@ -62,6 +77,34 @@ impl Real for f64 {
     #[inline(always)]
     fn recip(self) -> Self {
         1.0 / self
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f64::max(self, other)
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        f64::min(self, other)
+    }
+    #[inline(always)]
+    fn select_pos(self, a: Self, b: Self) -> Self {
+        if self > 0.0 {
+            a
+        } else {
+            b
+        }
+    }
+    #[inline(always)]
+    fn all_zero(self) -> bool {
+        self == 0.0
     }
 }
 
@@ -88,7 +131,7 @@ impl Default for Medium {
 /// (`shared/MODEL.md`, "Contact geometry"). The engine fills it once per contact and
 /// evaluation, and evaluates a contact term only where `depth > 0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactState<F> {
+pub struct ContactState<'a, F> {
     /// Depth of the contact d [m] (a rod's tip depth; a sole's immersed area / f_s).
     pub depth: F,
     /// Immersed volume V [m^3] (a rod's pi d_c^2 / 4 l).
@@ -105,6 +148,75 @@ pub struct ContactState<F> {
     /// The signs of v_Ex and v_Ey as the sign model gives them: held (-1, 0 or +1, 0 where
     /// sticking), plain `sign()`, or `tanh(v / eps)`.
     pub sign: [F; 2],
+    /// What the terms that integrate over the contact's boundary or act away from P read
+    /// (`rft`, `rft_inertial`, `poncelet`): filled only when a listed term reads it
+    /// ([`TermInfo::reads_frame`]), so that the thesis's law pays nothing for it.
+    pub boundary: Option<&'a Boundary<F>>,
+}
+
+/// A contact's pose, motion and shape, for the terms that read more than a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Boundary<F> {
+    /// Where the contact is and how it moves: its reference point T, T's velocity (as the
+    /// mode holds it through a step: `dynamics::held_shift`), the link's angular velocity
+    /// and the contact's axis.
+    pub frame: Frame<F>,
+    /// The contact's shape below the surface (its boundary plates).
+    pub outline: Outline<F>,
+    /// The point of application P of the scene (`apply_at`) [m]: a term with a moment
+    /// returns it about P.
+    pub apply: [F; 2],
+    /// The immersed centroid E [m] (where `poncelet` acts).
+    pub centroid: [F; 2],
+    /// E's velocity as the mode holds it through the step [m/s] (`dynamics::held_shift`).
+    pub v_centroid: [F; 2],
+    /// Per axis, 1 where a sticking reaction holds E's velocity component at zero (a listed
+    /// term owns the axis's slip switch and the mode sticks), else 0. A term gives no force
+    /// along a held axis (the reaction stands in) and adds its capacity to the axis's bound.
+    pub held: [F; 2],
+}
+
+/// A contact's pose and motion: what a term needs to find any point's velocity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame<F> {
+    /// The reference point T [m] (a rod's tip; a sole's middle).
+    pub origin: [F; 2],
+    /// T's velocity [m/s].
+    pub v: [F; 2],
+    /// The link's angular velocity, counter-clockwise [rad/s].
+    pub omega: F,
+    /// Unit vector of the contact's axis: a rod's from its tip towards its top; a sole's
+    /// from heel to toe.
+    pub axis: [F; 2],
+}
+
+impl<F: Real> Frame<F> {
+    /// Velocity of the point `p` [m/s] of the contact's rigid link.
+    #[inline(always)]
+    pub fn velocity_at(&self, p: [F; 2]) -> [F; 2] {
+        let r = [p[0] - self.origin[0], p[1] - self.origin[1]];
+        [self.v[0] - self.omega * r[1], self.v[1] + self.omega * r[0]]
+    }
+}
+
+/// A contact's shape, for the terms that integrate over its boundary (`outline.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outline<F> {
+    /// A round rod from T along the frame's axis: its diameter d_c and immersed length l.
+    Rod {
+        /// d_c [m].
+        diameter: F,
+        /// l [m].
+        immersed: F,
+    },
+    /// A box (a sole): corners heel, toe, toe top, heel top [m], and its width out of
+    /// the plane [m].
+    Box {
+        /// The four corners, world coordinates.
+        corners: [[F; 2]; 4],
+        /// w_s [m].
+        width: F,
+    },
 }
 
 /// What a contact term returns: its force and, for a set-valued (Coulomb-like) term, the
@@ -117,6 +229,22 @@ pub struct TermForce<F> {
     /// Largest reaction along x and y it supplies while sticking [N] (zero for a term that
     /// owns no slip switch).
     pub bound: [F; 2],
+    /// Its moment about the point of application P, counter-clockwise [N m]: zero for a
+    /// term that acts at P; a term that integrates over the contact's boundary (`rft`) or
+    /// acts at T (`poncelet`) returns it.
+    pub moment: F,
+}
+
+impl<F: Real> TermForce<F> {
+    /// A force with no sticking bound and no moment.
+    #[inline(always)]
+    pub fn force(force: [F; 2]) -> Self {
+        TermForce {
+            force,
+            bound: [F::splat(0.0); 2],
+            moment: F::splat(0.0),
+        }
+    }
 }
 
 /// The discrete switches of the engine a term can own. The solver watches a switch only
@@ -177,6 +305,15 @@ pub struct Param {
     pub min: f64,
     /// What it is.
     pub description: &'static str,
+    /// Whether it is a count (an integer >= `min`).
+    pub integer: bool,
+}
+
+impl Param {
+    /// Whether the scene must give it (no default: `default` is NaN).
+    pub fn required(&self) -> bool {
+        self.default.is_nan()
+    }
 }
 
 /// Everything known about a term, for validation, docs, TOML and errors.
@@ -203,6 +340,9 @@ pub struct TermInfo {
     /// Whether it reads [`ContactState::area_speed`] (computed only when a listed term
     /// does: a sole's projected area is a polygon clip).
     pub reads_area_speed: bool,
+    /// Whether it reads [`ContactState::boundary`] (filled only
+    /// when a listed term does).
+    pub reads_frame: bool,
     /// The switches it owns.
     pub switches: &'static [Switch],
     /// Its per-contact series columns (`c{i}.{column}` with `record=("forces",)`) and the
@@ -222,9 +362,6 @@ pub trait Term: Copy + Debug + PartialEq {
     /// The force on one contact in the sand (contact terms; body terms return zero).
     #[inline(always)]
     fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        TermForce {
-            force: [F::splat(0.0); 2],
-            bound: [F::splat(0.0); 2],
-        }
+        TermForce::force([F::splat(0.0); 2])
     }
 }

@@ -5,8 +5,8 @@
 //! [`TermInfo`] in the order the docs list them.
 
 use super::{
-    drag, gravity, joint_springs, static_h, static_v, Acts, Class, ContactState, Medium, Real,
-    Switch, Term, TermForce, TermInfo,
+    drag, gravity, joint_springs, poncelet, rft, static_h, static_v, Acts, Class, ContactState,
+    Medium, Real, Switch, Term, TermForce, TermInfo,
 };
 use crate::error::{suggest, GranrsError, Result};
 
@@ -57,6 +57,28 @@ macro_rules! registry {
                     $($(#[$m])* AnyTerm::$variant(t) => t.contact_force(c, m),)*
                 }
             }
+
+            /// [`AnyTerm::contact_force`] of a term that does not read the contact's
+            /// boundary; zero for one that does (`TermInfo::reads_frame`, known at compile
+            /// time). The loop of a scene whose terms read no boundary dispatches here: its
+            /// arms are all inlined arithmetic, with no call that would make the loop keep
+            /// its values in memory (measured: 7 % of a free-link run).
+            #[inline(always)]
+            pub fn contact_force_local<F: Real>(
+                &self,
+                c: &ContactState<F>,
+                m: &Medium<F>,
+            ) -> TermForce<F> {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => {
+                        if <$ty as Term>::INFO.reads_frame {
+                            TermForce::force([F::splat(0.0); 2])
+                        } else {
+                            t.contact_force(c, m)
+                        }
+                    })*
+                }
+            }
         }
     };
 }
@@ -67,6 +89,9 @@ registry! {
     StaticH(static_h::StaticH),
     StaticV(static_v::StaticV),
     JointSprings(joint_springs::JointSprings),
+    Poncelet(poncelet::Poncelet),
+    Rft(rft::Rft),
+    RftInertial(rft::RftInertial),
     // The worked example of docs/forces.md, a fixture of the crate's own tests.
     #[cfg(test)]
     Constant(super::constant::Constant),
@@ -166,6 +191,15 @@ impl TermSpec {
                 .find(|(k, _)| k == p.name)
                 .map(|(_, v)| v.as_slice());
             let values: Vec<f64> = match given {
+                None if p.required() => {
+                    return Err(GranrsError::InvalidScene {
+                        field: field(),
+                        message: format!(
+                            "required: {} [{}] has no default ({})",
+                            p.description, p.unit, p.source
+                        ),
+                    })
+                }
                 None => vec![p.default],
                 Some(v) => v.to_vec(),
             };
@@ -179,11 +213,17 @@ impl TermSpec {
                 });
             }
             for &v in &values {
-                if !(v.is_finite() && v >= p.min) {
+                if !(v.is_finite() && v >= p.min) || (p.integer && v.fract() != 0.0) {
+                    let kind = if p.integer { "an integer" } else { "finite" };
+                    let min = if p.min == f64::NEG_INFINITY {
+                        String::new()
+                    } else {
+                        format!(", >= {}", p.min)
+                    };
                     return Err(GranrsError::InvalidParameter {
                         field: field(),
                         value: v,
-                        allowed: format!("finite, >= {} ({} [{}])", p.min, p.description, p.unit),
+                        allowed: format!("{kind}{min} ({} [{}])", p.description, p.unit),
                     });
                 }
             }
@@ -277,6 +317,8 @@ pub struct ForceSet {
     pub owns: [bool; 3],
     /// Whether a listed term reads A_r |v_E|.
     pub reads_area_speed: bool,
+    /// Whether a listed term reads the contact's frame and outline.
+    pub reads_frame: bool,
     /// Per axis, the one static term that writes that axis (by its columns) when it also
     /// owns the axis's slip switch: a sticking reaction then simply replaces its component
     /// and the static sum's (see `ContactForce::set_reaction`).
@@ -296,6 +338,7 @@ impl ForceSet {
             owns: [false; 3],
             dynamic: [false; MAX_TERMS],
             reads_area_speed: false,
+            reads_frame: false,
             sole_static_owner: [None; 2],
         };
         for spec in specs {
@@ -330,6 +373,7 @@ impl ForceSet {
                         set.owns[*s as usize] = true;
                     }
                     set.reads_area_speed |= info.reads_area_speed;
+                    set.reads_frame |= info.reads_frame;
                 }
             }
         }

@@ -39,12 +39,14 @@ impl Term for StaticH {
             source: "thesis Table 3.4, q = 0",
             min: 0.0,
             description: "horizontal static scaling constant",
+            integer: false,
         }],
         acts: Acts::Contact,
         class: Class::Static,
         velocity_dependent: false,
         reads: "g, rho_g; the contact's width w, depth d and the sign of v_Ex",
         reads_area_speed: false,
+        reads_frame: false,
         switches: &[Switch::SlipX],
         columns: &[("F_sh", 0)],
     };
@@ -65,6 +67,7 @@ impl Term for StaticH {
         TermForce {
             force: [-c.sign[0] * bound, zero],
             bound: [bound, zero],
+            moment: F::splat(0.0),
         }
     }
 }

@@ -42,6 +42,7 @@ impl Term for StaticV {
                 source: "thesis Table 3.4, q = 0",
                 min: 0.0,
                 description: "vertical static scaling constant",
+                integer: false,
             },
             Param {
                 name: "lam",
@@ -50,6 +51,7 @@ impl Term for StaticV {
                 source: "thesis Table 3.4, q = 0",
                 min: 0.0,
                 description: "depth exponent lambda",
+                integer: false,
             },
         ],
         acts: Acts::Contact,
@@ -57,6 +59,7 @@ impl Term for StaticV {
         velocity_dependent: false,
         reads: "g, rho_g; the contact's depth d, L_ref, immersed volume V and the sign of v_Ey",
         reads_area_speed: false,
+        reads_frame: false,
         switches: &[Switch::SlipY],
         columns: &[("F_sv", 1)],
     };
@@ -82,6 +85,7 @@ impl Term for StaticV {
         TermForce {
             force: [zero, -c.sign[1] * bound],
             bound: [zero, bound],
+            moment: F::splat(0.0),
         }
     }
 }

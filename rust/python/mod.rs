@@ -47,6 +47,12 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_LINKS", crate::bodies::MAX_LINKS)?;
     m.add("MAX_CONTACTS", crate::dynamics::MAX_CONTACTS)?;
     m.add_function(wrap_pyfunction!(terms::check_term, m)?)?;
+    m.add_function(wrap_pyfunction!(terms::rft_alpha, m)?)?;
+    m.add("RFT_GENERIC", crate::forces::rft::GENERIC.to_vec())?;
+    m.add(
+        "RFT_COEFFICIENTS",
+        crate::forces::rft::COEFFICIENT_NAMES.to_vec(),
+    )?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -50,12 +50,42 @@ pub fn term_infos(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             pd.set_item("source", p.source)?;
             pd.set_item("min", p.min)?;
             pd.set_item("description", p.description)?;
+            pd.set_item("integer", p.integer)?;
+            pd.set_item("required", p.required())?;
             params.append(pd)?;
         }
         d.set_item("params", params)?;
         out.append(d)?;
     }
     Ok(out)
+}
+
+/// The RFT coefficients (alpha_x, alpha_z) at the angles `beta` and `gamma` [rad] (equal
+/// lengths), with the nine Fourier coefficients `coefficients` (order of
+/// `forces::rft::GENERIC`): `granrs.forces.rft_alpha`.
+#[pyfunction]
+pub fn rft_alpha<'py>(
+    py: Python<'py>,
+    beta: numpy::PyReadonlyArray1<'py, f64>,
+    gamma: numpy::PyReadonlyArray1<'py, f64>,
+    coefficients: [f64; 9],
+) -> PyResult<(
+    Bound<'py, numpy::PyArray1<f64>>,
+    Bound<'py, numpy::PyArray1<f64>>,
+)> {
+    use numpy::IntoPyArray;
+    let (b, g) = (beta.as_array(), gamma.as_array());
+    if b.len() != g.len() {
+        return Err(pyo3::exceptions::PyValueError::new_err(
+            "rft_alpha: beta and gamma must have the same length",
+        ));
+    }
+    let (ax, az): (Vec<f64>, Vec<f64>) = b
+        .iter()
+        .zip(g.iter())
+        .map(|(&b, &g)| crate::forces::rft::alpha_at(&coefficients, b, g))
+        .unzip();
+    Ok((ax.into_pyarray(py), az.into_pyarray(py)))
 }
 
 /// A term's parameters from a Python mapping: each a number or a sequence of numbers (one

@@ -57,6 +57,7 @@ from . import ch3_free_link as ch3_free_link
 from . import ch4_chain as ch4_chain
 from . import ch5_leg as ch5_leg
 from . import calibration as calibration
+from . import force_laws as force_laws
 
 # isort: on
 from .ch3_free_link import chapter_3 as chapter_3

@@ -1,0 +1,210 @@
+//! A contact's boundary below the surface, as the terms that integrate over it read it
+//! (`rft`, `rft_inertial`, `poncelet`).
+//!
+//! - **A rod** is two plates (Li, Zhang & Goldman 2013 lump a plate's two faces into one
+//!   set of coefficients, so a thin body counts once):
+//!   - the shaft, on the rod's axis from the tip T along the immersed length l;
+//!   - the tip end, of length d_c across the axis at T.
+//!
+//!   Both are d_c wide out of the plane; the top end never counts.
+//! - **A box** (a sole) is three plates: its bottom (heel to toe) and its back and front
+//!   faces (from the heel and the toe up to the top), w_s wide out of the plane.
+//!
+//! A plate is cut into equal elements. Each element is clipped at the surface y = 0: only
+//! its immersed part counts, and the depth z = -y varies linearly along it, so the
+//! integrals below are exact for any element count while the element's direction of motion
+//! is one (a translating plate).
+
+use super::{Frame, Outline, Real};
+
+/// Most plates of an outline.
+pub const MAX_PLATES: usize = 3;
+
+/// One plate: from `a` to `b` [m] (world coordinates), `width` [m] out of the plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plate<F> {
+    /// One end [m].
+    pub a: [F; 2],
+    /// The other end [m].
+    pub b: [F; 2],
+    /// Width out of the plane [m].
+    pub width: F,
+}
+
+/// The immersed part of a plate, cut into `n` equal elements.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Elements<F> {
+    /// The immersed part's first end [m].
+    pub start: [F; 2],
+    /// From one element's middle to the next [m].
+    pub step: [F; 2],
+    /// One element's length [m].
+    pub length: F,
+    /// The plate's width out of the plane [m].
+    pub width: F,
+}
+
+impl<F: Real> Elements<F> {
+    /// The middle of element `k` [m] (its depth is the element's mean depth: the depth is
+    /// linear along a plate).
+    #[inline(always)]
+    pub fn mid(&self, k: usize) -> [F; 2] {
+        let t = F::splat(k as f64 + 0.5);
+        [
+            self.start[0] + t * self.step[0],
+            self.start[1] + t * self.step[1],
+        ]
+    }
+}
+
+impl<F: Real> Outline<F> {
+    /// The boundary plates (the first `n` of the array) at the pose `frame`.
+    #[inline]
+    pub fn plates(&self, frame: &Frame<F>) -> ([Plate<F>; MAX_PLATES], usize) {
+        let zero = F::splat(0.0);
+        let none = Plate {
+            a: [zero; 2],
+            b: [zero; 2],
+            width: zero,
+        };
+        let mut out = [none; MAX_PLATES];
+        match *self {
+            Outline::Rod { diameter, immersed } => {
+                let t = frame.origin;
+                let e = frame.axis;
+                let half = F::splat(0.5) * diameter;
+                // The normal to the axis, (-e_y, e_x).
+                let n = [-e[1], e[0]];
+                out[0] = Plate {
+                    a: t,
+                    b: [t[0] + immersed * e[0], t[1] + immersed * e[1]],
+                    width: diameter,
+                };
+                out[1] = Plate {
+                    a: [t[0] - half * n[0], t[1] - half * n[1]],
+                    b: [t[0] + half * n[0], t[1] + half * n[1]],
+                    width: diameter,
+                };
+                (out, 2)
+            }
+            Outline::Box { corners, width } => {
+                let [heel, toe, toe_top, heel_top] = corners;
+                out[0] = Plate {
+                    a: heel,
+                    b: toe,
+                    width,
+                };
+                out[1] = Plate {
+                    a: heel,
+                    b: heel_top,
+                    width,
+                };
+                out[2] = Plate {
+                    a: toe,
+                    b: toe_top,
+                    width,
+                };
+                (out, 3)
+            }
+        }
+    }
+}
+
+impl<F: Real> Plate<F> {
+    /// Its length [m].
+    #[inline(always)]
+    pub fn length(&self) -> F {
+        let d = [self.b[0] - self.a[0], self.b[1] - self.a[1]];
+        (d[0] * d[0] + d[1] * d[1]).sqrt()
+    }
+
+    /// Its part below the surface y = 0 (a plate of no length when none is), clipped once:
+    /// the depth is linear along it, so the elements of the immersed part integrate `|z| dA`
+    /// exactly for any count. A level plate counts whole from the moment it reaches the
+    /// surface (the right limit at its entry, which the engine locates).
+    #[inline(always)]
+    pub fn immersed(&self) -> Plate<F> {
+        let zero = F::splat(0.0);
+        let one = F::splat(1.0);
+        let (za, zb) = (-self.a[1], -self.b[1]);
+        let dz = za - zb;
+        // Where the plate meets the surface, as a fraction from `a` (level: no crossing).
+        let cut = dz.abs().select_pos(za * dz.recip(), zero);
+        let tiny = F::splat(f64::MIN_POSITIVE);
+        let a_in = za + tiny;
+        let b_in = zb + tiny;
+        // Immersed from t0 to t1 (both ends in: 0..1; one in: up to the cut; none: 0..0).
+        let t0 = a_in.select_pos(zero, b_in.select_pos(cut, zero));
+        let t1 = b_in.select_pos(one, a_in.select_pos(cut, zero));
+        let d = [self.b[0] - self.a[0], self.b[1] - self.a[1]];
+        Plate {
+            a: [self.a[0] + t0 * d[0], self.a[1] + t0 * d[1]],
+            b: [self.a[0] + t1 * d[0], self.a[1] + t1 * d[1]],
+            width: self.width,
+        }
+    }
+
+    /// Its immersed part cut into `n` equal elements.
+    #[inline(always)]
+    pub fn elements(&self, n: usize) -> Elements<F> {
+        let part = self.immersed();
+        let inv_n = F::splat(1.0 / n as f64);
+        let step = [
+            (part.b[0] - part.a[0]) * inv_n,
+            (part.b[1] - part.a[1]) * inv_n,
+        ];
+        Elements {
+            start: part.a,
+            step,
+            length: part.length() * inv_n,
+            width: self.width,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plate(a: [f64; 2], b: [f64; 2]) -> Plate<f64> {
+        Plate { a, b, width: 2.0 }
+    }
+
+    /// int |z| dA over the elements (midpoint rule).
+    fn depth_area(p: &Plate<f64>, n: usize) -> f64 {
+        let e = p.elements(n);
+        (0..n).map(|k| -e.mid(k)[1] * e.length * e.width).sum()
+    }
+
+    #[test]
+    fn clipped_elements_integrate_the_depth_exactly() {
+        // A plate from 0.3 m above the surface to 0.6 m below it, at 45 degrees: the
+        // immersed part is 0.6 sqrt(2) long with depths 0..0.6, so int |z| dA =
+        // width * length * 0.3 = 2 * 0.6 sqrt(2) * 0.3, at every element count, either way.
+        let exact = 2.0 * 0.6 * 2f64.sqrt() * 0.3;
+        for p in [
+            plate([0.0, 0.3], [0.9, -0.6]),
+            plate([0.9, -0.6], [0.0, 0.3]),
+        ] {
+            for n in [1, 2, 3, 7, 64] {
+                let sum = depth_area(&p, n);
+                assert!((sum - exact).abs() < 1e-14, "{n}: {sum} vs {exact}");
+                let e = p.elements(n);
+                assert!((e.length * n as f64 - 0.6 * 2f64.sqrt()).abs() < 1e-14);
+            }
+        }
+        // Wholly out of the sand: nothing.
+        let out = plate([0.0, 0.1], [1.0, 0.2]);
+        assert_eq!(out.elements(3).length, 0.0);
+        assert_eq!(depth_area(&out, 3), 0.0);
+    }
+
+    #[test]
+    fn a_level_plate_counts_whole_from_the_surface_down() {
+        let under = plate([0.0, -0.2], [1.0, -0.2]).elements(4);
+        assert!((under.length - 0.25).abs() < 1e-15);
+        let at = plate([0.0, 0.0], [1.0, 0.0]).elements(1);
+        assert_eq!(at.length, 1.0);
+        assert_eq!(plate([0.0, 0.2], [1.0, 0.2]).elements(1).length, 0.0);
+    }
+}
