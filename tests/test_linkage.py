@@ -351,3 +351,20 @@ def test_moving_root_keeps_its_velocity() -> None:
     assert np.abs(s["x_root"] - 0.5 * s["t"]).max() < 1e-12
     assert np.abs(s["y_root"] - (0.3 - 0.3 * s["t"])).max() < 1e-12
     assert r.contacts[0].summary["F_d_max"] > 0.0  # it went into the sand
+
+
+@pytest.mark.parametrize("term", ["rft", "rft_inertial"])
+def test_boundary_terms_act_on_a_linkage_contact(term: str) -> None:
+    """The terms that integrate over a contact's boundary act on a linkage's rod, moved
+    into the sand by a moving root."""
+    body = Linkage(
+        [Link("rod", 0.1, 1e-4, 0.1, (-0.05, 0.0), q_deg=30.0)],
+        contacts=[Contact.rod("rod", 0.1, 0.01, at=(-0.1, 0.0))],
+        root=Root("moving", link="rod", position=(0.0, 0.087), velocity=(0.0, -0.1)),
+    )
+    params = {"zeta": 1e6} if term == "rft" else {}
+    forces = [granrs.forces.gravity(), granrs.forces.term(term, **params)]
+    scene = granrs.Scene(body=body, forces=forces, end="time", t_end=0.2, record=("forces",))  # type: ignore[arg-type]
+    s = granrs.simulate(scene).series
+    columns = [k for k in s if k.startswith("F_")]
+    assert columns and max(np.abs(s[k]).max() for k in columns) > 0.0
