@@ -379,3 +379,20 @@ def test_leg_converges_at_second_order_or_better(scene: granrs.Scene) -> None:
         assert fine <= 1e-9 * abs((ref.depth, ref.t_s)[k]), (name, errors)
         order = math.log2(coarse / max(fine, 1e-300)) / 3.0
         assert order >= 2.0, f"{name}: errors {coarse:.3e} -> {fine:.3e}, order {order:.2f}"
+
+
+@pytest.mark.parametrize("term", ["rft", "rft_inertial"])
+def test_boundary_terms_act_on_a_linkage_contact(term: str) -> None:
+    """The terms that integrate over a contact's boundary act on a linkage's rod, moved
+    into the sand by a moving root."""
+    body = Linkage(
+        [Link("rod", 0.1, 1e-4, 0.1, (-0.05, 0.0), q_deg=30.0)],
+        contacts=[Contact.rod("rod", 0.1, 0.01, at=(-0.1, 0.0))],
+        root=Root("moving", link="rod", position=(0.0, 0.087), velocity=(0.0, -0.1)),
+    )
+    params = {"zeta": 1e6} if term == "rft" else {}
+    forces = [granrs.forces.gravity(), granrs.forces.term(term, **params)]
+    scene = granrs.Scene(body=body, forces=forces, end="time", t_end=0.2, record=("forces",))  # type: ignore[arg-type]
+    s = granrs.simulate(scene).series
+    columns = [k for k in s if k.startswith("F_")]
+    assert columns and max(np.abs(s[k]).max() for k in columns) > 0.0
