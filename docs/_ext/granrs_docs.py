@@ -67,8 +67,8 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     ),
     (
         "Calibration",
-        "Fitting the coefficients to measurements.",
-        ("calibrate", "Measurements", "CalibrationResult"),
+        "Fitting the coefficients to measurements, and comparing force laws.",
+        ("calibrate", "compare", "Measurements", "CalibrationResult"),
     ),
     (
         "The thesis's data",

@@ -22,6 +22,7 @@ from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
+from .compare import compare
 from .errors import (
     CoefficientTableError,
     GranrsError,
@@ -66,6 +67,7 @@ __all__ = [
     "calibrate",
     "cases",
     "coefficients",
+    "compare",
     "data",
     "forces",
     "resistance_force",

@@ -7,6 +7,8 @@ __all__ = [
     "EFFECTS",
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
+    "GEOM_OUTPUTS",
+    "GEOM_STATE",
     "MAX_CONTACTS",
     "MAX_LINKS",
     "RECORDS",
@@ -14,7 +16,9 @@ __all__ = [
     "RFT_GENERIC",
     "SCENE_FIELDS",
     "Compiled",
+    "GeomCoupling",
     "RunOutcome",
+    "SandGeoms",
     "__version__",
     "body_linkage",
     "check_term",
@@ -116,6 +120,72 @@ def resistance_force(
 ) -> Any:
     """The rod force over n states: nine contiguous float64 arrays (FORCE_INPUTS order) in,
     an n x 10 array (FORCE_OUTPUTS order) out."""
+
+GEOM_STATE: list[str]
+GEOM_OUTPUTS: list[str]
+
+@final
+class SandGeoms:
+    """N geoms (rods, sole boxes) of another engine under contact terms, through the free
+    link's right-hand side (granrs.mujoco.Sand)."""
+
+    def __new__(
+        cls,
+        names: list[str],
+        shapes: list[tuple[str, list[float]]],
+        forces: list[Any],
+        rho_g: float,
+        g: float,
+        apply_at: str = "tip",
+        sign_model: str = "raw",
+        smooth_eps: float = 1e-3,
+    ) -> SandGeoms: ...
+    def __len__(self) -> int: ...
+    def evaluate(self, states: Any, out: Any) -> None:
+        """Every geom's force: states n x 7 (GEOM_STATE order) in, out n x 18
+        (GEOM_OUTPUTS order) written."""
+
+@final
+class GeomCoupling:
+    """SandGeoms placed on the bodies of a MuJoCo model (granrs.mujoco.Sand)."""
+
+    def __new__(
+        cls,
+        rods: SandGeoms,
+        geom: list[int],
+        body: list[int],
+        root: list[int],
+        reach: list[float],
+        dofs: list[list[int]],
+        nv: int,
+        surface: float,
+        patch: tuple[float, float],
+        stick: bool,
+        implicit_damping: list[float],
+    ) -> GeomCoupling: ...
+    def bind(
+        self,
+        geom_xpos: Any,
+        geom_xmat: Any,
+        cvel: Any,
+        subtree_com: Any,
+        cdof: Any,
+        qvel: Any,
+        qacc: Any,
+        qfrc_applied: Any,
+        qfrc_passive: Any,
+        mass: Any,
+        outputs: Any,
+        applied: Any,
+        h_lambda: Any,
+        generalized: Any,
+        before: Any,
+        after: Any,
+    ) -> None:
+        """Bind one mjData's arrays and the caller's buffers (checked once)."""
+    def step(self, timestep: float, passive: bool, fresh: bool, hold: bool) -> tuple[float, int]:
+        """One evaluation at the bound arrays; the generalized force into qfrc_passive
+        (passive) or qfrc_applied. Returns the largest h_lambda and its geom."""
 
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""

@@ -12,6 +12,8 @@ Usage::
     granrs calibrate [--cases BODY] [--measurements thesis:NAME|FILE.csv] [--params P,...]
                      [--per-angle] [--base NAME] [--fit ROWS] [--predict ROWS] [--json]
                      [--out FILE.csv]
+    granrs compare [--laws L,...] [--measurements SPEC ...] [--folds COLUMN|auto|none]
+                   [--starts N] [--dt DT] [--json] [--out FILE.json] [--quiet]
 
 Each subcommand is one ``_add_<name>`` function that declares its arguments and one
 ``_cmd_<name>`` function that runs it and returns the exit code; :data:`_COMMANDS` lists
@@ -270,6 +272,115 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
             f"predicted rows: depth within 1 sd {within(predicted, 'depth', 1)}, t_s within "
             f"2 sd {within(predicted, 't_s', 2)} of {len(predicted)}"
         )
+    return 0
+
+
+def _add_compare(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Declare ``granrs compare``."""
+    parser = sub.add_parser(
+        "compare",
+        help="compare force laws on the experiments, cross-validated (granrs.compare)",
+        description=(
+            "Fit every force law to the measurements and check it out of sample by "
+            "leave-one-group-out cross-validation (granrs.compare); print one line per "
+            "dataset and law: parameters, in-sample chi2/dof, AIC, BIC, and the "
+            "out-of-sample counts within 1 and 2 sd."
+        ),
+    )
+    parser.add_argument(
+        "--laws",
+        default=None,
+        metavar="L,...",
+        help="comma-separated law names (default: every law of granrs.compare.LAWS)",
+    )
+    parser.add_argument(
+        "--measurements",
+        action="append",
+        default=None,
+        metavar="SPEC",
+        help=(
+            "thesis:table_3_1, thesis:table_4_chain, thesis:table_5_1_means, "
+            "thesis:table_5_1 (repeat for several; default: the first three)"
+        ),
+    )
+    parser.add_argument(
+        "--folds",
+        default="auto",
+        metavar="COLUMN",
+        help="the column whose groups are left out one at a time: auto (default), none, "
+        "or a column name",
+    )
+    parser.add_argument("--starts", type=int, default=1, metavar="N", help="starts (default 1)")
+    parser.add_argument("--dt", type=float, default=1e-4, metavar="DT", help="step [s]")
+    parser.add_argument("--json", action="store_true", help="print {dataset: {law: {...}}}")
+    parser.add_argument(
+        "--out", metavar="FILE.json", default=None, help="write {dataset: {law: {...}}} here"
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.set_defaults(handler=_cmd_compare)
+
+
+#: The columns ``granrs compare`` prints.
+_COMPARE_COLUMNS: tuple[str, ...] = (
+    "dataset",
+    "law",
+    "rank",
+    "n_params",
+    "chi2_dof",
+    "aic",
+    "bic",
+    "depth_within_1sd",
+    "ts_within_1sd",
+    "ts_within_2sd",
+    "n_rows",
+)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    """Run ``granrs compare``."""
+    from .calibrate import Measurements
+    from .compare import compare, to_json
+
+    laws = None
+    if args.laws is not None:
+        laws = [name.strip() for name in args.laws.split(",") if name.strip()]
+    measurements = None
+    if args.measurements:
+        measurements = {}
+        for spec in args.measurements:
+            m = Measurements.load(spec)
+            name = m.body if m.body not in measurements else spec.removeprefix("thesis:")
+            measurements[name] = m
+    folds = None if args.folds == "none" else args.folds
+    frame = compare(
+        laws,
+        measurements,
+        folds=folds,
+        dt=args.dt,
+        starts=args.starts,
+        progress=False if args.quiet else None,
+    )
+    data = to_json(frame)
+    text = json.dumps(data, indent=2, allow_nan=False)
+    if args.out:
+        Path(args.out).write_text(text + "\n", encoding="utf-8")
+    if args.json:
+        print(text)
+        return 0
+    rows, notes = [], []
+    for rec in frame.to_dict("records"):
+        if not rec["available"]:
+            rows.append([rec["dataset"], rec["law"], *["-"] * (len(_COMPARE_COLUMNS) - 2)])
+            notes.append(f"{rec['dataset']} {rec['law']}: not run: {rec['reason']}")
+            continue
+        rows.append([_number(_plain(rec[c])) for c in _COMPARE_COLUMNS])
+    print("\n".join(_table(list(_COMPARE_COLUMNS), rows)))
+    if folds is None:
+        print("(no cross-validation: every number in sample; rank by chi2)")
+    else:
+        print("(counts out of sample; chi2/dof, AIC, BIC in sample; rank by out-of-sample chi2)")
+    for note in notes:
+        print(note)
     return 0
 
 
@@ -643,6 +754,7 @@ _COMMANDS: tuple[Callable[[argparse._SubParsersAction[argparse.ArgumentParser]],
     _add_reproduce,
     _add_bench,
     _add_calibrate,
+    _add_compare,
 )
 
 

@@ -268,7 +268,7 @@ def joint_springs() -> Term:
     return Term("joint_springs", {})
 
 
-#: Names of the nine RFT coefficients, in the order of :data:`RFT_GENERIC` (``m1`` is the
+#: Names of the nine RFT coefficients, in the order of ``granrs.forces.RFT_GENERIC`` (``m1`` is the
 #: paper's -1: ``Bm11`` is B_{-1,1}).
 RFT_COEFFICIENTS: tuple[str, ...] = tuple(_granrs.RFT_COEFFICIENTS)
 #: The generic coefficients of Li, Zhang & Goldman 2013 (supplementary Table S2).
@@ -299,8 +299,8 @@ def rft(
             (1 N/cm^3) for their media; the docs tabulate values with sources.
         elements: elements per boundary plate (default 8; the docs show the convergence).
         coefficients: the nine Fourier coefficients of another medium, by name
-            (:data:`RFT_COEFFICIENTS`; the paper's ``B-11``, ``C-11`` are also accepted);
-            those left out keep the generic values (:data:`RFT_GENERIC`).
+            (``granrs.forces.RFT_COEFFICIENTS``; the paper's ``B-11``, ``C-11`` are also accepted);
+            those left out keep the generic values (``granrs.forces.RFT_GENERIC``).
     """
     params: dict[str, ParamValue] = {"zeta": zeta, "elements": elements}
     for k, v in (coefficients or {}).items():

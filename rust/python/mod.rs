@@ -7,12 +7,13 @@
 //!
 //! One file per part: `convert.rs` (Python values to spec values), `errors.rs` (the
 //! exception conversion), `run.rs` (compile and run one scene), `sweep.rs` (batches),
-//! `force.rs` (`resistance_force`) and `terms.rs` (the force terms' registry). This file
-//! only registers them.
+//! `force.rs` (`resistance_force`), `mujoco.rs` (`SandGeoms`, for `granrs.mujoco`) and
+//! `terms.rs` (the force terms' registry). This file only registers them.
 
 mod convert;
 mod errors;
 mod force;
+mod mujoco;
 mod run;
 mod sweep;
 mod terms;
@@ -36,6 +37,10 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(force::resistance_force, m)?)?;
     m.add("FORCE_INPUTS", crate::evaluate::INPUTS.to_vec())?;
     m.add("FORCE_OUTPUTS", crate::evaluate::OUTPUTS.to_vec())?;
+    m.add_class::<mujoco::SandGeoms>()?;
+    m.add_class::<mujoco::GeomCoupling>()?;
+    m.add("GEOM_STATE", crate::evaluate::geoms::STATE.to_vec())?;
+    m.add("GEOM_OUTPUTS", crate::evaluate::geoms::OUTPUTS.to_vec())?;
     m.add("EFFECTS", EFFECTS.to_vec())?;
     m.add("RECORDS", RECORDS.to_vec())?;
     m.add("SCENE_FIELDS", SCENE_FIELDS.to_vec())?;

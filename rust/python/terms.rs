@@ -60,6 +60,12 @@ pub fn term_infos(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     Ok(out)
 }
 
+/// A pair of float arrays, returned to Python as a tuple.
+type ArrayPair<'py> = (
+    Bound<'py, numpy::PyArray1<f64>>,
+    Bound<'py, numpy::PyArray1<f64>>,
+);
+
 /// The RFT coefficients (alpha_x, alpha_z) at the angles `beta` and `gamma` [rad] (equal
 /// lengths), with the nine Fourier coefficients `coefficients` (order of
 /// `forces::rft::GENERIC`): `granrs.forces.rft_alpha`.
@@ -69,10 +75,7 @@ pub fn rft_alpha<'py>(
     beta: numpy::PyReadonlyArray1<'py, f64>,
     gamma: numpy::PyReadonlyArray1<'py, f64>,
     coefficients: [f64; 9],
-) -> PyResult<(
-    Bound<'py, numpy::PyArray1<f64>>,
-    Bound<'py, numpy::PyArray1<f64>>,
-)> {
+) -> PyResult<ArrayPair<'py>> {
     use numpy::IntoPyArray;
     let (b, g) = (beta.as_array(), gamma.as_array());
     if b.len() != g.len() {

@@ -18,22 +18,33 @@ all p + 1 parameter vectors (the point and one step per parameter) in one sweep 
 
 Parameters (``params``), by name:
 
-* ``eta_h``, ``eta_d``, ``eta_v``, ``lam`` (``lambda`` is accepted): one value of the
-  coefficient for every row (both links of the chain, both speeds of the leg);
-* ``eta_v@45`` (any coefficient, any angle in degrees, free link only): the coefficient at
-  the angle node q = 45 deg; a row at another angle takes the value interpolated between
-  the nodes on either side (linearly in q: in log for the etas, plainly for lambda; constant
-  beyond the outermost nodes). Nodes at the measured angles are per-angle coefficients,
-  as Table 3.4 tabulates them; ``per_angle=True`` makes them from plain names;
-* ``scale.eta_h``, ``scale.eta_d``, ``scale.eta_v``, ``scale.lam``: a factor on the base
-  coefficients of every row (``base``: Table 3.4's nearest row or the Table 3.2 closed forms
-  for the free link, Table 4.4 per link and case for the chain, the thesis's row of sec.
-  5.3.2 for the leg), so that the shape in angle (or link, or speed) of the base is kept;
-* ``joints.k`` [N m/rad] and ``joints.c`` [N m s/rad] (leg only): one rotational
-  spring-damper at the ankle, knee and hip.
+* ``TERM.PARAM``: any parameter of any term of the law (``static_v.eta_v``, ``drag.eta_d``,
+  ``poncelet.c``, ``rft.zeta``, ...; the names of :mod:`granrs.forces` and each term's
+  ``.info.params``): one value for every row (both links of the chain, both speeds of the
+  leg). The thesis's short names ``eta_h``, ``eta_d``, ``eta_v``, ``lam`` (``lambda`` is
+  accepted) are ``static_h.eta_h``, ``drag.eta_d``, ``static_v.eta_v``, ``static_v.lam``;
+* ``eta_v@45``, ``static_v.eta_v@45`` (any parameter, any angle in degrees, free link
+  only): the parameter at the angle node q = 45 deg; a row at another angle takes the value
+  interpolated between the nodes on either side (linearly in q: in log for a parameter
+  fitted in log space, plainly for lambda; constant beyond the outermost nodes). Nodes at
+  the measured angles are per-angle coefficients, as Table 3.4 tabulates them;
+  ``per_angle=True`` makes them from plain names;
+* ``scale.eta_v``, ``scale.TERM.PARAM``: a factor on the base value of every row (``base``:
+  Table 3.4's nearest row or the Table 3.2 closed forms for the free link, Table 4.4 per
+  link and case for the chain, the thesis's row of sec. 5.3.2 for the leg; or the terms
+  given as ``forces``), so that the shape in angle (or link, or speed) of the base is kept;
+* the body's unknowns: ``mass`` [kg] (the link mass: the chain's is not in the thesis),
+  ``pin_mass`` [kg] (chain), ``joints.k`` [N m/rad] and ``joints.c`` [N m s/rad] (leg: one
+  rotational spring-damper at the ankle, knee and hip).
 
-The etas, the scale factors and the joint settings are positive and fitted in log space;
-lambda is fitted as it is. Bounds are given in natural units.
+The law is the thesis's (its terms built from ``base``'s coefficients) unless ``forces``
+gives the terms: a list for every row, or a function of the row. A fitted parameter of a
+term the law does not list is an error before any simulation.
+
+A term's parameter whose registry minimum is >= 0 (the etas, ``poncelet.c``, ...), the
+scale factors, the masses and the joint settings are positive and fitted in log space;
+lambda (an exponent, which may be 0) and any parameter allowed below 0 are fitted as they
+are. Bounds are given in natural units.
 
 Weights. Each quantity's sd in the fit is ``sd_fit = sqrt(sd^2 + resolution^2 / 12)``: the
 measured sd and, in quadrature, the rounding of the printed mean (uniform over one unit of

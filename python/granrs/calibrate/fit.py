@@ -23,7 +23,7 @@ from ..errors import (
     UnknownNameError,
 )
 from .measurements import _KEY_COLUMNS, BODIES, QUANTITIES, Measurements, _is_number
-from .model import _JOINT_START, _JOINTS, _Model, _Param, _parse_param
+from .model import _JOINT_START, _JOINTS, LawSpec, _Model, _Param, _parse_param
 
 __all__ = ["CalibrationResult", "calibrate", "evaluate", "within"]
 
@@ -114,6 +114,11 @@ class CalibrationResult:
         """The fitted coefficients for one measurement row (e.g. ``{"q_deg": 60,
         "v0_mean": 1.5}``; the chain's rows need ``link`` and ``v0_case``)."""
         return self._model.coefficients(row, [self.values[p] for p in self.params])
+
+    def terms(self, row: Mapping[str, Any]) -> tuple[Any, ...]:
+        """The fitted law's terms for one measurement row (one contact: the chain's rows
+        need ``link`` and ``v0_case``)."""
+        return self._model.row_terms(row, [self.values[p] for p in self.params])
 
     def within(self, quantity: str, k: float) -> int:
         """Rows with the fitted simulation within ``k`` measured sd (see :func:`within`)."""
@@ -221,7 +226,7 @@ def _bounds_for(
     given = {k.replace("lambda", "lam"): v for k, v in given.items()}
     out = []
     for p in params:
-        pair = given.get(p.name, p.default_bounds())
+        pair = given[p.name] if p.name in given else p.default_bounds()
         try:
             lo, hi = (float(pair[0]), float(pair[1]))
             if len(pair) != 2:
@@ -241,13 +246,23 @@ def _bounds_for(
                 f"bounds for {p.name!r} must be > 0 (it is fitted in log space); got low = {lo}",
                 field=f"bounds.{p.name}",
             )
-        if p.target == "lam" and p.kind != "scale" and lo < 0.0:
+        if not p.log and p.kind != "scale" and lo < 0.0:
             raise InvalidParameterError(
                 f"bounds for {p.name!r}: lambda must be >= 0; got low = {lo}",
                 field=f"bounds.{p.name}",
             )
         out.append((lo, hi))
     return out
+
+
+def _check_law(law: Any) -> LawSpec | None:
+    """The law's terms as given: None, a function of the row, or a list of terms (checked
+    here: a typed error names the item)."""
+    if law is None or callable(law):
+        return law
+    from ..forces import as_terms
+
+    return as_terms(law, "forces")
 
 
 def _check_body(cases: Any) -> str:
@@ -278,7 +293,7 @@ def _parse_params(
         expanded = []
         for p in parsed:
             if p.kind == "coef":
-                expanded += [_Param(f"{p.target}@{q:g}", "node", p.target, q) for q in angles]
+                expanded += [_Param(f"{p.name}@{q:g}", "node", p.target, p.term, q) for q in angles]
             else:
                 expanded.append(p)
         parsed = expanded
@@ -286,11 +301,21 @@ def _parse_params(
     dupes = sorted({n for n in names if names.count(n) > 1})
     if dupes:
         raise InvalidParameterError(f"parameter {dupes[0]!r} is given twice", field=dupes[0])
-    kinds = {p.target: p.kind for p in parsed if p.kind in ("coef", "node")}
+    seen: dict[str, _Param] = {}
     for p in parsed:
-        if p.kind in ("coef", "node") and kinds[p.target] != p.kind:
+        key = (p.key + f"@{p.node:g}") if p.kind == "node" else f"{p.kind}:{p.key}"
+        if p.kind == "coef":
+            key = p.key
+        if key in seen and seen[key].name != p.name:
             raise InvalidParameterError(
-                f"{p.target} is fitted both as one value and per angle node; choose one",
+                f"{p.name!r} and {seen[key].name!r} are the same parameter", field=p.name
+            )
+        seen[key] = p
+    kinds = {p.key: p.kind for p in parsed if p.kind in ("coef", "node")}
+    for p in parsed:
+        if p.kind in ("coef", "node") and kinds[p.key] != p.kind:
+            raise InvalidParameterError(
+                f"{p.key} is fitted both as one value and per angle node; choose one",
                 field=p.name,
             )
     return parsed
@@ -405,13 +430,22 @@ def _start_values(
             v = 1.0
         elif p.kind == "joint":
             v = fixed.get(p.target, _JOINT_START[p.target])
+        elif p.kind == "body":
+            v = model.body_default(p.target)
         else:
             if p.kind == "node":
                 row = min(records, key=lambda r: abs(abs(float(r["q_deg"])) - p.node))
                 row = {**row, "q_deg": p.node}
             else:
                 row = records[0]
-            v = getattr(model.base_coefficients(row), p.target)
+            by_name = {t.name: t.params for t in model.base_terms(row)}
+            if p.term not in by_name:
+                raise UnknownNameError(
+                    f"parameter {p.name!r}: the term {p.term!r} is not in the law "
+                    f"({', '.join(by_name) or 'no terms'})",
+                    field=p.name,
+                )
+            v = float(by_name[p.term][p.target])
         x_start.append(min(max(v, lo), hi))
     return x_start
 
@@ -612,6 +646,7 @@ def calibrate(
     per_angle: bool = False,
     quantities: Sequence[str] = QUANTITIES,
     joints: Mapping[str, float] | None = None,
+    forces: LawSpec | None = None,
     dt: float = 1e-4,
     rel_step: float = 1e-3,
     error_scale: str = "auto",
@@ -631,9 +666,12 @@ def calibrate(
         measurements: a :class:`Measurements`, a thesis name (``"table_3_1"``,
             ``"table_4_chain"``, ``"table_5_1_means"``, ...; ``"thesis:"`` may prefix it) or
             the path of a CSV with the same columns.
-        params: the parameters to fit (see the module's notes): ``eta_h``, ``eta_d``,
-            ``eta_v``, ``lam``; ``<coef>@<q_deg>`` angle nodes (free link);
-            ``scale.<coef>``; ``joints.k``, ``joints.c`` (leg). The rest keep their base value.
+        params: the parameters to fit (see the module's notes): any term's parameter as
+            ``TERM.PARAM`` (``static_v.eta_v``, ``poncelet.c``, ...) or the thesis's short
+            names ``eta_h``, ``eta_d``, ``eta_v``, ``lam``; ``<param>@<q_deg>`` angle nodes
+            (free link); ``scale.<param>``; the body's unknowns: ``mass`` (free link,
+            chain), ``pin_mass`` (chain), ``joints.k``, ``joints.c`` (leg). The rest keep
+            their base value.
         bounds: ``{name: (low, high)}`` in natural units; defaults: etas 1e-3..1e5 (eta_v
             1e-3..1e6), lambda 0..3, scale factors 1e-3..1e3, joints.k 1..1e5 N m/rad,
             joints.c 0.01..100 N m s/rad (the damper's rate must stay within RK4's stability
@@ -647,6 +685,11 @@ def calibrate(
         per_angle: free link: turn each plain coefficient name into one node per measured
             angle (``eta_v`` -> ``eta_v@0``, ``eta_v@45``, ...).
         quantities: which of ``"depth"``, ``"t_s"`` to fit (default both).
+        forces: the law's terms, instead of the thesis's from ``base``: a list of
+            :mod:`granrs.forces` terms for every row (a per-contact tuple gives each chain
+            link its own value), or a function of the measurement row (a dict of its
+            columns) returning them. A fitted parameter of a term that is not listed
+            raises :class:`~granrs.errors.UnknownNameError` before any simulation.
         joints: leg: fixed joint settings ``{"k": ..., "c": ...}`` for what is not fitted
             (default: locked joints unless ``joints.k`` or ``joints.c`` is fitted).
         dt: integration step [s] (default 1e-4, the thesis's 10 kHz).
@@ -692,7 +735,8 @@ def calibrate(
     _check_options(dt, rel_step, starts, max_nfev, error_scale)
     fixed = _check_joints(joints, body)
     box = _bounds_for(parsed, bounds)
-    model = _Model(body, tuple(parsed), base, float(dt), dict(overrides), fixed)
+    law = _check_law(forces)
+    model = _Model(body, tuple(parsed), base, float(dt), dict(overrides), fixed, law)
     x_start = _start_values(parsed, box, start, model, m, fixed)
     # Build every scene once up front: bad overrides or values fail here, before any run.
     model.scenes(m.rows, x_start)
@@ -756,6 +800,8 @@ def evaluate(
     measurements: Measurements | str | os.PathLike[str],
     *,
     base: str | Coefficients | None = None,
+    forces: LawSpec | None = None,
+    joints: Mapping[str, float] | None = None,
     dt: float = 1e-4,
     threads: int | None = None,
     **overrides: Any,
@@ -770,7 +816,8 @@ def evaluate(
     m = _check_measurements(measurements, cases)
     if base is None:
         base = "table_3_4" if cases == "free_link" else "thesis"
-    model = _Model(cases, (), base, float(dt), dict(overrides), {})
+    fixed = _check_joints(joints, cases)
+    model = _Model(cases, (), base, float(dt), dict(overrides), fixed, _check_law(forces))
     depth, t_s, _ = model.simulate(m.rows, [[]], threads)
     frame = _residual_frame(m, depth[0], t_s[0])
     frame["unresolved"] = model.last_unresolved[0]

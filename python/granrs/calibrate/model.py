@@ -1,6 +1,7 @@
-"""The parameter model of a calibration: parameter names parsed (plain coefficients,
-angle nodes, scale factors, joints), their bounds and fitted space (log or not), and the
-scenes and simulated depths and stopping times for a set of parameter values.
+"""The parameter model of a calibration: parameter names parsed (any term's parameter,
+angle nodes, scale factors, the body's unknowns), their bounds and fitted space (log or
+not), the law's terms per row, and the scenes and simulated depths and stopping times for
+a set of parameter values.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ import difflib
 import math
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,6 +19,7 @@ import pandas as pd
 
 from .. import cases as _cases
 from .. import data
+from .. import forces as _forces
 from ..coefficients import Coefficients, table_3_2, table_3_4
 from ..errors import (
     InvalidParameterError,
@@ -38,8 +40,24 @@ except ImportError:  # pragma: no cover - older builds have neither
 
 __all__: list[str] = []  # all of it is internal to granrs.calibrate
 
-_COEFS = ("eta_h", "eta_d", "eta_v", "lam")
+#: The thesis's coefficients by their short names: the term and parameter each is.
+ALIASES: dict[str, tuple[str, str]] = {
+    "eta_h": ("static_h", "eta_h"),
+    "eta_d": ("drag", "eta_d"),
+    "eta_v": ("static_v", "eta_v"),
+    "lam": ("static_v", "lam"),
+}
+_COEFS = tuple(ALIASES)
 _JOINTS = ("k", "c")
+#: A body's unknowns that a fit may take, by body: Scene fields (``mass``: the link mass
+#: [kg]; the free link's is measured, the chain's is not in the thesis) and the leg's joints.
+BODY_PARAMS: dict[str, tuple[str, ...]] = {
+    "free_link": ("mass",),
+    "chain": ("mass", "pin_mass"),
+    "leg": ("joints.k", "joints.c"),
+}
+#: Parameters fitted as they are (not in log space): exponents, which may be 0.
+_PLAIN: frozenset[tuple[str, str]] = frozenset({("static_v", "lam")})
 #: Default bounds in natural units, by kind.
 _DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     "eta_h": (1e-3, 1e5),
@@ -49,10 +67,11 @@ _DEFAULT_BOUNDS: dict[str, tuple[float, float]] = {
     "scale": (1e-3, 1e3),
     "joints.k": (1.0, 1e5),
     "joints.c": (1e-2, 100.0),
+    "mass": (1e-4, 100.0),
+    "pin_mass": (1e-4, 100.0),
 }
 #: Start of the joint settings when not given [N m/rad], [N m s/rad].
 _JOINT_START: dict[str, float] = {"k": 1000.0, "c": 10.0}
-#: Residual of a run that failed (SimulationError): large, finite, so that the optimizer
 
 
 # --------------------------------------------------------------------------------------------
@@ -61,70 +80,200 @@ _JOINT_START: dict[str, float] = {"k": 1000.0, "c": 10.0}
 
 @dataclass(frozen=True)
 class _Param:
-    """One fitted parameter: ``kind`` is coef, node, scale or joint."""
+    """One fitted parameter.
+
+    ``kind`` is ``coef`` (a term's parameter, one value for every row), ``node`` (a term's
+    parameter at an angle node), ``scale`` (a factor on a term's base parameter), ``joint``
+    (the leg's joints: ``target`` k or c) or ``body`` (a Scene field: ``target``)."""
 
     name: str
     kind: str
     target: str
+    term: str = ""
     node: float = math.nan
 
     @property
+    def key(self) -> str:
+        """``term.param`` for a term's parameter, else the name."""
+        return f"{self.term}.{self.target}" if self.term else self.name
+
+    @property
     def log(self) -> bool:
-        return self.target != "lam" or self.kind == "scale"
+        if self.kind in ("scale", "joint", "body"):
+            return True
+        if (self.term, self.target) in _PLAIN:
+            return False
+        return _param_info(self.term, self.target).min >= 0.0
 
     def default_bounds(self) -> tuple[float, float]:
         if self.kind == "scale":
             return _DEFAULT_BOUNDS["scale"]
         if self.kind == "joint":
             return _DEFAULT_BOUNDS[f"joints.{self.target}"]
-        return _DEFAULT_BOUNDS[self.target]
+        if self.kind == "body":
+            return _DEFAULT_BOUNDS[self.target]
+        if (self.term, self.target) in ALIASES.values():
+            return _DEFAULT_BOUNDS[self.target]
+        default = _param_info(self.term, self.target).default
+        if math.isfinite(default) and default > 0.0:
+            return (default * 1e-3, default * 1e3)
+        raise InvalidParameterError(
+            f"{self.name} has no default to take bounds from; give bounds[{self.name!r}] = "
+            "(low, high)",
+            field=f"bounds.{self.name}",
+        )
+
+
+def _param_info(term: str, param: str) -> Any:
+    """The registry's description of ``term.param`` (unknown names raise, with a hint)."""
+    info = _forces.info(term)
+    for p in info.params:
+        if p.name == param:
+            return p
+    names = [p.name for p in info.params]
+    hint = difflib.get_close_matches(param, names, n=1)
+    more = f"; did you mean {term + '.' + hint[0]!r}?" if hint else ""
+    raise UnknownNameError(
+        f"the term {term!r} has no parameter {param!r}{more} (its parameters: "
+        f"{', '.join(names) or 'none'})",
+        field=f"{term}.{param}",
+    )
 
 
 def _known_names(body: str) -> list[str]:
     names = [*_COEFS, *(f"scale.{c}" for c in _COEFS)]
+    names += [f"{t}.{p.name}" for t in _forces.TERMS for p in _forces.info(t).params]
     if body == "free_link":
         names += [f"{c}@45" for c in _COEFS]
-    if body == "leg":
-        names += [f"joints.{j}" for j in _JOINTS]
+    names += list(BODY_PARAMS[body])
     return names
 
 
-_NODE = re.compile(r"^(eta_h|eta_d|eta_v|lam|lambda)@([-+]?\d+(\.\d*)?)$")
+_NODE = re.compile(r"^(.+)@([-+]?\d+(\.\d*)?)$")
+
+
+def _term_param(text: str, full: str) -> tuple[str, str] | None:
+    """``(term, param)`` for a short coefficient name or ``term.param``; None if neither
+    (an unknown parameter of a known term raises)."""
+    plain = text.replace("lambda", "lam")
+    if plain in ALIASES:
+        return ALIASES[plain]
+    if "." in plain:
+        term, param = plain.split(".", 1)
+        if term in _forces.TERMS:
+            _param_info(term, param)
+            return term, param
+        if term not in ("scale", "joints"):
+            hint = difflib.get_close_matches(term, _forces.TERMS, n=1)
+            more = f"; did you mean {hint[0]!r}?" if hint else ""
+            raise UnknownNameError(
+                f"parameter {full!r}: no term {term!r}{more} (terms: {', '.join(_forces.TERMS)})",
+                field=full,
+            )
+    return None
 
 
 def _parse_param(name: Any, body: str) -> _Param:
     if not isinstance(name, str):
         raise InvalidParameterError(f"parameter names are strings; got {name!r}", field="params")
     plain = name.replace("lambda", "lam")
-    if plain in _COEFS:
-        return _Param(plain, "coef", plain)
-    if plain.startswith("scale.") and plain[6:] in _COEFS:
-        return _Param(plain, "scale", plain[6:])
-    match = _NODE.match(name)
-    if match and body == "free_link":
-        q = abs(float(match.group(2)))
-        if q >= 90.0:
-            raise InvalidParameterError(
-                f"parameter {name!r}: the angle node must be |q| < 90 deg", field=name
-            )
-        target = match.group(1).replace("lambda", "lam")
-        return _Param(f"{target}@{q:g}", "node", target, q)
-    if body == "leg" and plain.startswith("joints.") and plain[7:] in _JOINTS:
-        return _Param(plain, "joint", plain[7:])
+    if plain.startswith("scale."):
+        tp = _term_param(plain[6:], name)
+        if tp is not None:
+            return _Param(plain, "scale", tp[1], tp[0])
+    match = _NODE.match(plain)
+    if match:
+        tp = _term_param(match.group(1), name)
+        if tp is not None and body == "free_link":
+            q = abs(float(match.group(2)))
+            if q >= 90.0:
+                raise InvalidParameterError(
+                    f"parameter {name!r}: the angle node must be |q| < 90 deg", field=name
+                )
+            return _Param(f"{match.group(1)}@{q:g}", "node", tp[1], tp[0], q)
+    else:
+        tp = _term_param(plain, name)
+        if tp is not None:
+            return _Param(plain, "coef", tp[1], tp[0])
+    if plain in BODY_PARAMS[body]:
+        if plain.startswith("joints."):
+            return _Param(plain, "joint", plain[7:])
+        return _Param(plain, "body", plain)
     known = _known_names(body)
     hint = difflib.get_close_matches(name, known, n=1)
     more = f"; did you mean {hint[0]!r}?" if hint else ""
     extra = " (angle nodes 'eta_v@45' are for the free link)" if match else ""
     raise UnknownNameError(
         f"unknown parameter {name!r} for the {body}{more}{extra}; parameters are "
-        f"{', '.join(_COEFS)}, <coef>@<q_deg> (free link), scale.<coef>"
-        + (", joints.k, joints.c" if body == "leg" else ""),
+        f"{', '.join(_COEFS)} or any term's TERM.PARAM (e.g. static_v.eta_v), "
+        f"<param>@<q_deg> (free link), scale.<param>, and the body's "
+        f"{', '.join(BODY_PARAMS[body])}",
         field=name,
     )
 
 
 # --------------------------------------------------------------------------------------------
 # The model: parameters -> scenes -> simulated values
+
+#: A law given to the model: terms for every row, or a function of the row giving them.
+LawSpec = Sequence[_forces.Term] | Callable[[Mapping[str, Any]], Sequence[_forces.Term]]
+
+
+def base_coefficients(
+    body: str, row: Mapping[str, Any], base: Any = None, rho_g: float = 1650.0
+) -> Coefficients:
+    """The thesis's published coefficients of one measurement row: free link Table 3.4's
+    nearest row (``base="table_3_2"``: the closed forms at the row's angle), chain Table 4.4
+    per link and case, leg the row of sec. 5.3.2 at the nearest speed; or ``base`` itself
+    if it is a :class:`~granrs.Coefficients`."""
+    if isinstance(base, Coefficients):
+        return base
+    if body == "free_link":
+        if base == "table_3_2":
+            return table_3_2(row["q_deg"], rho_g)
+        return table_3_4(row["q_deg"])[0]
+    if body == "chain":
+        case = int(row["v0_case"])
+        spec = _cases.chain_case(case if case in (1, 2, 3) else 1)
+        return spec["coefficients"][int(row["link"]) - 1]
+    table = data.load("human_coefficients", as_="numpy")
+    i = int(np.argmin(np.abs(table["v0"] - row["v0_mean"])))
+    return Coefficients(
+        eta_h=float(table["eta_h"][i]),
+        eta_d=float(table["eta_d"][i]),
+        eta_v=float(table["eta_v"][i]),
+        lam=float(table["lambda"][i]),
+    )
+
+
+def _contact(row: Mapping[str, Any]) -> int:
+    """The contact a measurement row is (the chain's link 2 is contact 1)."""
+    return int(row["link"]) - 1 if "link" in row else 0
+
+
+def _at(value: Any, i: int) -> float:
+    return float(value[i]) if isinstance(value, tuple) else float(value)
+
+
+def _merge(per_contact: Sequence[Sequence[_forces.Term]]) -> tuple[_forces.Term, ...]:
+    """One term list from per-contact single-valued ones (the chain's two links): a
+    parameter that differs between contacts becomes a tuple."""
+    first = per_contact[0]
+    names = [t.name for t in first]
+    for other in per_contact[1:]:
+        if [t.name for t in other] != names:
+            raise InvalidParameterError(
+                f"the links' laws list different terms: {names} and {[t.name for t in other]}",
+                field="forces",
+            )
+    out = []
+    for j, t in enumerate(first):
+        params: dict[str, Any] = {}
+        for k in t.params:
+            vals = tuple(_at(c[j].params[k], 0) for c in per_contact)
+            params[k] = vals[0] if all(v == vals[0] for v in vals) else vals
+        out.append(_forces.Term(t.name, params))
+    return tuple(out)
 
 
 @dataclass
@@ -135,6 +284,8 @@ class _Model:
     dt: float
     overrides: dict[str, Any]
     fixed_joints: dict[str, float]
+    #: The law's terms (None: the thesis's, from ``base``'s coefficients).
+    law: LawSpec | None = None
     #: Per vector and row of the last :meth:`simulate`: the step did not resolve the run.
     last_unresolved: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
 
@@ -146,78 +297,106 @@ class _Model:
     def to_natural(self, x: Sequence[float]) -> np.ndarray:
         return np.array([math.exp(u) if p.log else u for p, u in zip(self.params, x, strict=True)])
 
-    # base coefficients -------------------------------------------------------------------
+    # base law ----------------------------------------------------------------------------
     def base_coefficients(self, row: Mapping[str, Any]) -> Coefficients:
-        if isinstance(self.base, Coefficients):
-            return self.base
-        if self.body == "free_link":
-            if self.base == "table_3_2":
-                return table_3_2(row["q_deg"], self.overrides.get("rho_g", 1650.0))
-            return table_3_4(row["q_deg"])[0]
-        if self.body == "chain":
-            case = int(row["v0_case"])
-            spec = _cases.chain_case(case)
-            return spec["coefficients"][int(row["link"]) - 1]
-        table = data.load("human_coefficients", as_="numpy")
-        i = int(np.argmin(np.abs(table["v0"] - row["v0_mean"])))
-        return Coefficients(
-            eta_h=float(table["eta_h"][i]),
-            eta_d=float(table["eta_d"][i]),
-            eta_v=float(table["eta_v"][i]),
-            lam=float(table["lambda"][i]),
+        return base_coefficients(self.body, row, self.base, self.overrides.get("rho_g", 1650.0))
+
+    def base_terms(self, row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
+        """The law's terms for one row (one contact), before the fitted parameters."""
+        if self.law is None:
+            return _forces.thesis(self.base_coefficients(row))
+        terms = self.law(row) if callable(self.law) else self.law
+        i = _contact(row)
+        return tuple(
+            _forces.Term(t.name, {k: _at(v, i) for k, v in t.params.items()})
+            for t in _forces.as_terms(terms)
         )
 
-    def coefficients(self, row: Mapping[str, Any], values: Sequence[float]) -> Coefficients:
-        """The coefficients of one row (one link) at the natural parameter ``values``."""
-        c = self.base_coefficients(row).as_dict()
-        nodes: dict[str, list[tuple[float, float]]] = {}
+    def row_terms(self, row: Mapping[str, Any], values: Sequence[float]) -> tuple[Any, ...]:
+        """The terms of one row (one contact) at the natural parameter ``values``."""
+        terms = {t.name: dict(t.params) for t in self.base_terms(row)}
+        base = {name: dict(p) for name, p in terms.items()}
+        nodes: dict[tuple[str, str], list[tuple[float, float, bool]]] = {}
         for p, v in zip(self.params, values, strict=True):
+            if p.kind not in ("coef", "scale", "node"):
+                continue
+            if p.term not in terms:
+                raise UnknownNameError(
+                    f"parameter {p.name!r}: the term {p.term!r} is not in the law "
+                    f"({', '.join(terms) or 'no terms'})",
+                    field=p.name,
+                )
             if p.kind == "scale":
-                c[p.target] *= v
+                terms[p.term][p.target] = base[p.term][p.target] * v
             elif p.kind == "coef":
-                c[p.target] = v
-            elif p.kind == "node":
-                nodes.setdefault(p.target, []).append((p.node, v))
+                terms[p.term][p.target] = v
+            else:
+                nodes.setdefault((p.term, p.target), []).append((p.node, v, p.log))
         if nodes:
             q = abs(float(row.get("q_deg", row.get("q0_deg", 0.0))))
-            for target, pts in nodes.items():
+            for (term, target), pts in nodes.items():
                 pts.sort()
-                xs = np.array([a for a, _ in pts])
-                ys = np.array([b for _, b in pts])
-                if target == "lam":
-                    c[target] = float(np.interp(q, xs, ys))
+                xs = np.array([a for a, _, _ in pts])
+                ys = np.array([b for _, b, _ in pts])
+                if pts[0][2]:
+                    terms[term][target] = float(np.exp(np.interp(q, xs, np.log(ys))))
                 else:
-                    c[target] = float(np.exp(np.interp(q, xs, np.log(ys))))
-        return Coefficients(**c)
+                    terms[term][target] = float(np.interp(q, xs, ys))
+        return tuple(_forces.Term(name, p) for name, p in terms.items())
+
+    def coefficients(self, row: Mapping[str, Any], values: Sequence[float]) -> Coefficients:
+        """The thesis's coefficients of one row (one link) at the natural parameter
+        ``values`` (a view of its terms; raises if the law is not the thesis's)."""
+        row_c = _forces.thesis_row(self.row_terms(row, values))
+        if row_c is None:
+            raise InvalidParameterError(
+                "the law has no drag, static_h and static_v: no thesis coefficients; use terms()",
+                field="forces",
+            )
+        return row_c
+
+    def body_default(self, target: str) -> float:
+        """A body field's value when not fitted: the override, else the case's default."""
+        if target in self.overrides:
+            return float(self.overrides[target])
+        defaults = {"free_link": _cases.FREE_LINK, "chain": _cases.CHAIN}.get(self.body, {})
+        return float(defaults.get(target, getattr(Scene, target, 0.0)))
+
+    def body_values(self, values: Sequence[float]) -> tuple[dict[str, Any], Any]:
+        """The Scene fields and the leg's joints at ``values``."""
+        fields = dict(self.overrides)
+        named = {}
+        for p, v in zip(self.params, values, strict=True):
+            if p.kind == "body":
+                fields[p.target] = float(v)
+            elif p.kind == "joint":
+                named[p.target] = float(v)
+        joints: Any = None
+        if named or self.fixed_joints:
+            joints = {**_JOINT_START, **self.fixed_joints, **named}
+        return fields, joints
 
     def scenes(self, rows: pd.DataFrame, values: Sequence[float]) -> list[Scene]:
         """One scene per run: per row (free link, leg) or per chain case (two rows)."""
         records = rows.to_dict("records")
+        fields, joints = self.body_values(values)
         if self.body == "free_link":
             return [
                 _cases.free_link(
                     r["q_deg"],
                     r["v0_mean"],
-                    coefficients=self.coefficients(r, values),
                     dt=self.dt,
-                    **self.overrides,
+                    **{**fields, "forces": self.row_terms(r, values)},
                 )
                 for r in records
             ]
         if self.body == "leg":
-            joints: Any = None
-            named = {
-                p.target: v for p, v in zip(self.params, values, strict=True) if p.kind == "joint"
-            }
-            if named or self.fixed_joints:
-                joints = {**_JOINT_START, **self.fixed_joints, **named}
             return [
                 _cases.leg(
                     r["v0_mean"],
-                    coefficients=self.coefficients(r, values),
                     joints=joints,
                     dt=self.dt,
-                    **self.overrides,
+                    **{**fields, "forces": self.row_terms(r, values)},
                 )
                 for r in records
             ]
@@ -225,14 +404,14 @@ class _Model:
         for link1, link2 in _chain_pairs(rows):
             r1, r2 = records[link1], records[link2]
             case = int(r1["v0_case"])
-            overrides = {"end": "all_stops", **self.overrides}
+            overrides = {"end": "all_stops", **fields}
             overrides.setdefault("v0", 0.5 * (r1["v0_mean"] + r2["v0_mean"]))
+            overrides["forces"] = _merge([self.row_terms(r1, values), self.row_terms(r2, values)])
             out.append(
                 _cases.chain(
                     case=case if case in (1, 2, 3) else 1,
                     q1_deg=r1["q0_deg"],
                     q2_deg=r2["q0_deg"],
-                    coefficients=(self.coefficients(r1, values), self.coefficients(r2, values)),
                     dt=self.dt,
                     **overrides,
                 )

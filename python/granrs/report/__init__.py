@@ -7,8 +7,10 @@ report. The command line ``granrs reproduce --out DIR`` calls it (see :mod:`gran
 Chapters form a registry (:data:`CHAPTERS`): a chapter is a function that takes a
 :class:`ReportContext`, runs its simulations through it, adds its figures and headline
 numbers to it, and returns its Markdown text. :func:`register_chapter` adds one; the free
-link (chapter 3), the chain (chapter 4), the leg (chapter 5) and the calibration chapter
-register themselves when this package imports their modules, in that order.
+link (chapter 3), the chain (chapter 4), the leg (chapter 5), the calibration chapter, the
+force laws (:mod:`~granrs.report.force_laws`) and "Which law fits the experiments"
+(:mod:`~granrs.report.laws`, which also writes ``laws.json``) register themselves when this
+package imports their modules, in that order.
 
 The package by concern: :mod:`~granrs.report.framework` (the registry, the context, writing
 the report), :mod:`~granrs.report.format` (numbers and Markdown), one module per chapter
@@ -51,13 +53,14 @@ place, so an error leaves no half-written report.
 from __future__ import annotations
 
 # The chapters register themselves on import; the order of these imports is the order of
-# the report (3, 4, 5, calibration), so it is kept out of the import sorting.
+# the report (3, 4, 5, calibration, force_laws, laws), so it is kept out of the import sorting.
 # isort: off
 from . import ch3_free_link as ch3_free_link
 from . import ch4_chain as ch4_chain
 from . import ch5_leg as ch5_leg
 from . import calibration as calibration
 from . import force_laws as force_laws
+from . import laws as laws
 
 # isort: on
 from .ch3_free_link import chapter_3 as chapter_3

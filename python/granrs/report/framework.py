@@ -94,6 +94,8 @@ class ReportContext:
         runs: the number of simulations run so far.
         sim_seconds: wall time spent in :func:`granrs.simulate` [s].
         settings: every (sign model, point of application) pair that was run.
+        files: other files by name (relative to the output directory, e.g. a chapter's
+            ``laws.json``), filled by :meth:`add_file`.
     """
 
     dt: float
@@ -103,6 +105,7 @@ class ReportContext:
     runs: int = 0
     sim_seconds: float = 0.0
     settings: set[tuple[str, str]] = field(default_factory=set)
+    files: dict[str, bytes] = field(default_factory=dict)
 
     def log(self, message: str) -> None:
         """Print one progress line to stderr (nothing when ``progress`` is False)."""
@@ -148,6 +151,15 @@ class ReportContext:
         self.figures[name] = png
         self.log(f"figure {FIGURES_DIR}/{name}")
         return f"![{alt}]({FIGURES_DIR}/{name})"
+
+    def add_file(self, name: str, content: bytes) -> str:
+        """Keep ``content`` to be written as ``name`` in the output directory (next to the
+        report, replaced like it); return the name."""
+        if name in self.files or name == REPORT_NAME or "/" in name or name == FIGURES_DIR:
+            raise ValueError(f"file {name!r} was added twice or is reserved")
+        self.files[name] = content
+        self.log(f"file {name}")
+        return name
 
     def watch(self, name: str, scene: Scene, caption: str, frame_dt: float) -> str:
         """A chapter's "Watch it" section: run ``scene`` recording its state and forces,
@@ -242,12 +254,17 @@ def _validate_out_dir(out_dir: Path) -> None:
         )
 
 
-def _write(out_dir: Path, report: str, figures: Mapping[str, bytes]) -> Path:
+def _write(
+    out_dir: Path,
+    report: str,
+    figures: Mapping[str, bytes],
+    files: Mapping[str, bytes] | None = None,
+) -> Path:
     """Write the report and figures to a temporary directory, then move them into place.
 
-    A new ``out_dir`` is created by one rename. In an existing ``out_dir`` the report file
-    and the ``figures`` folder are replaced (the old folder is removed); other files are
-    left alone.
+    A new ``out_dir`` is created by one rename. In an existing ``out_dir`` the report file,
+    the chapters' other ``files`` and the ``figures`` folder are replaced (the old folder is
+    removed); other files are left alone.
     """
     out_dir = out_dir.absolute()
     out_dir.parent.mkdir(parents=True, exist_ok=True)
@@ -259,6 +276,8 @@ def _write(out_dir: Path, report: str, figures: Mapping[str, bytes]) -> Path:
         for name, png in figures.items():
             (new / FIGURES_DIR / name).write_bytes(png)
         (new / REPORT_NAME).write_text(report, encoding="utf-8")
+        for name, content in (files or {}).items():
+            (new / name).write_bytes(content)
         if not out_dir.exists():
             os.replace(new, out_dir)
             return out_dir / REPORT_NAME
@@ -267,6 +286,8 @@ def _write(out_dir: Path, report: str, figures: Mapping[str, bytes]) -> Path:
         if old_figures.exists():
             os.replace(old_figures, staging / "old-figures")
         os.replace(new / FIGURES_DIR, old_figures)
+        for name in files or {}:
+            os.replace(new / name, out_dir / name)
         os.replace(new / REPORT_NAME, out_dir / REPORT_NAME)
         return out_dir / REPORT_NAME
     finally:
@@ -331,6 +352,6 @@ def reproduce(
         bodies.append(f"## {chapter.title}\n\n{chapter.build(ctx).strip()}\n")
     seconds = time.perf_counter() - start
     report = _header(ctx, selected, dt, seconds) + "\n" + "\n".join(bodies)
-    path = _write(out_path, report, ctx.figures)
+    path = _write(out_path, report, ctx.figures, ctx.files)
     ctx.log(f"wrote {path} and {len(ctx.figures)} figures in {seconds:.1f} s")
     return path

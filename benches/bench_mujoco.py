@@ -1,0 +1,185 @@
+"""granrs.mujoco.Sand: its accuracy against granrs.simulate, and its cost per MuJoCo step.
+
+**Accuracy (``--part table``).** The thesis's free link dropped in MuJoCo
+(:func:`granrs.mujoco.rod_drop`: a cylinder geom on slide x, slide z and hinge y, its tip at
+the surface, v0 = 2 m/s straight down) under a law's contact terms, against
+:func:`granrs.simulate` of the same scene (RK4 at 1e-4 s with its events located: the
+converged answer), for q = 0, 30 and 60 deg, MuJoCo timesteps 1e-4, 1e-3 and 2e-3 s, and the
+Euler (MuJoCo's default), RK4 and implicitfast integrators, with ``Sand.step`` before
+``mj_step`` (the force held through MuJoCo's step) and, for RK4, also as the passive callback
+(evaluated at each stage). The stop is the first step whose end has the tip's vertical
+velocity >= 0 (within 1e-9 m/s), interpolated linearly inside the step. The laws: the
+thesis's (Table 3.4's row nearest q) and, where the core has it, ``rft(zeta=1e6,
+elements=64)``. A row passes when the depth is within 2 % and t_s within 5 %.
+
+**Cost (``--part cost``).** The gallery's walker (:func:`granrs.mujoco.walker_mjcf`, 7 dofs,
+2 sand geoms), landed and standing in sand under the thesis's law (both geoms in the sand, the
+static terms as reactions): the time of ``mj_step`` alone, of ``Sand.step`` + ``mj_step``, and
+of ``mj_step`` with the Sand installed as the passive callback, each over ``--steps`` steps
+from the same state, timed in turn within each of ``--repeats`` repeats. The coupling's cost
+is the difference to ``mj_step`` alone, quoted as a ratio to it: of the minimum times, and
+the median (and range) of the ratios within each repeat (two times of the same stretch). Build
+the extension with ``maturin develop --release`` first (the dev build is several times
+slower); the machines are shared and noisy: read the ratios.
+
+Usage::
+
+    python benches/bench_mujoco.py [--part all|table|cost] [--repeats 15] [--steps 1000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+import warnings
+
+import mujoco
+import numpy as np
+
+import granrs
+from granrs import forces
+from granrs.mujoco import WALKER_SAND_GEOMS, Sand, rod_drop, walker_mjcf
+
+TIMESTEPS = (1e-4, 1e-3, 2e-3)
+RUNS = (("Euler", "step"), ("RK4", "step"), ("RK4", "callback"), ("implicitfast", "step"))
+
+
+def laws(q_deg: float) -> dict[str, granrs.Scene]:
+    """The free-link scenes of each law the core has, at q_deg and v0 = 2 m/s."""
+    scenes = {"thesis": granrs.cases.free_link(q_deg=q_deg, v0=2.0)}
+    try:
+        rft = forces.term("rft", zeta=1e6, elements=64)
+    except granrs.GranrsError:
+        return scenes  # the core has no rft yet
+    scenes["rft(zeta=1e6, elements=64)"] = granrs.cases.free_link(
+        q_deg=q_deg, v0=2.0, forces=[forces.gravity(), rft]
+    )
+    return scenes
+
+
+def table() -> list[dict[str, object]]:
+    rows = []
+    print(
+        "| law | q [deg] | integrator | coupling | timestep [s] | depth [mm] | simulate "
+        "[mm] | error | t_s [ms] | simulate [ms] | error | within 2 % / 5 % |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for q_deg in (0.0, 30.0, 60.0):
+        for law, scene in laws(q_deg).items():
+            ref = granrs.simulate(scene)
+            for integrator, mode in RUNS:
+                for h in TIMESTEPS:
+                    with warnings.catch_warnings(record=True) as caught:
+                        warnings.simplefilter("always")
+                        got = rod_drop(scene, timestep=h, integrator=integrator, mode=mode)
+                    e_d = got["depth"] / ref.depth - 1.0
+                    e_t = got["t_s"] / ref.t_s - 1.0
+                    ok = abs(e_d) <= 0.02 and abs(e_t) <= 0.05
+                    warned = any(issubclass(w.category, granrs.StepSizeWarning) for w in caught)
+                    rows.append(
+                        {
+                            "law": law,
+                            "q_deg": q_deg,
+                            "integrator": integrator,
+                            "mode": mode,
+                            "timestep": h,
+                            "depth_error": e_d,
+                            "t_s_error": e_t,
+                            "ok": ok,
+                        }
+                    )
+                    print(
+                        f"| {law} | {q_deg:g} | {integrator} | {mode} | {h:g} | "
+                        f"{got['depth'] * 1e3:.2f} | {ref.depth * 1e3:.2f} | {e_d * 100:+.2f} % | "
+                        f"{got['t_s'] * 1e3:.2f} | {ref.t_s * 1e3:.2f} | {e_t * 100:+.2f} % | "
+                        f"{'yes' if ok else 'no'}{' (StepSizeWarning)' if warned else ''} |"
+                    )
+    return rows
+
+
+def cost(repeats: int, steps: int) -> dict[str, float]:
+    model = mujoco.MjModel.from_xml_string(walker_mjcf())
+    data = mujoco.MjData(model)
+    data.qvel[1] = -2.0
+    thesis = [forces.drag(), forces.static_h(), forces.static_v()]
+    sand = Sand(model, list(WALKER_SAND_GEOMS), thesis)
+    for _ in range(round(0.3 / model.opt.timestep)):  # land
+        sand.step(data)
+        mujoco.mj_step(model, data)
+    assert np.all(sand.output[:, 3] > 0.0), "both shanks in the sand"
+    start = (data.qpos.copy(), data.qvel.copy(), data.qacc.copy(), data.time)
+    base = data.qfrc_applied.copy()
+
+    def restore() -> None:
+        data.qpos[:], data.qvel[:], data.qacc[:], data.time = start
+        data.qfrc_applied[:] = base
+
+    def alone() -> None:
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+
+    def stepped() -> None:
+        for _ in range(steps):
+            sand.step(data)
+            mujoco.mj_step(model, data)
+
+    def callback() -> None:
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+
+    best = {"mj_step": np.inf, "Sand.step + mj_step": np.inf, "mj_step, callback": np.inf}
+    ratios: dict[str, list[float]] = {"Sand.step + mj_step": [], "mj_step, callback": []}
+    for _ in range(repeats):
+        this: dict[str, float] = {}
+        for name, run in (
+            ("mj_step", alone),
+            ("Sand.step + mj_step", stepped),
+            ("mj_step, callback", callback),
+        ):
+            restore()
+            if name == "mj_step, callback":
+                sand.install()
+            t = time.perf_counter()
+            try:
+                run()
+            finally:
+                if name == "mj_step, callback":
+                    sand.uninstall()
+            this[name] = (time.perf_counter() - t) / steps
+            best[name] = min(best[name], this[name])
+        for name, r in ratios.items():
+            r.append(this[name] / this["mj_step"] - 1.0)
+    step = best["mj_step"]
+    print(f"walker, {model.nv} dofs, 2 sand geoms, {steps} steps, {repeats} repeats:")
+    print(
+        "| run | us per step (min) | coupling's cost [us] | cost / mj_step (of the mins) | "
+        "cost / mj_step (median of the repeats, range) |"
+    )
+    print("|---|---|---|---|---|")
+    for name, t in best.items():
+        extra = t - step
+        if name == "mj_step":
+            print(f"| {name} | {t * 1e6:.2f} | | | |")
+            continue
+        r = np.array(ratios[name])
+        print(
+            f"| {name} | {t * 1e6:.2f} | {extra * 1e6:.2f} | {extra / step:.2f} | "
+            f"{np.median(r):.2f} ({r.min():.2f} to {r.max():.2f}) |"
+        )
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--part", choices=("all", "table", "cost"), default="all")
+    parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--steps", type=int, default=1000)
+    args = parser.parse_args()
+    if args.part in ("all", "cost"):
+        cost(args.repeats, args.steps)
+    if args.part in ("all", "table"):
+        table()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,664 @@
+"""Sand under a MuJoCo model: granrs's force terms on the geoms of a planar MuJoCo robot.
+
+``pip install 'granrs[mujoco]'`` (the ``mujoco`` package from PyPI). MuJoCo has no granular
+ground; :class:`Sand` gives the named capsule, cylinder and box geoms of a model that moves
+in the x-z plane (the hopper and walker2d pattern: slide x, slide z and hinge y at the root)
+the resistance force of granrs's terms, evaluated by the same Rust code as
+:func:`granrs.simulate` (a rod geom is the free link's rod, a box the leg's sole; one call
+for all geoms)::
+
+    import mujoco
+    from granrs import forces
+    from granrs.mujoco import Sand
+
+    model = mujoco.MjModel.from_xml_path("hopper.xml")
+    data = mujoco.MjData(model)
+    sand = Sand(model, geoms=["foot"], forces=[forces.drag(), forces.static_h(), forces.static_v()])
+    for _ in range(1000):
+        sand.step(data)          # before mujoco.mj_step
+        mujoco.mj_step(model, data)
+
+or ``sand.install()`` once, to run as MuJoCo's passive-force callback inside every
+``mj_step`` (``sand.uninstall()`` to stop). See ``docs/mujoco.md`` for the frame, the geoms'
+contact geometry, where the force is applied, the static terms at rest and the stability
+limit (:class:`granrs.StepSizeWarning`).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+try:
+    import mujoco
+except ImportError as exc:  # pragma: no cover - exercised in a venv without mujoco
+    raise ImportError(
+        "granrs.mujoco needs the `mujoco` package: pip install 'granrs[mujoco]' "
+        "(or pip install 'mujoco>=3')"
+    ) from exc
+
+from . import _granrs
+from .api import RK4_STABILITY_LIMIT
+from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
+from .forces import as_terms
+
+__all__ = [
+    "EULER_STABILITY_LIMIT",
+    "GEOM_OUTPUTS",
+    "INTEGRATORS",
+    "STATICS",
+    "WALKER_SAND_GEOMS",
+    "Sand",
+    "free_link_mjcf",
+    "rod_drop",
+    "walker_mjcf",
+]
+
+#: ``h lambda`` beyond which explicit Euler is unstable for a real, negative rate (|1 - h
+#: lambda| > 1). MuJoCo's Euler, implicit and implicitfast integrators all take the sand's
+#: force explicitly, as a constant through the step.
+EULER_STABILITY_LIMIT = 2.0
+
+#: The columns of ``Sand.output``, one row per geom (the core's ``GEOM_OUTPUTS``).
+GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.GEOM_OUTPUTS)
+
+#: How :class:`Sand` treats the static terms (those with a sticking bound: ``static_h``,
+#: ``static_v``): ``"stick"`` solves each step for the reaction that brings the immersed
+#: centroid's velocity to zero at the step's end, within the terms' bounds (the default);
+#: ``"raw"`` applies the terms as evaluated (the thesis's plain sign, which chatters at rest).
+STATICS = ("stick", "raw")
+
+_SUPPORTED = {
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder",
+    int(mujoco.mjtGeom.mjGEOM_BOX): "box",
+}
+_PLANE_TOL = 1e-9
+
+
+def _number(value: Any, name: str) -> float:
+    if isinstance(value, bool):
+        raise InvalidParameterError(f"`{name}` must be a number, got {value!r}", field=name)
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            f"`{name}` must be a number, got {value!r}", field=name
+        ) from None
+    if not math.isfinite(x):
+        raise InvalidParameterError(f"`{name}` must be finite, got {x}", field=name)
+    return x
+
+
+class Sand:
+    """granrs's force terms on named rod geoms of a planar MuJoCo model.
+
+    Args:
+        model: a ``mujoco.MjModel`` that moves in the x-z plane (gravity along -z).
+        geoms: names of capsule, cylinder or box geoms. A capsule or cylinder is the free
+            link's rod: its tip T is the lower end of its axis, its diameter d_c twice its
+            radius, its length L (also L_ref) the cylinder's length; a capsule's caps count
+            (T is the bottom of the lower cap, L the capsule's whole length, as the thesis's
+            round-ended rod). A box is the leg's sole box: f_s its length along x (also
+            L_ref), w_s its width along y; use ``apply_at="centroid"`` with boxes (see
+            docs/mujoco.md).
+        forces: the medium's contact terms (``granrs.forces``: ``drag``, ``static_h``,
+            ``static_v``, ...). MuJoCo applies gravity and the joints: a ``gravity`` or
+            ``joint_springs`` term is an error naming it. A parameter is one value for every
+            geom or a tuple with one per geom.
+        surface: height z of the sand's surface [m].
+        rho_g: the sand's bulk density [kg/m^3] (the thesis's 1650). The static terms use
+            g = |``model.opt.gravity``|.
+        apply_at: ``"tip"`` (as :func:`granrs.simulate`'s default; a box's sole middle) or
+            ``"centroid"``.
+        patch: the sand's extent in x, ``(x_min, x_max)`` [m]; a geom whose tip is outside
+            feels nothing from the sand. Geoms not listed keep MuJoCo's own contacts.
+        statics: ``"stick"`` (default) or ``"raw"``: see :data:`STATICS` and docs/mujoco.md.
+        sign_model: ``"raw"`` (the thesis's sign) or ``"smooth"`` (``tanh(v / smooth_eps)``).
+        smooth_eps: the smooth sign's velocity scale [m/s].
+
+    Every argument is checked here, before the first step; each error is a
+    :class:`granrs.GranrsError` (a ``ValueError``) naming the geom or parameter.
+
+    After each step, ``output`` holds each geom's evaluation (columns
+    :data:`GEOM_OUTPUTS`), ``applied`` the force (x, z) [N] and moment about y [N m]
+    applied at its tip, and ``h_lambda`` each geom's timestep times the drag's rate.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        geoms: Sequence[str],
+        forces: Sequence[Any],
+        surface: float = 0.0,
+        rho_g: float = 1650.0,
+        apply_at: str = "tip",
+        patch: tuple[float, float] = (-math.inf, math.inf),
+        statics: str = "stick",
+        sign_model: str = "raw",
+        smooth_eps: float = 1e-3,
+    ) -> None:
+        if not isinstance(model, mujoco.MjModel):
+            raise InvalidParameterError(
+                f"`model` must be a mujoco.MjModel, got {type(model).__name__}", field="model"
+            )
+        self.model = model
+        if isinstance(geoms, str) or not isinstance(geoms, Sequence) or len(geoms) == 0:
+            raise InvalidParameterError(
+                "`geoms` must be a non-empty list of geom names", field="geoms"
+            )
+        names = [str(g) for g in geoms]
+        if len(set(names)) != len(names):
+            raise InvalidSceneError("`geoms` lists a geom twice", field="geoms")
+        self.surface = _number(surface, "surface")
+        rho = _number(rho_g, "rho_g")
+        if rho <= 0.0:
+            raise InvalidParameterError(f"`rho_g` must be > 0, got {rho}", field="rho_g")
+        if statics not in STATICS:
+            raise UnknownNameError(
+                f"unknown statics `{statics}` (allowed: {', '.join(STATICS)})", field="statics"
+            )
+        self.statics = statics
+        try:
+            lo, hi = (float(x) for x in patch)
+        except (TypeError, ValueError):
+            raise InvalidParameterError(
+                f"`patch` must be (x_min, x_max), got {patch!r}", field="patch"
+            ) from None
+        if math.isnan(lo) or math.isnan(hi) or not lo < hi:
+            raise InvalidParameterError(
+                f"`patch` must be (x_min, x_max) with x_min < x_max, got {patch!r}",
+                field="patch",
+            )
+        self.patch = (lo, hi)
+        gravity = np.asarray(model.opt.gravity, dtype=float)
+        if not np.all(np.isfinite(gravity)) or abs(gravity[0]) > 0 or abs(gravity[1]) > 0:
+            raise InvalidSceneError(
+                f"the sand needs gravity along -z, got model.opt.gravity = {gravity.tolist()}",
+                field="model.opt.gravity",
+            )
+        self.g = float(np.linalg.norm(gravity))
+
+        ids, half, shapes = [], [], []
+        for i, name in enumerate(names):
+            gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+            if gid < 0:
+                raise UnknownNameError(f"the model has no geom named `{name}`", field=f"geoms[{i}]")
+            kind = int(model.geom_type[gid])
+            if kind not in _SUPPORTED:
+                type_name = mujoco.mjtGeom(kind).name.removeprefix("mjGEOM_").lower()
+                raise InvalidSceneError(
+                    f"geom `{name}` is a {type_name}; Sand takes "
+                    f"{', '.join(_SUPPORTED.values())} geoms",
+                    field=f"geoms[{i}]",
+                )
+            ids.append(gid)
+            size = [float(x) for x in model.geom_size[gid]]
+            if _SUPPORTED[kind] == "box":
+                # The leg's sole box, centred on the geom: f_s along its x, its height along
+                # z, w_s along y; L_ref its length.
+                half.append(0.0)
+                shapes.append(("sole", [2 * size[0], 2 * size[2], 2 * size[1], 2 * size[0]]))
+                continue
+            r, h = size[0], size[1]
+            # A capsule's caps count: its tip is the bottom of the lower cap.
+            reach = h + r if _SUPPORTED[kind] == "capsule" else h
+            half.append(reach)
+            shapes.append(("rod", [2.0 * r, 2.0 * reach]))
+        self.geoms = tuple(names)
+        self._ids = np.asarray(ids, dtype=np.intp)
+        self._body = np.asarray(model.geom_bodyid[self._ids], dtype=np.intp)
+        self._root = np.asarray(model.body_rootid[self._body], dtype=np.intp)
+        self._half = np.asarray(half, dtype=float)
+        self._check_planar()
+        self._core = _granrs.SandGeoms(
+            list(names),
+            shapes,
+            list(as_terms(forces)),
+            rho,
+            self.g,
+            apply_at,
+            sign_model,
+            float(smooth_eps),
+        )
+        self.apply_at = apply_at
+        dofs = []
+        for body in self._body:
+            chain, b = [], int(body)
+            while b > 0:
+                chain.extend(
+                    range(model.body_dofadr[b], model.body_dofadr[b] + model.body_dofnum[b])
+                )
+                b = int(model.body_parentid[b])
+            dofs.append(sorted(chain))
+        self._coupling = _granrs.GeomCoupling(
+            self._core,
+            [int(i) for i in self._ids],
+            [int(b) for b in self._body],
+            [int(r) for r in self._root],
+            [float(h) for h in self._half],
+            dofs,
+            model.nv,
+            self.surface,
+            self.patch,
+            statics == "stick",
+            self._implicit_damping(),
+        )
+        n = len(names)
+        #: Each geom's evaluation at the last step (columns :data:`GEOM_OUTPUTS`).
+        self.output = np.zeros((n, len(GEOM_OUTPUTS)))
+        #: The force (x, z) [N] and moment about +y [N m] applied at each tip, last step.
+        self.applied = np.zeros((n, 3))
+        #: Each geom's timestep times the drag's rate at the last step (0 out of the sand).
+        self.h_lambda = np.zeros(n)
+        #: The largest of ``h_lambda`` over every step so far.
+        self.max_h_lambda = 0.0
+        self._warned = False
+        self._mass = np.zeros((model.nv, model.nv))
+        self._stage = (0, math.nan)
+        # The model's options (a live view: the timestep is read at every step) and its
+        # integrator, read here as the implicit damping is.
+        self._opt = model.opt
+        self._rk4 = model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
+        self._generalized = np.zeros(model.nv)
+        self._data_ref: Any = None
+        self._before = np.zeros(model.nv)
+        self._after = np.zeros(model.nv)
+
+    def _implicit_damping(self) -> list[float]:
+        """The dof damping that MuJoCo's step takes implicitly (its velocity update is
+        ``(M + h B)^-1`` times the force): Euler (unless ``eulerdamp`` is disabled), implicit
+        and implicitfast; none for RK4. Read when the Sand is built."""
+        m = self.model
+        kind = m.opt.integrator
+        euler = kind == mujoco.mjtIntegrator.mjINT_EULER
+        implicit = kind in (
+            mujoco.mjtIntegrator.mjINT_IMPLICIT,
+            mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+        )
+        off = m.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_EULERDAMP
+        if implicit or (euler and not off):
+            return [float(b) for b in m.dof_damping]
+        return [0.0] * m.nv
+
+    # -- checks -------------------------------------------------------------------------
+
+    def _check_planar(self) -> None:
+        """Every joint above each geom keeps it in the x-z plane: slides in x-z, hinges
+        about y; and each geom's axis lies in the plane (at the model's qpos0)."""
+        m = self.model
+        d = mujoco.MjData(m)
+        mujoco.mj_kinematics(m, d)
+        for i, (name, body) in enumerate(zip(self.geoms, self._body, strict=True)):
+            b = int(body)
+            while b > 0:
+                for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b]):
+                    kind = int(m.jnt_type[j])
+                    axis = d.xaxis[j]
+                    joint = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) or f"#{j}"
+                    if kind == mujoco.mjtJoint.mjJNT_SLIDE:
+                        ok = abs(axis[1]) <= _PLANE_TOL
+                    elif kind == mujoco.mjtJoint.mjJNT_HINGE:
+                        ok = abs(axis[0]) <= _PLANE_TOL and abs(axis[2]) <= _PLANE_TOL
+                    else:
+                        ok = False
+                    if not ok:
+                        raise InvalidSceneError(
+                            f"geom `{name}` is not planar: joint `{joint}` of body "
+                            f"`{mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)}` lets it "
+                            "leave the x-z plane (the rod terms need slides in x-z and "
+                            "hinges about y)",
+                            field=f"geoms[{i}]",
+                        )
+                b = int(m.body_parentid[b])
+            frame = d.geom_xmat[self._ids[i]].reshape(3, 3)
+            # A rod's axis (local z) and a box's x and z lie in the plane: its local y is y.
+            e = frame[:, 2]
+            if abs(e[1]) > 1e-6 or (
+                int(m.geom_type[self._ids[i]]) == mujoco.mjtGeom.mjGEOM_BOX
+                and abs(frame[1, 1]) < 1 - 1e-6
+            ):
+                raise InvalidSceneError(
+                    f"geom `{name}` is not planar: its axis {e.round(6).tolist()} leaves the "
+                    "x-z plane",
+                    field=f"geoms[{i}]",
+                )
+
+    # -- the coupling -------------------------------------------------------------------
+
+    def step(self, data: Any) -> None:
+        """Compute each geom's force from ``data.qpos`` and ``data.qvel`` and put it in
+        ``data.qfrc_applied`` (call before ``mujoco.mj_step``). Replaces this Sand's own
+        previous contribution; an entry of ``qfrc_applied`` that changed since this Sand
+        last wrote it is taken as the user's and kept as it is."""
+        m = self.model
+        # Right after mj_step, xpos and cvel still hold the previous state: bring the
+        # kinematics and the mass matrix to qpos and qvel.
+        mujoco.mj_kinematics(m, data)
+        mujoco.mj_comPos(m, data)
+        mujoco.mj_comVel(m, data)
+        mujoco.mj_makeM(m, data)
+        self._evaluate(data, passive=False)
+
+    def _callback(self, m: Any, data: Any) -> None:
+        """The passive-force callback: add the sand's force to ``qfrc_passive`` (MuJoCo
+        recomputes it at every evaluation, so there is nothing of ours to replace)."""
+        if m is not self.model:
+            return
+        self._evaluate(data, passive=True, hold=self._later_stage(data))
+
+    def install(self) -> None:
+        """Run as MuJoCo's passive-force callback (``mujoco.set_mjcb_passive``), inside
+        every ``mj_step`` and ``mj_forward`` of this Sand's model (at each RK4 stage, with
+        that stage's state). The callback is global to the process: every installed Sand is
+        called, each acting only on its own model (so two Sands on one model both act, and
+        their forces add), and a callback that was installed before the first Sand is
+        called first and restored when the last Sand is uninstalled.
+
+        MuJoCo's compiler fails (``engine error: Python exception raised``) while any Python
+        passive callback is installed: compile every model before ``install()``, or use
+        :meth:`step`."""
+        _Dispatch.add(self)
+
+    def uninstall(self) -> None:
+        """Stop acting as the passive-force callback (other installed Sands go on)."""
+        _Dispatch.remove(self)
+
+    def _later_stage(self, data: Any) -> bool:
+        """Whether this callback is a later stage of MuJoCo's RK4 step (its four
+        evaluations are at t, t + h/2, t + h/2 and t + h): the static reactions solved at
+        its first stage then act through the whole step, as with :meth:`step`. Any other
+        call (Euler's one evaluation, an ``mj_forward``) solves them anew."""
+        if not self._rk4:
+            return False
+        t, h = data.time, self._opt.timestep
+        stage, t0 = self._stage
+        same = math.isclose
+        if stage == 1 and same(t, t0 + 0.5 * h, rel_tol=1e-12, abs_tol=1e-15):
+            stage = 2
+        elif stage == 2 and same(t, t0 + 0.5 * h, rel_tol=1e-12, abs_tol=1e-15):
+            stage = 3
+        elif stage == 3 and same(t, t0 + h, rel_tol=1e-12, abs_tol=1e-15):
+            stage = 4
+        else:
+            stage, t0 = 1, t
+        self._stage = (stage, t0)
+        return stage > 1
+
+    def _evaluate(self, data: Any, passive: bool, hold: bool = False) -> None:
+        """One call of the core for every geom: each geom's state from MuJoCo's arrays, its
+        force through the free link's right-hand side, the static terms' reactions (with
+        ``statics="stick"``), the generalized force of it all into ``qfrc_passive``
+        (``passive``) or ``qfrc_applied``, and the drag's h lambda."""
+        m = self.model
+        fresh = data is not self._data_ref
+        if fresh:
+            # MuJoCo allocates an mjData's arrays once: the core binds their views once.
+            self._coupling.bind(
+                data.geom_xpos,
+                data.geom_xmat,
+                data.cvel,
+                data.subtree_com,
+                data.cdof,
+                data.qvel,
+                data.qacc,
+                data.qfrc_applied,
+                data.qfrc_passive,
+                self._mass,
+                self.output,
+                self.applied,
+                self.h_lambda,
+                self._generalized,
+                self._before,
+                self._after,
+            )
+            self._data_ref = data
+        mujoco.mj_fullM(m, data, self._mass)
+        worst, geom = self._coupling.step(self._opt.timestep, passive, fresh, hold)
+        if worst > self.max_h_lambda:
+            self.max_h_lambda = worst
+            self._warn_step_size(worst, geom)
+
+    def _warn_step_size(self, h_lambda: float, geom: int) -> None:
+        limit = RK4_STABILITY_LIMIT if self._rk4 else EULER_STABILITY_LIMIT
+        if h_lambda > limit and not self._warned:
+            self._warned = True
+            h = self._opt.timestep
+            rate = h_lambda / h
+            warnings.warn(
+                StepSizeWarning(
+                    f"MuJoCo's timestep {h:g} s does not resolve the sand's drag on geom "
+                    f"`{self.geoms[geom]}`: timestep x rate = {h_lambda:.3g} (the integrator "
+                    f"is stable below {limit}); use timestep <= {0.5 / rate:.2g} s "
+                    "(timestep x rate <= 0.5)"
+                ),
+                stacklevel=4,
+            )
+
+
+class _Dispatch:
+    """The one passive-force callback of the process, calling every installed Sand."""
+
+    installed: list[Sand] = []  # noqa: RUF012
+    previous: Any = None
+
+    @classmethod
+    def add(cls, sand: Sand) -> None:
+        if sand in cls.installed:
+            return
+        if not cls.installed:
+            cls.previous = mujoco.get_mjcb_passive()
+            mujoco.set_mjcb_passive(cls.call)
+        cls.installed.append(sand)
+
+    @classmethod
+    def remove(cls, sand: Sand) -> None:
+        if sand not in cls.installed:
+            return
+        cls.installed.remove(sand)
+        if not cls.installed:
+            mujoco.set_mjcb_passive(cls.previous)
+            cls.previous = None
+
+    @classmethod
+    def call(cls, m: Any, d: Any) -> None:
+        if cls.previous is not None:
+            cls.previous(m, d)
+        for sand in cls.installed:
+            sand._callback(m, d)
+
+
+#: MuJoCo's integrators by their MJCF names.
+INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+
+
+def free_link_mjcf(scene: Any, timestep: float = 1e-4, integrator: str = "Euler") -> str:
+    """The MJCF of a free-link scene (:func:`granrs.cases.free_link`): its rod as a
+    cylinder geom ``rod`` of the scene's length, diameter and mass (MuJoCo's solid-cylinder
+    inertia, the scene's default) on a body with slide x, slide z and hinge y at its centre,
+    gravity ``scene.g`` along -z, no contacts."""
+    if integrator not in INTEGRATORS:
+        raise UnknownNameError(
+            f"unknown integrator `{integrator}` (allowed: {', '.join(INTEGRATORS)})",
+            field="integrator",
+        )
+    if scene.inertia is not None:
+        raise InvalidSceneError(
+            "free_link_mjcf builds MuJoCo's solid cylinder; the scene sets its own inertia",
+            field="inertia",
+        )
+    return f"""<mujoco model="granrs free link">
+  <option timestep="{_number(timestep, "timestep")!r}" integrator="{integrator}"
+          gravity="0 0 {-scene.g!r}"/>
+  <worldbody>
+    <body name="rod" pos="0 0 0">
+      <joint name="x" type="slide" axis="1 0 0"/>
+      <joint name="z" type="slide" axis="0 0 1"/>
+      <joint name="q" type="hinge" axis="0 1 0"/>
+      <geom name="rod" type="cylinder" size="{scene.diameter / 2!r} {scene.length / 2!r}"
+            mass="{scene.mass!r}" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def rod_drop(
+    scene: Any,
+    timestep: float = 1e-4,
+    integrator: str = "Euler",
+    mode: str = "step",
+    statics: str = "stick",
+    t_after: float = 0.0,
+) -> dict[str, Any]:
+    """Drop a free-link scene's rod in MuJoCo with :class:`Sand` under the scene's contact
+    terms, from the scene's initial state (tip at the surface, velocity (vx0, -v0), spin
+    omega0), until its stop, and ``t_after`` seconds on.
+
+    The stop is the first step at whose end the tip's vertical velocity is >= 0 (or within
+    1e-9 m/s of it: the stick brings it to zero to round-off), interpolated linearly inside
+    the step. Returns ``t_s`` [s], ``depth`` [m] (the tip's, at the stop), ``steps``, and
+    after the stop ``t``, ``tip`` (x, z) and ``energy`` (KE + gravitational PE [J]) per step.
+    ``mode`` is ``"step"`` (:meth:`Sand.step`) or ``"callback"`` (:meth:`Sand.install`).
+    """
+    from . import forces as _forces
+
+    if mode not in ("step", "callback"):
+        raise UnknownNameError(f"unknown mode `{mode}` (allowed: step, callback)", field="mode")
+    model = mujoco.MjModel.from_xml_string(free_link_mjcf(scene, timestep, integrator))
+    data = mujoco.MjData(model)
+    q = math.radians(scene.q_deg)
+    half = scene.length / 2
+    e = np.array([math.sin(q), math.cos(q)])
+    normal = np.array([math.cos(q), -math.sin(q)])
+    v_c = np.array([scene.vx0, -scene.v0]) + scene.omega0 * half * normal
+    data.qpos[:] = [half * e[0], half * e[1] - scene.depth0, q]
+    data.qvel[:] = [v_c[0], v_c[1], scene.omega0]
+    contact = [t for t in scene.forces if t.name not in ("gravity", "joint_springs")]
+    sand = Sand(
+        model,
+        ["rod"],
+        list(_forces.as_terms(contact)),
+        rho_g=scene.rho_g,
+        apply_at=scene.apply_at,
+        statics=statics,
+    )
+    mass = scene.mass
+    inertia = float(model.body_inertia[1, 1])
+    g = sand.g
+
+    def tip() -> tuple[float, float, float]:
+        angle = data.qpos[2]
+        s, c = math.sin(angle), math.cos(angle)
+        return (
+            data.qpos[0] - half * s,
+            data.qpos[1] - half * c,
+            data.qvel[1] + data.qvel[2] * half * s,
+        )
+
+    def energy() -> float:
+        v = data.qvel
+        return (
+            0.5 * mass * (v[0] ** 2 + v[1] ** 2)
+            + 0.5 * inertia * v[2] ** 2
+            + mass * g * (data.qpos[1])
+        )
+
+    if mode == "callback":
+        sand.install()
+    try:
+        t_prev, z_prev, v_prev = 0.0, tip()[1], tip()[2]
+        limit = math.ceil(max(scene.t_end, 1.0) / timestep)
+        for steps in range(1, limit + 1):  # noqa: B007
+            if mode == "step":
+                sand.step(data)
+            mujoco.mj_step(model, data)
+            _, z, v = tip()
+            if v >= -1e-9:
+                f = -v_prev / (v - v_prev) if v != v_prev else 1.0
+                t_s = t_prev + f * (data.time - t_prev)
+                depth = -(z_prev + f * (z - z_prev))
+                break
+            t_prev, z_prev, v_prev = data.time, z, v
+        else:
+            return {"t_s": math.nan, "depth": math.nan, "steps": limit, "sand": sand}
+        after_t, after_tip, after_e = [data.time], [tip()[:2]], [energy()]
+        for _ in range(round(t_after / timestep)):
+            if mode == "step":
+                sand.step(data)
+            mujoco.mj_step(model, data)
+            after_t.append(data.time)
+            after_tip.append(tip()[:2])
+            after_e.append(energy())
+    finally:
+        if mode == "callback":
+            sand.uninstall()
+    return {
+        "t_s": t_s,
+        "depth": depth,
+        "steps": steps,
+        "t": np.asarray(after_t),
+        "tip": np.asarray(after_tip),
+        "energy": np.asarray(after_e),
+        "sand": sand,
+    }
+
+
+#: The sand geoms of :func:`walker_mjcf`: its two shanks.
+WALKER_SAND_GEOMS = ("shank_r", "shank_l")
+
+
+def walker_mjcf(floor: bool = False, timestep: float = 2e-4, integrator: str = "Euler") -> str:
+    """The MJCF of the gallery's passive planar walker (written for granrs; SI units): a
+    torso on slide x, slide z and hinge y; two legs, each a thigh and a shank (capsules of
+    density 1000 kg/m^3, about 13 kg in all) with stiff, damped hinges about y at the hip
+    and knee (600 N m/rad, 10 N m s/rad), no actuators. The shanks' tips (the bottoms of
+    their caps) start at z = 0; ``floor`` adds MuJoCo's rigid ground there (a plane).
+    :data:`WALKER_SAND_GEOMS` are the shanks."""
+    if integrator not in INTEGRATORS:
+        raise UnknownNameError(
+            f"unknown integrator `{integrator}` (allowed: {', '.join(INTEGRATORS)})",
+            field="integrator",
+        )
+    ground = (
+        '<geom name="floor" type="plane" size="5 1 0.1" rgba="0.6 0.5 0.35 1"/>' if floor else ""
+    )
+    # The hip is 0.05 m below the torso's origin, the knee 0.4 m lower, the shank's end
+    # 0.45 m below the knee, and its cap reaches one radius (0.035 m) further.
+    z0 = 0.05 + 0.4 + 0.45 + 0.035
+    return f"""<mujoco model="granrs planar walker">
+  <option timestep="{_number(timestep, "timestep")!r}" integrator="{integrator}"
+          gravity="0 0 -9.81"/>
+  <default>
+    <joint type="hinge" axis="0 1 0" stiffness="600" damping="10" armature="0.01"/>
+    <geom type="capsule" density="1000" friction="0.9"/>
+  </default>
+  <worldbody>
+    {ground}
+    <body name="torso" pos="0 0 {z0!r}">
+      <joint name="rootx" type="slide" axis="1 0 0" stiffness="0" damping="0" armature="0"/>
+      <joint name="rootz" type="slide" axis="0 0 1" stiffness="0" damping="0" armature="0"/>
+      <joint name="rooty" stiffness="0" damping="0" armature="0"/>
+      <geom name="torso" fromto="0 0 0.3 0 0 -0.05" size="0.06"/>
+      <body name="thigh_r" pos="0 0 -0.05">
+        <joint name="hip_r"/>
+        <geom name="thigh_r" fromto="0 0 0 0.12 0 -0.4" size="0.045"/>
+        <body name="shank_r" pos="0.12 0 -0.4">
+          <joint name="knee_r"/>
+          <geom name="shank_r" fromto="0 0 0 0.05 0 -0.45" size="0.035"/>
+        </body>
+      </body>
+      <body name="thigh_l" pos="0 0 -0.05">
+        <joint name="hip_l"/>
+        <geom name="thigh_l" fromto="0 0 0 -0.12 0 -0.4" size="0.045"/>
+        <body name="shank_l" pos="-0.12 0 -0.4">
+          <joint name="knee_l"/>
+          <geom name="shank_l" fromto="0 0 0 -0.05 0 -0.45" size="0.035"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""

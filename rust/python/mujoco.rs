@@ -1,0 +1,427 @@
+//! `SandGeoms`: the force and moment on N rod geoms of another engine (`granrs.mujoco.Sand`)
+//! in one call, through the free link's right-hand side (see `rust/evaluate.rs`, `geoms`).
+
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadwriteArray2, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+use super::errors::to_pyerr;
+use super::terms::terms_from_py;
+use crate::body::rod::ApplyAt;
+use crate::dynamics::SignModel;
+use crate::error::GranrsError;
+use crate::evaluate::geoms::{
+    self, Coupling, EngineOut, EnginePlace, EngineState, GeomShape, Work, MAX_COUPLED, STATE,
+};
+use crate::forces::{ForceSet, Medium};
+use crate::spec::Value;
+
+/// N geoms (rods and sole boxes) under a list of contact terms in one sand, checked once;
+/// `evaluate` takes every geom's state and writes every geom's force, moment and findings.
+#[pyclass(module = "granrs._granrs", frozen)]
+pub struct SandGeoms {
+    inner: geoms::SandGeoms,
+    names: Vec<String>,
+}
+
+#[pymethods]
+impl SandGeoms {
+    /// `names` and `shapes` per geom (`("rod", [d_c, L])` or `("sole", [length, height,
+    /// width, l_ref])`); `forces` a sequence of `granrs.forces.Term` (contact terms only);
+    /// the sand's `rho_g` and `g`; `apply_at` ("tip": a rod's tip, a sole's middle; or
+    /// "centroid"); `sign_model` ("raw" or "smooth", with `smooth_eps` in m/s). Every error
+    /// names the geom, term or parameter.
+    #[new]
+    #[pyo3(signature = (names, shapes, forces, rho_g, g, apply_at="tip", sign_model="raw", smooth_eps=1e-3))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        names: Vec<String>,
+        shapes: Vec<(String, Vec<f64>)>,
+        forces: &Bound<'_, PyList>,
+        rho_g: f64,
+        g: f64,
+        apply_at: &str,
+        sign_model: &str,
+        smooth_eps: f64,
+    ) -> PyResult<Self> {
+        let err = |e: GranrsError| to_pyerr(py, e);
+        let specs = match terms_from_py(forces.iter()) {
+            Some(Value::Terms(specs)) => specs,
+            _ if forces.is_empty() => Vec::new(),
+            _ => {
+                return Err(err(GranrsError::WrongType {
+                    field: "forces".into(),
+                    expected: "a list of granrs.forces terms".into(),
+                    got: "something else".into(),
+                }))
+            }
+        };
+        let set = ForceSet::build(&specs, names.len()).map_err(err)?;
+        let apply_at = match apply_at {
+            "tip" => ApplyAt::Tip,
+            "centroid" => ApplyAt::Centroid,
+            other => {
+                return Err(err(GranrsError::UnknownName {
+                    field: "apply_at".into(),
+                    value: other.into(),
+                    allowed: "tip, centroid".into(),
+                }))
+            }
+        };
+        let sign_model = match sign_model {
+            "raw" => SignModel::Raw,
+            "smooth" => SignModel::Smooth { eps: smooth_eps },
+            other => {
+                return Err(err(GranrsError::UnknownName {
+                    field: "sign_model".into(),
+                    value: other.into(),
+                    allowed: "raw, smooth".into(),
+                }))
+            }
+        };
+        let mut kinds = Vec::with_capacity(shapes.len());
+        for (i, (kind, size)) in shapes.iter().enumerate() {
+            kinds.push(match (kind.as_str(), size.as_slice()) {
+                ("rod", &[diameter, length]) => GeomShape::Rod { diameter, length },
+                ("sole", &[length, height, width, l_ref]) => GeomShape::Sole {
+                    length,
+                    height,
+                    width,
+                    l_ref,
+                },
+                _ => {
+                    return Err(err(GranrsError::UnknownName {
+                        field: format!("shapes[{i}]"),
+                        value: kind.clone(),
+                        allowed: "(\"rod\", [d_c, L]), (\"sole\", [length, height, width, l_ref])"
+                            .into(),
+                    }))
+                }
+            });
+        }
+        let inner = geoms::SandGeoms::new(
+            &names,
+            &kinds,
+            &set,
+            Medium { rho_g, g },
+            apply_at,
+            sign_model,
+        )
+        .map_err(err)?;
+        Ok(SandGeoms { inner, names })
+    }
+
+    /// Number of geoms.
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Every geom's force, moment and findings: `states` is `n x 7` in the order of
+    /// `GEOM_STATE`, `out` an `n x 18` float array written in the order of `GEOM_OUTPUTS`.
+    /// A non-finite state, an axis that is not a unit vector, or a rod's axis pointing down
+    /// from its tip is an error naming the geom, before any is evaluated.
+    fn evaluate(
+        &self,
+        py: Python<'_>,
+        states: PyReadonlyArray2<'_, f64>,
+        mut out: PyReadwriteArray2<'_, f64>,
+    ) -> PyResult<()> {
+        let n = self.inner.len();
+        let width = geoms::OUTPUTS.len();
+        if states.shape() != [n, STATE.len()] || out.shape() != [n, width] {
+            return Err(PyValueError::new_err(format!(
+                "evaluate takes states of shape ({n}, {}) and out of shape ({n}, {width})",
+                STATE.len()
+            )));
+        }
+        let states = states
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("evaluate needs C-contiguous arrays"))?;
+        let out = out
+            .as_slice_mut()
+            .map_err(|_| PyValueError::new_err("evaluate needs C-contiguous arrays"))?;
+        let mut rows = Vec::with_capacity(n);
+        for (i, s) in states.chunks_exact(STATE.len()).enumerate() {
+            let row: [f64; 7] = s.try_into().expect("seven columns");
+            self.inner
+                .check_state(i, &self.names[i], &row)
+                .map_err(|e| to_pyerr(py, e))?;
+            rows.push(row);
+        }
+        for (i, (row, o)) in rows.iter().zip(out.chunks_exact_mut(width)).enumerate() {
+            self.inner.evaluate(i, row, o);
+        }
+        Ok(())
+    }
+}
+
+/// The arrays one `GeomCoupling` reads and writes at every step, bound once per `mjData`
+/// (MuJoCo allocates them once, so their views stay valid while held): reading them then
+/// costs no conversion per step.
+struct Arrays {
+    geom_xpos: Py<PyArray2<f64>>,
+    geom_xmat: Py<PyArray2<f64>>,
+    cvel: Py<PyArray2<f64>>,
+    subtree_com: Py<PyArray2<f64>>,
+    cdof: Py<PyArray2<f64>>,
+    mass: Py<PyArray2<f64>>,
+    qvel: Py<PyArray1<f64>>,
+    qacc: Py<PyArray1<f64>>,
+    outputs: Py<PyArray2<f64>>,
+    applied: Py<PyArray2<f64>>,
+    h_lambda: Py<PyArray1<f64>>,
+    generalized: Py<PyArray1<f64>>,
+    qfrc_applied: Py<PyArray1<f64>>,
+    qfrc_passive: Py<PyArray1<f64>>,
+    before: Py<PyArray1<f64>>,
+    after: Py<PyArray1<f64>>,
+}
+
+/// [`SandGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
+/// model's arrays, evaluates every geom and puts the generalized force into MuJoCo's (see
+/// `granrs.mujoco.Sand`).
+#[pyclass(module = "granrs._granrs", unsendable)]
+pub struct GeomCoupling {
+    inner: Coupling,
+    bound: Option<Arrays>,
+}
+
+#[pymethods]
+impl GeomCoupling {
+    /// `rods` on MuJoCo's geoms `geom` (bodies `body`, tree roots `root`, tip `reach` from
+    /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
+    /// height and patch in x; `stick` for the static terms as reactions;
+    /// `implicit_damping` the dof damping the engine's step takes implicitly (nv).
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        rods: PyRef<'_, SandGeoms>,
+        geom: Vec<usize>,
+        body: Vec<usize>,
+        root: Vec<usize>,
+        reach: Vec<f64>,
+        dofs: Vec<Vec<usize>>,
+        nv: usize,
+        surface: f64,
+        patch: (f64, f64),
+        stick: bool,
+        implicit_damping: Vec<f64>,
+    ) -> PyResult<Self> {
+        let n = rods.inner.len();
+        if [geom.len(), body.len(), root.len(), reach.len(), dofs.len()]
+            .iter()
+            .any(|&l| l != n)
+            || dofs.iter().flatten().any(|&j| j >= nv)
+            || implicit_damping.len() != nv
+        {
+            return Err(PyValueError::new_err("one place per geom, dofs below nv"));
+        }
+        if n > MAX_COUPLED {
+            return Err(PyValueError::new_err(format!(
+                "at most {MAX_COUPLED} geoms"
+            )));
+        }
+        let places = (0..n)
+            .map(|i| EnginePlace {
+                geom: geom[i],
+                body: body[i],
+                root: root[i],
+                reach: reach[i],
+                dofs: dofs[i].clone(),
+            })
+            .collect();
+        Ok(GeomCoupling {
+            inner: Coupling {
+                rods: rods.inner.clone(),
+                places,
+                nv,
+                surface,
+                patch,
+                stick,
+                previous: vec![0.0; nv],
+                implicit_damping,
+                work: Work::new(n, nv),
+                held: vec![None; n],
+            },
+            bound: None,
+        })
+    }
+
+    /// Bind the arrays of one `mjData` (`geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`,
+    /// `cdof`, `qvel`, `qacc`, `qfrc_applied`, `qfrc_passive`) and the caller's buffers (the
+    /// dense mass matrix it fills, `outputs` per geom in GEOM_OUTPUTS order, `applied`
+    /// force and moment, `h_lambda`, the generalized force, and `before` and `after`, the
+    /// bookkeeping of `qfrc_applied`), each checked for its shape once.
+    #[allow(clippy::too_many_arguments)]
+    fn bind(
+        &mut self,
+        geom_xpos: Bound2<'_>,
+        geom_xmat: Bound2<'_>,
+        cvel: Bound2<'_>,
+        subtree_com: Bound2<'_>,
+        cdof: Bound2<'_>,
+        qvel: Bound1<'_>,
+        qacc: Bound1<'_>,
+        qfrc_applied: Bound1<'_>,
+        qfrc_passive: Bound1<'_>,
+        mass: Bound2<'_>,
+        outputs: Bound2<'_>,
+        applied: Bound2<'_>,
+        h_lambda: Bound1<'_>,
+        generalized: Bound1<'_>,
+        before: Bound1<'_>,
+        after: Bound1<'_>,
+    ) -> PyResult<()> {
+        let c = &self.inner;
+        let (n, nv) = (c.places.len(), c.nv);
+        let max_geom = c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0);
+        let max_body = c
+            .places
+            .iter()
+            .map(|p| p.body.max(p.root) + 1)
+            .max()
+            .unwrap_or(0);
+        let width = crate::evaluate::geoms::OUTPUTS.len();
+        let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
+            let [r, k] = [a.shape()[0], a.shape()[1]];
+            let ok = k == cols && if exact { r == rows } else { r >= rows };
+            if ok && a.is_c_contiguous() {
+                Ok(a.clone().unbind())
+            } else {
+                Err(PyValueError::new_err(format!("GeomCoupling.bind: {name}")))
+            }
+        };
+        let one = |a: &Bound1<'_>, name: &str, len: usize| {
+            if a.len() == len && a.is_c_contiguous() {
+                Ok(a.clone().unbind())
+            } else {
+                Err(PyValueError::new_err(format!("GeomCoupling.bind: {name}")))
+            }
+        };
+        self.bound = Some(Arrays {
+            geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
+            geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
+            cvel: two(&cvel, "cvel", max_body, 6, false)?,
+            subtree_com: two(&subtree_com, "subtree_com", max_body, 3, false)?,
+            cdof: two(&cdof, "cdof", nv, 6, true)?,
+            mass: two(&mass, "mass", nv, nv, true)?,
+            qvel: one(&qvel, "qvel", nv)?,
+            qacc: one(&qacc, "qacc", nv)?,
+            outputs: two(&outputs, "outputs", n, width, true)?,
+            applied: two(&applied, "applied", n, 3, true)?,
+            h_lambda: one(&h_lambda, "h_lambda", n)?,
+            generalized: one(&generalized, "generalized", nv)?,
+            qfrc_applied: one(&qfrc_applied, "qfrc_applied", nv)?,
+            qfrc_passive: one(&qfrc_passive, "qfrc_passive", nv)?,
+            before: one(&before, "before", nv)?,
+            after: one(&after, "after", nv)?,
+        });
+        Ok(())
+    }
+
+    /// One evaluation at the bound arrays (the mass matrix filled by the caller): writes
+    /// each geom's outputs, applied force and moment and `h_lambda`, and the generalized
+    /// force, and puts it into MuJoCo's: with `passive`, added to `qfrc_passive` (the
+    /// callback); else into `qfrc_applied`, where an entry still equal to `after` (what
+    /// the last step left there) is restored to `before` (what it held before), any other
+    /// entry is the user's, the new contribution is added and `before` and `after` kept
+    /// (`fresh`: no last step, every entry is the user's); `hold`: a later stage of RK4's
+    /// step, which keeps the static reactions of its first. Returns the largest `h_lambda`
+    /// and its geom.
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        timestep: f64,
+        passive: bool,
+        fresh: bool,
+        hold: bool,
+    ) -> PyResult<(f64, usize)> {
+        let Some(b) = &self.bound else {
+            return Err(PyValueError::new_err("GeomCoupling.step before bind"));
+        };
+        let nv = self.inner.nv;
+        // SAFETY: the arrays were checked contiguous with their shapes at `bind`; MuJoCo
+        // never reallocates an mjData's arrays, the buffers are this Sand's own, and with
+        // the GIL held nothing else touches them during the call. Each is read or written
+        // through one slice at a time (no two slices alias: distinct arrays).
+        unsafe {
+            let state = EngineState {
+                geom_xpos: ro(py, &b.geom_xpos),
+                geom_xmat: ro(py, &b.geom_xmat),
+                cvel: ro(py, &b.cvel),
+                subtree_com: ro(py, &b.subtree_com),
+                cdof: ro(py, &b.cdof),
+                mass: ro(py, &b.mass),
+                qvel: ro(py, &b.qvel),
+                qacc: ro(py, &b.qacc),
+            };
+            let out = EngineOut {
+                outputs: rw(py, &b.outputs),
+                applied: rw(py, &b.applied),
+                h_lambda: rw(py, &b.h_lambda),
+                generalized: rw(py, &b.generalized),
+            };
+            self.inner.step(&state, timestep, hold, out);
+            let gen = ro(py, &b.generalized);
+            if passive {
+                let target = rw(py, &b.qfrc_passive);
+                target.iter_mut().zip(gen).for_each(|(t, g)| *t += g);
+            } else {
+                let target = rw(py, &b.qfrc_applied);
+                let before = rw(py, &b.before);
+                let after = rw(py, &b.after);
+                for j in 0..nv {
+                    let user = if !fresh && target[j] == after[j] {
+                        before[j]
+                    } else {
+                        target[j]
+                    };
+                    before[j] = user;
+                    target[j] = user + gen[j];
+                    after[j] = target[j];
+                }
+            }
+            let h = ro(py, &b.h_lambda);
+            let (mut k, mut top) = (0, 0.0);
+            for (i, &x) in h.iter().enumerate() {
+                if x > top {
+                    (k, top) = (i, x);
+                }
+            }
+            Ok((top, k))
+        }
+    }
+}
+
+/// A bound array's data, read-only.
+///
+/// # Safety
+/// As [`PyArrayMethods::as_slice`]: nothing may write the array while the slice lives.
+unsafe fn ro<'a, D: numpy::ndarray::Dimension>(
+    py: Python<'a>,
+    a: &'a Py<numpy::PyArray<f64, D>>,
+) -> &'a [f64] {
+    a.bind(py).as_slice().expect("contiguous, checked at bind")
+}
+
+/// A bound array's data, writable.
+///
+/// # Safety
+/// As [`PyArrayMethods::as_slice_mut`]: nothing else may read or write the array while the
+/// slice lives.
+#[allow(clippy::mut_from_ref)]
+unsafe fn rw<'a, D: numpy::ndarray::Dimension>(
+    py: Python<'a>,
+    a: &'a Py<numpy::PyArray<f64, D>>,
+) -> &'a mut [f64] {
+    a.bind(py)
+        .as_slice_mut()
+        .expect("contiguous, checked at bind")
+}
+
+type Bound1<'py> = Bound<'py, PyArray1<f64>>;
+type Bound2<'py> = Bound<'py, PyArray2<f64>>;
