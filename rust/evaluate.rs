@@ -352,6 +352,7 @@ pub mod geoms {
                             joint: Joint::Free,
                         }],
                         root_mass: 0.0,
+                        root_fixed: false,
                     },
                     contacts: vec![Contact { shape }],
                     medium,

@@ -135,6 +135,7 @@ fn one_link_engine_is_the_free_link() {
                     joint: Joint::Free,
                 }],
                 root_mass: 0.0,
+                root_fixed: false,
             },
             contacts: vec![Contact {
                 shape: Shape::Rod(RodContact {

@@ -118,6 +118,7 @@ fn vertical_stick_releases_when_bound_is_exceeded() {
         stopped: false,
         cross: Slip::Pos,
         full: false,
+        corners: 0,
     };
     modes[0].sx = if col(&s, "c0.mode_x")[release] < 0.0 {
         Slip::Neg

@@ -26,7 +26,7 @@ class TestChainCase:
         exp = [r for r in _csv_rows("chain_experiments") if r["v0_case"] == case]
         coef = [r for r in _csv_rows("chain_coefficients") if r["v0_case"] == case]
         scene = cases.chain(case)
-        assert scene.body == "chain"
+        assert scene.kind == "chain"
         assert scene.q_deg == exp[0]["q0_deg"] and scene.q2_deg == exp[1]["q0_deg"]
         assert scene.v0 == pytest.approx((exp[0]["v0_mean"] + exp[1]["v0_mean"]) / 2)
         for c, row in ((thesis_row(scene.forces), coef[0]), (thesis_row(scene.forces, 1), coef[1])):

@@ -253,7 +253,7 @@ def test_example_scene_files_are_the_thesis_cases(name: str, expected: Scene) ->
 def test_template_loads_to_the_body(body: str) -> None:
     """``granrs scene new``'s template is a valid scene file of that body with notes."""
     text = template(body)
-    assert loads(text).body == body
+    assert loads(text).kind == body
     assert "# m" in text or "# deg" in text
 
 

@@ -427,7 +427,9 @@ def body_fields(body: str, shared: bool = False) -> list[str]:
     """The Scene fields of one body (``shared=False``: those of that body alone; ``True``:
     those every body has)."""
     names = [f.name for f in dataclasses.fields(granrs.Scene)]
-    body_only = granrs.scene.BODY_FIELDS
+    built_in = set(granrs.scene.BODIES)
+    # Fields of every built-in body (v0, depth0, vx0: a linkage's are in its elements).
+    body_only = {n: b for n, b in granrs.scene.BODY_FIELDS.items() if not built_in <= set(b)}
     if shared:
         return [n for n in names if n not in body_only]
     return [n for n in names if body in body_only.get(n, ())]
@@ -466,6 +468,22 @@ def list_table(header: Sequence[str], rows: Iterable[Sequence[str]], widths: str
         for i, cell in enumerate(row):
             lines.append(f"   {'* -' if i == 0 else '  -'} {cell}")
     return "\n".join(lines) + "\n"
+
+
+def element_fields_rows() -> list[list[str]]:
+    """Rows of the linkage elements' table (the core's ``ELEMENT_FIELDS``): element, field,
+    unit, allowed values and what it is."""
+    return [
+        [
+            element,
+            f"``{name}``",
+            f["unit"] if f["unit"] not in ("", "-") else "",
+            _escape_prose(f["note"]),
+            _escape_prose(f["doc"]),
+        ]
+        for element, table in granrs.bodies.ELEMENT_FIELDS.items()
+        for name, f in table.items()
+    ]
 
 
 def leg_segments_rows() -> list[list[str]]:
@@ -743,6 +761,13 @@ def setup(app: Any) -> dict[str, Any]:
             rows = body_fields_rows(body, case=case, shared=shared)
             return list_table(header, rows, widths)
 
+    class ElementFields(_RstDirective):
+        """``.. granrs-element-fields::``: the fields of a linkage's elements."""
+
+        def rst(self) -> str:
+            header = ["element", "field", "unit", "allowed", "what it is"]
+            return list_table(header, element_fields_rows(), "10 14 10 20 46")
+
     class LegSegments(_RstDirective):
         """``.. granrs-leg-segments::``."""
 
@@ -836,5 +861,6 @@ def setup(app: Any) -> dict[str, Any]:
     app.connect("build-finished", finished)
     app.add_directive("granrs-body-fields", BodyFields)
     app.add_directive("granrs-leg-segments", LegSegments)
+    app.add_directive("granrs-element-fields", ElementFields)
     app.add_directive("granrs-scene-template", SceneTemplate)
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from . import _granrs, cases, coefficients, data, forces, scenefile
+from . import _granrs, bodies, cases, coefficients, data, forces, scenefile
 from .animate import animate
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
@@ -63,6 +63,7 @@ __all__ = [
     "UnknownNameError",
     "__version__",
     "animate",
+    "bodies",
     "calibrate",
     "cases",
     "coefficients",

@@ -160,7 +160,7 @@ def _pose(result: Result, frames: np.ndarray) -> _Pose:
     assert series is not None
     col = lambda name: _column(series, name, frames)  # noqa: E731
     centroid = scene.apply_at == "centroid"
-    if scene.body == "free_link":
+    if scene.kind == "free_link":
         centre = np.stack([col("x"), col("y")], axis=-1)
         q = col("q")
         tip = _local(centre, q, -0.5 * scene.length, 0.0)
@@ -169,7 +169,7 @@ def _pose(result: Result, frames: np.ndarray) -> _Pose:
         applied = _rod_centroid(tip, top, scene.length) if centroid else tip
         contact = _Contact("rod", rod, tip, applied, _contact_forces(series, "", frames))
         return _Pose([rod], None, [contact], scene.length)
-    if scene.body == "chain":
+    if scene.kind == "chain":
         pin = np.stack([col("x_pin"), col("y_pin")], axis=-1)
         outlines, contacts = [], []
         for i in range(2):
@@ -180,9 +180,54 @@ def _pose(result: Result, frames: np.ndarray) -> _Pose:
             forces = _contact_forces(series, f"c{i}.", frames)
             contacts.append(_Contact(f"link{i + 1}", rod, tip, applied, forces))
         return _Pose(outlines, None, contacts, scene.length)
-    if scene.body == "leg":
+    if scene.kind == "leg":
         return _leg_pose(result, frames)
-    raise InvalidParameterError(f"cannot draw body {scene.body!r}", field="body")
+    if scene.kind == "linkage":
+        return _linkage_pose(result, frames)
+    raise InvalidParameterError(f"cannot draw body {scene.kind!r}", field="body")
+
+
+def _linkage_pose(result: Result, frames: np.ndarray) -> _Pose:
+    """A linkage: each link a bar from its joint along its axis (its joints placed on their
+    parents, the root link at the root), each contact's rod or box outline."""
+    scene, series = result.scene, result.series
+    assert series is not None
+    col = lambda name: _column(series, name, frames)  # noqa: E731
+    body = scene.body
+    links = {link.name: link for link in body.links}  # type: ignore[union-attr]
+    joint_of = {j.child: j for j in body.joints}  # type: ignore[union-attr]
+    origin: dict[str, np.ndarray] = {}
+    q: dict[str, np.ndarray] = {}
+    for name in body.order:  # type: ignore[union-attr]
+        q[name] = col(f"q_{name}")
+        j = joint_of.get(name)
+        if j is None:
+            origin[name] = np.stack([col("x_root"), col("y_root")], axis=-1)
+        else:
+            origin[name] = _local(origin[j.parent], q[j.parent], *j.at)
+    size = max(link.length for link in links.values())
+    bars = [
+        _rod_outline(origin[n], _local(origin[n], q[n], links[n].length, 0.0), 0.04 * size)
+        for n in body.order  # type: ignore[union-attr]
+    ]
+    contacts = []
+    several = len(body.contacts) > 1  # type: ignore[union-attr]
+    for i, c in enumerate(body.contacts):  # type: ignore[union-attr]
+        o, a = origin[c.link], q[c.link]
+        s0, n0 = c.at
+        if c.shape == "rod":
+            tip = _local(o, a, s0, n0)
+            top = _local(o, a, s0 + c.length, n0)
+            shape = _rod_outline(tip, top, c.diameter or 0.0)
+            reference = tip
+        else:
+            h = c.height or 0.0
+            corners = ((s0, n0), (s0 + c.length, n0), (s0 + c.length, n0 - h), (s0, n0 - h))
+            shape = np.stack([_local(o, a, s, n) for s, n in corners], axis=1)
+            reference = _local(o, a, s0 + 0.5 * c.length, n0)
+        forces = _contact_forces(series, f"c{i}." if several else "", frames)
+        contacts.append(_Contact(c.name or c.link, shape, reference, reference, forces))
+    return _Pose(bars, None, contacts, size)
 
 
 def _leg_pose(result: Result, frames: np.ndarray) -> _Pose:
@@ -423,8 +468,10 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         self.dpi = dpi
         self._pose = _pose(result, frame_times)
         self.depths = np.stack(
-            [np.maximum(-c.reference[:, 1], 0.0) for c in self._pose.contacts], axis=-1
-        )
+            [np.maximum(-c.reference[:, 1], 0.0) for c in self._pose.contacts]
+            or [np.zeros(len(frame_times))],
+            axis=-1,
+        )[:, : len(self._pose.contacts)]
         self.figure = self._build_figure()
         super().__init__(
             self.figure,
@@ -485,7 +532,7 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             ax.set_xlabel("x [mm]")
             if i == 0:
                 ax.set_ylabel("y [mm]")
-            ax.set_title(title or f"{scene.body}, v0 = {scene.v0:g} m/s", fontsize=10)
+            ax.set_title(title or f"{scene.kind}, v0 = {scene.v0:g} m/s", fontsize=10)
             ax.axhspan((lo[1] - 1.0) * _MM, 0.0, color=_SAND, zorder=0)
             ax.axhline(0.0, color=_SURFACE, lw=1.2, zorder=1)
             self._views.append(_ViewArtists.build(ax, pose))

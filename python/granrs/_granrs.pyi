@@ -9,6 +9,8 @@ __all__ = [
     "FORCE_OUTPUTS",
     "GEOM_OUTPUTS",
     "GEOM_STATE",
+    "MAX_CONTACTS",
+    "MAX_LINKS",
     "RECORDS",
     "RFT_COEFFICIENTS",
     "RFT_GENERIC",
@@ -18,10 +20,12 @@ __all__ = [
     "RunOutcome",
     "SandGeoms",
     "__version__",
+    "body_linkage",
     "check_term",
     "compile",
     "compile_fields",
     "compiled_scene",
+    "element_fields",
     "leg_segments",
     "resistance_force",
     "rft_alpha",
@@ -39,6 +43,8 @@ RECORDS: list[str]
 RFT_COEFFICIENTS: list[str]
 RFT_GENERIC: list[float]
 SCENE_FIELDS: list[str]
+MAX_LINKS: int
+MAX_CONTACTS: int
 
 @final
 class Compiled:
@@ -183,6 +189,13 @@ class GeomCoupling:
 
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""
+
+def element_fields() -> list[dict[str, Any]]:
+    """The one table of a linkage's element fields (element, name, unit, note, doc)."""
+
+def body_linkage(scene: dict[str, Any], check: bool = False) -> dict[str, Any]:
+    """A scene's body as a linkage's plain parts (links, joints, contacts, root) and the
+    links' names in the engine's order; ``check`` validates the body's structure."""
 
 def term_infos() -> list[dict[str, Any]]:
     """Every registered force term's description (name, equation, params, ...)."""

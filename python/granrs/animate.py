@@ -42,6 +42,7 @@ from .errors import InvalidParameterError
 if TYPE_CHECKING:
     from ._animation import ImpactAnimation
     from .result import Result
+    from .scene import Scene
 
 __all__ = [
     "ANIMATION_FORMATS",
@@ -175,10 +176,10 @@ def check_output(path: str | os.PathLike[str]) -> Path:
     return out
 
 
-def _state_columns(body: str) -> Sequence[str]:
-    from .result import _COORDS
+def _state_columns(scene: Scene) -> Sequence[str]:
+    from .result import _names
 
-    return _COORDS.get(body, ())
+    return _names(scene)["coords"]
 
 
 def animate(
@@ -226,7 +227,7 @@ def animate(
     assert dpi_value is not None
     target = check_output(out) if out is not None else None
     series = result.series
-    needed = ("t", *_state_columns(result.scene.body))
+    needed = ("t", *_state_columns(result.scene))
     if series is None or any(name not in series for name in needed) or len(series["t"]) == 0:
         raise InvalidParameterError(
             "the result recorded no state to animate: run the scene with "

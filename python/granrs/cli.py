@@ -502,9 +502,9 @@ def _plain(value: Any) -> Any:
 
 
 def _contact_names(result: Any) -> list[str]:
-    from .result import LINK_NAMES
+    from .result import _names
 
-    names = LINK_NAMES.get(result.scene.body, ())
+    names = _names(result.scene)["links"]
     return [names[i] if i < len(names) else f"c{i}" for i in range(len(result.contacts))]
 
 
@@ -525,7 +525,7 @@ def summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
     return _plain(
         {
             "scene": source,
-            "body": result.scene.body,
+            "body": result.scene.kind,
             "status": result.status,
             "t_s": result.t_s,
             "depth": result.depth,
@@ -567,7 +567,7 @@ def summary_text(result: Any, source: str | None = None) -> str:
     s = result.summary
     title = f"{source}: " if source else ""
     lines = [
-        f"{title}{result.scene.body}, status {result.status} at t = {_number(s['t_final'])} s "
+        f"{title}{result.scene.kind}, status {result.status} at t = {_number(s['t_final'])} s "
         f"({s['steps']} steps, {s['rhs_evals']} rhs evaluations, {s['events']} events)",
         f"energy: {_number(s['energy_start'])} J at the start, "
         f"{_number(s['energy_end'])} J at the end",

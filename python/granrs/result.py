@@ -70,6 +70,37 @@ JOINT_NAMES = {
 }
 
 
+def _names(scene: Scene) -> dict[str, tuple[str, ...]]:
+    """Names of a scene's coordinates, rates, links and joints: a built-in body's from the
+    tables above; a linkage's from its links in the engine's order (coordinates
+    ``x_root, y_root, q_<link>...``; the joint that carries each link, ``root`` for the root
+    link)."""
+    kind = scene.kind
+    if kind != "linkage":
+        return {
+            "coords": _COORDS[kind],
+            "rates": _RATES[kind],
+            "links": LINK_NAMES[kind],
+            "joints": JOINT_NAMES[kind],
+        }
+    body = scene.body
+    order = body.order  # type: ignore[union-attr]
+    carrier = {j.child: j.name for j in body.joints}  # type: ignore[union-attr]
+    # A sinusoidal drive reads the time from a clock coordinate after the links'.
+    clock = ("clock",) if any(j.amplitude_deg for j in body.joints) else ()  # type: ignore[union-attr]
+    return {
+        "coords": ("x_root", "y_root", *(f"q_{n}" for n in order), *clock),
+        "rates": (
+            "vx_root",
+            "vy_root",
+            *(f"omega_{n}" for n in order),
+            *(f"{c}_rate" for c in clock),
+        ),
+        "links": order,
+        "joints": tuple(carrier.get(n, "root") for n in order),
+    }
+
+
 @dataclass(frozen=True)
 class ContactResult:
     """The results of one contact.
@@ -138,12 +169,13 @@ class Result:
                 ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=stopped, summary=c)
                 for c, stopped in zip(raw["contacts"], raw["stopped"], strict=True)
             ]
-            summary = dict(raw["contacts"][0])
+            # A body without contacts (a linkage in the air) has the run's entries only.
+            summary = dict(raw["contacts"][0]) if raw["contacts"] else {}
             summary.update(raw["run"])
-            names = JOINT_NAMES.get(scene.body, ())
+            names = _names(scene)["joints"]
             joints = (
                 {}
-                if scene.body == "free_link"
+                if scene.kind == "free_link"
                 else {
                     names[i] if i < len(names) else f"joint{i}": j
                     for i, j in enumerate(raw["joints"])
@@ -234,7 +266,7 @@ class Result:
 
     def _repr_html_(self) -> str:
         """Jupyter: the status and a compact table of each contact's results with units."""
-        names = LINK_NAMES.get(self.scene.body, ())
+        names = _names(self.scene)["links"]
         columns = (
             ("t_s", "t_s [ms]", 1e3),
             ("depth", "depth [mm]", 1e3),
@@ -260,7 +292,7 @@ class Result:
             rows.append(f"<tr><td>{html.escape(name)}</td><td>{stopped}</td>{cells}</tr>")
         summary = self.summary
         caption = (
-            f"granrs {html.escape(self.scene.body)}: {html.escape(self.status)}, "
+            f"granrs {html.escape(self.scene.kind)}: {html.escape(self.status)}, "
             f"{summary.get('steps', '-')} steps, {summary.get('rhs_evals', '-')} rhs evaluations"
         )
         return (
@@ -281,8 +313,8 @@ def _rename_series(
 ) -> dict[str, np.ndarray] | None:
     if raw is None:
         return None
-    coords = _COORDS.get(scene.body, ())
-    rates = _RATES.get(scene.body, ())
+    named = _names(scene)
+    coords, rates = named["coords"], named["rates"]
     out: dict[str, np.ndarray] = {}
     for name, values in raw.items():
         new = name
@@ -294,12 +326,12 @@ def _rename_series(
             new = name[3:]
         elif name.startswith("joint") and "." in name:
             idx, _, rest = name[5:].partition(".")
-            joints = JOINT_NAMES.get(scene.body, ())
+            joints = named["joints"]
             if idx.isdigit() and int(idx) < len(joints):
                 new = f"{joints[int(idx)]}.{rest}"
         elif name.startswith("link") and "." in name:
             idx, _, rest = name[4:].partition(".")
-            links = LINK_NAMES.get(scene.body, ())
+            links = named["links"]
             if idx.isdigit() and int(idx) < len(links):
                 new = f"{links[int(idx)]}.{rest}"
         out[new] = values

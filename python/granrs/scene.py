@@ -1,11 +1,14 @@
 """What a run is: :class:`Scene`, a frozen description of one impact.
 
-Three bodies share one scene type (``body``): ``"free_link"`` (a round rod), ``"chain"``
-(two rods pinned at their top ends, chapter 4) and ``"leg"`` (foot, shank, thigh and half
-of head-arms-trunk for one leg of a person landing on both feet, chapter 5). Fields that
-belong to one body only are listed in :data:`BODY_FIELDS`; setting one for another body
-raises :class:`~granrs.errors.InvalidSceneError`. :mod:`granrs.cases` builds the thesis's
-scenes with every default set.
+Three built-in bodies share one scene type (``body``): ``"free_link"`` (a round rod),
+``"chain"`` (two rods pinned at their top ends, chapter 4) and ``"leg"`` (foot, shank, thigh
+and half of head-arms-trunk for one leg of a person landing on both feet, chapter 5); each is
+held as a :class:`granrs.bodies.Linkage` built from the scene's fields (``scene.body.name``
+says which; ``scene.kind`` too). Any other body is a :class:`granrs.bodies.Linkage` of your
+own, whose initial state is in its elements. Fields that belong to some bodies only are
+listed in :data:`BODY_FIELDS`; setting one for another body raises
+:class:`~granrs.errors.InvalidSceneError`. :mod:`granrs.cases` builds the thesis's scenes
+with every default set.
 
 A scene is plain data: the body and its size, the sand, the force terms that act (each with
 its parameters: :mod:`granrs.forces`), the initial state, the step, the end condition and
@@ -28,13 +31,25 @@ from dataclasses import dataclass
 from typing import Any
 
 from . import _granrs
+from .bodies import Linkage
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from .forces import Term, as_terms, thesis
 
-__all__ = ["BODIES", "BODY_FIELDS", "FIELD_INFO", "JOINTS", "RECORDS", "JointSpec", "Scene"]
+__all__ = [
+    "BODIES",
+    "BODY_FIELDS",
+    "FIELD_INFO",
+    "JOINTS",
+    "KINDS",
+    "RECORDS",
+    "JointSpec",
+    "Scene",
+]
 
-#: The body models.
+#: The built-in bodies.
 BODIES: tuple[str, ...] = ("free_link", "chain", "leg")
+#: What a scene's body may be: a built-in body, or a linkage of your own.
+KINDS: tuple[str, ...] = (*BODIES, "linkage")
 #: Named joint settings; a spring-damper is a mapping ``{"k": N m/rad, "c": N m s/rad}``.
 JOINTS: tuple[str, ...] = ("free", "locked")
 #: A joint: ``"free"``, ``"locked"`` or ``{"k": stiffness, "c": damping}``.
@@ -121,7 +136,7 @@ class Scene:
     table of the core: ``granrs.scene.FIELD_INFO``).
     """
 
-    body: str = "free_link"
+    body: str | Linkage = "free_link"
     length: float = 0.190
     diameter: float = 0.0127
     mass: float = 0.184
@@ -165,24 +180,42 @@ class Scene:
     sole_model: str = "box"
 
     def __post_init__(self) -> None:
-        if self.body not in BODIES:
+        for name in ("pin_joint", "ankle", "knee", "hip"):
+            object.__setattr__(self, name, _joint(getattr(self, name), name))
+        body = self.body
+        if isinstance(body, Mapping):
+            body = Linkage.from_mapping(body)
+        if isinstance(body, Linkage):
+            kind = body.name
+        elif isinstance(body, str) and body in BODIES:
+            kind = body
+        else:
             raise UnknownNameError(
-                f"unknown body {self.body!r}; allowed: {', '.join(BODIES)}", field="body"
+                f"unknown body {body!r}; allowed: {', '.join(BODIES)} or a granrs.bodies.Linkage",
+                field="body",
             )
+        if kind != "linkage":
+            fields = self.__dict__
+            body = Linkage._built_in(kind, {n: fields[n] for n in _BODY_PART_FIELDS[kind]})
+        object.__setattr__(self, "body", body)
         for name in _NOT_NONE:
             if getattr(self, name) is None:
                 raise InvalidParameterError(
                     f"{name} must be a value, not None (its default: {_DEFAULTS[name]!r})",
                     field=name,
                 )
-        for name in ("pin_joint", "ankle", "knee", "hip"):
-            object.__setattr__(self, name, _joint(getattr(self, name), name))
+
         defaults = _DEFAULTS
         for name, bodies in BODY_FIELDS.items():
-            if self.body not in bodies and getattr(self, name) != defaults[name]:
+            if kind not in bodies and getattr(self, name) != defaults[name]:
                 raise InvalidSceneError(
                     f"{name} applies to body {' or '.join(repr(b) for b in bodies)} only, "
-                    f"not {self.body!r}",
+                    f"not {kind!r}"
+                    + (
+                        " (a linkage's initial state is in its links and root)"
+                        if kind == "linkage"
+                        else ""
+                    ),
                     field=name,
                 )
         object.__setattr__(self, "forces", as_terms(self.forces))
@@ -203,9 +236,26 @@ class Scene:
                 )
         return dataclasses.replace(self, **changes)
 
+    @property
+    def kind(self) -> str:
+        """The body's kind: a built-in body's name (``"free_link"``, ``"chain"``,
+        ``"leg"``) or ``"linkage"``."""
+        return self.body.name  # type: ignore[union-attr]
+
+    def as_linkage(self) -> Scene:
+        """This scene with its body as a plain linkage (``body.detached()``) and every field
+        that belongs to the built-in bodies only back at its default: the same run through
+        the linkage's path, to the same result."""
+        if self.kind == "linkage":
+            return self
+        reset = {n: _DEFAULTS[n] for n in BODY_FIELDS if "linkage" not in BODY_FIELDS[n]}
+        return dataclasses.replace(self, body=self.body.detached(), **reset)  # type: ignore[union-attr]
+
     def to_dict(self) -> dict[str, Any]:
-        """The scene as plain Python values, every field (a new dict)."""
+        """The scene as plain Python values, every field (a new dict): ``body`` is a
+        built-in body's name or a linkage's mapping (links, joints, contacts, root)."""
         d = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        d["body"] = self.body._core_value  # type: ignore[union-attr]
         d["forces"] = [t.to_dict() for t in self.forces]
         d["record"] = list(self.record)
         return d
@@ -216,7 +266,7 @@ class Scene:
         cached: dict[str, Any] | None = self.__dict__.get("_plain_cache")
         if cached is None:
             fields = self.__dict__
-            cached = {name: fields[name] for name in _CORE_FIELDS[self.body]}
+            cached = {name: fields[name] for name in _CORE_FIELDS[self.kind]}
             cached["forces"] = list(self.forces)
             cached["record"] = list(self.record)
             object.__setattr__(self, "_plain_cache", cached)
@@ -240,7 +290,7 @@ class Scene:
     def leg_segments(self) -> list[dict[str, Any]]:
         """The leg's segments scaled to this scene's body: name, mass [kg], length [m], com
         (from the segment's lower joint) [m], inertia about the centre of mass [kg m^2]."""
-        if self.body != "leg":
+        if self.kind != "leg":
             raise InvalidSceneError("leg_segments() needs body='leg'", field="body")
         return list(_granrs.leg_segments(self.to_dict()))
 
@@ -284,7 +334,10 @@ def _scene_doc() -> str:
     if missing:  # the dataclass and the core's table name the same fields (tested)
         raise ImportError(f"granrs.Scene and the core's field table differ: {sorted(missing)}")
     groups = [
-        ("    Attributes:", [n for n in names if FIELD_INFO[n]["bodies"] in ([], RODS)]),
+        (
+            "    Attributes:",
+            [n for n in names if FIELD_INFO[n]["bodies"] in ([], RODS, list(BODIES))],
+        ),
         (
             "    Chain only (thesis chapter 4):",
             [n for n in names if FIELD_INFO[n]["bodies"] == ["chain"]],
@@ -315,6 +368,13 @@ _CORE_FIELDS: dict[str, tuple[str, ...]] = {
         f.name
         for f in dataclasses.fields(Scene)
         if body in BODY_FIELDS.get(f.name, (body,)) and FIELD_INFO[f.name]["part"] != "notes"
+    )
+    for body in KINDS
+}
+#: Per built-in body, the fields its linkage is built from (its body and start fields).
+_BODY_PART_FIELDS: dict[str, tuple[str, ...]] = {
+    body: tuple(
+        n for n in _CORE_FIELDS[body] if FIELD_INFO[n]["part"] in ("body", "start") and n != "body"
     )
     for body in BODIES
 }

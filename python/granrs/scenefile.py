@@ -47,6 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _granrs, forces
+from .bodies import ELEMENT_FIELDS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from .scene import BODY_FIELDS, FIELD_INFO, Scene
 
@@ -90,6 +91,14 @@ _NOTES: dict[str, str] = {
     for name, f in FIELD_INFO.items()
 }
 
+#: The same for the fields of a linkage's elements (:data:`granrs.bodies.ELEMENT_FIELDS`).
+_ELEMENT_NOTES: dict[str, dict[str, str]] = {
+    element: {
+        name: ", ".join(x for x in (f["unit"] if f["unit"] != "-" else "", f["note"]) if x)
+        for name, f in table.items()
+    }
+    for element, table in ELEMENT_FIELDS.items()
+}
 
 # ---------------------------------------------------------------------------------------
 # Writing
@@ -181,12 +190,18 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
     lines.append(f"format = {FORMAT_VERSION}")
     tables: list[str] = []
     for name in _FIELD_NAMES:
-        if not _applies(name, scene.body):
+        if not _applies(name, scene.kind):
             continue
         value = getattr(scene, name)
         note = _NOTES.get(name) if comments else None
         if value is None:
             lines.append(f"# {name} = ...  ({note})" if note else f"# {name} = (left out)")
+            continue
+        if name == "body":
+            if scene.kind != "linkage":
+                lines.append(_line(name, _format_value(scene.kind), note))
+            else:
+                tables.extend(_body_tables(value._core_value))
             continue
         if name == "forces":
             if not value:
@@ -202,6 +217,48 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
             continue
         lines.append(_line(name, _format_value(value), note))
     return "\n".join(lines + tables) + "\n"
+
+
+def _body_tables(body: Mapping[str, Any]) -> list[str]:
+    """A linkage as ``[body.root]`` and ``[[body.links]]``, ``[[body.joints]]``,
+    ``[[body.contacts]]`` tables (each element's fields left at ``None`` left out)."""
+
+    def lines(element: str, values: Mapping[str, Any]) -> list[str]:
+        return [
+            _line(_format_key(k), _format_value(v), _ELEMENT_NOTES[element].get(k))
+            for k, v in values.items()
+        ]
+
+    out = [
+        "",
+        "# The body: a linkage (granrs.bodies.Linkage): its root, links, joints, contacts.",
+        "[body.root]",
+    ]
+    out.extend(lines("root", body["root"]))
+    for part, element in (("links", "link"), ("joints", "joint"), ("contacts", "contact")):
+        for values in body[part]:
+            out.extend(["", f"[[body.{part}]]"])
+            out.extend(lines(element, values))
+    return out
+
+
+def _body_path(field: str, body: Any) -> tuple[str, ...]:
+    """Where a linkage's element field (``links.shank.mass``, ``joints[2].parent``,
+    ``root.kind``) is in the TOML data: ``("body", "links", "#1", "mass")``."""
+    parts = field.split(".")
+    head = re.fullmatch(r"(links|joints|contacts)(?:\[(\d+)\])?", parts[0])
+    if parts[0] == "root":
+        return ("body", *parts)
+    if not head or not isinstance(body, Mapping):
+        return ("body",)
+    part, index = head.group(1), head.group(2)
+    rest = parts[1:]
+    if index is None and rest:
+        names = [e.get("name") if isinstance(e, Mapping) else None for e in body.get(part, [])]
+        if rest[0] in names:
+            index = str(names.index(rest[0]))
+        rest = rest[1:]
+    return ("body", part, f"#{index}", *rest) if index is not None else ("body", part)
 
 
 def dump(scene: Scene, path: str | os.PathLike[str]) -> str:
@@ -403,6 +460,8 @@ def _build(
         scene.validate()
     except InvalidSceneError as exc:
         path = tuple((exc.field or "").split(".")) if exc.field else ()
+        if exc.field and isinstance(fields.get("body"), Mapping) and path[0] not in fields:
+            path = _body_path(exc.field, fields["body"])
         raise _reraise(exc, locate(path)) from None
     return scene
 

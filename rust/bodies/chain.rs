@@ -156,6 +156,7 @@ impl ChainScene {
             mechanism: Mechanism {
                 links: vec![link(None), link(Some(0))],
                 root_mass: self.pin_mass,
+                root_fixed: false,
             },
             contacts: vec![rod(0), rod(1)],
             medium: self.medium,

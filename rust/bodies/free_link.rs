@@ -117,6 +117,7 @@ impl FreeLinkScene {
             mechanism: Mechanism {
                 links: vec![link],
                 root_mass: 0.0,
+                root_fixed: false,
             },
             contacts: vec![Contact {
                 shape: Shape::Rod(RodContact {

@@ -336,6 +336,7 @@ impl LegScene {
             mechanism: Mechanism {
                 links,
                 root_mass: 0.0,
+                root_fixed: false,
             },
             contacts: vec![Contact {
                 shape: Shape::Sole(self.sole()),

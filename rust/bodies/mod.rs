@@ -18,10 +18,15 @@ use crate::integrate::{Method, Outcome, SolveOptions};
 pub mod chain;
 pub mod free_link;
 pub mod leg;
+pub mod linkage;
 
 pub use chain::{chain_defaults, ChainScene};
 pub use free_link::{free_link_defaults, FreeLinkScene};
 pub use leg::{leg_defaults, LegScene, Segment, LEG_JOINTS};
+pub use linkage::{
+    ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, PartNames, RootKind, RootSpec,
+    MAX_LINKS,
+};
 
 /// Validate the medium.
 pub fn validate_medium(m: &Medium) -> Result<()> {
@@ -161,6 +166,8 @@ pub enum AnyScene {
     Chain(ChainScene),
     /// The leg.
     Leg(LegScene),
+    /// A user-defined linkage.
+    Linkage(LinkageScene),
 }
 
 impl AnyScene {
@@ -170,6 +177,46 @@ impl AnyScene {
             AnyScene::FreeLink(s) => s.validate(),
             AnyScene::Chain(s) => s.validate(),
             AnyScene::Leg(s) => s.validate(),
+            AnyScene::Linkage(s) => s.validate(),
+        }
+    }
+
+    /// The body as a linkage: a built-in body's links, joints, contacts and initial state
+    /// (names: the result's link and joint names), or the linkage itself.
+    pub fn linkage(&self) -> Result<LinkageScene> {
+        match self {
+            AnyScene::FreeLink(s) => {
+                let (q0, qd0) = s.initial_state();
+                let names = PartNames {
+                    links: &["rod"],
+                    joints: &["root"],
+                    contacts: &["rod"],
+                    lengths: &[s.length],
+                };
+                LinkageScene::from_model(&s.model(), &q0, &qd0, &names, &s.options)
+            }
+            AnyScene::Chain(s) => {
+                let (q0, qd0) = s.initial_state();
+                let names = PartNames {
+                    links: &["link1", "link2"],
+                    joints: &["pin_on_link1", "pin"],
+                    contacts: &["link1", "link2"],
+                    lengths: &[s.length, s.length],
+                };
+                LinkageScene::from_model(&s.model(), &q0, &qd0, &names, &s.options)
+            }
+            AnyScene::Leg(s) => {
+                let (q0, qd0) = s.initial_state();
+                let seg = s.segments();
+                let names = PartNames {
+                    links: &["foot", "shank", "thigh", "trunk"],
+                    joints: &["root", "ankle", "knee", "hip"],
+                    contacts: &["sole"],
+                    lengths: &[seg[0].length, seg[1].length, seg[2].length, seg[3].length],
+                };
+                LinkageScene::from_model(&s.model(), &q0, &qd0, &names, &s.options)
+            }
+            AnyScene::Linkage(s) => Ok(s.clone()),
         }
     }
 
@@ -179,6 +226,7 @@ impl AnyScene {
             AnyScene::FreeLink(s) => s.run(),
             AnyScene::Chain(s) => s.run(),
             AnyScene::Leg(s) => s.run(),
+            AnyScene::Linkage(s) => s.run(),
         }
     }
 }

@@ -14,7 +14,9 @@
 //! the relative angle `q_i - q_parent`. A locked joint is the linear constraint
 //! `qdot_i - qdot_parent = 0` ([`Mechanism::locked_rows`]), enforced with the contacts'
 //! sticking constraints by `dynamics`; since it is linear in `q`, RK4 keeps it exactly (to
-//! round-off).
+//! round-off). A joint driven at a constant rate is the same row with the rate as its target
+//! (`qdot_i - qdot_parent = rate`, zero relative acceleration), and a root whose motion is
+//! prescribed (pinned, or moved at a constant velocity) holds `xddot = yddot = 0`.
 
 use nalgebra::{SMatrix, SVector, Vector2};
 
@@ -35,6 +37,54 @@ pub enum Joint {
         /// Relative angle at which the spring is relaxed [rad].
         rest: f64,
     },
+    /// Driven: the relative angle `q_i - q_parent` follows
+    /// `theta_0 + rate t + amplitude (sin(omega t + phase) - sin phase)` (its initial value
+    /// plus a constant rate and a sinusoid), held by an unbounded torque that the run reports.
+    /// A sinusoid reads the time from the mechanism's clock (see [`Mechanism::clock`]).
+    Driven {
+        /// Constant relative rate [rad/s].
+        rate: f64,
+        /// Amplitude of the sinusoid [rad] (0: none).
+        amplitude: f64,
+        /// Its angular frequency [rad/s].
+        omega: f64,
+        /// Its phase at t = 0 [rad].
+        phase: f64,
+    },
+}
+
+impl Joint {
+    /// A joint driven at a constant rate [rad/s].
+    pub fn driven(rate: f64) -> Joint {
+        Joint::Driven {
+            rate,
+            amplitude: 0.0,
+            omega: 0.0,
+            phase: 0.0,
+        }
+    }
+
+    /// Whether the joint's motion depends on the time beyond a constant rate.
+    #[inline]
+    pub fn reads_clock(&self) -> bool {
+        matches!(self, Joint::Driven { amplitude, .. } if *amplitude != 0.0)
+    }
+}
+
+/// One constraint row of the mechanism itself: `qdot_link - qdot_parent - clock_coef *
+/// qdot_clock = target`, whose velocity-product acceleration is `bias`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeldRow {
+    /// The child link.
+    pub link: usize,
+    /// Its parent.
+    pub parent: usize,
+    /// The clock's coefficient, `-theta'(t)` of a sinusoid (0 otherwise).
+    pub clock_coef: f64,
+    /// `d(jac)/dt . qdot` [rad/s^2].
+    pub bias: f64,
+    /// The constrained rate [rad/s].
+    pub target: f64,
 }
 
 /// One rigid link.
@@ -61,6 +111,9 @@ pub struct Mechanism<const N: usize> {
     pub links: Vec<Link>,
     /// A point mass at the root [kg] (the chain's pin; 0 for none).
     pub root_mass: f64,
+    /// Whether the root's motion is prescribed (pinned, or moved at its initial velocity):
+    /// its coordinates then have zero acceleration, held by a reaction.
+    pub root_fixed: bool,
 }
 
 /// Positions and axes of every link for one configuration.
@@ -100,16 +153,72 @@ impl<const N: usize> Mechanism<N> {
         self.root_mass + self.links.iter().map(|l| l.mass).sum::<f64>()
     }
 
-    /// The (link, parent) pairs of the locked joints; each is the constraint
-    /// `qdot_link - qdot_parent = 0`.
+    /// The (link, parent) pairs of the locked and driven joints.
     pub fn locked_rows(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         self.links
             .iter()
             .enumerate()
             .filter_map(|(i, l)| match (l.parent, l.joint) {
-                (Some(p), Joint::Locked) => Some((i, p)),
+                (Some(p), Joint::Locked | Joint::Driven { .. }) => Some((i, p)),
                 _ => None,
             })
+    }
+
+    /// The clock's coordinate, if the mechanism has one: `N - 1` when `N` exceeds the
+    /// links' coordinates by one. It is the time (`q = t`, `qdot = 1`, held by a row of its
+    /// own), read by the sinusoidally driven joints; it has unit mass and no other part in
+    /// the dynamics or the energies.
+    #[inline]
+    pub fn clock(&self) -> Option<usize> {
+        (self.links.len() + 3 == N).then_some(N - 1)
+    }
+
+    /// The rows of the locked and driven joints at `(q, qd)`: a locked joint holds
+    /// `qdot_i - qdot_parent = 0`; a driven one `qdot_i - qdot_parent - theta'(t) = 0`, with
+    /// `theta'(t) = rate + amplitude omega cos(omega t + phase)` and `t` the clock's
+    /// coordinate.
+    pub fn held_rows<'a>(
+        &'a self,
+        q: &'a SVector<f64, N>,
+        qd: &'a SVector<f64, N>,
+    ) -> impl Iterator<Item = HeldRow> + 'a {
+        let clock = self.clock();
+        self.links.iter().enumerate().filter_map(move |(i, l)| {
+            let p = l.parent?;
+            let row = |clock_coef, bias, target| HeldRow {
+                link: i,
+                parent: p,
+                clock_coef,
+                bias,
+                target,
+            };
+            match l.joint {
+                Joint::Locked => Some(row(0.0, 0.0, 0.0)),
+                Joint::Driven {
+                    rate,
+                    amplitude,
+                    omega,
+                    phase,
+                } => match clock {
+                    Some(c) if amplitude != 0.0 => {
+                        let (s, co) = (omega * q[c] + phase).sin_cos();
+                        let speed = amplitude * omega * co;
+                        let accel = -amplitude * omega * omega * s;
+                        // jac = e_i - e_p - theta' e_c; d(jac)/dt . qd = -theta'' qd_c^2.
+                        Some(row(-(rate + speed), -accel * qd[c] * qd[c], 0.0))
+                    }
+                    _ => Some(row(0.0, 0.0, rate)),
+                },
+                _ => None,
+            }
+        })
+    }
+
+    /// Whether any constraint of the mechanism itself is in force: a locked or driven joint,
+    /// a prescribed root, or a clock.
+    #[inline]
+    pub fn has_constraints(&self) -> bool {
+        self.root_fixed || self.clock().is_some() || self.locked_rows().next().is_some()
     }
 
     /// Add the spring-damper torques of the joints to the generalized forces `out`; return
@@ -299,6 +408,9 @@ impl<const N: usize> Mechanism<N> {
         }
         m[(0, 0)] += self.root_mass;
         m[(1, 1)] += self.root_mass;
+        if let Some(c) = self.clock() {
+            m[(c, c)] = 1.0;
+        }
         m
     }
 
@@ -371,6 +483,7 @@ mod tests {
         Mechanism {
             links: vec![link.clone(), link],
             root_mass: 0.01,
+            root_fixed: false,
         }
     }
 

@@ -10,6 +10,6 @@ pub mod mechanism;
 pub mod rod;
 pub mod sole;
 
-pub use mechanism::{Joint, Link, Mechanism};
+pub use mechanism::{HeldRow, Joint, Link, Mechanism};
 pub use rod::{RodContact, RodGeometry};
 pub use sole::{SoleContact, SoleGeometry, SoleModel};

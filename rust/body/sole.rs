@@ -68,6 +68,31 @@ pub struct SoleGeometry {
     pub lowest: f64,
     /// Highest y of the box [m] (negative when wholly immersed).
     pub highest: f64,
+    /// y of each corner, in the order of [`SoleContact::corners_local`] [m]: where one
+    /// crosses the surface the immersed polygon gains or loses a vertex (a located event).
+    pub corners_y: [f64; 4],
+}
+
+/// Below this area, as a fraction of `length^2`, the immersed polygon is a sliver whose
+/// area centroid is round-off (1e-9: a depth of about 1e-9 of the sole's length).
+const SLIVER: f64 = 1e-9;
+
+/// The centroid of a polygon's edges below the surface (those with both ends on y = 0,
+/// the waterline, left out), weighted by length; `None` without any.
+fn sliver_centroid(vertices: &[Vector2<f64>]) -> Option<Vector2<f64>> {
+    let n = vertices.len();
+    let mut sum = Vector2::zeros();
+    let mut total = 0.0;
+    for i in 0..n {
+        let (p, q) = (vertices[i], vertices[(i + 1) % n]);
+        if p.y == 0.0 && q.y == 0.0 {
+            continue;
+        }
+        let len = (q - p).norm();
+        sum += len * 0.5 * (p + q);
+        total += len;
+    }
+    (total > 0.0).then(|| sum / total)
 }
 
 impl SoleContact {
@@ -132,11 +157,17 @@ impl SoleContact {
             cy += (p.y + q.y) * cr;
         }
         let area = 0.5 * a2.abs();
-        let centroid = if n >= 3 && a2 != 0.0 {
+        let centroid = if n >= 3 && area > SLIVER * self.length * self.length {
             Vector2::new(cx / (3.0 * a2), cy / (3.0 * a2))
         } else {
-            let r = self.reference_point();
-            joint + r.x * axis + r.y * normal
+            // A sliver (a flat sole at touchdown): its area centroid is round-off (its
+            // corners' heights are known to ~1e-17 m only); its limit is the centroid of
+            // its edges in the sand (the waterline left out): a flat sole's middle, a
+            // tilted one's corner.
+            sliver_centroid(&vertices[..n]).unwrap_or_else(|| {
+                let r = self.reference_point();
+                joint + r.x * axis + r.y * normal
+            })
         };
         SoleGeometry {
             depth: area / self.length,
@@ -146,6 +177,7 @@ impl SoleContact {
             n_vertices: n,
             lowest,
             highest,
+            corners_y: corners.map(|p| p.y),
         }
     }
 
@@ -216,6 +248,30 @@ mod tests {
         assert_eq!(g.area, 0.0);
         assert_eq!(s.drag_area_speed(&g, Vector2::new(0.0, -1.0)), 0.0);
         assert!((g.lowest - 0.01).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_flat_sole_at_touchdown_acts_at_its_middle() {
+        // Heel and toe a few 1e-17 m deep, unevenly (round-off of a flat landing): the
+        // area centroid of that sliver is round-off, its limit the sole's middle.
+        let s = sole();
+        let a: f64 = 1e-16; // a tilt at round-off level
+        let axis = Vector2::new(a.cos(), a.sin());
+        let normal = Vector2::new(a.sin(), -a.cos());
+        let g = s.geometry(Vector2::new(0.0, 0.07 - 3e-17), axis, normal);
+        assert!(g.n_vertices >= 3 && g.area < 1e-15);
+        assert!(g.centroid.x.abs() < 1e-12, "{}", g.centroid);
+        // Tilted by a visible angle, the sliver's limit is the corner that went in first.
+        let a: f64 = 0.2;
+        let axis = Vector2::new(a.cos(), a.sin());
+        let normal = Vector2::new(a.sin(), -a.cos());
+        let heel = s.heel.x * axis + s.heel.y * normal;
+        let g = s.geometry(Vector2::new(0.0, -heel.y - 1e-13), axis, normal);
+        assert!(
+            (g.centroid - Vector2::new(heel.x, -1e-13)).norm() < 1e-12,
+            "{}",
+            g.centroid
+        );
     }
 
     #[test]

@@ -13,8 +13,9 @@ use super::{
 use crate::body::mechanism::Pose;
 use crate::forces::{ForceSet, Switch};
 
-/// Most constraint rows at once: two sticking components per contact and the locked joints.
-const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED;
+/// Most constraint rows at once: two sticking components per contact, the locked (and
+/// driven) joints, a prescribed root's two and the clock's.
+const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED + 3;
 
 /// Unit vector of axis `k` (0 = x, 1 = y).
 #[inline]
@@ -31,8 +32,10 @@ fn unit(k: usize) -> Vector2<f64> {
 enum RowKind {
     /// A sticking component: contact and axis (0 = x, 1 = y).
     Stick { contact: usize, axis: usize },
-    /// A locked joint of this link.
+    /// A locked (or driven) joint of this link.
     Lock { link: usize },
+    /// A prescribed root's coordinate (0 = x, 1 = y).
+    Root,
 }
 
 /// One constraint `jac . qdot = 0`, with what its multiplier does.
@@ -45,6 +48,9 @@ struct Row<const N: usize> {
     bias: f64,
     /// `M^-1 Q_u`: the accelerations caused by a unit multiplier.
     response: SVector<f64, N>,
+    /// The constrained velocity's value, `jac . qdot = target` (a driven joint's rate; 0
+    /// otherwise).
+    target: f64,
 }
 
 /// A set of at most `R` constraint rows (no allocation in the right-hand side): `R` is
@@ -202,6 +208,7 @@ fn apply_rows<const N: usize, const R: usize>(
                 contacts[contact].force.set_reaction(forces, axis, mult);
             }
             RowKind::Lock { link } => joint_torque[link] = mult,
+            RowKind::Root => {}
         }
     }
 }
@@ -218,7 +225,7 @@ fn project_rows<const N: usize, const R: usize>(
     if k == 0 {
         return false;
     }
-    if (0..k).any(|i| rows.get(i).jac.dot(qd).abs() > PROJECTION_LIMIT) {
+    if (0..k).any(|i| (rows.get(i).jac.dot(qd) - rows.get(i).target).abs() > PROJECTION_LIMIT) {
         return false;
     }
     // M^-1 J^T columns and J M^-1 J^T.
@@ -230,7 +237,7 @@ fn project_rows<const N: usize, const R: usize>(
     let lam = solve_small::<R>(k, |(a, b)| {
         for i in 0..k {
             let ji = &rows.get(i).jac;
-            b[i] = ji.dot(&v);
+            b[i] = ji.dot(&v) - rows.get(i).target;
             for (j, aij) in a[i].iter_mut().enumerate().take(k) {
                 *aij = ji.dot(&minv_jt[j]);
             }
@@ -273,6 +280,16 @@ impl<const N: usize> Model<N> {
                 a[2 + parent] = -1.0;
                 a
             })
+            .chain(
+                (0..2)
+                    .filter(|_| self.mechanism.root_fixed)
+                    .chain(self.mechanism.clock())
+                    .map(|k| {
+                        let mut a = SVector::<f64, N>::zeros();
+                        a[k] = 1.0;
+                        a
+                    }),
+            )
             .collect();
         let responses: Vec<SVector<f64, N>> = locks.iter().map(|a| chol.solve(a)).collect();
         let schur = nalgebra::DMatrix::from_fn(locks.len(), locks.len(), |i, j| {
@@ -327,16 +344,39 @@ impl<const N: usize> Model<N> {
         chol: &nalgebra::Cholesky<f64, nalgebra::Const<N>>,
     ) -> Rows<N, MAX_ROWS> {
         let mut rows = Rows::new();
-        for (link, parent) in self.mechanism.locked_rows() {
+        let clock = self.mechanism.clock();
+        for r in self.mechanism.held_rows(q, qd) {
             let mut jac = SVector::<f64, N>::zeros();
-            jac[2 + link] = 1.0;
-            jac[2 + parent] = -1.0;
+            jac[2 + r.link] = 1.0;
+            jac[2 + r.parent] = -1.0;
+            if let Some(c) = clock {
+                jac[c] = r.clock_coef;
+            }
             rows.push(Row {
-                kind: RowKind::Lock { link },
+                kind: RowKind::Lock { link: r.link },
                 jac,
-                bias: 0.0,
+                bias: r.bias,
                 response: chol.solve(&jac),
+                target: r.target,
             });
+        }
+        if self.mechanism.root_fixed || clock.is_some() {
+            let root = if self.mechanism.root_fixed {
+                0..2
+            } else {
+                0..0
+            };
+            for k in root.chain(clock) {
+                let mut jac = SVector::<f64, N>::zeros();
+                jac[k] = 1.0;
+                rows.push(Row {
+                    kind: RowKind::Root,
+                    jac,
+                    bias: 0.0,
+                    response: chol.solve(&jac),
+                    target: qd[k],
+                });
+            }
         }
         if self.sign_model != SignModel::Modes {
             return rows;
@@ -381,6 +421,7 @@ impl<const N: usize> Model<N> {
                     jac: (u.transpose() * jac_e).transpose(),
                     bias: u.dot(&a_bias),
                     response: chol.solve(&gen),
+                    target: 0.0,
                 });
             }
         }

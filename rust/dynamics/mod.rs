@@ -94,6 +94,11 @@ pub struct ContactMode {
     /// the kink of l = min(d / cos q, L) is a located event too, so that a step never
     /// straddles it.
     pub full: bool,
+    /// Which of a box's four corners are in the sand (bit k: corner k of
+    /// `SoleContact::corners_local`): a corner crossing the surface adds or removes a vertex
+    /// of the immersed polygon, a kink of its area and of the drag's extent, located as an
+    /// event.
+    pub corners: u8,
 }
 
 impl Default for ContactMode {
@@ -105,6 +110,7 @@ impl Default for ContactMode {
             stopped: false,
             cross: Slip::Pos,
             full: false,
+            corners: 0,
         }
     }
 }
@@ -364,6 +370,8 @@ pub struct ContactEval {
     pub cross: f64,
     /// Margin to full immersion [m] (negative when wholly immersed).
     pub immersion_margin: f64,
+    /// y of a box's corners [m] (0 for a rod).
+    pub corners_y: [f64; 4],
     /// Magnitudes of the set-valued terms along x and y (the bounds of a sticking
     /// reaction) [N].
     pub bound: [f64; 2],

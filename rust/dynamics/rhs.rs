@@ -402,8 +402,14 @@ impl<const N: usize> Model<N> {
             }
             out.depth = geom.depth;
             out.immersion_margin = geom.margin;
+            if let Some(sg) = &geom.sole {
+                out.corners_y = sg.corners_y;
+            }
             let is_rod = matches!(c.shape, Shape::Rod(_));
-            let at_entry = geom.depth <= 0.0 && !self.forces.reads_frame;
+            // A box in contact with an edge on the surface (a flat sole at touchdown) takes
+            // its forces' limit from inside: no area yet, but the drag's extent is the edge.
+            let on_surface = geom.sole.is_some_and(|sg| sg.n_vertices >= 3);
+            let at_entry = geom.depth <= 0.0 && !self.forces.reads_frame && !on_surface;
             if at_entry && !is_rod {
                 continue;
             }
@@ -490,8 +496,7 @@ impl<const N: usize> Model<N> {
             };
         };
         let mut qdd = chol.solve(&rhs);
-        let has_locks = self.mechanism.locked_rows().next().is_some();
-        if has_locks || self.any_stuck(modes) {
+        if self.mechanism.has_constraints() || self.any_stuck(modes) {
             self.solve_constraints(
                 &pose,
                 q,
@@ -506,7 +511,8 @@ impl<const N: usize> Model<N> {
         // Power of the sand's forces at their points of application.
         let mut power = moment_power;
         for (ci, ce) in contacts.iter().enumerate().take(self.contacts.len()) {
-            if (ce.depth <= 0.0 && !self.forces.reads_frame) || !modes[ci].in_contact {
+            // (A contact whose force was not evaluated holds a zero force.)
+            if !modes[ci].in_contact {
                 continue;
             }
             let p = match self.apply_at {

@@ -120,7 +120,11 @@ impl<const N: usize> Model<N> {
     /// parent, one rod contact on it), or `None` for any other body.
     #[inline]
     pub(super) fn rigid_rod(&self) -> Option<&RodContact> {
-        if N != 3 || self.mechanism.links.len() != 1 || self.contacts.len() != 1 {
+        if N != 3
+            || self.mechanism.links.len() != 1
+            || self.contacts.len() != 1
+            || self.mechanism.root_fixed
+        {
             return None;
         }
         let link = &self.mechanism.links[0];

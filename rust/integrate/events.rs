@@ -8,7 +8,8 @@ use super::observe::Observer;
 use super::outcome::Stats;
 use super::solve::EndCondition;
 use super::stepper::{deriv_of, step, Deriv, Hermite, State};
-use crate::dynamics::{ContactMode, Eval, Model, Modes, SignModel, Slip, MAX_CONTACTS};
+use crate::body::{SoleContact, SoleModel};
+use crate::dynamics::{ContactMode, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS};
 use crate::forces::Switch;
 
 /// Relative tolerance of event location, in units of the step.
@@ -32,6 +33,8 @@ enum Kind {
     Stop,
     Immersion,
     Cross,
+    /// A box's corner (0..4) crossing the surface.
+    Corner(u8),
 }
 
 /// The value of a switching function: non-negative while the mode holds; the event is
@@ -55,6 +58,13 @@ fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) 
                 c.immersion_margin
             }
         }
+        Kind::Corner(k) => {
+            if modes[ci].corners & (1 << k) != 0 {
+                -c.corners_y[k as usize]
+            } else {
+                c.corners_y[k as usize]
+            }
+        }
     }
 }
 
@@ -69,6 +79,11 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
         }
         out.push((Kind::Exit, ci));
         out.push((Kind::Immersion, ci));
+        if is_box(model, ci) {
+            for k in 0..4 {
+                out.push((Kind::Corner(k), ci));
+            }
+        }
         if !m.stopped {
             out.push((Kind::Stop, ci));
         }
@@ -105,6 +120,26 @@ fn active<const N: usize>(model: &Model<N>, modes: &Modes, out: &mut Vec<(Kind, 
             }
         }
     }
+}
+
+/// Whether contact `ci` is a box (a sole): its corners are events.
+#[inline]
+fn is_box<const N: usize>(model: &Model<N>, ci: usize) -> bool {
+    matches!(
+        model.contacts[ci].shape,
+        Shape::Sole(SoleContact {
+            model: SoleModel::Box,
+            ..
+        })
+    )
+}
+
+/// The corners of box contact `ci` in the sand at `e` (bit k: corner k at or below the
+/// surface).
+#[inline]
+fn corners_in<const N: usize>(e: &Eval<N>, ci: usize) -> u8 {
+    let y = e.contacts[ci].corners_y;
+    (0..4).fold(0, |bits, k| if y[k] <= 0.0 { bits | 1 << k } else { bits })
 }
 
 /// Whether the function has crossed (the event happened by the end of the step).
@@ -182,6 +217,11 @@ fn enter_contact<const N: usize>(
     stats: &mut Stats,
 ) {
     modes[ci].in_contact = true;
+    if is_box(model, ci) {
+        let e = model.eval(&y.q, &y.qd, modes);
+        stats.rhs_evals += 1;
+        modes[ci].corners = corners_in(&e, ci);
+    }
     if model.sign_model != SignModel::Modes {
         return;
     }
@@ -400,7 +440,8 @@ impl Events {
     ///
     /// The interpolant's root is the step map's only to the interpolant's error: O(h^4)
     /// where the held modes keep the right-hand side smooth through the step, but first
-    /// order where the step straddles a kink no mode holds: the cap of the immersed
+    /// order where the step straddles a kink no mode holds: a box's corner crossing the
+    /// surface, the cap of the immersed
     /// length (l <= L, a sole box under the surface) and the exit, where the static
     /// term's d^lambda has an unbounded derivative. Polish those events on the map
     /// itself, h' -> g(step(y, h')), which is what the run will follow; its bracket [0, 1]
@@ -425,7 +466,10 @@ impl Events {
                 g0,
                 g1,
             } = *hit;
-            if !matches!(kind, Kind::Immersion | Kind::Exit) || guess <= 0.0 || guess >= 1.0 {
+            if !matches!(kind, Kind::Immersion | Kind::Exit | Kind::Corner(_))
+                || guess <= 0.0
+                || guess >= 1.0
+            {
                 continue;
             }
             let mut map = |th: f64| {
@@ -482,6 +526,7 @@ impl Events {
                     modes[ci].sy = Slip::Stick;
                 }
                 Kind::Immersion => modes[ci].full = !modes[ci].full,
+                Kind::Corner(k) => modes[ci].corners ^= 1 << k,
                 Kind::Cross => {
                     modes[ci].cross = if modes[ci].cross == Slip::Pos {
                         Slip::Neg

@@ -50,6 +50,7 @@ pub(super) fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
                 if let Some(terms) = terms::terms_from_py(t.iter()) {
                     return terms;
                 }
+                return Value::List(t.iter().map(|x| value_from_py(&x)).collect());
             }
         }
         return names_from_py(t.iter());
@@ -60,6 +61,7 @@ pub(super) fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
                 if let Some(terms) = terms::terms_from_py(l.iter()) {
                     return terms;
                 }
+                return Value::List(l.iter().map(|x| value_from_py(&x)).collect());
             }
         }
         return names_from_py(l.iter());
@@ -71,6 +73,10 @@ pub(super) fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         .unwrap_or_default();
     if type_name == "bool_" {
         return Value::Bool(v.is_truthy().unwrap_or(false));
+    }
+    // A `granrs.bodies.Linkage`: its plain form (a built-in body's name, or a mapping).
+    if let Ok(inner) = v.getattr(pyo3::intern!(v.py(), "_core_value")) {
+        return value_from_py(&inner);
     }
     match v.extract::<f64>() {
         Ok(x) => Value::Num(x),
@@ -183,5 +189,151 @@ pub fn scene_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
         d.set_item("doc", f.doc)?;
         out.append(d)?;
     }
+    Ok(out)
+}
+
+/// The table of a linkage's element fields ([`crate::spec::ELEMENT_FIELDS`]): element,
+/// name, unit, note and doc of each, for `granrs.bodies`, the TOML notes and the docs.
+#[pyfunction]
+pub fn element_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let out = PyList::empty(py);
+    for f in crate::spec::ELEMENT_FIELDS.iter() {
+        let d = PyDict::new(py);
+        d.set_item("element", f.element)?;
+        d.set_item("name", f.name)?;
+        d.set_item("unit", f.unit)?;
+        d.set_item("note", f.note)?;
+        d.set_item("doc", f.doc)?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
+/// A built-in body of a scene dict as a linkage's plain parts (`links`, `joints`,
+/// `contacts`, `root`, with angles in degrees), or a linkage's own: what
+/// `granrs.bodies.Linkage` holds; and `order`, the links' names in the engine's order (a
+/// parent before its children: the order of the state's angles and of the results' links).
+/// Only the body is read; `check` validates its structure and elements (not the rest of the
+/// scene).
+#[pyfunction]
+#[pyo3(signature = (scene, check=false))]
+pub fn body_linkage<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyDict>,
+    check: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    use crate::bodies::{ContactShape, RootKind};
+    use crate::body::Joint;
+    let err = |e| super::errors::to_pyerr(py, e);
+    let l = spec_from_dict(scene)
+        .body_scene()
+        .and_then(|s| s.linkage())
+        .map_err(err)?;
+    if check {
+        l.validate_body().map_err(err)?;
+    }
+    let pair = |v: nalgebra::Vector2<f64>| (v.x, v.y);
+    let links = PyList::empty(py);
+    for k in &l.links {
+        let d = PyDict::new(py);
+        d.set_item("name", &k.name)?;
+        d.set_item("mass", k.mass)?;
+        d.set_item("inertia", k.inertia)?;
+        d.set_item("length", k.length)?;
+        d.set_item("com", pair(k.com))?;
+        d.set_item("q_deg", k.q.to_degrees())?;
+        d.set_item("omega0", k.omega)?;
+        links.append(d)?;
+    }
+    let joints = PyList::empty(py);
+    for j in &l.joints {
+        let d = PyDict::new(py);
+        d.set_item("name", &j.name)?;
+        d.set_item("parent", &j.parent)?;
+        d.set_item("child", &j.child)?;
+        d.set_item("at", pair(j.at))?;
+        match j.joint {
+            Joint::Free => d.set_item("kind", "free")?,
+            Joint::Locked => d.set_item("kind", "locked")?,
+            Joint::Spring { k, c, rest } => {
+                d.set_item("kind", "spring")?;
+                d.set_item("k", k)?;
+                d.set_item("c", c)?;
+                d.set_item("rest_deg", rest.to_degrees())?;
+            }
+            Joint::Driven {
+                rate,
+                amplitude,
+                omega,
+                phase,
+            } => {
+                d.set_item("kind", "driven")?;
+                d.set_item("rate", rate)?;
+                if amplitude != 0.0 {
+                    d.set_item("amplitude_deg", amplitude.to_degrees())?;
+                    d.set_item("frequency", omega / (2.0 * std::f64::consts::PI))?;
+                    d.set_item("phase_deg", phase.to_degrees())?;
+                }
+            }
+        }
+        joints.append(d)?;
+    }
+    let contacts = PyList::empty(py);
+    for c in &l.contacts {
+        let d = PyDict::new(py);
+        d.set_item("name", &c.name)?;
+        d.set_item("link", &c.link)?;
+        match c.shape {
+            ContactShape::Rod {
+                tip,
+                length,
+                diameter,
+            } => {
+                d.set_item("shape", "rod")?;
+                d.set_item("at", pair(tip))?;
+                d.set_item("length", length)?;
+                d.set_item("diameter", diameter)?;
+            }
+            ContactShape::Box {
+                corner,
+                length,
+                height,
+                width,
+                l_ref,
+            } => {
+                d.set_item("shape", "box")?;
+                d.set_item("at", pair(corner))?;
+                d.set_item("length", length)?;
+                d.set_item("height", height)?;
+                d.set_item("width", width)?;
+                d.set_item("l_ref", l_ref)?;
+            }
+        }
+        contacts.append(d)?;
+    }
+    let root = PyDict::new(py);
+    root.set_item(
+        "kind",
+        match l.root.kind {
+            RootKind::Free => "free",
+            RootKind::Pinned => "pinned",
+            RootKind::Moving => "moving",
+        },
+    )?;
+    root.set_item("link", &l.root.link)?;
+    root.set_item("position", pair(l.root.position))?;
+    root.set_item("velocity", pair(l.root.velocity))?;
+    root.set_item("mass", l.root.mass)?;
+    let out = PyDict::new(py);
+    let order: Vec<&str> = l
+        .order()
+        .iter()
+        .map(|&i| l.links[i].name.as_str())
+        .collect();
+    out.set_item("order", order)?;
+    out.set_item("links", links)?;
+    out.set_item("joints", joints)?;
+    out.set_item("contacts", contacts)?;
+    out.set_item("root", root)?;
     Ok(out)
 }

@@ -47,6 +47,10 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::leg_segments, m)?)?;
     m.add_function(wrap_pyfunction!(terms::term_infos, m)?)?;
     m.add_function(wrap_pyfunction!(convert::scene_fields, m)?)?;
+    m.add_function(wrap_pyfunction!(convert::element_fields, m)?)?;
+    m.add_function(wrap_pyfunction!(convert::body_linkage, m)?)?;
+    m.add("MAX_LINKS", crate::bodies::MAX_LINKS)?;
+    m.add("MAX_CONTACTS", crate::dynamics::MAX_CONTACTS)?;
     m.add_function(wrap_pyfunction!(terms::check_term, m)?)?;
     m.add_function(wrap_pyfunction!(terms::rft_alpha, m)?)?;
     m.add("RFT_GENERIC", crate::forces::rft::GENERIC.to_vec())?;

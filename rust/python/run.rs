@@ -133,8 +133,16 @@ pub(super) fn compiled_scene<'py>(
         return Ok(compiled);
     }
     let body = fields.get_item(pyo3::intern!(py, "body"))?;
+    // A body is a name, or a `granrs.bodies.Linkage` whose `name` is a built-in body's or
+    // "linkage".
     let names = match &body {
-        Some(body) => core_fields.get_item(body)?,
+        Some(body) if body.is_instance_of::<pyo3::types::PyString>() => {
+            core_fields.get_item(body)?
+        }
+        Some(body) => match body.getattr(pyo3::intern!(py, "name")) {
+            Ok(name) => core_fields.get_item(name)?,
+            Err(_) => None,
+        },
         None => None,
     };
     let Some(names) = names else {

@@ -29,6 +29,8 @@ pub struct FieldInfo {
 const CHAIN: &[&str] = &["chain"];
 const LEG: &[&str] = &["leg"];
 const RODS: &[&str] = &["free_link", "chain"];
+/// The built-in bodies (a linkage's initial motion is in its elements).
+const BUILT_IN: &[&str] = &["free_link", "chain", "leg"];
 const ALL: &[&str] = &[];
 
 macro_rules! scene_fields {
@@ -65,13 +67,13 @@ scene_fields! {
         "where the contact terms act: \"tip\" (default; the thesis's CAD runs, sec. 3.3.2) or \"centroid\" (the immersed centroid E, sec. 3.3.1; strictly dissipative)";
     "atol": "solver", ALL, "-", "> 0",
         "absolute tolerance of \"dopri5\" [SI units of each coordinate]";
-    "body": "body", ALL, "", "free_link, chain or leg",
-        "the body model: \"free_link\" (a round rod, 3 degrees of freedom), \"chain\" (two rods pinned at their top ends, 4) or \"leg\" (foot, shank, thigh, half trunk, 6)";
+    "body": "body", ALL, "", "free_link, chain, leg or a linkage",
+        "the body: \"free_link\" (a round rod, 3 degrees of freedom), \"chain\" (two rods pinned at their top ends, 4), \"leg\" (foot, shank, thigh, half trunk, 6), each held as a granrs.bodies.Linkage, or a granrs.bodies.Linkage of your own (links, joints, contacts, root)";
     "body_mass": "body", LEG, "kg", "> 0; the leg carries half",
         "body mass (thesis sec. 5.2.1: 75.35); the leg carries half of it";
     "coefficients_source": "notes", ALL, "", "text",
         "where the force terms' parameters come from (for reports; not used by the run)";
-    "depth0": "start", ALL, "m", ">= 0",
+    "depth0": "start", BUILT_IN, "m", ">= 0",
         "initial depth of the tip (0: at the surface, as in the thesis)";
     "diameter": "body", RODS, "m", "> 0",
         "rod diameter d_c (thesis sec. 3.2.1: 0.0127); each chain link's";
@@ -139,9 +141,9 @@ scene_fields! {
         "tibia l_l (thesis sec. 5.3.2: 0.432): the shank and L_ref of eq. 5.4";
     "trunk_deg": "start", LEG, "deg", "-60..60",
         "trunk lean forward at touchdown (granrs assumption: 10)";
-    "v0": "start", ALL, "m/s", ">= 0",
+    "v0": "start", BUILT_IN, "m/s", ">= 0",
         "initial downward speed";
-    "vx0": "start", ALL, "m/s", "finite",
+    "vx0": "start", BUILT_IN, "m/s", "finite",
         "initial horizontal velocity of the tip";
 }
 
@@ -170,3 +172,74 @@ pub fn info(name: &str) -> Option<&'static FieldInfo> {
     let base = name.split('.').next().unwrap_or(name);
     field_slot(base).map(|i| &FIELDS[i])
 }
+
+/// One field of an element of a linkage (`granrs.bodies`: a link, a joint, a contact or
+/// the root).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ElementField {
+    /// The element: `link`, `joint`, `contact` or `root`.
+    pub element: &'static str,
+    /// The field's name (dataclass attribute, TOML key, error `field` after the element).
+    pub name: &'static str,
+    /// Its unit (`-`: none; a name or a kind: empty).
+    pub unit: &'static str,
+    /// A short note: the allowed values or range.
+    pub note: &'static str,
+    /// What it is.
+    pub doc: &'static str,
+}
+
+/// Every field of a linkage's elements, by element (the one table: the core's parsing,
+/// `granrs.bodies`' dataclasses and docs, the TOML notes).
+pub static ELEMENT_FIELDS: [ElementField; 33] = {
+    const fn f(
+        element: &'static str,
+        name: &'static str,
+        unit: &'static str,
+        note: &'static str,
+        doc: &'static str,
+    ) -> ElementField {
+        ElementField {
+            element,
+            name,
+            unit,
+            note,
+            doc,
+        }
+    }
+    [
+        f("link", "name", "", "unique", "the link's name (results: <name>.KE, <name>.PE)"),
+        f("link", "mass", "kg", "> 0", "mass"),
+        f("link", "inertia", "kg m^2", "> 0", "moment of inertia about the centre of mass, out of the plane"),
+        f("link", "length", "m", "> 0", "length along the link's axis (drawing and reports)"),
+        f("link", "com", "m", "(s, n), finite", "centre of mass in the link's (s, n) coordinates: s along the axis from the link's joint, n normal to it"),
+        f("link", "q_deg", "deg", "finite", "initial angle of the link's axis from the vertical"),
+        f("link", "omega0", "rad/s", "finite", "initial angular velocity (behind a locked or driven joint: the parent's plus the joint's rate)"),
+        f("joint", "name", "", "unique", "the joint's name (results: <name>.Fx, .Fy, .torque)"),
+        f("joint", "parent", "", "a link's name", "the link the joint sits on"),
+        f("joint", "child", "", "a link's name", "the link the joint carries (its (s, n) origin is the joint)"),
+        f("joint", "at", "m", "(s, n), finite", "where the joint sits on the parent, in the parent's (s, n) coordinates"),
+        f("joint", "kind", "", "free, locked, spring or driven", "\"free\" (frictionless), \"locked\", \"spring\" (a spring-damper k, c about rest_deg) or \"driven\" (its relative angle moves at rate)"),
+        f("joint", "k", "N m/rad", ">= 0", "a spring's stiffness"),
+        f("joint", "c", "N m s/rad", ">= 0", "a spring's damping"),
+        f("joint", "rest_deg", "deg", "finite; left out: the initial angle", "a spring's rest angle, child relative to parent; None: the initial relative angle"),
+        f("joint", "rate", "rad/s", "finite; left out: 0", "a driven joint's constant relative rate; its angle is the initial one plus rate t plus the sinusoid; the run reports the torque it takes"),
+        f("joint", "amplitude_deg", "deg", "finite; left out: 0", "a driven joint's sinusoid: amplitude_deg (sin(2 pi frequency t + phase) - sin(phase)) added to its angle"),
+        f("joint", "frequency", "Hz", "finite; needed with an amplitude", "the sinusoid's frequency"),
+        f("joint", "phase_deg", "deg", "finite; left out: 0", "the sinusoid's phase at t = 0"),
+        f("contact", "name", "", "text", "the contact's name"),
+        f("contact", "shape", "", "rod or box", "\"rod\" (a round rod meeting the sand with its tip: tip and outline) or \"box\" (a sole, a plate)"),
+        f("contact", "link", "", "a link's name", "the link the contact is fixed on"),
+        f("contact", "at", "m", "(s, n), finite", "a rod's tip, or a box's corner on the sole, in the link's (s, n) coordinates"),
+        f("contact", "length", "m", "> 0", "a rod's length from its tip along +s, or a box's along +s (also the width of a box's horizontal static term)"),
+        f("contact", "diameter", "m", "> 0", "a rod's diameter"),
+        f("contact", "height", "m", "> 0", "a box's height from the sole towards -n"),
+        f("contact", "width", "m", "> 0", "a box's width out of the plane"),
+        f("contact", "l_ref", "m", "> 0; left out: length", "reference length of the depth factor (eq. 5.4)"),
+        f("root", "kind", "", "free, pinned or moving", "\"free\" (a floating base), \"pinned\" (fixed in space) or \"moving\" (at a constant velocity)"),
+        f("root", "link", "", "a link's name", "the root link: its (s, n) origin is the root point"),
+        f("root", "position", "m", "(x, y), finite", "initial position of the root point (y = 0: the sand's surface)"),
+        f("root", "mass", "kg", ">= 0", "a point mass at the root (the chain's pin)"),
+        f("root", "velocity", "m/s", "(vx, vy), finite", "initial velocity of a free root; a moving root's constant one; none for a pinned root"),
+    ]
+};

@@ -8,7 +8,12 @@
 
 use std::borrow::Cow;
 
-use crate::bodies::{AnyScene, ChainScene, FreeLinkScene, LegScene, LEG_JOINTS};
+use nalgebra::Vector2;
+
+use crate::bodies::{
+    AnyScene, ChainScene, ContactShape, ContactSpec, FreeLinkScene, JointSpec, LegScene, LinkSpec,
+    LinkageScene, RootKind, RootSpec, LEG_JOINTS,
+};
 use crate::body::rod::ApplyAt;
 use crate::body::{Joint, SoleModel};
 use crate::dynamics::SignModel;
@@ -22,7 +27,7 @@ mod tests;
 mod value;
 
 use fields::field_slot;
-pub use fields::{FieldInfo, FIELDS, SCENE_FIELDS};
+pub use fields::{ElementField, FieldInfo, ELEMENT_FIELDS, FIELDS, SCENE_FIELDS};
 
 #[cfg(test)]
 pub(crate) use tests::free_link_spec;
@@ -215,9 +220,10 @@ impl SceneSpec {
     /// thesis's law with each term's defaults, Table 3.4 at q = 0, as `granrs.Scene`'s).
     fn forces(&self, n_contacts: usize) -> Result<ForceSet> {
         match self.get("forces") {
+            // (A body without contacts, a linkage swinging in the air, takes one row.)
             None | Some(Value::None) => Ok(ForceSet::thesis(&vec![
                 Coefficients::TABLE_3_4_VERTICAL;
-                n_contacts
+                n_contacts.max(1)
             ])),
             Some(Value::Terms(specs)) => ForceSet::build(specs, n_contacts),
             Some(Value::Names(n)) if n.is_empty() => ForceSet::build(&[], n_contacts),
@@ -282,7 +288,9 @@ impl SceneSpec {
         Ok(r)
     }
 
-    fn common(&self) -> Result<Common> {
+    /// The fields every body shares but the initial motion (a linkage's is in its
+    /// elements).
+    fn common_numerics(&self) -> Result<Common> {
         let apply_at = match self.str("apply_at")? {
             "tip" => ApplyAt::Tip,
             "centroid" => ApplyAt::Centroid,
@@ -324,9 +332,19 @@ impl SceneSpec {
                 end,
                 record: self.record()?,
             },
+            v0: 0.0,
+            depth0: 0.0,
+            vx0: 0.0,
+        })
+    }
+
+    fn common(&self) -> Result<Common> {
+        let c = self.common_numerics()?;
+        Ok(Common {
             v0: self.f64("v0")?,
             depth0: self.f64_or("depth0", 0.0)?,
             vx0: self.f64_or("vx0", 0.0)?,
+            ..c
         })
     }
 
@@ -415,8 +433,11 @@ impl SceneSpec {
         })
     }
 
-    /// The body named by the `body` field.
+    /// The body named by the `body` field (`"linkage"` for a linkage's mapping).
     pub fn body(&self) -> Result<&str> {
+        if let Some(Value::Map(_)) = self.get("body") {
+            return Ok("linkage");
+        }
         let body = self.str("body")?;
         if BODIES.contains(&body) {
             Ok(body)
@@ -427,13 +448,288 @@ impl SceneSpec {
 
     /// Build the scene and validate every field; the error names the first bad one.
     pub fn build(&self) -> Result<AnyScene> {
-        let scene = match self.body()? {
-            "free_link" => AnyScene::FreeLink(self.free_link()?),
-            "chain" => AnyScene::Chain(self.chain()?),
-            _ => AnyScene::Leg(self.leg()?),
-        };
+        let scene = self.body_scene()?;
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// Build the scene, checking only what building needs (types, names); [`Self::build`]
+    /// validates the rest.
+    pub fn body_scene(&self) -> Result<AnyScene> {
+        Ok(match self.body()? {
+            "free_link" => AnyScene::FreeLink(self.free_link()?),
+            "chain" => AnyScene::Chain(self.chain()?),
+            "linkage" => AnyScene::Linkage(self.linkage()?),
+            _ => AnyScene::Leg(self.leg()?),
+        })
+    }
+}
+
+/// The entries of one element of a linkage (`body.links[i]`, ...), each key checked
+/// against [`ELEMENT_FIELDS`].
+struct Element<'a> {
+    /// `links.<name>` (or `links[i]` before the name is known).
+    path: String,
+    entries: &'a [(Cow<'static, str>, Value)],
+}
+
+impl<'a> Element<'a> {
+    fn new(kind: &str, plural: &str, i: usize, v: &'a Value) -> Result<(Element<'a>, String)> {
+        let at = format!("{plural}[{i}]");
+        let Value::Map(entries) = v else {
+            return Err(wrong(&at, &format!("a {kind} (a mapping)"), v));
+        };
+        let allowed: Vec<&str> = ELEMENT_FIELDS
+            .iter()
+            .filter(|f| f.element == kind)
+            .map(|f| f.name)
+            .collect();
+        for (k, _) in entries.iter() {
+            if !allowed.contains(&k.as_ref()) {
+                return Err(unknown(&format!("{at}.{k}"), k, &allowed));
+            }
+        }
+        let name = match map_get(entries, "name") {
+            None | Some(Value::None) => String::new(),
+            Some(Value::Str(s)) => s.to_string(),
+            Some(other) => return Err(wrong(&format!("{at}.name"), "a string", other)),
+        };
+        let path = if name.is_empty() {
+            at
+        } else {
+            format!("{plural}.{name}")
+        };
+        Ok((Element { path, entries }, name))
+    }
+
+    fn field(&self, k: &str) -> String {
+        format!("{}.{k}", self.path)
+    }
+
+    fn get(&self, k: &str) -> Option<&'a Value> {
+        match map_get(self.entries, k) {
+            None | Some(Value::None) => None,
+            v => v,
+        }
+    }
+
+    fn num(&self, k: &str) -> Result<f64> {
+        num(&self.field(k), self.get(k))
+    }
+
+    fn num_or(&self, k: &str, default: f64) -> Result<f64> {
+        match self.get(k) {
+            None => Ok(default),
+            v => num(&self.field(k), v),
+        }
+    }
+
+    fn str(&self, k: &str) -> Result<&'a str> {
+        match self.get(k) {
+            None => Err(missing(&self.field(k))),
+            Some(Value::Str(s)) => Ok(s.as_ref()),
+            Some(other) => Err(wrong(&self.field(k), "a string", other)),
+        }
+    }
+
+    fn point_or(&self, k: &str, default: Vector2<f64>) -> Result<Vector2<f64>> {
+        match self.get(k) {
+            None => Ok(default),
+            Some(Value::List(xs)) if xs.len() == 2 => {
+                let a = num(&format!("{}[0]", self.field(k)), Some(&xs[0]))?;
+                let b = num(&format!("{}[1]", self.field(k)), Some(&xs[1]))?;
+                Ok(Vector2::new(a, b))
+            }
+            Some(other) => Err(wrong(&self.field(k), "a pair of numbers", other)),
+        }
+    }
+}
+
+/// The elements of one list of a linkage (`links`, `joints`, `contacts`).
+fn elements<'a>(entries: &'a [(Cow<'static, str>, Value)], k: &str) -> Result<&'a [Value]> {
+    match map_get(entries, k) {
+        None | Some(Value::None) => Ok(&[]),
+        Some(Value::List(items)) => Ok(items),
+        Some(Value::Names(n)) if n.is_empty() => Ok(&[]),
+        Some(other) => Err(wrong(k, "a list of mappings", other)),
+    }
+}
+
+impl SceneSpec {
+    /// A user-defined linkage: the `body` mapping (`links`, `joints`, `contacts`, `root`)
+    /// and the fields every body shares.
+    fn linkage(&self) -> Result<LinkageScene> {
+        let Some(Value::Map(body)) = self.get("body") else {
+            return Err(missing("body"));
+        };
+        for (k, _) in body.iter() {
+            if !["links", "joints", "contacts", "root"].contains(&k.as_ref()) {
+                return Err(unknown(
+                    &format!("body.{k}"),
+                    k,
+                    &["links", "joints", "contacts", "root"],
+                ));
+            }
+        }
+        let mut links = Vec::new();
+        for (i, v) in elements(body, "links")?.iter().enumerate() {
+            let (e, name) = Element::new("link", "links", i, v)?;
+            links.push(LinkSpec {
+                name,
+                mass: e.num("mass")?,
+                inertia: e.num("inertia")?,
+                com: e.point_or("com", Vector2::zeros())?,
+                length: e.num("length")?,
+                q: e.num_or("q_deg", 0.0)?.to_radians(),
+                omega: e.num_or("omega0", 0.0)?,
+            });
+        }
+        let mut joints = Vec::new();
+        for (i, v) in elements(body, "joints")?.iter().enumerate() {
+            let (e, name) = Element::new("joint", "joints", i, v)?;
+            let kind = match e.get("kind") {
+                None => "free",
+                Some(_) => e.str("kind")?,
+            };
+            let parent = e.str("parent")?.to_string();
+            let child = e.str("child")?.to_string();
+            let joint = match kind {
+                "free" => Joint::Free,
+                "locked" => Joint::Locked,
+                "spring" => {
+                    let rest = match e.get("rest_deg") {
+                        Some(_) => e.num("rest_deg")?.to_radians(),
+                        None => {
+                            // The initial relative angle.
+                            let q =
+                                |n: &str| links.iter().find(|l| l.name == n).map_or(0.0, |l| l.q);
+                            q(&child) - q(&parent)
+                        }
+                    };
+                    Joint::Spring {
+                        k: e.num("k")?,
+                        c: e.num("c")?,
+                        rest,
+                    }
+                }
+                "driven" => {
+                    let amplitude = e.num_or("amplitude_deg", 0.0)?;
+                    Joint::Driven {
+                        rate: e.num_or("rate", 0.0)?,
+                        amplitude: amplitude.to_radians(),
+                        omega: if amplitude != 0.0 {
+                            2.0 * std::f64::consts::PI * e.num("frequency")?
+                        } else {
+                            e.num_or("frequency", 0.0)?
+                        },
+                        phase: e.num_or("phase_deg", 0.0)?.to_radians(),
+                    }
+                }
+                other => {
+                    return Err(unknown(
+                        &e.field("kind"),
+                        other,
+                        &["free", "locked", "spring", "driven"],
+                    ))
+                }
+            };
+            joints.push(JointSpec {
+                name,
+                parent,
+                child,
+                at: e.point_or("at", Vector2::zeros())?,
+                joint,
+            });
+        }
+        let mut contacts = Vec::new();
+        for (i, v) in elements(body, "contacts")?.iter().enumerate() {
+            let (e, name) = Element::new("contact", "contacts", i, v)?;
+            let at = e.point_or("at", Vector2::zeros())?;
+            let length = e.num("length")?;
+            let shape = match e.str("shape")? {
+                "rod" => ContactShape::Rod {
+                    tip: at,
+                    length,
+                    diameter: e.num("diameter")?,
+                },
+                "box" => ContactShape::Box {
+                    corner: at,
+                    length,
+                    height: e.num("height")?,
+                    width: e.num("width")?,
+                    l_ref: e.num_or("l_ref", length)?,
+                },
+                other => return Err(unknown(&e.field("shape"), other, &["rod", "box"])),
+            };
+            contacts.push(ContactSpec {
+                name,
+                link: e.str("link")?.to_string(),
+                shape,
+            });
+        }
+        let root = match map_get(body, "root") {
+            None | Some(Value::None) => RootSpec {
+                kind: RootKind::Free,
+                link: links.first().map(|l| l.name.clone()).unwrap_or_default(),
+                position: Vector2::zeros(),
+                velocity: Vector2::zeros(),
+                mass: 0.0,
+            },
+            Some(v @ Value::Map(entries)) => {
+                let e = Element {
+                    path: "root".into(),
+                    entries,
+                };
+                for (k, _) in entries.iter() {
+                    if !ELEMENT_FIELDS
+                        .iter()
+                        .any(|f| f.element == "root" && f.name == k)
+                    {
+                        let allowed: Vec<&str> = ELEMENT_FIELDS
+                            .iter()
+                            .filter(|f| f.element == "root")
+                            .map(|f| f.name)
+                            .collect();
+                        return Err(unknown(&format!("root.{k}"), k, &allowed));
+                    }
+                }
+                let _ = v;
+                let kind = match e.get("kind") {
+                    None => RootKind::Free,
+                    Some(_) => match e.str("kind")? {
+                        "free" => RootKind::Free,
+                        "pinned" => RootKind::Pinned,
+                        "moving" => RootKind::Moving,
+                        other => {
+                            return Err(unknown("root.kind", other, &["free", "pinned", "moving"]))
+                        }
+                    },
+                };
+                RootSpec {
+                    kind,
+                    link: match e.get("link") {
+                        None => links.first().map(|l| l.name.clone()).unwrap_or_default(),
+                        Some(_) => e.str("link")?.to_string(),
+                    },
+                    position: e.point_or("position", Vector2::zeros())?,
+                    velocity: e.point_or("velocity", Vector2::zeros())?,
+                    mass: e.num_or("mass", 0.0)?,
+                }
+            }
+            Some(other) => return Err(wrong("root", "a mapping", other)),
+        };
+        let c = self.common_numerics()?;
+        Ok(LinkageScene {
+            forces: self.forces(contacts.len())?,
+            links,
+            joints,
+            contacts,
+            root,
+            medium: c.medium,
+            apply_at: c.apply_at,
+            sign_model: c.sign_model,
+            options: c.options,
+        })
     }
 }
 

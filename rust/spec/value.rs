@@ -21,6 +21,8 @@ pub enum Value {
     Map(Vec<(Cow<'static, str>, Value)>),
     /// A list of force terms, each with its parameters.
     Terms(Vec<TermSpec>),
+    /// A list of other values (a linkage's elements, a point's coordinates).
+    List(Vec<Value>),
     /// Anything else, by its type name (for the error message).
     Other(String),
 }
@@ -36,6 +38,7 @@ impl Value {
             Value::Names(_) => "a list".into(),
             Value::Map(_) => "a mapping".into(),
             Value::Terms(_) => "a list of force terms".into(),
+            Value::List(_) => "a list".into(),
             Value::Other(t) => t.clone(),
         }
     }
@@ -57,6 +60,9 @@ pub fn word(s: &str) -> Cow<'static, str> {
         "free_link" "chain" "leg" "tip" "centroid" "modes" "raw" "smooth" "rk4" "dopri5"
         "first_stop" "all_stops" "time" "free" "locked" "box" "thesis" "gravity" "drag"
         "static_h" "static_v" "joint_springs" "state" "forces" "energy" "eta_h" "eta_d"
-        "eta_v" "lam" "k" "c"
+        "eta_v" "lam" "k" "c" "links" "joints" "contacts" "root" "name" "mass" "inertia"
+        "length" "com" "q_deg" "omega0" "parent" "child" "at" "kind" "rest_deg" "rate" "shape"
+        "link" "diameter" "height" "width" "l_ref" "position" "velocity" "rod" "spring"
+        "driven" "pinned" "moving"
     )
 }

@@ -1,0 +1,807 @@
+//! A user-defined planar linkage: links, revolute joints, contacts of several shapes and a
+//! root that is free, pinned or moved at a constant velocity (`granrs.bodies.Linkage`).
+//!
+//! Every element has a name, and every error names the element (`links.shank.mass`,
+//! `joints.knee.parent`, ...). The linkage is checked in full before any work: unknown or
+//! duplicate names, links no joint connects to the root link, joint cycles, non-positive
+//! masses and inertias, too many links or contacts, contacts on unknown links and driven
+//! joints with non-finite trajectories are refused.
+//!
+//! The engine is the general one ([`Model`] over a [`Mechanism`] of `N = 2 + links`
+//! generalized coordinates), compiled for 1 to [`MAX_LINKS`] links; a single link whose
+//! root is its centre of mass with one rod contact (the free link) takes the closed-form
+//! fast path as before.
+
+use nalgebra::{SVector, Vector2};
+
+use super::{validate_joint_stiffness, validate_options};
+use crate::body::rod::ApplyAt;
+use crate::body::{Joint, Link, Mechanism, RodContact, SoleContact, SoleModel};
+use crate::dynamics::{Contact, Model, Shape, SignModel, MAX_CONTACTS, MAX_LOCKED};
+use crate::error::{check_finite, check_range, GranrsError, Result};
+use crate::forces::{ForceSet, Medium};
+use crate::integrate::{solve, Outcome, SolveOptions};
+
+/// Most links a linkage may have (the engine is compiled for 1 to `MAX_LINKS` links).
+pub const MAX_LINKS: usize = 6;
+
+/// One rigid link of a linkage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkSpec {
+    /// Its name (unique in the linkage).
+    pub name: String,
+    /// Mass [kg], > 0.
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass [kg m^2], > 0.
+    pub inertia: f64,
+    /// Centre of mass in the link's local (s, n) coordinates, from its joint [m].
+    pub com: Vector2<f64>,
+    /// Length [m] (drawing and reports), > 0.
+    pub length: f64,
+    /// Initial angle of the link's axis from the vertical [rad].
+    pub q: f64,
+    /// Initial angular velocity [rad/s] (a link behind a locked or driven joint takes its
+    /// parent's plus the joint's rate instead).
+    pub omega: f64,
+}
+
+/// A revolute joint between two links.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointSpec {
+    /// Its name (unique in the linkage).
+    pub name: String,
+    /// The parent link's name.
+    pub parent: String,
+    /// The child link's name (its local origin is at the joint).
+    pub child: String,
+    /// Where the joint is on the parent, local (s, n) coordinates [m].
+    pub at: Vector2<f64>,
+    /// Free, locked, a spring-damper (rest angle in rad) or driven at a constant rate.
+    pub joint: Joint,
+}
+
+/// A contact's shape and where it sits on its link.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactShape {
+    /// A round rod from `tip` along the link's +s axis.
+    Rod {
+        /// The tip, local (s, n) [m].
+        tip: Vector2<f64>,
+        /// Length [m].
+        length: f64,
+        /// Diameter [m].
+        diameter: f64,
+    },
+    /// A box (a sole, a plate) with one corner at `corner`, `length` along +s and `height`
+    /// towards -n, `width` out of the plane.
+    Box {
+        /// The corner on the sole (the heel), local (s, n) [m].
+        corner: Vector2<f64>,
+        /// Length along +s [m].
+        length: f64,
+        /// Height towards -n [m].
+        height: f64,
+        /// Width out of the plane [m].
+        width: f64,
+        /// Reference length of the depth factor [m].
+        l_ref: f64,
+    },
+}
+
+/// A contact of a linkage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactSpec {
+    /// Its name.
+    pub name: String,
+    /// The link it is fixed on.
+    pub link: String,
+    /// Its shape.
+    pub shape: ContactShape,
+}
+
+/// How the root moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RootKind {
+    /// A floating base: the root point moves freely, from its initial velocity.
+    Free,
+    /// Fixed in space.
+    Pinned,
+    /// Moved at its (constant) velocity.
+    Moving,
+}
+
+/// The root: the point the root link hangs from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RootSpec {
+    /// Free, pinned or moving.
+    pub kind: RootKind,
+    /// The root link (its local origin is the root point).
+    pub link: String,
+    /// Initial position [m].
+    pub position: Vector2<f64>,
+    /// Initial velocity (a moving root's constant one) [m/s].
+    pub velocity: Vector2<f64>,
+    /// A point mass at the root [kg].
+    pub mass: f64,
+}
+
+/// A linkage in sand: the body, the medium, the force terms, the numerics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkageScene {
+    /// The links.
+    pub links: Vec<LinkSpec>,
+    /// The joints.
+    pub joints: Vec<JointSpec>,
+    /// The contacts.
+    pub contacts: Vec<ContactSpec>,
+    /// The root.
+    pub root: RootSpec,
+    /// The sand.
+    pub medium: Medium,
+    /// Point of application of the forces.
+    pub apply_at: ApplyAt,
+    /// Sign model of the static terms.
+    pub sign_model: SignModel,
+    /// The force terms that act, with their parameters per contact.
+    pub forces: ForceSet,
+    /// Step, end and recording.
+    pub options: SolveOptions,
+}
+
+#[cold]
+fn bad(field: String, message: String) -> GranrsError {
+    GranrsError::InvalidScene { field, message }
+}
+
+fn check_point(field: &str, p: Vector2<f64>) -> Result<()> {
+    check_finite(&format!("{field}[0]"), p.x)?;
+    check_finite(&format!("{field}[1]"), p.y)?;
+    Ok(())
+}
+
+/// Run `$body` with `const $n: usize` set to `2 + $links` (1 to [`MAX_LINKS`] links).
+macro_rules! with_size {
+    ($links:expr, $n:ident => $body:expr) => {
+        match $links {
+            1 => {
+                const $n: usize = 3;
+                $body
+            }
+            2 => {
+                const $n: usize = 4;
+                $body
+            }
+            3 => {
+                const $n: usize = 5;
+                $body
+            }
+            4 => {
+                const $n: usize = 6;
+                $body
+            }
+            5 => {
+                const $n: usize = 7;
+                $body
+            }
+            6 => {
+                const $n: usize = 8;
+                $body
+            }
+            n => unreachable!("{n} links passed validation"),
+        }
+    };
+}
+
+impl LinkageScene {
+    /// Check the structure and every element; the error names the first bad one.
+    pub fn validate_body(&self) -> Result<()> {
+        let n = self.links.len();
+        if n == 0 || n > MAX_LINKS {
+            return Err(GranrsError::InvalidParameter {
+                field: "links".into(),
+                value: n as f64,
+                allowed: format!("1 to {MAX_LINKS} links"),
+            });
+        }
+        if self.contacts.len() > MAX_CONTACTS {
+            return Err(GranrsError::InvalidParameter {
+                field: "contacts".into(),
+                value: self.contacts.len() as f64,
+                allowed: format!("at most {MAX_CONTACTS} contacts"),
+            });
+        }
+        for (i, l) in self.links.iter().enumerate() {
+            let f = |k: &str| format!("links.{}.{k}", l.name);
+            if l.name.is_empty() {
+                return Err(bad(
+                    format!("links[{i}].name"),
+                    "a link needs a name".into(),
+                ));
+            }
+            if self.links[..i].iter().any(|o| o.name == l.name) {
+                return Err(bad(f("name"), format!("two links are named {:?}", l.name)));
+            }
+            check_range(&f("mass"), l.mass, 0.0, true)?;
+            check_range(&f("inertia"), l.inertia, 0.0, true)?;
+            check_range(&f("length"), l.length, 0.0, true)?;
+            check_point(&f("com"), l.com)?;
+            check_finite(&f("q_deg"), l.q)?;
+            check_finite(&f("omega0"), l.omega)?;
+        }
+        let r = &self.root;
+        if self.link_index(&r.link).is_none() {
+            return Err(self.unknown_link("root.link", &r.link));
+        }
+        check_range("root.mass", r.mass, 0.0, false)?;
+        check_point("root.position", r.position)?;
+        check_point("root.velocity", r.velocity)?;
+        if r.kind == RootKind::Pinned && r.velocity != Vector2::zeros() {
+            return Err(bad(
+                "root.velocity".into(),
+                "a pinned root does not move: leave the velocity out (or kind = \"moving\")".into(),
+            ));
+        }
+        let mut locked = 0;
+        for (i, j) in self.joints.iter().enumerate() {
+            let f = |k: &str| format!("joints.{}.{k}", j.name);
+            if j.name.is_empty() {
+                return Err(bad(
+                    format!("joints[{i}].name"),
+                    "a joint needs a name".into(),
+                ));
+            }
+            if self.joints[..i].iter().any(|o| o.name == j.name) {
+                return Err(bad(f("name"), format!("two joints are named {:?}", j.name)));
+            }
+            for (k, name) in [("parent", &j.parent), ("child", &j.child)] {
+                if self.link_index(name).is_none() {
+                    return Err(self.unknown_link(&f(k), name));
+                }
+            }
+            if j.parent == j.child {
+                return Err(bad(
+                    f("child"),
+                    "a joint connects two different links".into(),
+                ));
+            }
+            if j.child == r.link {
+                return Err(bad(
+                    f("child"),
+                    format!(
+                        "{:?} is the root link: it hangs from the root, not from a joint \
+                         (a joint cycle)",
+                        j.child
+                    ),
+                ));
+            }
+            if let Some(o) = self.joints[..i].iter().find(|o| o.child == j.child) {
+                return Err(bad(
+                    f("child"),
+                    format!(
+                        "link {:?} already hangs from joint {:?}: each link has one parent \
+                         (a joint cycle)",
+                        j.child, o.name
+                    ),
+                ));
+            }
+            check_point(&f("at"), j.at)?;
+            match j.joint {
+                Joint::Spring { k, c, rest } => {
+                    check_range(&f("k"), k, 0.0, false)?;
+                    check_range(&f("c"), c, 0.0, false)?;
+                    check_finite(&f("rest_deg"), rest)?;
+                }
+                Joint::Driven {
+                    rate,
+                    amplitude,
+                    omega,
+                    phase,
+                } => {
+                    for (k, v, what) in [
+                        ("rate", rate, "a finite rate [rad/s]"),
+                        ("amplitude_deg", amplitude, "a finite amplitude [deg]"),
+                        ("frequency", omega, "a finite frequency [Hz]"),
+                        ("phase_deg", phase, "a finite phase [deg]"),
+                    ] {
+                        if !v.is_finite() {
+                            return Err(GranrsError::InvalidParameter {
+                                field: f(k),
+                                value: v,
+                                allowed: format!("a finite trajectory: {what}"),
+                            });
+                        }
+                    }
+                    if amplitude != 0.0 && n >= MAX_LINKS {
+                        return Err(GranrsError::InvalidParameter {
+                            field: "links".into(),
+                            value: n as f64,
+                            allowed: format!(
+                                "at most {} links with a sinusoidal drive (its clock takes a \
+                                 coordinate)",
+                                MAX_LINKS - 1
+                            ),
+                        });
+                    }
+                    locked += 1;
+                }
+                Joint::Locked => locked += 1,
+                Joint::Free => {}
+            }
+        }
+        if locked > MAX_LOCKED {
+            return Err(GranrsError::InvalidParameter {
+                field: "joints".into(),
+                value: locked as f64,
+                allowed: format!("at most {MAX_LOCKED} locked or driven joints"),
+            });
+        }
+        // Every link reaches the root link through its parents (with one parent each and
+        // none for the root link, a walk that does not end there is a cycle or a gap).
+        for l in &self.links {
+            let mut at = l.name.as_str();
+            let mut steps = 0;
+            while at != r.link {
+                match self.joints.iter().find(|j| j.child == at) {
+                    Some(j) if steps <= n => {
+                        at = j.parent.as_str();
+                        steps += 1;
+                    }
+                    Some(_) => {
+                        return Err(bad(
+                            format!("links.{}", l.name),
+                            "its joints form a cycle that does not reach the root link".into(),
+                        ))
+                    }
+                    None => {
+                        return Err(bad(
+                            format!("links.{}", l.name),
+                            format!(
+                                "not connected: no joint leads from it to the root link {:?}",
+                                r.link
+                            ),
+                        ))
+                    }
+                }
+            }
+        }
+        for (i, c) in self.contacts.iter().enumerate() {
+            let name = if c.name.is_empty() {
+                format!("{i}")
+            } else {
+                c.name.clone()
+            };
+            let f = |k: &str| format!("contacts.{name}.{k}");
+            if self.link_index(&c.link).is_none() {
+                return Err(self.unknown_link(&f("link"), &c.link));
+            }
+            match c.shape {
+                ContactShape::Rod {
+                    tip,
+                    length,
+                    diameter,
+                } => {
+                    check_point(&f("at"), tip)?;
+                    check_range(&f("length"), length, 0.0, true)?;
+                    check_range(&f("diameter"), diameter, 0.0, true)?;
+                }
+                ContactShape::Box {
+                    corner,
+                    length,
+                    height,
+                    width,
+                    l_ref,
+                } => {
+                    check_point(&f("at"), corner)?;
+                    check_range(&f("length"), length, 0.0, true)?;
+                    check_range(&f("height"), height, 0.0, true)?;
+                    check_range(&f("width"), width, 0.0, true)?;
+                    check_range(&f("l_ref"), l_ref, 0.0, true)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Check every field (the body, the medium, the numerics and the joints' stiffness at
+    /// this step); the error names the first bad one.
+    pub fn validate(&self) -> Result<()> {
+        self.validate_body()?;
+        super::validate_medium(&self.medium)?;
+        validate_options(&self.options, &self.sign_model)?;
+        let order = self.order();
+        let names: Vec<String> = order
+            .iter()
+            .map(|&i| {
+                self.joints
+                    .iter()
+                    .find(|j| j.child == self.links[i].name)
+                    .map(|j| format!("joints.{}", j.name))
+                    .unwrap_or_default()
+            })
+            .collect();
+        let names: Vec<&str> = names.iter().map(|s| s.as_str()).collect();
+        with_size!(self.size(), N => {
+            let model = self.model::<N>();
+            validate_joint_stiffness(&model, &self.initial_state::<N>().0, &self.options, &names)
+        })
+    }
+
+    /// Whether a joint reads the time (a sinusoidal drive): the mechanism then has a clock
+    /// coordinate after the links' ([`Mechanism::clock`]).
+    pub fn has_clock(&self) -> bool {
+        self.joints.iter().any(|j| j.joint.reads_clock())
+    }
+
+    /// The generalized coordinates beyond the root's: a link's angle each, and the clock.
+    pub fn size(&self) -> usize {
+        self.links.len() + usize::from(self.has_clock())
+    }
+
+    fn link_index(&self, name: &str) -> Option<usize> {
+        self.links.iter().position(|l| l.name == name)
+    }
+
+    #[cold]
+    fn unknown_link(&self, field: &str, name: &str) -> GranrsError {
+        let names: Vec<&str> = self.links.iter().map(|l| l.name.as_str()).collect();
+        GranrsError::UnknownName {
+            field: field.into(),
+            value: name.into(),
+            allowed: format!("a link of this linkage: {}", names.join(", ")),
+        }
+    }
+
+    /// The links in the engine's order (a parent before its children): the root link, then
+    /// breadth first through the joints in their order. Needs a valid body.
+    pub fn order(&self) -> Vec<usize> {
+        let mut order = vec![self.link_index(&self.root.link).unwrap_or(0)];
+        let mut k = 0;
+        while k < order.len() {
+            let parent = &self.links[order[k]].name;
+            for j in self.joints.iter().filter(|j| &j.parent == parent) {
+                if let Some(c) = self.link_index(&j.child) {
+                    if !order.contains(&c) {
+                        order.push(c);
+                    }
+                }
+            }
+            k += 1;
+        }
+        order
+    }
+
+    /// The linkage as a model of `N = 2 + links` coordinates (a valid body).
+    pub fn model<const N: usize>(&self) -> Model<N> {
+        let order = self.order();
+        let slot = |name: &str| {
+            let i = self.link_index(name).unwrap_or(0);
+            order.iter().position(|&o| o == i).unwrap_or(0)
+        };
+        let links = order
+            .iter()
+            .map(|&i| {
+                let l = &self.links[i];
+                let joint = self.joints.iter().find(|j| j.child == l.name);
+                Link {
+                    mass: l.mass,
+                    inertia: l.inertia,
+                    com: l.com,
+                    parent: joint.map(|j| slot(&j.parent)),
+                    joint_on_parent: joint.map_or(Vector2::zeros(), |j| j.at),
+                    joint: joint.map_or(Joint::Free, |j| j.joint),
+                }
+            })
+            .collect();
+        let contacts = self
+            .contacts
+            .iter()
+            .map(|c| {
+                let link = slot(&c.link);
+                Contact {
+                    shape: match c.shape {
+                        ContactShape::Rod {
+                            tip,
+                            length,
+                            diameter,
+                        } => Shape::Rod(RodContact {
+                            link,
+                            tip,
+                            length,
+                            diameter,
+                        }),
+                        ContactShape::Box {
+                            corner,
+                            length,
+                            height,
+                            width,
+                            l_ref,
+                        } => Shape::Sole(SoleContact {
+                            link,
+                            angle_link: link,
+                            heel: corner,
+                            length,
+                            height,
+                            width,
+                            l_ref,
+                            model: SoleModel::Box,
+                        }),
+                    },
+                }
+            })
+            .collect();
+        Model {
+            mechanism: Mechanism {
+                links,
+                root_mass: self.root.mass,
+                root_fixed: self.root.kind != RootKind::Free,
+            },
+            contacts,
+            medium: self.medium,
+            apply_at: self.apply_at,
+            sign_model: self.sign_model,
+            forces: self.forces.clone(),
+        }
+    }
+
+    /// Initial coordinates and rates in the engine's order: the root's position and
+    /// velocity (zero for a pinned root), each link's angle and rate (behind a locked or
+    /// driven joint, the parent's rate plus the joint's).
+    pub fn initial_state<const N: usize>(&self) -> (SVector<f64, N>, SVector<f64, N>) {
+        let order = self.order();
+        let mut q = SVector::<f64, N>::zeros();
+        let mut qd = SVector::<f64, N>::zeros();
+        q[0] = self.root.position.x;
+        q[1] = self.root.position.y;
+        if self.root.kind != RootKind::Pinned {
+            qd[0] = self.root.velocity.x;
+            qd[1] = self.root.velocity.y;
+        }
+        for (k, &i) in order.iter().enumerate() {
+            let l = &self.links[i];
+            q[2 + k] = l.q;
+            qd[2 + k] = l.omega;
+            if let Some(j) = self.joints.iter().find(|j| j.child == l.name) {
+                let p = self.link_index(&j.parent).unwrap_or(0);
+                let pk = order.iter().position(|&o| o == p).unwrap_or(0);
+                match j.joint {
+                    Joint::Locked => qd[2 + k] = qd[2 + pk],
+                    Joint::Driven {
+                        rate,
+                        amplitude,
+                        omega,
+                        phase,
+                    } => qd[2 + k] = qd[2 + pk] + rate + amplitude * omega * phase.cos(),
+                    _ => {}
+                }
+            }
+        }
+        if self.has_clock() {
+            // The clock: q = t = 0, qdot = 1.
+            qd[N - 1] = 1.0;
+        }
+        (q, qd)
+    }
+
+    /// Validate and run.
+    pub fn run(&self) -> Result<Outcome> {
+        self.validate()?;
+        with_size!(self.size(), N => {
+            let (q0, qd0) = self.initial_state::<N>();
+            solve(&self.model::<N>(), q0, qd0, &self.options)
+        })
+    }
+}
+
+/// Names of a built-in body's parts, for [`LinkageScene::from_model`].
+pub struct PartNames<'a> {
+    /// Each link's, in the model's order.
+    pub links: &'a [&'a str],
+    /// The joint that carries each link (the root link's is not used).
+    pub joints: &'a [&'a str],
+    /// Each contact's.
+    pub contacts: &'a [&'a str],
+    /// Each link's length [m].
+    pub lengths: &'a [f64],
+}
+
+impl LinkageScene {
+    /// A built-in body's model and initial state as a linkage with a free root: the same
+    /// links, joints, contacts, medium, terms and numerics, so that it runs to the same
+    /// result. Fails (naming `sole_model`) for a contact a linkage cannot hold (the thesis
+    /// form of the sole).
+    pub fn from_model<const N: usize>(
+        model: &Model<N>,
+        q0: &SVector<f64, N>,
+        qd0: &SVector<f64, N>,
+        names: &PartNames<'_>,
+        options: &SolveOptions,
+    ) -> Result<LinkageScene> {
+        let m = &model.mechanism;
+        let name = |i: usize| names.links[i].to_string();
+        let links = m
+            .links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| LinkSpec {
+                name: name(i),
+                mass: l.mass,
+                inertia: l.inertia,
+                com: l.com,
+                length: names.lengths[i],
+                q: q0[2 + i],
+                omega: qd0[2 + i],
+            })
+            .collect();
+        let joints = m
+            .links
+            .iter()
+            .enumerate()
+            .filter_map(|(i, l)| {
+                l.parent.map(|p| JointSpec {
+                    name: names.joints[i].to_string(),
+                    parent: name(p),
+                    child: name(i),
+                    at: l.joint_on_parent,
+                    joint: l.joint,
+                })
+            })
+            .collect();
+        let mut contacts = Vec::with_capacity(model.contacts.len());
+        for (ci, c) in model.contacts.iter().enumerate() {
+            let (link, shape) =
+                match c.shape {
+                    Shape::Rod(r) => (
+                        r.link,
+                        ContactShape::Rod {
+                            tip: r.tip,
+                            length: r.length,
+                            diameter: r.diameter,
+                        },
+                    ),
+                    Shape::Sole(s) if s.model == SoleModel::Box => (
+                        s.link,
+                        ContactShape::Box {
+                            corner: s.heel,
+                            length: s.length,
+                            height: s.height,
+                            width: s.width,
+                            l_ref: s.l_ref,
+                        },
+                    ),
+                    Shape::Sole(_) => return Err(bad(
+                        "sole_model".into(),
+                        "the thesis form of the sole (eqs. 5.5-5.7) reads the shank's angle; a \
+                         linkage's box contact is the geometric box (sole_model = \"box\")"
+                            .into(),
+                    )),
+                };
+            contacts.push(ContactSpec {
+                name: names.contacts[ci].to_string(),
+                link: name(link),
+                shape,
+            });
+        }
+        let root = m.links.iter().position(|l| l.parent.is_none()).unwrap_or(0);
+        Ok(LinkageScene {
+            links,
+            joints,
+            contacts,
+            root: RootSpec {
+                kind: RootKind::Free,
+                link: name(root),
+                position: Vector2::new(q0[0], q0[1]),
+                velocity: Vector2::new(qd0[0], qd0[1]),
+                mass: m.root_mass,
+            },
+            medium: model.medium,
+            apply_at: model.apply_at,
+            sign_model: model.sign_model,
+            forces: model.forces.clone(),
+            options: *options,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bodies::{AnyScene, ChainScene, FreeLinkScene, LegScene};
+
+    /// Each built-in body as a linkage runs to the same outcome, bit for bit (the same
+    /// model and initial state through the same engine).
+    #[test]
+    fn built_in_bodies_run_the_same_as_linkages() {
+        let options = SolveOptions {
+            t_end: 0.05,
+            ..SolveOptions::default()
+        };
+        let scenes = [
+            AnyScene::FreeLink(FreeLinkScene {
+                q_deg: 30.0,
+                options,
+                ..FreeLinkScene::default()
+            }),
+            AnyScene::Chain(ChainScene {
+                options,
+                ..ChainScene::default()
+            }),
+            AnyScene::Leg(LegScene {
+                options,
+                ..LegScene::default()
+            }),
+        ];
+        for scene in scenes {
+            let linkage = scene.linkage().unwrap();
+            let a = scene.run().unwrap();
+            let b = linkage.run().unwrap();
+            // (Debug text: a NaN, a contact that has not stopped, equals itself there.)
+            assert_eq!(format!("{:?}", a.contacts), format!("{:?}", b.contacts));
+            assert_eq!(a.t_final, b.t_final);
+        }
+    }
+
+    fn pendulum(joint: Joint) -> LinkageScene {
+        let link = |name: &str, q: f64| LinkSpec {
+            name: name.into(),
+            mass: 1.0,
+            inertia: 0.0075,
+            com: Vector2::new(0.15, 0.0),
+            length: 0.3,
+            q,
+            omega: 0.0,
+        };
+        let scene = AnyScene::FreeLink(FreeLinkScene::default());
+        let base = scene.linkage().unwrap();
+        LinkageScene {
+            links: vec![link("a", 2.0), link("b", 2.5)],
+            joints: vec![JointSpec {
+                name: "j".into(),
+                parent: "a".into(),
+                child: "b".into(),
+                at: Vector2::new(0.3, 0.0),
+                joint,
+            }],
+            contacts: vec![],
+            root: RootSpec {
+                kind: RootKind::Pinned,
+                link: "a".into(),
+                position: Vector2::new(0.0, 1.0),
+                velocity: Vector2::zeros(),
+                mass: 0.0,
+            },
+            ..base
+        }
+    }
+
+    #[test]
+    fn structure_errors_name_the_element() {
+        let mut s = pendulum(Joint::Free);
+        s.joints[0].parent = "c".into();
+        let e = s.validate().unwrap_err();
+        assert!(
+            matches!(e, GranrsError::UnknownName { ref field, .. } if field == "joints.j.parent")
+        );
+        let mut s = pendulum(Joint::Free);
+        s.joints.clear();
+        let e = s.validate().unwrap_err();
+        assert!(matches!(e, GranrsError::InvalidScene { ref field, .. } if field == "links.b"));
+        let s = pendulum(Joint::driven(f64::NAN));
+        let e = s.validate().unwrap_err();
+        assert!(
+            matches!(e, GranrsError::InvalidParameter { ref field, .. } if field == "joints.j.rate")
+        );
+    }
+
+    #[test]
+    fn a_pinned_root_stays_put_and_a_locked_pendulum_swings_as_one() {
+        let mut s = pendulum(Joint::Locked);
+        s.options.t_end = 0.2;
+        s.options.end = crate::integrate::EndCondition::Time;
+        let model = s.model::<4>();
+        let (q0, qd0) = s.initial_state::<4>();
+        let e = model.eval(&q0, &qd0, &Default::default());
+        assert_eq!((e.qdd[0], e.qdd[1]), (0.0, 0.0));
+        assert!((e.qdd[2] - e.qdd[3]).abs() < 1e-12 * e.qdd[2].abs());
+        assert!(e.qdd[2].abs() > 1.0);
+    }
+}
