@@ -302,8 +302,7 @@ def term_rst(name: str) -> str:
         "",
         "In a scene file (:doc:`/scenes_toml`), with every parameter at its default"
         + (
-            f" ({', '.join(f'``{k}``' for k in example)}: an example value; it has no "
-            "default)"
+            f" ({', '.join(f'``{k}``' for k in example)}: an example value; it has no default)"
             if example
             else ""
         )
