@@ -56,6 +56,9 @@ use super::{
 /// second order in the element count on an oblique drop).
 pub const DEFAULT_ELEMENTS: usize = 8;
 
+/// Elements evaluated together in the element loop (independent square roots and divisions).
+const LANES: usize = 4;
+
 /// The paper's generic coefficients, in the order A00 A10 B11 B01 B-11 C11 C01 C-11 D10
 /// (Li, Zhang & Goldman 2013, supplementary Table S2; `shared/LAWS.md`).
 pub const GENERIC: [f64; 9] = [
@@ -162,6 +165,58 @@ fn alpha_affine<F: Real>(k: &[f64; 9], c2: F, s2: F) -> ([F; 2], [F; 2], [F; 2])
     ([-x0, z0], [-xc, zc], [xs, -zs])
 }
 
+/// One plate's element sums (`Rft::integrate`): the element at `t = k + 1/2` from the
+/// immersed part's start has depth `d0 + t dd` and velocity `v0 + t dv`; `g` is
+/// [`alpha_affine`]'s map; `sums` gathers `df`, `t df` and the moving elements' `(-alpha_x,
+/// alpha_z)`.
+struct PlateSums<F> {
+    v0: [F; 2],
+    dv: [F; 2],
+    d0: F,
+    dd: F,
+    load: F,
+    g: [[F; 2]; 3],
+    sums: [[F; 2]; 3],
+}
+
+impl<F: Real> PlateSums<F> {
+    /// Adds the `L` elements from `first`.
+    #[inline(always)]
+    fn add<const L: usize>(&mut self, first: usize) {
+        let zero = F::splat(0.0);
+        let one = F::splat(1.0);
+        let t: [F; L] = std::array::from_fn(|j| F::splat((first + j) as f64 + 0.5));
+        let v: [[F; 2]; L] = std::array::from_fn(|j| {
+            [
+                self.v0[0] + t[j] * self.dv[0],
+                self.v0[1] + t[j] * self.dv[1],
+            ]
+        });
+        // An element at rest has no direction: no force (the sticking reaction stands in
+        // where the whole contact is at rest).
+        let inv: [F; L] = std::array::from_fn(|j| {
+            let s = (v[j][0] * v[j][0] + v[j][1] * v[j][1]).sqrt();
+            s.select_pos(s.recip(), zero)
+        });
+        let [g0, gx, gy] = self.g;
+        let [mut sf, mut st, mut sg] = self.sums;
+        for j in 0..L {
+            let moving = inv[j].select_pos(one, zero);
+            let c = [v[j][0] * inv[j], v[j][1] * inv[j]];
+            let g = [
+                moving * g0[0] + c[0] * gx[0] + c[1] * gy[0],
+                moving * g0[1] + c[0] * gx[1] + c[1] * gy[1],
+            ];
+            let w = self.load * (self.d0 + t[j] * self.dd);
+            let df = [w * g[0], w * g[1]];
+            sf = [sf[0] + df[0], sf[1] + df[1]];
+            st = [st[0] + t[j] * df[0], st[1] + t[j] * df[1]];
+            sg = [sg[0] + g[0], sg[1] + g[1]];
+        }
+        self.sums = [sf, st, sg];
+    }
+}
+
 impl Rft {
     /// The force on the contact's immersed boundary and its moment about P, every element
     /// moving along its own velocity, or all along `dir` (a unit vector) when given.
@@ -174,8 +229,6 @@ impl Rft {
     #[inline(always)]
     fn integrate<F: Real>(&self, b: &Boundary<F>, dir: Option<[F; 2]>) -> ([F; 2], F) {
         let zero = F::splat(0.0);
-        let one = F::splat(1.0);
-        let half = F::splat(0.5);
         let zeta = F::splat(self.zeta);
         let (plates, np) = b.outline.plates(&b.frame);
         let mut f = [zero; 2];
@@ -204,29 +257,26 @@ impl Rft {
                     )
                 }
             };
-            // Sums over the plate: df, t df and the moving elements' (-alpha_x, alpha_z).
-            let mut sf = [zero; 2];
-            let mut st = [zero; 2];
-            let mut sg = [zero; 2];
-            for k in 0..self.elements {
-                let t = F::splat(k as f64) + half;
-                let v = [v0[0] + t * dv[0], v0[1] + t * dv[1]];
-                let s = (v[0] * v[0] + v[1] * v[1]).sqrt();
-                // An element at rest has no direction: no force (the sticking reaction
-                // stands in where the whole contact is at rest).
-                let moving = s.select_pos(one, zero);
-                let inv = s.select_pos(s.recip(), zero);
-                let c = (v[0] * inv, v[1] * inv);
-                let g = [
-                    moving * g0[0] + c.0 * gx[0] + c.1 * gy[0],
-                    moving * g0[1] + c.0 * gx[1] + c.1 * gy[1],
-                ];
-                let w = load * (d0 + t * dd);
-                let df = [w * g[0], w * g[1]];
-                sf = [sf[0] + df[0], sf[1] + df[1]];
-                st = [st[0] + t * df[0], st[1] + t * df[1]];
-                sg = [sg[0] + g[0], sg[1] + g[1]];
+            let mut plate = PlateSums {
+                v0,
+                dv,
+                d0,
+                dd,
+                load,
+                g: [g0, gx, gy],
+                sums: [[zero; 2]; 3],
+            };
+            // Elements in groups of LANES (independent square roots and divisions), the
+            // rest one by one.
+            let full = self.elements - self.elements % LANES;
+            for c in (0..full).step_by(LANES) {
+                plate.add::<LANES>(c);
             }
+            for c in full..self.elements {
+                plate.add::<1>(c);
+            }
+            // df, t df and the moving elements' (-alpha_x, alpha_z), over the plate.
+            let [sf, st, sg] = plate.sums;
             f = [f[0] + sf[0], f[1] + sf[1]];
             let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
             moment = moment + cross(r0, sf) + cross(el.step, st) + slope * cross(el.step, sg);
