@@ -56,9 +56,6 @@ use super::{
 /// second order in the element count on an oblique drop).
 pub const DEFAULT_ELEMENTS: usize = 8;
 
-/// Elements evaluated together in the element loop (independent square roots and divisions).
-const LANES: usize = 4;
-
 /// The paper's generic coefficients, in the order A00 A10 B11 B01 B-11 C11 C01 C-11 D10
 /// (Li, Zhang & Goldman 2013, supplementary Table S2; `shared/LAWS.md`).
 pub const GENERIC: [f64; 9] = [
@@ -266,14 +263,20 @@ impl Rft {
                 g: [g0, gx, gy],
                 sums: [[zero; 2]; 3],
             };
-            // Elements in groups of LANES (independent square roots and divisions), the
+            // Elements in groups of 8 and 4 (independent square roots and divisions), the
             // rest one by one.
-            let full = self.elements - self.elements % LANES;
-            for c in (0..full).step_by(LANES) {
-                plate.add::<LANES>(c);
+            let n = self.elements;
+            let mut c = 0;
+            while c + 8 <= n {
+                plate.add::<8>(c);
+                c += 8;
             }
-            for c in full..self.elements {
-                plate.add::<1>(c);
+            if c + 4 <= n {
+                plate.add::<4>(c);
+                c += 4;
+            }
+            for k in c..n {
+                plate.add::<1>(k);
             }
             // df, t df and the moving elements' (-alpha_x, alpha_z), over the plate.
             let [sf, st, sg] = plate.sums;
@@ -553,17 +556,20 @@ mod tests {
                 v_centroid: v,
                 held: [0.0; 2],
             };
-            let t = Rft {
-                zeta: 1e6,
-                elements: 5,
-                coefficients: GENERIC,
-            };
-            let (f, m) = t.integrate(&b, None);
-            let (fe, me) = element_sum(&t, &b);
-            let scale = fe[0].hypot(fe[1]);
-            assert!((f[0] - fe[0]).abs() < 1e-12 * scale, "{f:?} {fe:?}");
-            assert!((f[1] - fe[1]).abs() < 1e-12 * scale, "{f:?} {fe:?}");
-            assert!((m - me).abs() < 1e-12 * scale * l, "{omega}: {m} {me}");
+            // 3: one by one; 13: a group of 8, one of 4 and one alone.
+            for elements in [3, 13] {
+                let t = Rft {
+                    zeta: 1e6,
+                    elements,
+                    coefficients: GENERIC,
+                };
+                let (f, m) = t.integrate(&b, None);
+                let (fe, me) = element_sum(&t, &b);
+                let scale = fe[0].hypot(fe[1]);
+                assert!((f[0] - fe[0]).abs() < 1e-12 * scale, "{f:?} {fe:?}");
+                assert!((f[1] - fe[1]).abs() < 1e-12 * scale, "{f:?} {fe:?}");
+                assert!((m - me).abs() < 1e-12 * scale * l, "{omega}: {m} {me}");
+            }
         }
     }
 
