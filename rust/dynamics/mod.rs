@@ -277,22 +277,9 @@ pub fn terms_on(
     if forces.reads_frame {
         return terms_on_boundary(forces, terms, state, medium, out, bound);
     }
-    out.dynamic = Vector2::zeros();
-    out.statics = Vector2::zeros();
-    out.moment = 0.0;
-    *bound = [0.0; 2];
-    for (k, t) in terms.iter().enumerate() {
-        let tf = t.contact_force_local(state, medium);
-        let v = Vector2::new(tf.force[0], tf.force[1]);
-        out.terms[k] = v;
-        if forces.dynamic[k] {
-            out.dynamic += v;
-        } else {
-            out.statics += v;
-        }
-        bound[0] += tf.bound[0];
-        bound[1] += tf.bound[1];
-    }
+    sum_terms(forces, terms, out, bound, |t| {
+        t.contact_force_local(state, medium)
+    });
 }
 
 /// [`terms_on`] for a scene with a term that reads the contact's boundary (`rft`,
@@ -306,12 +293,27 @@ fn terms_on_boundary(
     out: &mut ContactForce,
     bound: &mut [f64; 2],
 ) {
+    sum_terms(forces, terms, out, bound, |t| {
+        t.contact_force(state, medium)
+    });
+}
+
+/// Each term's force by `force_of` into `out`, their sums by class, their moments and the
+/// bounds of a sticking reaction.
+#[inline(always)]
+fn sum_terms(
+    forces: &ForceSet,
+    terms: &[AnyTerm],
+    out: &mut ContactForce,
+    bound: &mut [f64; 2],
+    force_of: impl Fn(&AnyTerm) -> crate::forces::TermForce<f64>,
+) {
     out.dynamic = Vector2::zeros();
     out.statics = Vector2::zeros();
     out.moment = 0.0;
     *bound = [0.0; 2];
     for (k, t) in terms.iter().enumerate() {
-        let tf = t.contact_force(state, medium);
+        let tf = force_of(t);
         let v = Vector2::new(tf.force[0], tf.force[1]);
         out.terms[k] = v;
         if forces.dynamic[k] {
