@@ -1,5 +1,6 @@
-"""Bodies of your own: a planar :class:`Linkage` of rigid :class:`Link` s, revolute
-:class:`Joint` s, :class:`Contact` s with the sand and a :class:`Root`.
+"""Bodies of your own: a planar :class:`~granrs.bodies.Linkage` of rigid
+:class:`~granrs.bodies.Link` s, revolute :class:`~granrs.bodies.Joint` s,
+:class:`~granrs.bodies.Contact` s with the sand and a :class:`~granrs.bodies.Root`.
 
 A linkage is a tree: one link (the root link) hangs from the root point, every other link
 from one joint on its parent. Each link has its local coordinates ``(s, n)``: ``s`` along
