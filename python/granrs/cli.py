@@ -177,8 +177,10 @@ def _add_calibrate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         default="eta_h,eta_d,eta_v,lam",
         metavar="P,...",
         help=(
-            "comma-separated parameters: eta_h, eta_d, eta_v, lam; eta_v@45 (an angle node); "
-            "scale.eta_v (a factor on the base); joints.k, joints.c (leg)"
+            "comma-separated parameters: any term's as TERM.PARAM (static_v.eta_v, rft.zeta, "
+            "poncelet.k), a factor on one as scale.TERM.PARAM, a free-link angle node as "
+            "TERM.PARAM@45; the body's unknowns mass, pin_mass, joints.k, joints.c; the "
+            "thesis's short names eta_h, eta_d, eta_v, lam also work"
         ),
     )
     parser.add_argument(
