@@ -66,11 +66,7 @@ impl Term for Constant {
     }
 
     fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        TermForce {
-            force: [F::splat(self.fx), F::splat(self.fy)],
-            bound: [F::splat(0.0); 2],
-            moment: F::splat(0.0),
-        }
+        TermForce::force([F::splat(self.fx), F::splat(self.fy)])
     }
 }
 

@@ -64,10 +64,6 @@ impl Term for Drag {
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let k = -(F::splat(self.eta_d) * m.rho_g * c.area_speed);
-        TermForce {
-            force: [k * c.v[0], k * c.v[1]],
-            bound: [F::splat(0.0); 2],
-            moment: F::splat(0.0),
-        }
+        TermForce::force([k * c.v[0], k * c.v[1]])
     }
 }
