@@ -35,6 +35,7 @@ import argparse
 import collections
 import faulthandler
 import math
+import pathlib
 import random
 import signal
 import string
@@ -46,6 +47,7 @@ import granrs
 from granrs import Scene, _granrs, cases, forces, scenefile
 from granrs.errors import GranrsError
 
+C_LEG = pathlib.Path(__file__).parent.parent / "examples" / "scenes" / "c_leg_rft.toml"
 FIELDS = [
     name
     for name in Scene.__dataclass_fields__  # every Scene field
@@ -54,7 +56,8 @@ JOINT_FIELDS = ("pin_joint", "ankle", "knee", "hip")
 NAMES = (
     "free_link chain leg tip centroid modes raw smooth rk4 dopri5 first_stop all_stops time "
     "state forces energy gravity drag static_h static_v joint_springs free locked box thesis "
-    "rft rft_inertial poncelet zeta elements c k A00 Bm11"
+    "rft rft_inertial poncelet zeta elements c k A00 Bm11 arc radius start_deg end_deg "
+    "chords rate pinned moving"
 ).split()
 
 
@@ -190,6 +193,8 @@ def base_scenes() -> list[Scene]:
             v0=2.0,
             forces=[forces.gravity(), forces.rft(zeta=1e6, elements=2), forces.rft_inertial()],
         ),
+        # An arc contact on a driven root (issue 19): the C-leg scene file.
+        Scene.from_toml(C_LEG).replace(t_end=0.05),
     ]
 
 

@@ -1,11 +1,15 @@
-"""Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6).
+"""Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6), and
+among them random C-legs (issue 19).
 
 Checks that a long batch never returns NaN or infinity in a run that did not fail, never
 hangs and keeps its memory flat. Scenes are drawn from the valid domain of
 tests/test_properties.py (angle in (-90, 90) deg, v0 in [0, 10] m/s, coefficients 0..10x
 Table 3.4, masses 1 g .. 100 kg, every sign model, both points of application) with the
 thesis's step (dt = 1e-4 s by default; ``--dt-range`` draws dt from 1e-6 .. 1e-3 s) and
-``t_end`` capped so that a run takes at most ``--max-steps`` steps.
+``t_end`` capped so that a run takes at most ``--max-steps`` steps. One scene in twenty is
+a random arc contact instead (:func:`random_arc`): a linkage of one link carrying a circular
+arc of random radius, span and chords, on a pinned, moving or free root whose angle is
+driven at a random rate or free, under ``rft`` (with ``rft_inertial`` in half of them).
 
 They run in chunks (``--chunk``, 50,000 by default), each one ``granrs.sweep`` over a list
 of scenes; after each chunk the script prints the chunk, its seconds, the runs per second,
@@ -64,6 +68,9 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
     out = []
     for i in range(n):
         f = factors[i]
+        if rng.random() < 0.05:
+            out.append(random_arc(rng, float(dt[i]), float(t_end[i])))
+            continue
         out.append(
             Scene(
                 q_deg=float(q[i]),
@@ -81,6 +88,57 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
             )
         )
     return out
+
+
+def random_arc(rng: np.random.Generator, dt: float, t_end: float) -> Scene:
+    """A random valid arc contact (issue 19): radius 1 cm .. 20 cm, span 1 .. 360 deg,
+    1 .. MAX_CHORDS chords, on a link of 10 g .. 10 kg hung 0 .. 2 radii above the sand; the
+    root pinned (its angle driven at -30 .. 30 rad/s, or free), moving (down at 0 .. 3 m/s)
+    or free; rft with zeta 0 .. 1e7 N/m^3, and rft_inertial in half of them."""
+    from granrs.bodies import MAX_CHORDS, Contact, Link, Linkage, Root
+
+    radius = float(10.0 ** rng.uniform(-2.0, np.log10(0.2)))
+    start = float(rng.uniform(-360.0, 360.0))
+    span = float(rng.uniform(1.0, 360.0))
+    mass = float(10.0 ** rng.uniform(-2.0, 1.0))
+    kind = ("pinned", "moving", "free")[int(rng.integers(0, 3))]
+    rate = float(rng.uniform(-30.0, 30.0)) if kind != "free" and rng.random() < 0.7 else None
+    velocity = (float(rng.uniform(-1.0, 1.0)), float(-rng.uniform(0.0, 3.0)))
+    body = Linkage(
+        links=[
+            Link(
+                "leg",
+                mass,
+                mass * radius * radius,
+                2 * radius,
+                (radius, 0.0),
+                q_deg=float(rng.uniform(-180.0, 180.0)),
+            )
+        ],
+        contacts=[
+            Contact.arc(
+                "leg",
+                radius=radius,
+                start_deg=start,
+                end_deg=start + span,
+                width=float(rng.uniform(0.001, 0.05)),
+                at=(radius, 0.0),
+                chords=int(rng.integers(1, MAX_CHORDS + 1)),
+            )
+        ],
+        root=Root(
+            kind,
+            link="leg",
+            position=(0.0, float(rng.uniform(0.0, 2.0)) * radius),
+            velocity=(0.0, 0.0) if kind == "pinned" else velocity,
+            rate=rate,
+        ),
+    )
+    terms: list[forces.Term] = [forces.gravity(), forces.rft(zeta=float(rng.uniform(0.0, 1e7)))]
+    if rng.random() < 0.5:
+        terms.append(forces.rft_inertial(lam=float(rng.uniform(0.0, 2.0))))
+    return Scene(body=body, forces=terms, dt=dt, t_end=t_end, end="time",
+                 sign_model=SIGN_MODELS[int(rng.integers(0, 3))])  # fmt: skip
 
 
 def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
@@ -112,6 +170,10 @@ def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
 
 
 def describe(scene: Scene) -> str:
+    if scene.kind == "linkage":
+        return f"Scene(body={scene.body!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, " + (
+            f"sign_model={scene.sign_model!r}, forces={scene.forces!r})"
+        )
     return (
         f"Scene(q_deg={scene.q_deg!r}, v0={scene.v0!r}, vx0={scene.vx0!r}, "
         f"omega0={scene.omega0!r}, mass={scene.mass!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, "
@@ -136,24 +198,32 @@ def soak(args: argparse.Namespace) -> int:
         size = min(args.chunk, args.n - done)
         scenes = random_scenes(rng, size, args.dt_range, args.max_steps)
         t0 = time.perf_counter()
-        df = granrs.sweep(scenes, progress=False)
+        counts: collections.Counter[str] = collections.Counter()
+        # A sweep runs one body: the free links, then the arcs.
+        for kind in ("free_link", "linkage"):
+            where = [i for i, sc in enumerate(scenes) if sc.kind == kind]
+            if not where:
+                continue
+            group = [scenes[i] for i in where]
+            df = granrs.sweep(group, progress=False)
+            counts.update({str(k): int(v) for k, v in df["status"].value_counts().items() if v})
+            bad = (df["status"] == "failed").to_numpy()
+            for i in np.flatnonzero(bad):
+                failed.append((done + where[i], describe(group[i]), str(df["error"].iloc[i])))
+            ok = df[~bad]
+            numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
+            values = numeric.select_dtypes("number").to_numpy()
+            rows = np.flatnonzero(~np.isfinite(values).all(axis=1))
+            stopped = (ok["status"] == "stopped").to_numpy()
+            rows = np.union1d(rows, np.flatnonzero(stopped & ok["t_s"].isna().to_numpy()))
+            index = np.flatnonzero(~bad)
+            for r in rows:
+                cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
+                non_finite.append((done + where[index[r]], describe(group[index[r]]), cols))
+            del df, ok, numeric, values
         seconds = time.perf_counter() - t0
-        counts = df["status"].value_counts()
-        statuses.update({str(k): int(v) for k, v in counts.items() if v})
-        bad = (df["status"] == "failed").to_numpy()
-        for i in np.flatnonzero(bad):
-            failed.append((done + int(i), describe(scenes[i]), str(df["error"].iloc[i])))
-        ok = df[~bad]
-        numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
-        values = numeric.select_dtypes("number").to_numpy()
-        rows = np.flatnonzero(~np.isfinite(values).all(axis=1))
-        stopped = (ok["status"] == "stopped").to_numpy()
-        rows = np.union1d(rows, np.flatnonzero(stopped & ok["t_s"].isna().to_numpy()))
-        index = np.flatnonzero(~bad)
-        for r in rows:
-            cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
-            non_finite.append((done + int(index[r]), describe(scenes[index[r]]), cols))
-        del df, scenes, ok, numeric, values
+        statuses.update(counts)
+        del scenes
         rss.append(rss_mb())
         short = ", ".join(f"{k} {int(v)}" for k, v in counts.items() if v)
         print(

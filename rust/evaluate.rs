@@ -353,6 +353,7 @@ pub mod geoms {
                         }],
                         root_mass: 0.0,
                         root_fixed: false,
+                        root_rate: None,
                     },
                     contacts: vec![Contact { shape }],
                     medium,
@@ -431,6 +432,16 @@ pub mod geoms {
                     let t = sole.reference_point();
                     let centroid = sole.geometry(root, axis, normal).centroid;
                     (0.0, centroid, root + t.x * axis + t.y * normal)
+                }
+                Shape::Arc(arc) => {
+                    let normal = Vector2::new(axis.y, -axis.x);
+                    let t = arc.reference_point();
+                    let g = arc.geometry(root, axis, normal);
+                    (
+                        g.immersed_length,
+                        g.centroid,
+                        root + t.x * axis + t.y * normal,
+                    )
                 }
             };
             let apply = match model.apply_at {

@@ -136,6 +136,7 @@ fn one_link_engine_is_the_free_link() {
                 }],
                 root_mass: 0.0,
                 root_fixed: false,
+                root_rate: None,
             },
             contacts: vec![Contact {
                 shape: Shape::Rod(RodContact {

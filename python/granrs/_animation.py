@@ -6,6 +6,7 @@ and :class:`ImpactAnimation`. Kept apart because it imports matplotlib, which
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 
 from .animate import TERM_COLOURS, check_output
+from .bodies import DEFAULT_CHORDS
 from .errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -215,16 +217,26 @@ def _linkage_pose(result: Result, frames: np.ndarray) -> _Pose:
     for i, c in enumerate(body.contacts):  # type: ignore[union-attr]
         o, a = origin[c.link], q[c.link]
         s0, n0 = c.at
+        length = c.length or 0.0
         if c.shape == "rod":
             tip = _local(o, a, s0, n0)
-            top = _local(o, a, s0 + c.length, n0)
+            top = _local(o, a, s0 + length, n0)
             shape = _rod_outline(tip, top, c.diameter or 0.0)
             reference = tip
+        elif c.shape == "arc":
+            # A thin band about the arc (10 % of its radius thick), through its vertices.
+            r, start, end = c.radius or 0.0, c.start_deg or 0.0, c.end_deg or 0.0
+            phi = np.radians(np.linspace(start, end, (c.chords or DEFAULT_CHORDS) + 1))
+            band = [(s0 + k * r * np.cos(f), n0 + k * r * np.sin(f)) for k, f in
+                    [(1.05, f) for f in phi] + [(0.95, f) for f in phi[::-1]]]  # fmt: skip
+            shape = np.stack([_local(o, a, s, n) for s, n in band], axis=1)
+            mid = math.radians(0.5 * (start + end))
+            reference = _local(o, a, s0 + r * math.cos(mid), n0 + r * math.sin(mid))
         else:
             h = c.height or 0.0
-            corners = ((s0, n0), (s0 + c.length, n0), (s0 + c.length, n0 - h), (s0, n0 - h))
+            corners = ((s0, n0), (s0 + length, n0), (s0 + length, n0 - h), (s0, n0 - h))
             shape = np.stack([_local(o, a, s, n) for s, n in corners], axis=1)
-            reference = _local(o, a, s0 + 0.5 * c.length, n0)
+            reference = _local(o, a, s0 + 0.5 * length, n0)
         forces = _contact_forces(series, f"c{i}." if several else "", frames)
         contacts.append(_Contact(c.name or c.link, shape, reference, reference, forces))
     return _Pose(bars, None, contacts, size)

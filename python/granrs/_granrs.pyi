@@ -4,11 +4,13 @@ from collections.abc import Callable
 from typing import Any, final
 
 __all__ = [
+    "DEFAULT_CHORDS",
     "EFFECTS",
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
     "GEOM_OUTPUTS",
     "GEOM_STATE",
+    "MAX_CHORDS",
     "MAX_CONTACTS",
     "MAX_LINKS",
     "RECORDS",
@@ -45,6 +47,8 @@ RFT_GENERIC: list[float]
 SCENE_FIELDS: list[str]
 MAX_LINKS: int
 MAX_CONTACTS: int
+MAX_CHORDS: int
+DEFAULT_CHORDS: int
 
 @final
 class Compiled:

@@ -18,7 +18,8 @@ Every element is checked by the Rust core before any work; an error names the el
 element are one table of the core (:data:`ELEMENT_FIELDS`); the dataclasses below are held to
 it by a test.
 
-Limits: at most :data:`MAX_LINKS` links and :data:`MAX_CONTACTS` contacts.
+Limits: at most :data:`MAX_LINKS` links and :data:`MAX_CONTACTS` contacts, and an arc of
+at most :data:`MAX_CHORDS` chords.
 
 Example::
 
@@ -46,7 +47,9 @@ from . import _granrs
 from .errors import InvalidParameterError, UnknownNameError
 
 __all__ = [
+    "DEFAULT_CHORDS",
     "ELEMENT_FIELDS",
+    "MAX_CHORDS",
     "MAX_CONTACTS",
     "MAX_LINKS",
     "Contact",
@@ -173,7 +176,11 @@ class Joint:
 
 
 #: The shapes of contact.
-CONTACT_SHAPES: tuple[str, ...] = ("rod", "box")
+CONTACT_SHAPES: tuple[str, ...] = ("rod", "box", "arc")
+#: Most chords of an arc contact.
+MAX_CHORDS: int = int(_granrs.MAX_CHORDS)
+#: The chords of an arc contact unless it says otherwise.
+DEFAULT_CHORDS: int = int(_granrs.DEFAULT_CHORDS)
 
 
 @dataclass(frozen=True)
@@ -186,18 +193,29 @@ class Contact:
     * ``"box"``: a box (a sole, a plate) with its corner ``at`` on the sole, ``length``
       along ``+s``, ``height`` towards ``-n`` and ``width`` out of the plane; its immersed
       part is the box clipped by the surface (MODEL.md, "Foot"). ``l_ref``: the depth
-      factor's reference length (default: ``length``).
+      factor's reference length (default: ``length``);
+    * ``"arc"``: a thin circular arc (a C-shaped leg) with its centre ``at``, ``radius``,
+      from the angle ``start_deg`` to ``end_deg`` and ``width`` out of the plane, cut into
+      ``chords`` chords (default :data:`DEFAULT_CHORDS`, at most :data:`MAX_CHORDS`). The
+      angles are measured in the link's frame from its ``+s`` axis towards its ``+n`` axis:
+      the arc's point at angle ``phi`` is ``at + radius (cos phi, sin phi)`` in ``(s, n)``.
+      ``length`` is not used. Only the terms that read the boundary's chords act on it
+      (``rft``, ``rft_inertial``; and the body terms).
     """
 
     link: str
     shape: str
-    length: float
+    length: float | None = None
     at: Point = (0.0, 0.0)
     diameter: float | None = None
     height: float | None = None
     width: float | None = None
     l_ref: float | None = None
     name: str = ""
+    radius: float | None = None
+    start_deg: float | None = None
+    end_deg: float | None = None
+    chords: int | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "at", _point(self.at, f"contacts.{self.name or self.link}.at"))
@@ -223,6 +241,32 @@ class Contact:
         """A box contact (see the class)."""
         return cls(link, "box", length, at, height=height, width=width, l_ref=l_ref, name=name)
 
+    @classmethod
+    def arc(
+        cls,
+        link: str,
+        radius: float,
+        start_deg: float,
+        end_deg: float,
+        width: float,
+        at: Point = (0.0, 0.0),
+        chords: int | None = None,
+        name: str = "",
+    ) -> Contact:
+        """An arc contact (see the class): centre ``at``, from ``start_deg`` to ``end_deg``
+        (from ``+s`` towards ``+n``)."""
+        return cls(
+            link,
+            "arc",
+            at=at,
+            width=width,
+            radius=radius,
+            start_deg=start_deg,
+            end_deg=end_deg,
+            chords=chords,
+            name=name,
+        )
+
 
 #: How a root may move.
 ROOT_KINDS: tuple[str, ...] = ("free", "pinned", "moving")
@@ -234,13 +278,16 @@ class Root:
     floating base starting at ``position`` with ``velocity``), ``"pinned"`` (fixed at
     ``position``) or ``"moving"`` (at the constant ``velocity``, e.g. a leg on a robot body
     moving at constant speed). ``mass``: a point mass at the root [kg]. ``link=None``: the
-    first link."""
+    first link. ``rate`` [rad/s]: the root link's angle driven at this constant rate from
+    its ``q_deg`` (e.g. a C-leg turned about a fixed axle), held by a torque the run reports
+    as the joint ``root``'s; ``None``: its angle is free."""
 
     kind: str = "free"
     link: str | None = None
     position: Point = (0.0, 0.0)
     velocity: Point = (0.0, 0.0)
     mass: float = 0.0
+    rate: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", _point(self.position, "root.position"))

@@ -157,6 +157,7 @@ impl ChainScene {
                 links: vec![link(None), link(Some(0))],
                 root_mass: self.pin_mass,
                 root_fixed: false,
+                root_rate: None,
             },
             contacts: vec![rod(0), rod(1)],
             medium: self.medium,

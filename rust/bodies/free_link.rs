@@ -118,6 +118,7 @@ impl FreeLinkScene {
                 links: vec![link],
                 root_mass: 0.0,
                 root_fixed: false,
+                root_rate: None,
             },
             contacts: vec![Contact {
                 shape: Shape::Rod(RodContact {

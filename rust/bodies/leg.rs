@@ -337,6 +337,7 @@ impl LegScene {
                 links,
                 root_mass: 0.0,
                 root_fixed: false,
+                root_rate: None,
             },
             contacts: vec![Contact {
                 shape: Shape::Sole(self.sole()),

@@ -15,8 +15,9 @@
 use nalgebra::{SVector, Vector2};
 
 use super::{validate_joint_stiffness, validate_options};
+use crate::body::arc::MAX_CHORDS;
 use crate::body::rod::ApplyAt;
-use crate::body::{Joint, Link, Mechanism, RodContact, SoleContact, SoleModel};
+use crate::body::{ArcContact, Joint, Link, Mechanism, RodContact, SoleContact, SoleModel};
 use crate::dynamics::{Contact, Model, Shape, SignModel, MAX_CONTACTS, MAX_LOCKED};
 use crate::error::{check_finite, check_range, GranrsError, Result};
 use crate::forces::{ForceSet, Medium};
@@ -86,6 +87,22 @@ pub enum ContactShape {
         /// Reference length of the depth factor [m].
         l_ref: f64,
     },
+    /// A thin circular arc (`body::arc`): centre, radius, from `start` over `span` (angles
+    /// from +s towards +n), `width` out of the plane, cut into `chords` chords.
+    Arc {
+        /// The centre, local (s, n) [m].
+        centre: Vector2<f64>,
+        /// Radius [m].
+        radius: f64,
+        /// The first end's angle [rad].
+        start: f64,
+        /// The last end's angle [rad] (start < end <= start + 2 pi).
+        end: f64,
+        /// Width out of the plane [m].
+        width: f64,
+        /// The chords (1..=MAX_CHORDS; a non-integer is refused).
+        chords: f64,
+    },
 }
 
 /// A contact of a linkage.
@@ -123,6 +140,8 @@ pub struct RootSpec {
     pub velocity: Vector2<f64>,
     /// A point mass at the root [kg].
     pub mass: f64,
+    /// The root link's angle driven at this constant rate [rad/s], or `None`: free.
+    pub rate: Option<f64>,
 }
 
 /// A linkage in sand: the body, the medium, the force terms, the numerics.
@@ -235,6 +254,15 @@ impl LinkageScene {
         check_range("root.mass", r.mass, 0.0, false)?;
         check_point("root.position", r.position)?;
         check_point("root.velocity", r.velocity)?;
+        if let Some(rate) = r.rate {
+            if !rate.is_finite() {
+                return Err(GranrsError::InvalidParameter {
+                    field: "root.rate".into(),
+                    value: rate,
+                    allowed: "a finite rate [rad/s] of the root link's angle".into(),
+                });
+            }
+        }
         if r.kind == RootKind::Pinned && r.velocity != Vector2::zeros() {
             return Err(bad(
                 "root.velocity".into(),
@@ -397,6 +425,38 @@ impl LinkageScene {
                     check_range(&f("width"), width, 0.0, true)?;
                     check_range(&f("l_ref"), l_ref, 0.0, true)?;
                 }
+                ContactShape::Arc {
+                    centre,
+                    radius,
+                    start,
+                    end,
+                    width,
+                    chords,
+                } => {
+                    check_point(&f("at"), centre)?;
+                    check_range(&f("radius"), radius, 0.0, true)?;
+                    check_finite(&f("start_deg"), start)?;
+                    check_finite(&f("end_deg"), end)?;
+                    let span = end - start;
+                    if !(span > 0.0 && span <= std::f64::consts::TAU * (1.0 + 1e-12)) {
+                        return Err(GranrsError::InvalidParameter {
+                            field: f("end_deg"),
+                            value: end.to_degrees(),
+                            allowed: format!(
+                                "start_deg < end_deg <= start_deg + 360 (start_deg = {})",
+                                start.to_degrees()
+                            ),
+                        });
+                    }
+                    check_range(&f("width"), width, 0.0, true)?;
+                    if !(chords >= 1.0 && chords <= MAX_CHORDS as f64 && chords.fract() == 0.0) {
+                        return Err(GranrsError::InvalidParameter {
+                            field: f("chords"),
+                            value: chords,
+                            allowed: format!("a whole number from 1 to {MAX_CHORDS}"),
+                        });
+                    }
+                }
             }
         }
         Ok(())
@@ -406,6 +466,7 @@ impl LinkageScene {
     /// this step); the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
         self.validate_body()?;
+        self.validate_terms_on_shapes()?;
         super::validate_medium(&self.medium)?;
         validate_options(&self.options, &self.sign_model)?;
         let order = self.order();
@@ -424,6 +485,38 @@ impl LinkageScene {
             let model = self.model::<N>();
             validate_joint_stiffness(&model, &self.initial_state::<N>().0, &self.options, &names)
         })
+    }
+
+    /// Refuse a contact term that is not defined on a contact's shape (an arc: only the
+    /// terms of [`TermInfo::on_arc`](crate::forces::TermInfo::on_arc) act on it), naming the term and
+    /// the contact.
+    pub fn validate_terms_on_shapes(&self) -> Result<()> {
+        for (i, c) in self.contacts.iter().enumerate() {
+            if !matches!(c.shape, ContactShape::Arc { .. }) {
+                continue;
+            }
+            let name = if c.name.is_empty() {
+                format!("{i}")
+            } else {
+                c.name.clone()
+            };
+            if let Some(info) = self.forces.contact_info.iter().find(|t| !t.on_arc) {
+                let fine: Vec<&str> = crate::forces::TERMS
+                    .iter()
+                    .filter(|t| t.on_arc)
+                    .map(|t| t.name)
+                    .collect();
+                return Err(bad(
+                    format!("forces.{}", info.name),
+                    format!(
+                        "the term {:?} is not defined on an arc, and contacts.{name} is one;                          the terms that act on an arc: {}",
+                        info.name,
+                        fine.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Whether a joint reads the time (a sinusoidal drive): the mechanism then has a clock
@@ -525,6 +618,22 @@ impl LinkageScene {
                             l_ref,
                             model: SoleModel::Box,
                         }),
+                        ContactShape::Arc {
+                            centre,
+                            radius,
+                            start,
+                            end,
+                            width,
+                            chords,
+                        } => Shape::Arc(ArcContact {
+                            link,
+                            centre,
+                            radius,
+                            start,
+                            span: end - start,
+                            width,
+                            chords: chords as usize,
+                        }),
                     },
                 }
             })
@@ -534,6 +643,7 @@ impl LinkageScene {
                 links,
                 root_mass: self.root.mass,
                 root_fixed: self.root.kind != RootKind::Free,
+                root_rate: self.root.rate,
             },
             contacts,
             medium: self.medium,
@@ -560,6 +670,11 @@ impl LinkageScene {
             let l = &self.links[i];
             q[2 + k] = l.q;
             qd[2 + k] = l.omega;
+            if k == 0 {
+                if let Some(rate) = self.root.rate {
+                    qd[2] = rate;
+                }
+            }
             if let Some(j) = self.joints.iter().find(|j| j.child == l.name) {
                 let p = self.link_index(&j.parent).unwrap_or(0);
                 let pk = order.iter().position(|&o| o == p).unwrap_or(0);
@@ -668,6 +783,17 @@ impl LinkageScene {
                             l_ref: s.l_ref,
                         },
                     ),
+                    Shape::Arc(a) => (
+                        a.link,
+                        ContactShape::Arc {
+                            centre: a.centre,
+                            radius: a.radius,
+                            start: a.start,
+                            end: a.start + a.span,
+                            width: a.width,
+                            chords: a.chords as f64,
+                        },
+                    ),
                     Shape::Sole(_) => return Err(bad(
                         "sole_model".into(),
                         "the thesis form of the sole (eqs. 5.5-5.7) reads the shank's angle; a \
@@ -692,6 +818,7 @@ impl LinkageScene {
                 position: Vector2::new(q0[0], q0[1]),
                 velocity: Vector2::new(qd0[0], qd0[1]),
                 mass: m.root_mass,
+                rate: m.root_rate,
             },
             medium: model.medium,
             apply_at: model.apply_at,
@@ -768,6 +895,7 @@ mod tests {
                 position: Vector2::new(0.0, 1.0),
                 velocity: Vector2::zeros(),
                 mass: 0.0,
+                rate: None,
             },
             ..base
         }

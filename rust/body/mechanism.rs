@@ -114,6 +114,9 @@ pub struct Mechanism<const N: usize> {
     /// Whether the root's motion is prescribed (pinned, or moved at its initial velocity):
     /// its coordinates then have zero acceleration, held by a reaction.
     pub root_fixed: bool,
+    /// The root link's angle driven at this constant rate [rad/s] (held by a torque that the
+    /// run reports as the root link's joint torque), or `None`: free.
+    pub root_rate: Option<f64>,
 }
 
 /// Positions and axes of every link for one configuration.
@@ -161,6 +164,25 @@ impl<const N: usize> Mechanism<N> {
             .filter_map(|(i, l)| match (l.parent, l.joint) {
                 (Some(p), Joint::Locked | Joint::Driven { .. }) => Some((i, p)),
                 _ => None,
+            })
+    }
+
+    /// The root links (no parent) whose angle is driven at a constant rate, with the rate.
+    pub fn driven_roots(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.links
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.parent.is_none())
+            .filter_map(|(i, _)| self.root_rate.map(|r| (i, r)))
+    }
+
+    /// Whether every coordinate's motion is prescribed (a pinned or moving root, a driven
+    /// root angle, and every other joint locked or driven): nothing the sand does moves it.
+    pub fn prescribed(&self) -> bool {
+        self.root_fixed
+            && self.root_rate.is_some()
+            && self.links.iter().all(|l| {
+                l.parent.is_none() || matches!(l.joint, Joint::Locked | Joint::Driven { .. })
             })
     }
 
@@ -218,7 +240,10 @@ impl<const N: usize> Mechanism<N> {
     /// a prescribed root, or a clock.
     #[inline]
     pub fn has_constraints(&self) -> bool {
-        self.root_fixed || self.clock().is_some() || self.locked_rows().next().is_some()
+        self.root_fixed
+            || self.root_rate.is_some()
+            || self.clock().is_some()
+            || self.locked_rows().next().is_some()
     }
 
     /// Add the spring-damper torques of the joints to the generalized forces `out`; return
@@ -484,6 +509,7 @@ mod tests {
             links: vec![link.clone(), link],
             root_mass: 0.01,
             root_fixed: false,
+            root_rate: None,
         }
     }
 

@@ -14,8 +14,8 @@ use crate::body::mechanism::Pose;
 use crate::forces::{ForceSet, Switch};
 
 /// Most constraint rows at once: two sticking components per contact, the locked (and
-/// driven) joints, a prescribed root's two and the clock's.
-const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED + 3;
+/// driven) joints, a prescribed root's two, a driven root angle's and the clock's.
+const MAX_ROWS: usize = 2 * MAX_CONTACTS + MAX_LOCKED + 4;
 
 /// Unit vector of axis `k` (0 = x, 1 = y).
 #[inline]
@@ -32,7 +32,7 @@ fn unit(k: usize) -> Vector2<f64> {
 enum RowKind {
     /// A sticking component: contact and axis (0 = x, 1 = y).
     Stick { contact: usize, axis: usize },
-    /// A locked (or driven) joint of this link.
+    /// A locked (or driven) joint of this link, or its driven angle for a root link.
     Lock { link: usize },
     /// A prescribed root's coordinate (0 = x, 1 = y).
     Root,
@@ -280,6 +280,11 @@ impl<const N: usize> Model<N> {
                 a[2 + parent] = -1.0;
                 a
             })
+            .chain(self.mechanism.driven_roots().map(|(link, _)| {
+                let mut a = SVector::<f64, N>::zeros();
+                a[2 + link] = 1.0;
+                a
+            }))
             .chain(
                 (0..2)
                     .filter(|_| self.mechanism.root_fixed)
@@ -358,6 +363,18 @@ impl<const N: usize> Model<N> {
                 bias: r.bias,
                 response: chol.solve(&jac),
                 target: r.target,
+            });
+        }
+        for (link, rate) in self.mechanism.driven_roots() {
+            // A root link's angle driven at a constant rate: qdot_link = rate.
+            let mut jac = SVector::<f64, N>::zeros();
+            jac[2 + link] = 1.0;
+            rows.push(Row {
+                kind: RowKind::Lock { link },
+                jac,
+                bias: 0.0,
+                response: chol.solve(&jac),
+                target: rate,
             });
         }
         if self.mechanism.root_fixed || clock.is_some() {

@@ -22,7 +22,7 @@
 use nalgebra::{SVector, Vector2};
 
 use crate::body::rod::ApplyAt;
-use crate::body::{Mechanism, RodContact, SoleContact};
+use crate::body::{ArcContact, Mechanism, RodContact, SoleContact};
 use crate::forces::registry::MAX_TERMS;
 use crate::forces::{AnyTerm, ContactState, ForceSet, Medium, Switch};
 
@@ -125,6 +125,8 @@ pub enum Shape {
     Rod(RodContact),
     /// A foot's sole box (leg).
     Sole(SoleContact),
+    /// A thin circular arc (a C-shaped leg), as its chords.
+    Arc(ArcContact),
 }
 
 /// One contact of a body: which link, where, what shape. The force terms and their
@@ -142,16 +144,19 @@ impl Contact {
         match &self.shape {
             Shape::Rod(r) => r.link,
             Shape::Sole(s) => s.link,
+            Shape::Arc(a) => a.link,
         }
     }
 
-    /// The reference point T (local coordinates): a rod's tip, the middle of a sole. Its
+    /// The reference point T (local coordinates): a rod's tip, the middle of a sole, the
+    /// middle of an arc. Its
     /// depth and vertical velocity give the contact's depth and stop.
     #[inline]
     pub fn reference_point(&self) -> Vector2<f64> {
         match &self.shape {
             Shape::Rod(r) => r.tip,
             Shape::Sole(s) => s.reference_point(),
+            Shape::Arc(a) => a.reference_point(),
         }
     }
 }

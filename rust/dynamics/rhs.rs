@@ -113,6 +113,26 @@ impl<const N: usize> Model<N> {
                     },
                 }
             }
+            Shape::Arc(arc) => {
+                let joint = pose.joint[link];
+                let normal = pose.normal[link];
+                let g = arc.geometry(joint, axis, normal);
+                let rel = g.centroid - joint;
+                Geometry {
+                    depth: g.depth,
+                    centroid: Vector2::new(rel.dot(&axis), rel.dot(&normal)),
+                    // A thin arc has no volume; the terms that read it (and A_r, w, L_ref)
+                    // are refused on an arc before any work (`ForceSet::check_shapes`).
+                    volume: 0.0,
+                    width: arc.width,
+                    l_ref: arc.radius,
+                    margin: g.highest,
+                    lowest: g.lowest,
+                    cross_axis: axis,
+                    factor: 0.0,
+                    sole: None,
+                }
+            }
         }
     }
 
@@ -142,6 +162,20 @@ impl<const N: usize> Model<N> {
                     .map(|w| [w.x, w.y]),
                 width: sole.width,
             },
+            Shape::Arc(arc) => {
+                let centre = self.mechanism.point(pose, link, arc.centre);
+                let first = self.mechanism.point(pose, link, arc.vertex(0));
+                // phi grows from +s towards +n, the axis turned clockwise: in the world a
+                // chord turns the vertex by -span / chords.
+                let (sin, cos) = arc.chord_angle().sin_cos();
+                Outline::Arc {
+                    centre: [centre.x, centre.y],
+                    first: [first.x, first.y],
+                    turn: [cos, -sin],
+                    chords: arc.chords,
+                    width: arc.width,
+                }
+            }
         };
         let tip = self.mechanism.point(pose, link, t_local);
         let v_tip = self.mechanism.point_velocity(pose, link, t_local, qd);
@@ -204,9 +238,9 @@ impl<const N: usize> Model<N> {
                 let l_rate = rod.immersed_length_rate(&g, axis, -v_tip.y, -axis.x * omega);
                 Vector2::new(0.5 * l_rate, 0.0)
             }
-            Shape::Sole(_) => {
-                // Central difference along the motion (the polygon's centroid has no simple
-                // closed-form rate).
+            Shape::Sole(_) | Shape::Arc(_) => {
+                // Central difference along the motion (the polygon's or the chords' centroid
+                // has no simple closed-form rate).
                 let h = 1e-7;
                 let at = |sign: f64| {
                     let qh = q + (sign * h) * qd;

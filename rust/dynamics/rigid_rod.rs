@@ -124,6 +124,7 @@ impl<const N: usize> Model<N> {
             || self.mechanism.links.len() != 1
             || self.contacts.len() != 1
             || self.mechanism.root_fixed
+            || self.mechanism.root_rate.is_some()
         {
             return None;
         }

@@ -255,3 +255,60 @@ fn only_a_rod_about_its_centre_of_mass_is_closed_form() {
     model.mechanism.links[0].com = Vector2::new(0.01, 0.0);
     assert!(model.rigid_rod().is_none());
 }
+
+/// An arc's outline, as the terms walk it, runs through the arc's own vertices (placed on
+/// the link by the mechanism): the world turn from one to the next has the sign of the
+/// link's frame (phi from +s towards +n, a clockwise turn in the world).
+#[test]
+fn an_arc_outline_walks_its_vertices() {
+    use crate::body::{ArcContact, Joint, Link, Mechanism};
+    let arc = ArcContact {
+        link: 0,
+        centre: Vector2::new(0.03, 0.01),
+        radius: 0.03,
+        start: 2.5,
+        span: 4.0,
+        width: 0.01,
+        chords: 7,
+    };
+    let model = Model::<3> {
+        mechanism: Mechanism {
+            links: vec![Link {
+                mass: 0.1,
+                inertia: 1e-4,
+                com: Vector2::zeros(),
+                parent: None,
+                joint_on_parent: Vector2::zeros(),
+                joint: Joint::Free,
+            }],
+            root_mass: 0.0,
+            root_fixed: true,
+            root_rate: Some(3.0),
+        },
+        contacts: vec![Contact {
+            shape: Shape::Arc(arc),
+        }],
+        medium: Default::default(),
+        apply_at: ApplyAt::Tip,
+        sign_model: SignModel::Modes,
+        forces: thesis_subset(1, 1),
+    };
+    let q = SVector::<f64, 3>::new(0.1, -0.02, 0.7);
+    let qd = SVector::<f64, 3>::new(0.0, 0.0, 3.0);
+    let pose = model.mechanism.pose(&q);
+    let c = &model.contacts[0];
+    let geom = model.geometry(c, &pose);
+    let b = model.boundary(c, &pose, &qd, &geom, Vector2::zeros());
+    let plates: Vec<_> = b.outline.plates(&b.frame).collect();
+    assert_eq!(plates.len(), 7);
+    for (k, p) in plates.iter().enumerate() {
+        let a = model.mechanism.point(&pose, 0, arc.vertex(k));
+        let e = model.mechanism.point(&pose, 0, arc.vertex(k + 1));
+        assert!((Vector2::new(p.a[0], p.a[1]) - a).norm() < 1e-15, "{k}");
+        assert!((Vector2::new(p.b[0], p.b[1]) - e).norm() < 1e-15, "{k}");
+        assert_eq!(p.width, 0.01);
+    }
+    // The driven root angle: qdot_link = rate held, the root pinned; nothing else moves.
+    let e = model.eval(&q, &qd, &Default::default());
+    assert!(e.qdd.norm() < 1e-12, "{}", e.qdd);
+}

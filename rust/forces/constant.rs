@@ -53,6 +53,7 @@ impl Term for Constant {
         reads: "nothing",
         reads_area_speed: false,
         reads_frame: false,
+        on_arc: true,
         switches: &[],
         columns: &[("F_cx", 0), ("F_cy", 1)],
     };

@@ -217,6 +217,21 @@ pub enum Outline<F> {
         /// w_s [m].
         width: F,
     },
+    /// A thin circular arc cut into chords (`body::arc`): its centre, its first vertex,
+    /// the turn from one vertex to the next about the centre, its chord count and its width
+    /// out of the plane.
+    Arc {
+        /// The centre, world coordinates [m].
+        centre: [F; 2],
+        /// The first vertex, world coordinates [m].
+        first: [F; 2],
+        /// `(cos, sin)` of the world angle from one vertex to the next.
+        turn: [F; 2],
+        /// The number of chords.
+        chords: usize,
+        /// Width out of the plane [m].
+        width: F,
+    },
 }
 
 /// What a contact term returns: its force and, for a set-valued (Coulomb-like) term, the
@@ -343,6 +358,10 @@ pub struct TermInfo {
     /// Whether it reads [`ContactState::boundary`] (filled only
     /// when a listed term does).
     pub reads_frame: bool,
+    /// Whether it is defined on an arc contact (`body::arc`): a term that reads the
+    /// boundary's chords, or none of the contact's shape. A contact term that is not is
+    /// refused on an arc before any work, naming the term and the contact.
+    pub on_arc: bool,
     /// The switches it owns.
     pub switches: &'static [Switch],
     /// Its per-contact series columns (`c{i}.{column}` with `record=("forces",)`) and the

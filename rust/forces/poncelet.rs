@@ -66,12 +66,16 @@ impl Poncelet {
                     + diameter * immersed * across
             }
             Outline::Box { width, .. } => {
-                let (plates, _) = b.outline.plates(&b.frame);
+                let plates = b.outline.plates(&b.frame);
+                let plates = plates.fixed();
                 let immersed = |i: usize| plates[i].immersed().length();
                 let bottom = immersed(0);
                 let face = immersed(1).max(immersed(2));
                 width * (bottom * across + face * along)
             }
+            // Refused on an arc before any work (`ForceSet::check_shapes`): a thin arc's
+            // cross-section normal to v is not the law's.
+            Outline::Arc { .. } => F::splat(0.0),
         }
     }
 }
@@ -110,6 +114,7 @@ impl Term for Poncelet {
                 held signs of v_E (sticking)",
         reads_area_speed: false,
         reads_frame: true,
+        on_arc: false,
         switches: &[Switch::SlipY],
         columns: &[("F_px", 0), ("F_py", 1)],
     };

@@ -227,12 +227,11 @@ impl Rft {
     fn integrate<F: Real>(&self, b: &Boundary<F>, dir: Option<[F; 2]>) -> ([F; 2], F) {
         let zero = F::splat(0.0);
         let zeta = F::splat(self.zeta);
-        let (plates, np) = b.outline.plates(&b.frame);
         let mut f = [zero; 2];
         let mut moment = zero;
         let twelfth = F::splat(1.0 / 12.0);
-        for p in &plates[..np] {
-            let (c2, s2) = line_angle(p);
+        for p in b.outline.plates(&b.frame) {
+            let (c2, s2) = line_angle(&p);
             let (g0, gx, gy) = alpha_affine(&self.coefficients, c2, s2);
             let el = p.elements(self.elements);
             // Each element's load zeta w L |z_mid| (exact: the depth is linear along it).
@@ -324,6 +323,7 @@ impl Term for Rft {
                 velocity; the held signs of v_E (sticking)",
         reads_area_speed: false,
         reads_frame: true,
+        on_arc: true,
         switches: &[Switch::SlipY],
         columns: &[("F_rft_x", 0), ("F_rft_y", 1)],
     };
@@ -415,6 +415,7 @@ impl Term for RftInertial {
                 velocity normal to it",
         reads_area_speed: false,
         reads_frame: true,
+        on_arc: true,
         switches: &[],
         columns: &[("F_ri_x", 0), ("F_ri_y", 1)],
     };
@@ -437,10 +438,9 @@ impl Term for RftInertial {
             return TermForce::force([zero; 2]);
         };
         let k = -(F::splat(self.lam) * m.rho_g);
-        let (plates, np) = b.outline.plates(&b.frame);
         let mut f = [zero; 2];
         let mut moment = zero;
-        for p in &plates[..np] {
+        for p in b.outline.plates(&b.frame) {
             let len = p.length();
             let inv = len.select_pos(len.recip(), zero);
             // The plate's normal (-u_y, u_x); either face leads, by the sign of v_n.
@@ -507,10 +507,9 @@ mod tests {
     /// eq. 1 with [`alpha`] per element (its direction from its middle's velocity) and the
     /// two-point Gauss rule along it (exact: the load is linear, the moment quadratic).
     fn element_sum(t: &Rft, b: &Boundary<f64>) -> ([f64; 2], f64) {
-        let (plates, np) = b.outline.plates(&b.frame);
         let (mut f, mut m) = ([0.0; 2], 0.0);
         let g = 0.5 / 3f64.sqrt();
-        for p in &plates[..np] {
+        for p in b.outline.plates(&b.frame) {
             let u = [p.b[0] - p.a[0], p.b[1] - p.a[1]];
             let beta = u[1].atan2(u[0]);
             let part = p.immersed();

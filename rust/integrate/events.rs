@@ -184,6 +184,22 @@ fn choose_slip<const N: usize>(
         }
     };
     let (mut reaction, mut bound, v) = judge(at, stats);
+    if model.mechanism.prescribed() {
+        // A body whose every coordinate is prescribed does not stick: its E passes through
+        // zero velocity the way the motion takes it (read at the step's end).
+        let (_, _, ahead) = judge(lookahead, stats);
+        let slip = if ahead < 0.0 || (ahead == 0.0 && v < 0.0) {
+            Slip::Neg
+        } else {
+            Slip::Pos
+        };
+        if axis == 0 {
+            modes[ci].sx = slip;
+        } else {
+            modes[ci].sy = slip;
+        }
+        return;
+    }
     if v.abs() <= SLIP_SPEED && bound == 0.0 {
         (reaction, bound, _) = judge(lookahead, stats);
     }

@@ -129,7 +129,7 @@ impl<const N: usize> Observer<N> {
                 best: DragStiffness::default(),
                 q: y.q,
             },
-            recorder: Recorder::new(record, &model.forces, N, nc, n_links),
+            recorder: Recorder::new(record, &model.forces, N, nc, n_links, joint_loads(model)),
             stride: record.stride.max(1) as u64,
             q0: y.q,
             ke0,
@@ -158,7 +158,7 @@ impl<const N: usize> Observer<N> {
                 self.stiffest.offer(&y.q, &DragStiffness::of(ci, c));
             }
         }
-        if self.joints.len() < 2 {
+        if !joint_loads(model) {
             return;
         }
         let f = model.joint_forces(&y.q, &y.qd, e, modes);
@@ -347,6 +347,7 @@ fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> 
             .map(|c| match c.shape {
                 Shape::Rod(r) => r.length,
                 Shape::Sole(s) => s.length + s.height,
+                Shape::Arc(a) => 2.0 * a.radius,
             })
             .sum::<f64>();
     let scale = out.energy_start.abs() + mass * model.gravity() * size + 1e-12 * mass;
@@ -362,19 +363,35 @@ fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> 
     Ok(())
 }
 
+/// Whether a body's joint loads are reported: several links, or a root link whose angle is
+/// driven (its torque).
+#[inline]
+fn joint_loads<const N: usize>(model: &Model<N>) -> bool {
+    model.mechanism.n_links() > 1 || model.mechanism.root_rate.is_some()
+}
+
 /// Recorder of time series.
 struct Recorder {
     on: Record,
     n_dof: usize,
     n_contacts: usize,
     n_links: usize,
+    /// Whether the joints' loads are recorded (several links, or a driven root angle).
+    joint_loads: bool,
     t: Vec<f64>,
     cols: Vec<Vec<f64>>,
     names: Vec<String>,
 }
 
 impl Recorder {
-    fn new(on: Record, forces: &ForceSet, n_dof: usize, n_contacts: usize, n_links: usize) -> Self {
+    fn new(
+        on: Record,
+        forces: &ForceSet,
+        n_dof: usize,
+        n_contacts: usize,
+        n_links: usize,
+        joint_loads: bool,
+    ) -> Self {
         let mut names = Vec::new();
         if on.state {
             for i in 0..n_dof {
@@ -404,7 +421,7 @@ impl Recorder {
                     names.push(format!("c{c}.{f}"));
                 }
             }
-            if n_links > 1 {
+            if joint_loads {
                 for i in 0..n_links {
                     for f in ["Fx", "Fy", "torque"] {
                         names.push(format!("joint{i}.{f}"));
@@ -429,6 +446,7 @@ impl Recorder {
             n_dof,
             n_contacts,
             n_links,
+            joint_loads,
             t: Vec::new(),
             cols,
             names,
@@ -495,7 +513,7 @@ impl Recorder {
                     put(&mut self.cols, mode(m.sy));
                 }
             }
-            if self.n_links > 1 {
+            if self.joint_loads {
                 let f = model.joint_forces(&y.q, &y.qd, e, modes);
                 for (fi, ti) in f.iter().zip(&e.joint_torque).take(self.n_links) {
                     put(&mut self.cols, fi.x);

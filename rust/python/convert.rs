@@ -308,6 +308,22 @@ pub fn body_linkage<'py>(
                 d.set_item("width", width)?;
                 d.set_item("l_ref", l_ref)?;
             }
+            ContactShape::Arc {
+                centre,
+                radius,
+                start,
+                end,
+                width,
+                chords,
+            } => {
+                d.set_item("shape", "arc")?;
+                d.set_item("at", pair(centre))?;
+                d.set_item("radius", radius)?;
+                d.set_item("start_deg", start.to_degrees())?;
+                d.set_item("end_deg", end.to_degrees())?;
+                d.set_item("width", width)?;
+                d.set_item("chords", chords as usize)?;
+            }
         }
         contacts.append(d)?;
     }
@@ -324,6 +340,9 @@ pub fn body_linkage<'py>(
     root.set_item("position", pair(l.root.position))?;
     root.set_item("velocity", pair(l.root.velocity))?;
     root.set_item("mass", l.root.mass)?;
+    if let Some(rate) = l.root.rate {
+        root.set_item("rate", rate)?;
+    }
     let out = PyDict::new(py);
     let order: Vec<&str> = l
         .order()

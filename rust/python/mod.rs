@@ -51,6 +51,8 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(convert::body_linkage, m)?)?;
     m.add("MAX_LINKS", crate::bodies::MAX_LINKS)?;
     m.add("MAX_CONTACTS", crate::dynamics::MAX_CONTACTS)?;
+    m.add("MAX_CHORDS", crate::body::arc::MAX_CHORDS)?;
+    m.add("DEFAULT_CHORDS", crate::body::arc::DEFAULT_CHORDS)?;
     m.add_function(wrap_pyfunction!(terms::check_term, m)?)?;
     m.add_function(wrap_pyfunction!(terms::rft_alpha, m)?)?;
     m.add("RFT_GENERIC", crate::forces::rft::GENERIC.to_vec())?;

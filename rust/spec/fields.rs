@@ -191,7 +191,7 @@ pub struct ElementField {
 
 /// Every field of a linkage's elements, by element (the one table: the core's parsing,
 /// `granrs.bodies`' dataclasses and docs, the TOML notes).
-pub static ELEMENT_FIELDS: [ElementField; 33] = {
+pub static ELEMENT_FIELDS: [ElementField; 38] = {
     const fn f(
         element: &'static str,
         name: &'static str,
@@ -228,18 +228,23 @@ pub static ELEMENT_FIELDS: [ElementField; 33] = {
         f("joint", "frequency", "Hz", "finite; needed with an amplitude", "the sinusoid's frequency"),
         f("joint", "phase_deg", "deg", "finite; left out: 0", "the sinusoid's phase at t = 0"),
         f("contact", "name", "", "text", "the contact's name"),
-        f("contact", "shape", "", "rod or box", "\"rod\" (a round rod meeting the sand with its tip: tip and outline) or \"box\" (a sole, a plate)"),
+        f("contact", "shape", "", "rod, box or arc", "\"rod\" (a round rod meeting the sand with its tip: tip and outline), \"box\" (a sole, a plate) or \"arc\" (a thin circular arc, a C-shaped leg, cut into chords)"),
         f("contact", "link", "", "a link's name", "the link the contact is fixed on"),
-        f("contact", "at", "m", "(s, n), finite", "a rod's tip, or a box's corner on the sole, in the link's (s, n) coordinates"),
-        f("contact", "length", "m", "> 0", "a rod's length from its tip along +s, or a box's along +s (also the width of a box's horizontal static term)"),
+        f("contact", "at", "m", "(s, n), finite", "a rod's tip, a box's corner on the sole, or an arc's centre, in the link's (s, n) coordinates"),
+        f("contact", "length", "m", "> 0; a rod or a box", "a rod's length from its tip along +s, or a box's along +s (also the width of a box's horizontal static term)"),
         f("contact", "diameter", "m", "> 0", "a rod's diameter"),
         f("contact", "height", "m", "> 0", "a box's height from the sole towards -n"),
-        f("contact", "width", "m", "> 0", "a box's width out of the plane"),
+        f("contact", "width", "m", "> 0", "a box's or an arc's width out of the plane"),
+        f("contact", "radius", "m", "> 0", "an arc's radius"),
+        f("contact", "start_deg", "deg", "finite", "the angle of an arc's first end, from the link's +s axis towards its +n axis: the arc's point at angle phi is at + radius (cos phi, sin phi) in (s, n)"),
+        f("contact", "end_deg", "deg", "start_deg < end_deg <= start_deg + 360", "the angle of an arc's last end (the arc runs from start_deg up to end_deg)"),
+        f("contact", "chords", "-", "a whole number 1..64; left out: 16", "the chords an arc is cut into: each is a plate of its boundary for rft and rft_inertial"),
         f("contact", "l_ref", "m", "> 0; left out: length", "reference length of the depth factor (eq. 5.4)"),
         f("root", "kind", "", "free, pinned or moving", "\"free\" (a floating base), \"pinned\" (fixed in space) or \"moving\" (at a constant velocity)"),
         f("root", "link", "", "a link's name", "the root link: its (s, n) origin is the root point"),
         f("root", "position", "m", "(x, y), finite", "initial position of the root point (y = 0: the sand's surface)"),
         f("root", "mass", "kg", ">= 0", "a point mass at the root (the chain's pin)"),
         f("root", "velocity", "m/s", "(vx, vy), finite", "initial velocity of a free root; a moving root's constant one; none for a pinned root"),
+        f("root", "rate", "rad/s", "finite; left out: the root link's angle is free", "the root link's angle driven at this constant rate (e.g. a C-leg turned about a fixed axle), from its q_deg; the run reports the torque it takes (the joint root)"),
     ]
 };

@@ -645,8 +645,21 @@ impl SceneSpec {
         for (i, v) in elements(body, "contacts")?.iter().enumerate() {
             let (e, name) = Element::new("contact", "contacts", i, v)?;
             let at = e.point_or("at", Vector2::zeros())?;
-            let length = e.num("length")?;
-            let shape = match e.str("shape")? {
+            let shape_name = e.str("shape")?;
+            let length = if shape_name == "arc" {
+                0.0
+            } else {
+                e.num("length")?
+            };
+            let shape = match shape_name {
+                "arc" => ContactShape::Arc {
+                    centre: at,
+                    radius: e.num("radius")?,
+                    start: e.num("start_deg")?.to_radians(),
+                    end: e.num("end_deg")?.to_radians(),
+                    width: e.num("width")?,
+                    chords: e.num_or("chords", crate::body::arc::DEFAULT_CHORDS as f64)?,
+                },
                 "rod" => ContactShape::Rod {
                     tip: at,
                     length,
@@ -659,7 +672,7 @@ impl SceneSpec {
                     width: e.num("width")?,
                     l_ref: e.num_or("l_ref", length)?,
                 },
-                other => return Err(unknown(&e.field("shape"), other, &["rod", "box"])),
+                other => return Err(unknown(&e.field("shape"), other, &["rod", "box", "arc"])),
             };
             contacts.push(ContactSpec {
                 name,
@@ -674,6 +687,7 @@ impl SceneSpec {
                 position: Vector2::zeros(),
                 velocity: Vector2::zeros(),
                 mass: 0.0,
+                rate: None,
             },
             Some(v @ Value::Map(entries)) => {
                 let e = Element {
@@ -714,6 +728,10 @@ impl SceneSpec {
                     position: e.point_or("position", Vector2::zeros())?,
                     velocity: e.point_or("velocity", Vector2::zeros())?,
                     mass: e.num_or("mass", 0.0)?,
+                    rate: match e.get("rate") {
+                        None => None,
+                        Some(_) => Some(e.num("rate")?),
+                    },
                 }
             }
             Some(other) => return Err(wrong("root", "a mapping", other)),

@@ -63,6 +63,6 @@ pub fn word(s: &str) -> Cow<'static, str> {
         "eta_v" "lam" "k" "c" "links" "joints" "contacts" "root" "name" "mass" "inertia"
         "length" "com" "q_deg" "omega0" "parent" "child" "at" "kind" "rest_deg" "rate" "shape"
         "link" "diameter" "height" "width" "l_ref" "position" "velocity" "rod" "spring"
-        "driven" "pinned" "moving"
+        "driven" "pinned" "moving" "arc" "radius" "start_deg" "end_deg" "chords"
     )
 }
