@@ -35,6 +35,10 @@ def scenes():
         "leg, thesis law, sprung (v0 3.28)": cases.leg(v0=3.28, joints={"k": 300.0, "c": 5.0}),
         "free link, rft (q 30, v0 2)": cases.free_link(q_deg=30.0, v0=2.0, forces=rft),
         "leg, rft (v0 2)": cases.leg(v0=2.0, forces=rft),
+        "free link, rft + rft_inertial": cases.free_link(
+            q_deg=30.0, v0=2.0, forces=[*rft, forces.rft_inertial()]
+        ),
+        "leg, rft + rft_inertial": cases.leg(v0=2.0, forces=[*rft, forces.rft_inertial()]),
     }
 
 repeats = int(sys.argv[1])

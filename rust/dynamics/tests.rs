@@ -299,7 +299,8 @@ fn an_arc_outline_walks_its_vertices() {
     let c = &model.contacts[0];
     let geom = model.geometry(c, &pose);
     let b = model.boundary(c, &pose, &qd, &geom, Vector2::zeros());
-    let plates: Vec<_> = b.outline.plates(&b.frame).collect();
+    let mut plates = Vec::new();
+    b.outline.for_each_plate(&b.frame, |p| plates.push(*p));
     assert_eq!(plates.len(), 7);
     for (k, p) in plates.iter().enumerate() {
         let a = model.mechanism.point(&pose, 0, arc.vertex(k));

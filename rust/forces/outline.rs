@@ -11,8 +11,8 @@
 //!   faces (from the heel and the toe up to the top), w_s wide out of the plane.
 //! - **An arc** is its chords (`body::arc`), each a plate, as many as the contact says (at
 //!   most [`MAX_CHORDS`](crate::body::arc::MAX_CHORDS)): they are made one by one as the
-//!   terms walk the outline (one turn about the centre each), so a rod's or a box's fixed
-//!   plates pay nothing for them.
+//!   terms walk the outline (one turn about the centre each), in a loop of their own, so a
+//!   rod's or a box's fixed plates pay nothing for them ([`Outline::for_each_plate`]).
 //!
 //! A plate is cut into equal elements. Each element is clipped at the surface y = 0: only
 //! its immersed part counts, and the depth z = -y varies linearly along it, so the
@@ -61,65 +61,44 @@ impl<F: Real> Elements<F> {
     }
 }
 
-/// The plates of an outline, in order: a rod's or a box's from a small array, an arc's
-/// chords made one by one.
-#[derive(Debug, Clone, Copy)]
-pub struct Plates<F> {
-    fixed: [Plate<F>; MAX_PLATES],
-    arc: Option<ArcWalk<F>>,
-    next: usize,
-    len: usize,
-}
-
-/// An arc's chords as they are walked: the centre, the current vertex from it, the turn to
-/// the next vertex and the width.
-#[derive(Debug, Clone, Copy)]
-struct ArcWalk<F> {
-    centre: [F; 2],
-    r: [F; 2],
-    turn: [F; 2],
-    width: F,
-}
-
-impl<F: Real> Plates<F> {
-    /// A rod's or a box's plates (the first `len` of the array).
-    #[inline(always)]
-    pub fn fixed(&self) -> &[Plate<F>] {
-        &self.fixed[..if self.arc.is_some() { 0 } else { self.len }]
-    }
-}
-
-impl<F: Real> Iterator for Plates<F> {
-    type Item = Plate<F>;
-
-    #[inline(always)]
-    fn next(&mut self) -> Option<Plate<F>> {
-        if self.next >= self.len {
-            return None;
-        }
-        let k = self.next;
-        self.next += 1;
-        match &mut self.arc {
-            None => Some(self.fixed[k]),
-            Some(w) => {
-                let [c, s] = w.turn;
-                let r = w.r;
-                let q = [c * r[0] - s * r[1], s * r[0] + c * r[1]];
-                w.r = q;
-                Some(Plate {
-                    a: [w.centre[0] + r[0], w.centre[1] + r[1]],
-                    b: [w.centre[0] + q[0], w.centre[1] + q[1]],
-                    width: w.width,
-                })
-            }
-        }
-    }
-}
-
 impl<F: Real> Outline<F> {
-    /// The boundary plates at the pose `frame`, in order.
-    #[inline]
-    pub fn plates(&self, frame: &Frame<F>) -> Plates<F> {
+    /// Call `f` on each boundary plate at the pose `frame`, in order: a rod's or a box's
+    /// from [`Outline::fixed_plates`], an arc's chords made one by one (one turn about its
+    /// centre each). Two loops, so that a rod's or a box's stays the plain loop over its
+    /// array that it was before arcs.
+    #[inline(always)]
+    pub fn for_each_plate(&self, frame: &Frame<F>, mut f: impl FnMut(&Plate<F>)) {
+        if let Outline::Arc {
+            centre,
+            first,
+            turn,
+            chords,
+            width,
+        } = *self
+        {
+            let [c, s] = turn;
+            let mut r = [first[0] - centre[0], first[1] - centre[1]];
+            for _ in 0..chords {
+                let q = [c * r[0] - s * r[1], s * r[0] + c * r[1]];
+                f(&Plate {
+                    a: [centre[0] + r[0], centre[1] + r[1]],
+                    b: [centre[0] + q[0], centre[1] + q[1]],
+                    width,
+                });
+                r = q;
+            }
+            return;
+        }
+        let (plates, n) = self.fixed_plates(frame);
+        for p in &plates[..n] {
+            f(p);
+        }
+    }
+
+    /// A rod's or a box's boundary plates (the first `n` of the array) at the pose `frame`;
+    /// none for an arc (its chords: [`Outline::for_each_plate`]).
+    #[inline(always)]
+    pub fn fixed_plates(&self, frame: &Frame<F>) -> ([Plate<F>; MAX_PLATES], usize) {
         let zero = F::splat(0.0);
         let none = Plate {
             a: [zero; 2],
@@ -127,7 +106,7 @@ impl<F: Real> Outline<F> {
             width: zero,
         };
         let mut out = [none; MAX_PLATES];
-        let (len, arc) = match *self {
+        match *self {
             Outline::Rod { diameter, immersed } => {
                 let t = frame.origin;
                 let e = frame.axis;
@@ -144,7 +123,7 @@ impl<F: Real> Outline<F> {
                     b: [t[0] + half * n[0], t[1] + half * n[1]],
                     width: diameter,
                 };
-                (2, None)
+                (out, 2)
             }
             Outline::Box { corners, width } => {
                 let [heel, toe, toe_top, heel_top] = corners;
@@ -163,29 +142,9 @@ impl<F: Real> Outline<F> {
                     b: toe_top,
                     width,
                 };
-                (3, None)
+                (out, 3)
             }
-            Outline::Arc {
-                centre,
-                first,
-                turn,
-                chords,
-                width,
-            } => (
-                chords,
-                Some(ArcWalk {
-                    centre,
-                    r: [first[0] - centre[0], first[1] - centre[1]],
-                    turn,
-                    width,
-                }),
-            ),
-        };
-        Plates {
-            fixed: out,
-            arc,
-            next: 0,
-            len,
+            Outline::Arc { .. } => (out, 0),
         }
     }
 }

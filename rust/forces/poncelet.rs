@@ -66,8 +66,7 @@ impl Poncelet {
                     + diameter * immersed * across
             }
             Outline::Box { width, .. } => {
-                let plates = b.outline.plates(&b.frame);
-                let plates = plates.fixed();
+                let (plates, _) = b.outline.fixed_plates(&b.frame);
                 let immersed = |i: usize| plates[i].immersed().length();
                 let bottom = immersed(0);
                 let face = immersed(1).max(immersed(2));

@@ -49,7 +49,8 @@
 
 use super::outline::Plate;
 use super::{
-    Acts, Boundary, Class, ContactState, Medium, Param, Real, Switch, Term, TermForce, TermInfo,
+    Acts, Boundary, Class, ContactState, Medium, Outline, Param, Real, Switch, Term, TermForce,
+    TermInfo,
 };
 
 /// Elements per plate unless the scene says otherwise (the convergence in docs/laws.md:
@@ -225,65 +226,91 @@ impl Rft {
     /// step x sum t_k df_k`, with `r_0` the immersed part's start from P.
     #[inline(always)]
     fn integrate<F: Real>(&self, b: &Boundary<F>, dir: Option<[F; 2]>) -> ([F; 2], F) {
+        if let Outline::Arc { .. } = b.outline {
+            return self.integrate_chords(b, dir);
+        }
+        // A rod's or a box's plates: the plain loop over their array.
+        let (plates, n) = b.outline.fixed_plates(&b.frame);
+        let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
+        for p in &plates[..n] {
+            self.add_plate(p, b, dir, &mut sum);
+        }
+        sum
+    }
+
+    /// [`Rft::integrate`] over an arc's chords, kept out of the rod's and the box's path.
+    #[inline(never)]
+    fn integrate_chords<F: Real>(&self, b: &Boundary<F>, dir: Option<[F; 2]>) -> ([F; 2], F) {
+        let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
+        b.outline
+            .for_each_plate(&b.frame, |p| self.add_plate(p, b, dir, &mut sum));
+        sum
+    }
+
+    /// Add plate `p`'s force and moment about P to `sum` ([`Rft::integrate`]).
+    #[inline(always)]
+    fn add_plate<F: Real>(
+        &self,
+        p: &Plate<F>,
+        b: &Boundary<F>,
+        dir: Option<[F; 2]>,
+        sum: &mut ([F; 2], F),
+    ) {
         let zero = F::splat(0.0);
         let zeta = F::splat(self.zeta);
-        let mut f = [zero; 2];
-        let mut moment = zero;
         let twelfth = F::splat(1.0 / 12.0);
-        for p in b.outline.plates(&b.frame) {
-            let (c2, s2) = line_angle(&p);
-            let (g0, gx, gy) = alpha_affine(&self.coefficients, c2, s2);
-            let el = p.elements(self.elements);
-            // Each element's load zeta w L |z_mid| (exact: the depth is linear along it).
-            let load = zeta * el.width * el.length;
-            // Its moment about its middle, for the depth's slope along it: zeta w (u x f)
-            // int (s - s_mid) |z| ds = zeta w (u x f) L^2 dz / 12 = zeta w (step x f) L dz
-            // / 12, with dz = -step_y the depth's change over one element.
-            let slope = zeta * el.width * (-el.step[1] * el.length * twelfth);
-            // At t = k + 1/2 from the start: depth d0 + t dd, velocity v0 + t dv.
-            let d0 = -el.start[1];
-            let dd = -el.step[1];
-            let (v0, dv) = match dir {
-                Some(u) => (u, [zero; 2]),
-                None => {
-                    let w = b.frame.omega;
-                    (
-                        b.frame.velocity_at(el.start),
-                        [-w * el.step[1], w * el.step[0]],
-                    )
-                }
-            };
-            let mut plate = PlateSums {
-                v0,
-                dv,
-                d0,
-                dd,
-                load,
-                g: [g0, gx, gy],
-                sums: [[zero; 2]; 3],
-            };
-            // Elements in groups of 8 and 4 (independent square roots and divisions), the
-            // rest one by one.
-            let n = self.elements;
-            let mut c = 0;
-            while c + 8 <= n {
-                plate.add::<8>(c);
-                c += 8;
+        let (c2, s2) = line_angle(p);
+        let (g0, gx, gy) = alpha_affine(&self.coefficients, c2, s2);
+        let el = p.elements(self.elements);
+        // Each element's load zeta w L |z_mid| (exact: the depth is linear along it).
+        let load = zeta * el.width * el.length;
+        // Its moment about its middle, for the depth's slope along it: zeta w (u x f)
+        // int (s - s_mid) |z| ds = zeta w (u x f) L^2 dz / 12 = zeta w (step x f) L dz
+        // / 12, with dz = -step_y the depth's change over one element.
+        let slope = zeta * el.width * (-el.step[1] * el.length * twelfth);
+        // At t = k + 1/2 from the start: depth d0 + t dd, velocity v0 + t dv.
+        let d0 = -el.start[1];
+        let dd = -el.step[1];
+        let (v0, dv) = match dir {
+            Some(u) => (u, [zero; 2]),
+            None => {
+                let w = b.frame.omega;
+                (
+                    b.frame.velocity_at(el.start),
+                    [-w * el.step[1], w * el.step[0]],
+                )
             }
-            if c + 4 <= n {
-                plate.add::<4>(c);
-                c += 4;
-            }
-            for k in c..n {
-                plate.add::<1>(k);
-            }
-            // df, t df and the moving elements' (-alpha_x, alpha_z), over the plate.
-            let [sf, st, sg] = plate.sums;
-            f = [f[0] + sf[0], f[1] + sf[1]];
-            let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
-            moment = moment + cross(r0, sf) + cross(el.step, st) + slope * cross(el.step, sg);
+        };
+        let mut plate = PlateSums {
+            v0,
+            dv,
+            d0,
+            dd,
+            load,
+            g: [g0, gx, gy],
+            sums: [[zero; 2]; 3],
+        };
+        // Elements in groups of 8 and 4 (independent square roots and divisions), the
+        // rest one by one.
+        let n = self.elements;
+        let mut c = 0;
+        while c + 8 <= n {
+            plate.add::<8>(c);
+            c += 8;
         }
-        (f, moment)
+        if c + 4 <= n {
+            plate.add::<4>(c);
+            c += 4;
+        }
+        for k in c..n {
+            plate.add::<1>(k);
+        }
+        // df, t df and the moving elements' (-alpha_x, alpha_z), over the plate.
+        let [sf, st, sg] = plate.sums;
+        let (f, moment) = sum;
+        *f = [f[0] + sf[0], f[1] + sf[1]];
+        let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
+        *moment = *moment + cross(r0, sf) + cross(el.step, st) + slope * cross(el.step, sg);
     }
 }
 
@@ -440,7 +467,7 @@ impl Term for RftInertial {
         let k = -(F::splat(self.lam) * m.rho_g);
         let mut f = [zero; 2];
         let mut moment = zero;
-        for p in b.outline.plates(&b.frame) {
+        b.outline.for_each_plate(&b.frame, |p| {
             let len = p.length();
             let inv = len.select_pos(len.recip(), zero);
             // The plate's normal (-u_y, u_x); either face leads, by the sign of v_n.
@@ -466,7 +493,7 @@ impl Term for RftInertial {
             let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
             let lever = [sw * r0[0] + stw * el.step[0], sw * r0[1] + stw * el.step[1]];
             moment = moment + cross(lever, n);
-        }
+        });
         TermForce {
             force: f,
             bound: [zero; 2],
@@ -509,7 +536,7 @@ mod tests {
     fn element_sum(t: &Rft, b: &Boundary<f64>) -> ([f64; 2], f64) {
         let (mut f, mut m) = ([0.0; 2], 0.0);
         let g = 0.5 / 3f64.sqrt();
-        for p in b.outline.plates(&b.frame) {
+        b.outline.for_each_plate(&b.frame, |p| {
             let u = [p.b[0] - p.a[0], p.b[1] - p.a[1]];
             let beta = u[1].atan2(u[0]);
             let part = p.immersed();
@@ -530,7 +557,7 @@ mod tests {
                     m += (x[0] - b.apply[0]) * df[1] - (x[1] - b.apply[1]) * df[0];
                 }
             }
-        }
+        });
         (f, m)
     }
 
