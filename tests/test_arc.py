@@ -324,6 +324,7 @@ BAD_ARCS = [
     ("more than a turn", _contact(end_deg=541.0), "contacts.c.end_deg"),
     ("no chord", _contact(chords=0), "contacts.c.chords"),
     ("too many chords", _contact(chords=bodies.MAX_CHORDS + 1), "contacts.c.chords"),
+    ("fractional chords", _contact(chords=2.5), "contacts.c.chords"),
     ("zero width", _contact(width=0.0), "contacts.c.width"),
 ]
 
