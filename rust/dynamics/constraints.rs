@@ -318,6 +318,67 @@ impl<const N: usize> Model<N> {
         })
     }
 
+    /// The impulse at one of the times of the table-driven joints: the smallest change of
+    /// the rates (M-orthogonal, `dqd = M^-1 J^T lambda`) that puts each joint of `targets`
+    /// (`(link, rate)`) on its new relative rate and keeps every other joint's and the
+    /// root's rows (a table joint without a time here keeps its rate). The sand's forces are
+    /// bounded and take no impulse: the contacts are left out (the run decides their modes
+    /// again). Returns, per joint of `targets`, `(link, impulse, energy)`: the angular
+    /// impulse the joint applies to its link [N m s] and the work it does,
+    /// `impulse (before + after) / 2` [J] (the rate moves linearly with the impulse).
+    pub fn drive_impulse(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &mut SVector<f64, N>,
+        targets: &[(usize, f64)],
+    ) -> Vec<(usize, f64, f64)> {
+        let pose = self.mechanism.pose(q);
+        let Some(chol) = self.mechanism.mass_matrix(&pose).cholesky() else {
+            return Vec::new();
+        };
+        let free: Modes = [ContactMode::default(); MAX_CONTACTS];
+        let mut rows = self.constraint_rows(&pose, q, qd, &free, &chol);
+        let k = rows.len;
+        for row in rows.rows.iter_mut().take(k).flatten() {
+            if let RowKind::Lock { link } = row.kind {
+                if let Some(&(_, rate)) = targets.iter().find(|(l, _)| *l == link) {
+                    row.target = rate;
+                }
+            }
+        }
+        let mut minv_jt = [SVector::<f64, N>::zeros(); MAX_ROWS];
+        for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
+            *m = chol.solve(&rows.get(i).jac);
+        }
+        let v = *qd;
+        let Some(lam) = solve_small::<MAX_ROWS>(k, |(a, b)| {
+            for i in 0..k {
+                let ji = &rows.get(i).jac;
+                b[i] = ji.dot(&v) - rows.get(i).target;
+                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                    *aij = ji.dot(&minv_jt[j]);
+                }
+            }
+        }) else {
+            return Vec::new();
+        };
+        for (l, m) in lam.iter().zip(&minv_jt).take(k) {
+            *qd -= *l * m;
+        }
+        let mut out = Vec::with_capacity(targets.len());
+        for (i, l) in lam.iter().enumerate().take(k) {
+            let r = rows.get(i);
+            if let RowKind::Lock { link } = r.kind {
+                if targets.iter().any(|(t, _)| *t == link) {
+                    let impulse = -l;
+                    let (before, after) = (r.jac.dot(&v), r.jac.dot(qd));
+                    out.push((link, impulse, 0.5 * impulse * (before + after)));
+                }
+            }
+        }
+        out
+    }
+
     /// Whether any sticking component is in force under `modes`.
     #[inline]
     pub(super) fn any_stuck(&self, modes: &Modes) -> bool {
