@@ -251,3 +251,22 @@ def test_a_table_round_trips_through_toml_and_a_bad_one_names_its_line() -> None
     assert info.value.field == "joints.elbow.table"
     number = next(i for i, t in enumerate(bad.splitlines(), 1) if t.startswith("table = "))
     assert f"<string>:{number}:" in str(info.value)
+
+
+def test_the_adaptive_stepper_lands_on_the_times_too() -> None:
+    """With dopri5 the steps end on the table's times as well: the joint follows the table
+    to 1e-9 rad and takes the new slope at each time, by the impulse the run reports."""
+    scene = _scene(_chain(), method="dopri5", rtol=1e-10, atol=1e-12)
+    r = granrs.simulate(scene)
+    s = r.series
+    t = s["t"]
+    assert [i["t"] for i in r.impulses] == [p[0] for p in TABLE if 0.0 < p[0] <= 0.5]
+    assert np.abs((s["q_fore"] - s["q_upper"]) - _table_angle(t)).max() < 1e-9
+    segments = [seg for seg in _segments(t) if t[seg][-1] > t[seg][0]]
+    # (The adaptive steps are long, so Simpson's rule on its samples is not the work to
+    # 1e-8: each impulse is checked against the jump of the kinetic energy instead.)
+    rel = s["omega_fore"] - s["omega_upper"]
+    for imp, seg, nxt in zip(r.impulses, segments, segments[1:], strict=False):
+        assert abs(rel[nxt][0] - _slope(t[nxt][0], t[nxt][-1])) < 1e-9
+        ke_jump = s["KE"][nxt][0] - s["KE"][seg][-1]
+        assert abs(imp["energy"] - ke_jump) < 1e-12 * max(abs(ke_jump), 1e-3)
