@@ -1,4 +1,6 @@
-"""Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6).
+"""Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6), and
+beside them (``--table-share``, 2 % by default) two-link linkages whose knee is driven along a
+random table (issue 19), swept separately.
 
 Checks that a long batch never returns NaN or infinity in a run that did not fail, never
 hangs and keeps its memory flat. Scenes are drawn from the valid domain of
@@ -111,7 +113,78 @@ def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
     return {"forces": terms}
 
 
+def random_table_scenes(
+    rng: np.random.Generator, n: int, dt_range: bool, max_steps: int
+) -> list[Scene]:
+    """``n`` random valid linkages with a table-driven joint: a thigh on a root moved into the
+    sand at 0..3 m/s, a shank hanging from it with a rod contact at its tip, the knee driven
+    along 2..6 random points (times -0.1 .. 1.2 t_end, angles -60..60 deg), the law as in
+    :func:`random_scenes`, gravity always."""
+    out = []
+    for _ in range(n):
+        dt = float(10.0 ** rng.uniform(-6.0, -3.0)) if dt_range else 1e-4
+        t_end = min(0.2, max_steps * dt)
+        k = int(rng.integers(2, 7))
+        times = np.unique(rng.uniform(-0.1, 1.2 * t_end, k))
+        if len(times) < 2:
+            times = np.array([0.0, t_end])
+        angles = rng.uniform(-60.0, 60.0, len(times))
+        start = float(np.interp(0.0, times, angles))
+        l1, l2 = rng.uniform(0.05, 0.4, 2)
+        m1, m2 = 10.0 ** rng.uniform(-2.0, 1.0, 2)
+        q1 = float(rng.uniform(-30.0, 30.0))
+        q2 = q1 + start
+        # The root above the shank's tip, which starts at the surface.
+        y0 = l1 * math.cos(math.radians(q1)) + l2 * math.cos(math.radians(q2))
+        x0 = l1 * math.sin(math.radians(q1)) + l2 * math.sin(math.radians(q2))
+        body = granrs.bodies.Linkage(
+            [
+                granrs.bodies.Link("thigh", m1, m1 * l1 * l1 / 12.0, l1, (-0.5 * l1, 0.0), q1),
+                granrs.bodies.Link("shank", m2, m2 * l2 * l2 / 12.0, l2, (-0.5 * l2, 0.0), q2),
+            ],
+            [
+                granrs.bodies.Joint(
+                    "knee",
+                    "thigh",
+                    "shank",
+                    (-l1, 0.0),
+                    kind="driven",
+                    table=tuple(zip(times.tolist(), angles.tolist(), strict=True)),
+                )
+            ],
+            [granrs.bodies.Contact.rod("shank", l2, 0.0127, at=(-l2, 0.0))],
+            granrs.bodies.Root(
+                "moving",
+                link="thigh",
+                position=(x0, y0),
+                velocity=(float(rng.uniform(-1.0, 1.0)), -float(rng.uniform(0.0, 3.0))),
+            ),
+        )
+        law = _law(rng, rng.uniform(0.0, 10.0, 4))
+        terms = tuple(law["forces"])  # type: ignore[arg-type]
+        if not any(t.name == "gravity" for t in terms):
+            terms = (forces.gravity(), *terms)
+        out.append(
+            Scene(
+                body=body,  # type: ignore[arg-type]
+                forces=terms,
+                dt=dt,
+                t_end=t_end,
+                end="time",
+                sign_model=SIGN_MODELS[int(rng.integers(0, 3))],
+                apply_at=APPLY_AT[int(rng.integers(0, 2))],
+            )
+        )
+    return out
+
+
 def describe(scene: Scene) -> str:
+    if scene.kind == "linkage":
+        return (
+            f"Scene(body={scene.body!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, "
+            f"sign_model={scene.sign_model!r}, apply_at={scene.apply_at!r}, "
+            f"forces={scene.forces!r})"
+        )
     return (
         f"Scene(q_deg={scene.q_deg!r}, v0={scene.v0!r}, vx0={scene.vx0!r}, "
         f"omega0={scene.omega0!r}, mass={scene.mass!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, "
@@ -134,26 +207,33 @@ def soak(args: argparse.Namespace) -> int:
     chunk = 0
     while done < args.n:
         size = min(args.chunk, args.n - done)
-        scenes = random_scenes(rng, size, args.dt_range, args.max_steps)
+        tables = int(rng.binomial(size, args.table_share))
+        scenes = random_scenes(rng, size - tables, args.dt_range, args.max_steps)
+        driven = random_table_scenes(rng, tables, args.dt_range, args.max_steps)
         t0 = time.perf_counter()
-        df = granrs.sweep(scenes, progress=False)
+        counts: collections.Counter[str] = collections.Counter()
+        for offset, batch in ((done, scenes), (done + len(scenes), driven)):
+            if not batch:
+                continue
+            df = granrs.sweep(batch, progress=False)
+            counts.update({str(k): int(v) for k, v in df["status"].value_counts().items() if v})
+            bad = (df["status"] == "failed").to_numpy()
+            for i in np.flatnonzero(bad):
+                failed.append((offset + int(i), describe(batch[i]), str(df["error"].iloc[i])))
+            ok = df[~bad]
+            numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
+            values = numeric.select_dtypes("number").to_numpy()
+            rows = np.flatnonzero(~np.isfinite(values).all(axis=1))
+            stopped = (ok["status"] == "stopped").to_numpy()
+            rows = np.union1d(rows, np.flatnonzero(stopped & ok["t_s"].isna().to_numpy()))
+            index = np.flatnonzero(~bad)
+            for r in rows:
+                cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
+                non_finite.append((offset + int(index[r]), describe(batch[index[r]]), cols))
+            del df, ok, numeric, values
         seconds = time.perf_counter() - t0
-        counts = df["status"].value_counts()
-        statuses.update({str(k): int(v) for k, v in counts.items() if v})
-        bad = (df["status"] == "failed").to_numpy()
-        for i in np.flatnonzero(bad):
-            failed.append((done + int(i), describe(scenes[i]), str(df["error"].iloc[i])))
-        ok = df[~bad]
-        numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
-        values = numeric.select_dtypes("number").to_numpy()
-        rows = np.flatnonzero(~np.isfinite(values).all(axis=1))
-        stopped = (ok["status"] == "stopped").to_numpy()
-        rows = np.union1d(rows, np.flatnonzero(stopped & ok["t_s"].isna().to_numpy()))
-        index = np.flatnonzero(~bad)
-        for r in rows:
-            cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
-            non_finite.append((done + int(index[r]), describe(scenes[index[r]]), cols))
-        del df, scenes, ok, numeric, values
+        statuses.update(counts)
+        del scenes, driven
         rss.append(rss_mb())
         short = ", ".join(f"{k} {int(v)}" for k, v in counts.items() if v)
         print(
@@ -191,6 +271,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument(
         "--max-steps", type=int, default=20_000, help="cap on steps per run via t_end (20000)"
+    )
+    parser.add_argument(
+        "--table-share",
+        type=float,
+        default=0.02,
+        help="share of the scenes that are linkages with a table-driven joint (0.02)",
     )
     parser.add_argument(
         "--max-growth",

@@ -51,6 +51,10 @@ pub enum Joint {
         /// Its phase at t = 0 [rad].
         phase: f64,
     },
+    /// Driven along a piecewise-linear table of the relative angle ([`super::DriveTable`]):
+    /// between the table's times a constant-rate drive whose rate is the one the rates have
+    /// (the run lands on each time and takes the impulse that sets the new segment's slope).
+    Table,
 }
 
 impl Joint {
@@ -159,7 +163,7 @@ impl<const N: usize> Mechanism<N> {
             .iter()
             .enumerate()
             .filter_map(|(i, l)| match (l.parent, l.joint) {
-                (Some(p), Joint::Locked | Joint::Driven { .. }) => Some((i, p)),
+                (Some(p), Joint::Locked | Joint::Driven { .. } | Joint::Table) => Some((i, p)),
                 _ => None,
             })
     }
@@ -209,6 +213,9 @@ impl<const N: usize> Mechanism<N> {
                     }
                     _ => Some(row(0.0, 0.0, rate)),
                 },
+                // The segment's slope is the rate the joint has (set at each of the table's
+                // times by an impulse): the row holds it.
+                Joint::Table => Some(row(0.0, 0.0, qd[2 + i] - qd[2 + p])),
                 _ => None,
             }
         })

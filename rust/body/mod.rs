@@ -9,7 +9,9 @@
 pub mod mechanism;
 pub mod rod;
 pub mod sole;
+pub mod table;
 
 pub use mechanism::{HeldRow, Joint, Link, Mechanism};
 pub use rod::{RodContact, RodGeometry};
 pub use sole::{SoleContact, SoleGeometry, SoleModel};
+pub use table::DriveTable;

@@ -27,13 +27,15 @@ fn unit(k: usize) -> Vector2<f64> {
     }
 }
 
-/// What a constraint row holds.
+/// What a constraint row holds. (Bytes, not words: a [`Row`] of the leg, `N = 6`, stays
+/// within 128 bytes, which a move copies inline; past that each push called `memmove`,
+/// measured at about 5 % of the leg's run.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum RowKind {
     /// A sticking component: contact and axis (0 = x, 1 = y).
-    Stick { contact: usize, axis: usize },
+    Stick { contact: u8, axis: u8 },
     /// A locked (or driven) joint of this link.
-    Lock { link: usize },
+    Lock { link: u8 },
     /// A prescribed root's coordinate (0 = x, 1 = y).
     Root,
 }
@@ -144,13 +146,20 @@ fn eliminate<const R: usize>((a, b): &mut Small<R>, k: usize, tiny: f64) -> bool
         if a[piv][col].abs() <= tiny {
             return false;
         }
-        a.swap(col, piv);
-        b.swap(col, piv);
+        // Row operations on the first `k` entries only, in place: a whole row of `R`
+        // (152 bytes) copied per operation called `memmove`.
+        if piv != col {
+            // (piv > col: the pivot is searched below the diagonal.)
+            let (top, rest) = a.split_at_mut(piv);
+            top[col][..k].swap_with_slice(&mut rest[0][..k]);
+            b.swap(col, piv);
+        }
         for r in col + 1..k {
             let f = a[r][col] / a[col][col];
             if f != 0.0 {
-                let pivot_row = a[col];
-                for (x, p) in a[r][col..k].iter_mut().zip(&pivot_row[col..k]) {
+                let (top, rest) = a.split_at_mut(r);
+                let pivot_row = &top[col];
+                for (x, p) in rest[0][col..k].iter_mut().zip(&pivot_row[col..k]) {
                     *x -= f * p;
                 }
                 b[r] -= f * b[col];
@@ -238,9 +247,11 @@ fn apply_rows<const N: usize, const R: usize>(
         *qdd += mult * r.response;
         match r.kind {
             RowKind::Stick { contact, axis } => {
-                contacts[contact].force.set_reaction(forces, axis, mult);
+                contacts[contact as usize]
+                    .force
+                    .set_reaction(forces, axis as usize, mult);
             }
-            RowKind::Lock { link } => joint_torque[link] = mult,
+            RowKind::Lock { link } => joint_torque[link as usize] = mult,
             RowKind::Root => {}
         }
     }
@@ -347,6 +358,67 @@ impl<const N: usize> Model<N> {
         })
     }
 
+    /// The impulse at one of the times of the table-driven joints: the smallest change of
+    /// the rates (M-orthogonal, `dqd = M^-1 J^T lambda`) that puts each joint of `targets`
+    /// (`(link, rate)`) on its new relative rate and keeps every other joint's and the
+    /// root's rows (a table joint without a time here keeps its rate). The sand's forces are
+    /// bounded and take no impulse: the contacts are left out (the run decides their modes
+    /// again). Returns, per joint of `targets`, `(link, impulse, energy)`: the angular
+    /// impulse the joint applies to its link [N m s] and the work it does,
+    /// `impulse (before + after) / 2` [J] (the rate moves linearly with the impulse).
+    pub fn drive_impulse(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &mut SVector<f64, N>,
+        targets: &[(usize, f64)],
+    ) -> Vec<(usize, f64, f64)> {
+        let pose = self.mechanism.pose(q);
+        let Some(chol) = self.mechanism.mass_matrix(&pose).cholesky() else {
+            return Vec::new();
+        };
+        let free: Modes = [ContactMode::default(); MAX_CONTACTS];
+        let mut rows = self.constraint_rows(&pose, q, qd, &free, &chol);
+        let k = rows.len;
+        for row in rows.rows.iter_mut().take(k).flatten() {
+            if let RowKind::Lock { link } = row.kind {
+                if let Some(&(_, rate)) = targets.iter().find(|(l, _)| *l == link as usize) {
+                    row.target = rate;
+                }
+            }
+        }
+        let mut minv_jt = [SVector::<f64, N>::zeros(); MAX_ROWS];
+        for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
+            *m = chol.solve(&rows.get(i).jac);
+        }
+        let v = *qd;
+        let Some(lam) = solve_small::<MAX_ROWS>(k, |(a, b)| {
+            for i in 0..k {
+                let ji = &rows.get(i).jac;
+                b[i] = ji.dot(&v) - rows.get(i).target;
+                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                    *aij = ji.dot(&minv_jt[j]);
+                }
+            }
+        }) else {
+            return Vec::new();
+        };
+        for (l, m) in lam.iter().zip(&minv_jt).take(k) {
+            *qd -= *l * m;
+        }
+        let mut out = Vec::with_capacity(targets.len());
+        for (i, l) in lam.iter().enumerate().take(k) {
+            let r = rows.get(i);
+            if let RowKind::Lock { link } = r.kind {
+                if targets.iter().any(|(t, _)| *t == link as usize) {
+                    let impulse = -l;
+                    let (before, after) = (r.jac.dot(&v), r.jac.dot(qd));
+                    out.push((link as usize, impulse, 0.5 * impulse * (before + after)));
+                }
+            }
+        }
+        out
+    }
+
     /// Whether any sticking component is in force under `modes`.
     #[inline]
     pub(super) fn any_stuck(&self, modes: &Modes) -> bool {
@@ -382,7 +454,7 @@ impl<const N: usize> Model<N> {
                 jac[c] = r.clock_coef;
             }
             rows.push(Row {
-                kind: RowKind::Lock { link: r.link },
+                kind: RowKind::Lock { link: r.link as u8 },
                 jac,
                 bias: r.bias,
                 response: chol.solve(&jac),
@@ -444,8 +516,8 @@ impl<const N: usize> Model<N> {
                 self.mechanism.add_point_force(pose, link, p, u, &mut gen);
                 rows.push(Row {
                     kind: RowKind::Stick {
-                        contact: ci,
-                        axis: k,
+                        contact: ci as u8,
+                        axis: k as u8,
                     },
                     jac: (u.transpose() * jac_e).transpose(),
                     bias: u.dot(&a_bias),
