@@ -11,7 +11,7 @@ machine.
 
 Usage::
 
-    python benches/bench_builds.py DIR_A DIR_B [--rounds 5] [--repeats 20]
+    python benches/bench_plates.py DIR_A DIR_B [--rounds 5] [--repeats 20]
 """
 
 from __future__ import annotations

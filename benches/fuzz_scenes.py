@@ -45,6 +45,7 @@ from typing import Any
 
 import granrs
 from granrs import Scene, _granrs, cases, forces, scenefile
+from granrs.bodies import Contact, Joint, Link, Linkage, Root
 from granrs.errors import GranrsError
 
 C_LEG = pathlib.Path(__file__).parent.parent / "examples" / "scenes" / "c_leg_rft.toml"
@@ -56,8 +57,8 @@ JOINT_FIELDS = ("pin_joint", "ankle", "knee", "hip")
 NAMES = (
     "free_link chain leg tip centroid modes raw smooth rk4 dopri5 first_stop all_stops time "
     "state forces energy gravity drag static_h static_v joint_springs free locked box thesis "
-    "rft rft_inertial poncelet zeta elements c k A00 Bm11 arc radius start_deg end_deg "
-    "chords rate pinned moving"
+    "rft rft_inertial poncelet zeta elements c k A00 Bm11 driven table arc radius start_deg "
+    "end_deg chords rate pinned moving"
 ).split()
 
 
@@ -192,6 +193,21 @@ def base_scenes() -> list[Scene]:
         cases.leg(
             v0=2.0,
             forces=[forces.gravity(), forces.rft(zeta=1e6, elements=2), forces.rft_inertial()],
+        ),
+        # A linkage with a joint driven along a table (issue 19).
+        Scene(
+            body=Linkage(
+                [Link("a", 1.0, 0.01, 0.3, (-0.15, 0.0)), Link("b", 0.5, 0.002, 0.2, (-0.1, 0.0))],
+                [
+                    Joint(
+                        "j", "a", "b", (-0.3, 0.0), kind="driven", table=((0.0, 0.0), (0.01, 20.0))
+                    )
+                ],
+                [Contact.rod("b", 0.2, 0.0127, at=(-0.2, 0.0))],
+                Root("moving", link="a", position=(0.0, 0.5), velocity=(0.0, -1.0)),
+            ),  # type: ignore[arg-type]
+            end="time",
+            t_end=0.02,
         ),
         # An arc contact on a driven root (issue 19): the C-leg scene file.
         Scene.from_toml(C_LEG).replace(t_end=0.05),

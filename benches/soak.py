@@ -1,15 +1,14 @@
 """Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6), and
-among them random C-legs (issue 19).
+beside them (``--table-share``, 2 % by default) two-link linkages whose knee is driven along a
+random table (issue 19), and (``--arc-share``, 2 %) random arc contacts, C-legs (issue 19,
+:func:`random_arc`), each kind swept separately.
 
 Checks that a long batch never returns NaN or infinity in a run that did not fail, never
 hangs and keeps its memory flat. Scenes are drawn from the valid domain of
 tests/test_properties.py (angle in (-90, 90) deg, v0 in [0, 10] m/s, coefficients 0..10x
 Table 3.4, masses 1 g .. 100 kg, every sign model, both points of application) with the
 thesis's step (dt = 1e-4 s by default; ``--dt-range`` draws dt from 1e-6 .. 1e-3 s) and
-``t_end`` capped so that a run takes at most ``--max-steps`` steps. One scene in twenty is
-a random arc contact instead (:func:`random_arc`): a linkage of one link carrying a circular
-arc of random radius, span and chords, on a pinned, moving or free root whose angle is
-driven at a random rate or free, under ``rft`` (with ``rft_inertial`` in half of them).
+``t_end`` capped so that a run takes at most ``--max-steps`` steps.
 
 They run in chunks (``--chunk``, 50,000 by default), each one ``granrs.sweep`` over a list
 of scenes; after each chunk the script prints the chunk, its seconds, the runs per second,
@@ -68,9 +67,6 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
     out = []
     for i in range(n):
         f = factors[i]
-        if rng.random() < 0.05:
-            out.append(random_arc(rng, float(dt[i]), float(t_end[i])))
-            continue
         out.append(
             Scene(
                 q_deg=float(q[i]),
@@ -90,13 +86,108 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
     return out
 
 
-def random_arc(rng: np.random.Generator, dt: float, t_end: float) -> Scene:
+def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
+    """The thesis's terms at 0..10x Table 3.4's q = 0 row; in a third of the scenes a random
+    subset of them (issue 16); in a quarter, one of the field's laws (issue 17) with random
+    parameters: rft (zeta 0..1e7 N/m^3, 1..16 elements), rft + rft_inertial, or poncelet
+    (c 0..5, k 0..1000 N/m)."""
+    u = rng.random()
+    if u < 0.25:
+        zeta = 1e7 * f[0] / 10.0
+        n = int(rng.integers(1, 17))
+        law = rng.integers(0, 3)
+        if law == 0:
+            extra: tuple[forces.Term, ...] = (forces.rft(zeta=zeta, elements=n),)
+        elif law == 1:
+            extra = (
+                forces.rft(zeta=zeta, elements=n),
+                forces.rft_inertial(lam=float(f[1]) / 5.0, elements=n),
+            )
+        else:
+            extra = (forces.poncelet(c=float(f[2]) / 2.0, k=100.0 * float(f[3])),)
+        return {"forces": (forces.gravity(), *extra)}
+    values = {k: SCALE[k] * x for k, x in zip(("eta_h", "eta_d", "eta_v", "lam"), f, strict=True)}
+    terms = forces.thesis(Coefficients(**values))
+    if u < 0.25 + 0.75 / 3:
+        keep = rng.random(len(terms)) < 0.75
+        terms = tuple(t for t, k in zip(terms, keep, strict=True) if k)
+    return {"forces": terms}
+
+
+def random_table_scenes(
+    rng: np.random.Generator, n: int, dt_range: bool, max_steps: int
+) -> list[Scene]:
+    """``n`` random valid linkages with a table-driven joint: a thigh on a root moved into the
+    sand at 0..3 m/s, a shank hanging from it with a rod contact at its tip, the knee driven
+    along 2..6 random points (times -0.1 .. 1.2 t_end, angles -60..60 deg), the law as in
+    :func:`random_scenes`, gravity always."""
+    out = []
+    for _ in range(n):
+        dt = float(10.0 ** rng.uniform(-6.0, -3.0)) if dt_range else 1e-4
+        t_end = min(0.2, max_steps * dt)
+        k = int(rng.integers(2, 7))
+        times = np.unique(rng.uniform(-0.1, 1.2 * t_end, k))
+        if len(times) < 2:
+            times = np.array([0.0, t_end])
+        angles = rng.uniform(-60.0, 60.0, len(times))
+        start = float(np.interp(0.0, times, angles))
+        l1, l2 = rng.uniform(0.05, 0.4, 2)
+        m1, m2 = 10.0 ** rng.uniform(-2.0, 1.0, 2)
+        q1 = float(rng.uniform(-30.0, 30.0))
+        q2 = q1 + start
+        # The root above the shank's tip, which starts at the surface.
+        y0 = l1 * math.cos(math.radians(q1)) + l2 * math.cos(math.radians(q2))
+        x0 = l1 * math.sin(math.radians(q1)) + l2 * math.sin(math.radians(q2))
+        body = granrs.bodies.Linkage(
+            [
+                granrs.bodies.Link("thigh", m1, m1 * l1 * l1 / 12.0, l1, (-0.5 * l1, 0.0), q1),
+                granrs.bodies.Link("shank", m2, m2 * l2 * l2 / 12.0, l2, (-0.5 * l2, 0.0), q2),
+            ],
+            [
+                granrs.bodies.Joint(
+                    "knee",
+                    "thigh",
+                    "shank",
+                    (-l1, 0.0),
+                    kind="driven",
+                    table=tuple(zip(times.tolist(), angles.tolist(), strict=True)),
+                )
+            ],
+            [granrs.bodies.Contact.rod("shank", l2, 0.0127, at=(-l2, 0.0))],
+            granrs.bodies.Root(
+                "moving",
+                link="thigh",
+                position=(x0, y0),
+                velocity=(float(rng.uniform(-1.0, 1.0)), -float(rng.uniform(0.0, 3.0))),
+            ),
+        )
+        law = _law(rng, rng.uniform(0.0, 10.0, 4))
+        terms = tuple(law["forces"])  # type: ignore[arg-type]
+        if not any(t.name == "gravity" for t in terms):
+            terms = (forces.gravity(), *terms)
+        out.append(
+            Scene(
+                body=body,  # type: ignore[arg-type]
+                forces=terms,
+                dt=dt,
+                t_end=t_end,
+                end="time",
+                sign_model=SIGN_MODELS[int(rng.integers(0, 3))],
+                apply_at=APPLY_AT[int(rng.integers(0, 2))],
+            )
+        )
+    return out
+
+
+def random_arc(rng: np.random.Generator, dt_range: bool, max_steps: int) -> Scene:
     """A random valid arc contact (issue 19): radius 1 cm .. 20 cm, span 1 .. 360 deg,
     1 .. MAX_CHORDS chords, on a link of 10 g .. 10 kg hung 0 .. 2 radii above the sand; the
     root pinned (its angle driven at -30 .. 30 rad/s, or free), moving (down at 0 .. 3 m/s)
     or free; rft with zeta 0 .. 1e7 N/m^3, and rft_inertial in half of them."""
     from granrs.bodies import MAX_CHORDS, Contact, Link, Linkage, Root
 
+    dt = float(10.0 ** rng.uniform(-6.0, -3.0)) if dt_range else 1e-4
+    t_end = min(0.2, max_steps * dt)
     radius = float(10.0 ** rng.uniform(-2.0, np.log10(0.2)))
     start = float(rng.uniform(-360.0, 360.0))
     span = float(rng.uniform(1.0, 360.0))
@@ -141,38 +232,12 @@ def random_arc(rng: np.random.Generator, dt: float, t_end: float) -> Scene:
                  sign_model=SIGN_MODELS[int(rng.integers(0, 3))])  # fmt: skip
 
 
-def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
-    """The thesis's terms at 0..10x Table 3.4's q = 0 row; in a third of the scenes a random
-    subset of them (issue 16); in a quarter, one of the field's laws (issue 17) with random
-    parameters: rft (zeta 0..1e7 N/m^3, 1..16 elements), rft + rft_inertial, or poncelet
-    (c 0..5, k 0..1000 N/m)."""
-    u = rng.random()
-    if u < 0.25:
-        zeta = 1e7 * f[0] / 10.0
-        n = int(rng.integers(1, 17))
-        law = rng.integers(0, 3)
-        if law == 0:
-            extra: tuple[forces.Term, ...] = (forces.rft(zeta=zeta, elements=n),)
-        elif law == 1:
-            extra = (
-                forces.rft(zeta=zeta, elements=n),
-                forces.rft_inertial(lam=float(f[1]) / 5.0, elements=n),
-            )
-        else:
-            extra = (forces.poncelet(c=float(f[2]) / 2.0, k=100.0 * float(f[3])),)
-        return {"forces": (forces.gravity(), *extra)}
-    values = {k: SCALE[k] * x for k, x in zip(("eta_h", "eta_d", "eta_v", "lam"), f, strict=True)}
-    terms = forces.thesis(Coefficients(**values))
-    if u < 0.25 + 0.75 / 3:
-        keep = rng.random(len(terms)) < 0.75
-        terms = tuple(t for t, k in zip(terms, keep, strict=True) if k)
-    return {"forces": terms}
-
-
 def describe(scene: Scene) -> str:
     if scene.kind == "linkage":
-        return f"Scene(body={scene.body!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, " + (
-            f"sign_model={scene.sign_model!r}, forces={scene.forces!r})"
+        return (
+            f"Scene(body={scene.body!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, "
+            f"sign_model={scene.sign_model!r}, apply_at={scene.apply_at!r}, "
+            f"forces={scene.forces!r})"
         )
     return (
         f"Scene(q_deg={scene.q_deg!r}, v0={scene.v0!r}, vx0={scene.vx0!r}, "
@@ -196,20 +261,25 @@ def soak(args: argparse.Namespace) -> int:
     chunk = 0
     while done < args.n:
         size = min(args.chunk, args.n - done)
-        scenes = random_scenes(rng, size, args.dt_range, args.max_steps)
+        tables = int(rng.binomial(size, args.table_share))
+        n_arcs = int(rng.binomial(size - tables, args.arc_share))
+        scenes = random_scenes(rng, size - tables - n_arcs, args.dt_range, args.max_steps)
+        driven = random_table_scenes(rng, tables, args.dt_range, args.max_steps)
+        arcs = [random_arc(rng, args.dt_range, args.max_steps) for _ in range(n_arcs)]
         t0 = time.perf_counter()
         counts: collections.Counter[str] = collections.Counter()
-        # A sweep runs one body: the free links, then the arcs.
-        for kind in ("free_link", "linkage"):
-            where = [i for i, sc in enumerate(scenes) if sc.kind == kind]
-            if not where:
+        for offset, batch in (
+            (done, scenes),
+            (done + len(scenes), driven),
+            (done + len(scenes) + len(driven), arcs),
+        ):
+            if not batch:
                 continue
-            group = [scenes[i] for i in where]
-            df = granrs.sweep(group, progress=False)
+            df = granrs.sweep(batch, progress=False)
             counts.update({str(k): int(v) for k, v in df["status"].value_counts().items() if v})
             bad = (df["status"] == "failed").to_numpy()
             for i in np.flatnonzero(bad):
-                failed.append((done + where[i], describe(group[i]), str(df["error"].iloc[i])))
+                failed.append((offset + int(i), describe(batch[i]), str(df["error"].iloc[i])))
             ok = df[~bad]
             numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
             values = numeric.select_dtypes("number").to_numpy()
@@ -219,11 +289,11 @@ def soak(args: argparse.Namespace) -> int:
             index = np.flatnonzero(~bad)
             for r in rows:
                 cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
-                non_finite.append((done + where[index[r]], describe(group[index[r]]), cols))
+                non_finite.append((offset + int(index[r]), describe(batch[index[r]]), cols))
             del df, ok, numeric, values
         seconds = time.perf_counter() - t0
         statuses.update(counts)
-        del scenes
+        del scenes, driven, arcs
         rss.append(rss_mb())
         short = ", ".join(f"{k} {int(v)}" for k, v in counts.items() if v)
         print(
@@ -261,6 +331,18 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument(
         "--max-steps", type=int, default=20_000, help="cap on steps per run via t_end (20000)"
+    )
+    parser.add_argument(
+        "--table-share",
+        type=float,
+        default=0.02,
+        help="share of the scenes that are linkages with a table-driven joint (0.02)",
+    )
+    parser.add_argument(
+        "--arc-share",
+        type=float,
+        default=0.02,
+        help="share of the scenes that are random arc contacts, C-legs (0.02)",
     )
     parser.add_argument(
         "--max-growth",

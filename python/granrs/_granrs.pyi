@@ -74,7 +74,9 @@ class RunOutcome:
     h_lambda: float
     unresolved: int
     def to_dict(self) -> dict[str, Any]:
-        """Everything, as a dict; once (the outcome moves out)."""
+        """Everything, as a dict; once (the outcome moves out). ``impulses``: the
+        table-driven joints' impulses, ``(link, t, impulse, energy)`` tuples in time order
+        (the link in the engine's order)."""
 
 def run(compiled: Compiled) -> RunOutcome:
     """Run a compiled scene."""

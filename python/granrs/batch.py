@@ -253,8 +253,8 @@ def sweep(
         scenes, none), then ``status`` (``stopped``, ``end_time``, ``not_stopped``,
         ``failed`` or ``cancelled``), the work counters, the energies, and the contact
         results of :attr:`granrs.Result.summary` (``t_s``, ``depth``, ``dq``, ...; the
-        chain's prefixed ``c0.`` and ``c1.``), and per joint
-        ``<joint>.F_max`` and ``<joint>.torque_max``. A run that failed has status
+        chain's prefixed ``c0.`` and ``c1.``), and per joint ``<joint>.F_max``,
+        ``<joint>.torque_max`` and ``<joint>.impulse_work``. A run that failed has status
         ``"failed"`` and its message in an ``error`` column (present only then).
 
     Raises:

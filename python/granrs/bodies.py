@@ -155,7 +155,13 @@ class Joint:
       plus a sinusoid ``amplitude_deg (sin(2 pi frequency t + phase) - sin(phase))``
       (``frequency`` in Hz, ``phase_deg``); the run reports the torque it takes
       (``Result.joints``). A sinusoid reads the time from a clock coordinate of its own
-      (the series ``clock``), so such a linkage has at most ``MAX_LINKS - 1`` links.
+      (the series ``clock``), so such a linkage has at most ``MAX_LINKS - 1`` links;
+      or, with ``table=[(t0, angle0_deg), (t1, angle1_deg), ...]`` (alone, without ``rate``
+      or a sinusoid), the relative angle ``q_child - q_parent`` itself [deg] follows the
+      table's linear interpolation, held at the first angle before ``t0`` and at the last
+      after the last time. Its angle at ``t = 0`` must be the initial relative angle (the
+      links' ``q_deg``, to 1e-9 rad). At each time the joint's rate jumps by an impulse,
+      reported in ``Result.impulses``.
     """
 
     name: str
@@ -170,9 +176,27 @@ class Joint:
     amplitude_deg: float | None = None
     frequency: float | None = None
     phase_deg: float | None = None
+    table: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "at", _point(self.at, f"joints.{self.name}.at"))
+        object.__setattr__(self, "table", _table(self.table))
+
+
+def _table(value: Any) -> Any:
+    """A table as a tuple of ``(time, angle)`` tuples (hashable, comparable); anything that is
+    not rows of values is left as it is, for the core to refuse naming the field."""
+    if value is None or isinstance(value, str | bytes | Mapping):
+        return value
+    try:
+        return tuple(
+            tuple(row)
+            if isinstance(row, Iterable) and not isinstance(row, str | bytes | Mapping)
+            else row
+            for row in value
+        )
+    except TypeError:
+        return value
 
 
 #: The shapes of contact.

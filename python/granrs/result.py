@@ -136,12 +136,18 @@ class Result:
             F_s_end, F_r_end, dKE, dPE, dE (thesis eqs. 3.22-3.26), steps, rhs_evals, ...
         contacts: per contact (the chain's link 1 and link 2; the leg's foot).
         joints: per joint, by name (see ``JOINT_NAMES``): ``F_max`` [N], the largest force
-            the joint passes to the link it carries, and ``torque_max`` [N m] (a spring's or
-            a locked joint's). The chain's ``"pin"`` is the force link 1 exerts on link 2.
+            the joint passes to the link it carries, ``torque_max`` [N m] (a spring's, a
+            locked or a driven joint's) and ``impulse_work`` [J] (the work of a
+            table-driven joint's impulses). The chain's ``"pin"`` is the force link 1
+            exerts on link 2.
         series: recorded time series (numpy arrays by name), or None. Multi-contact bodies
             keep the ``c0.``/``c1.`` prefixes; joint and link series are named
             ``<joint>.Fx/Fy/torque`` and ``<link>.KE/PE``.
         terms: the names of the force terms that acted, in the order of ``scene.forces``.
+        impulses: the impulses of the table-driven joints at their tables' times, in time
+            order: dicts with ``joint`` (its name), ``t`` [s], ``impulse`` (the angular
+            impulse on the link it carries, N m s) and ``energy`` (the work it does, J; each
+            joint's sum is its ``impulse_work`` in ``joints``).
     """
 
     __slots__ = ("_core", "_d", "_raw", "scene")
@@ -216,6 +222,14 @@ class Result:
     @property
     def joints(self) -> dict[str, dict[str, float]]:
         return self._parts()["joints"]  # type: ignore[no-any-return]
+
+    @property
+    def impulses(self) -> list[dict[str, Any]]:
+        names = _names(self.scene)["joints"]
+        return [
+            {"joint": names[link], "t": t, "impulse": p, "energy": e}
+            for link, t, p, e in self._raw_dict().get("impulses", ())
+        ]
 
     @property
     def series(self) -> dict[str, np.ndarray] | None:

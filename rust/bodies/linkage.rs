@@ -17,11 +17,17 @@ use nalgebra::{SVector, Vector2};
 use super::{validate_joint_stiffness, validate_options};
 use crate::body::arc::MAX_CHORDS;
 use crate::body::rod::ApplyAt;
-use crate::body::{ArcContact, Joint, Link, Mechanism, RodContact, SoleContact, SoleModel};
+use crate::body::{
+    ArcContact, DriveTable, Joint, Link, Mechanism, RodContact, SoleContact, SoleModel,
+};
 use crate::dynamics::{Contact, Model, Shape, SignModel, MAX_CONTACTS, MAX_LOCKED};
 use crate::error::{check_finite, check_range, GranrsError, Result};
 use crate::forces::{ForceSet, Medium};
-use crate::integrate::{solve, Outcome, SolveOptions};
+use crate::integrate::{solve_driven, Drives, Outcome, SolveOptions};
+
+/// How far [rad] a table's angle at t = 0 may be from its joint's initial relative angle
+/// (the degrees' round-off); the child's initial angle is then set from the table.
+const TABLE_START_TOL: f64 = 1e-9;
 
 /// Most links a linkage may have (the engine is compiled for 1 to `MAX_LINKS` links).
 pub const MAX_LINKS: usize = 6;
@@ -59,6 +65,8 @@ pub struct JointSpec {
     pub at: Vector2<f64>,
     /// Free, locked, a spring-damper (rest angle in rad) or driven at a constant rate.
     pub joint: Joint,
+    /// A [`Joint::Table`]'s table (angles in rad); `None` for every other joint.
+    pub table: Option<DriveTable>,
 }
 
 /// A contact's shape and where it sits on its link.
@@ -352,8 +360,20 @@ impl LinkageScene {
                     }
                     locked += 1;
                 }
+                Joint::Table => {
+                    self.validate_table(j)?;
+                    locked += 1;
+                }
                 Joint::Locked => locked += 1,
                 Joint::Free => {}
+            }
+            if j.table.is_some() && j.joint != Joint::Table {
+                return Err(bad(
+                    f("table"),
+                    "a table drives a joint of kind \"driven\" alone (without rate or a \
+                     sinusoid)"
+                        .into(),
+                ));
             }
         }
         if locked > MAX_LOCKED {
@@ -458,6 +478,67 @@ impl LinkageScene {
                     }
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Check a table-driven joint's table: at least two points, finite, the times strictly
+    /// increasing, and its angle at t = 0 the joint's initial relative angle.
+    fn validate_table(&self, j: &JointSpec) -> Result<()> {
+        let field = format!("joints.{}.table", j.name);
+        let Some(d) = &j.table else {
+            return Err(bad(
+                field,
+                "a joint driven along a table needs its table of (time, angle_deg) pairs".into(),
+            ));
+        };
+        let param = |value: f64, allowed: String| GranrsError::InvalidParameter {
+            field: field.clone(),
+            value,
+            allowed,
+        };
+        if d.times.len() < 2 || d.times.len() != d.angles.len() {
+            return Err(param(
+                d.times.len() as f64,
+                "at least 2 (time [s], angle [deg]) points".into(),
+            ));
+        }
+        for (i, (&t, &a)) in d.times.iter().zip(&d.angles).enumerate() {
+            if !t.is_finite() {
+                return Err(param(t, format!("a finite time [s] (row {i})")));
+            }
+            if !a.is_finite() {
+                return Err(param(
+                    a.to_degrees(),
+                    format!("a finite angle [deg] (row {i})"),
+                ));
+            }
+            if i > 0 && t <= d.times[i - 1] {
+                return Err(param(
+                    t,
+                    format!(
+                        "times strictly increasing: row {i}'s time after row {}'s ({} s)",
+                        i - 1,
+                        d.times[i - 1]
+                    ),
+                ));
+            }
+        }
+        let q = |name: &str| self.link_index(name).map_or(0.0, |i| self.links[i].q);
+        let initial = q(&j.child) - q(&j.parent);
+        let at_zero = d.angle(0.0);
+        if (initial - at_zero).abs() > TABLE_START_TOL {
+            return Err(bad(
+                field,
+                format!(
+                    "the table's angle at t = 0 ({:.9} deg) must be the joint's initial \
+                     relative angle, links.{}.q_deg - links.{}.q_deg ({:.9} deg)",
+                    at_zero.to_degrees(),
+                    j.child,
+                    j.parent,
+                    initial.to_degrees()
+                ),
+            ));
         }
         Ok(())
     }
@@ -686,6 +767,14 @@ impl LinkageScene {
                         omega,
                         phase,
                     } => qd[2 + k] = qd[2 + pk] + rate + amplitude * omega * phase.cos(),
+                    // The angle from the table (which agrees with the links' to
+                    // TABLE_START_TOL), the rate its segment's at t = 0.
+                    Joint::Table => {
+                        if let Some(d) = &j.table {
+                            q[2 + k] = q[2 + pk] + d.angle(0.0);
+                            qd[2 + k] = qd[2 + pk] + d.slope(0.0);
+                        }
+                    }
                     _ => {}
                 }
             }
@@ -702,8 +791,23 @@ impl LinkageScene {
         self.validate()?;
         with_size!(self.size(), N => {
             let (q0, qd0) = self.initial_state::<N>();
-            solve(&self.model::<N>(), q0, qd0, &self.options)
+            solve_driven(&self.model::<N>(), q0, qd0, &self.options, &self.drives())
         })
+    }
+
+    /// The table-driven joints, each with the link it carries in the engine's order.
+    pub fn drives(&self) -> Drives {
+        let order = self.order();
+        Drives::new(
+            self.joints
+                .iter()
+                .filter_map(|j| {
+                    let d = j.table.clone()?;
+                    let i = self.link_index(&j.child)?;
+                    Some((order.iter().position(|&o| o == i)?, d))
+                })
+                .collect(),
+        )
     }
 }
 
@@ -758,6 +862,7 @@ impl LinkageScene {
                     child: name(i),
                     at: l.joint_on_parent,
                     joint: l.joint,
+                    table: None,
                 })
             })
             .collect();
@@ -887,6 +992,7 @@ mod tests {
                 child: "b".into(),
                 at: Vector2::new(0.3, 0.0),
                 joint,
+                table: None,
             }],
             contacts: vec![],
             root: RootSpec {

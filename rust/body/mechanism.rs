@@ -51,6 +51,10 @@ pub enum Joint {
         /// Its phase at t = 0 [rad].
         phase: f64,
     },
+    /// Driven along a piecewise-linear table of the relative angle ([`super::DriveTable`]):
+    /// between the table's times a constant-rate drive whose rate is the one the rates have
+    /// (the run lands on each time and takes the impulse that sets the new segment's slope).
+    Table,
 }
 
 impl Joint {
@@ -162,7 +166,7 @@ impl<const N: usize> Mechanism<N> {
             .iter()
             .enumerate()
             .filter_map(|(i, l)| match (l.parent, l.joint) {
-                (Some(p), Joint::Locked | Joint::Driven { .. }) => Some((i, p)),
+                (Some(p), Joint::Locked | Joint::Driven { .. } | Joint::Table) => Some((i, p)),
                 _ => None,
             })
     }
@@ -182,7 +186,8 @@ impl<const N: usize> Mechanism<N> {
         self.root_fixed
             && self.root_rate.is_some()
             && self.links.iter().all(|l| {
-                l.parent.is_none() || matches!(l.joint, Joint::Locked | Joint::Driven { .. })
+                l.parent.is_none()
+                    || matches!(l.joint, Joint::Locked | Joint::Driven { .. } | Joint::Table)
             })
     }
 
@@ -231,6 +236,9 @@ impl<const N: usize> Mechanism<N> {
                     }
                     _ => Some(row(0.0, 0.0, rate)),
                 },
+                // The segment's slope is the rate the joint has (set at each of the table's
+                // times by an impulse): the row holds it.
+                Joint::Table => Some(row(0.0, 0.0, qd[2 + i] - qd[2 + p])),
                 _ => None,
             }
         })

@@ -10,8 +10,10 @@ pub mod arc;
 pub mod mechanism;
 pub mod rod;
 pub mod sole;
+pub mod table;
 
 pub use arc::{ArcContact, ArcGeometry};
 pub use mechanism::{HeldRow, Joint, Link, Mechanism};
 pub use rod::{RodContact, RodGeometry};
 pub use sole::{SoleContact, SoleGeometry, SoleModel};
+pub use table::DriveTable;

@@ -27,13 +27,15 @@ fn unit(k: usize) -> Vector2<f64> {
     }
 }
 
-/// What a constraint row holds.
+/// What a constraint row holds. (Bytes, not words: a [`Row`] of the leg, `N = 6`, stays
+/// within 128 bytes, which a move copies inline; past that each push called `memmove`,
+/// measured at about 5 % of the leg's run.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum RowKind {
     /// A sticking component: contact and axis (0 = x, 1 = y).
-    Stick { contact: usize, axis: usize },
+    Stick { contact: u8, axis: u8 },
     /// A locked (or driven) joint of this link, or its driven angle for a root link.
-    Lock { link: usize },
+    Lock { link: u8 },
     /// A prescribed root's coordinate (0 = x, 1 = y).
     Root,
 }
@@ -97,6 +99,43 @@ fn solve_small<const R: usize>(k: usize, fill: impl Fn(&mut Small<R>)) -> Option
     eliminate(&mut sys, k, 1e-13 * scale.max(f64::MIN_POSITIVE)).then_some(sys.1)
 }
 
+/// [`solve_small`] of the `k x k` system `a(i, j) x_j = b(i)`, assembled in the smallest of
+/// 4, 8 or `R` rows that holds it: the elimination touches only the first `k` rows and
+/// columns, so the result is the same to the bit, but zeroing, swapping and copying rows of
+/// a `MAX_ROWS`-wide array for a system of a few rows cost the leg a tenth of its time.
+#[inline]
+fn solve_sized<const R: usize>(
+    k: usize,
+    a: impl Fn(usize, usize) -> f64,
+    b: impl Fn(usize) -> f64,
+) -> Option<[f64; R]> {
+    #[inline(always)]
+    fn sized<const S: usize, const R: usize>(
+        k: usize,
+        a: &impl Fn(usize, usize) -> f64,
+        b: &impl Fn(usize) -> f64,
+    ) -> Option<[f64; R]> {
+        let x = solve_small::<S>(k, |sys| {
+            for i in 0..k {
+                sys.1[i] = b(i);
+                for (j, aij) in sys.0[i].iter_mut().enumerate().take(k) {
+                    *aij = a(i, j);
+                }
+            }
+        })?;
+        let mut out = [0.0; R];
+        out[..k].copy_from_slice(&x[..k]);
+        Some(out)
+    }
+    if k <= 4 && R >= 4 {
+        sized::<4, R>(k, &a, &b)
+    } else if k <= 8 && R >= 8 {
+        sized::<8, R>(k, &a, &b)
+    } else {
+        sized::<R, R>(k, &a, &b)
+    }
+}
+
 /// Gaussian elimination with partial pivoting in place (`b` becomes `x`); false at a pivot
 /// at or below `tiny`.
 fn eliminate<const R: usize>((a, b): &mut Small<R>, k: usize, tiny: f64) -> bool {
@@ -107,13 +146,20 @@ fn eliminate<const R: usize>((a, b): &mut Small<R>, k: usize, tiny: f64) -> bool
         if a[piv][col].abs() <= tiny {
             return false;
         }
-        a.swap(col, piv);
-        b.swap(col, piv);
+        // Row operations on the first `k` entries only, in place: a whole row of `R`
+        // (152 bytes) copied per operation called `memmove`.
+        if piv != col {
+            // (piv > col: the pivot is searched below the diagonal.)
+            let (top, rest) = a.split_at_mut(piv);
+            top[col][..k].swap_with_slice(&mut rest[0][..k]);
+            b.swap(col, piv);
+        }
         for r in col + 1..k {
             let f = a[r][col] / a[col][col];
             if f != 0.0 {
-                let pivot_row = a[col];
-                for (x, p) in a[r][col..k].iter_mut().zip(&pivot_row[col..k]) {
+                let (top, rest) = a.split_at_mut(r);
+                let pivot_row = &top[col];
+                for (x, p) in rest[0][col..k].iter_mut().zip(&pivot_row[col..k]) {
                     *x -= f * p;
                 }
                 b[r] -= f * b[col];
@@ -190,24 +236,22 @@ fn apply_rows<const N: usize, const R: usize>(
         return;
     }
     let free = *qdd;
-    let mults = solve_small::<R>(k, |(a, b)| {
-        for i in 0..k {
-            let ri = rows.get(i);
-            b[i] = -(ri.bias + ri.jac.dot(&free));
-            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
-                *aij = ri.jac.dot(&rows.get(j).response);
-            }
-        }
-    })
+    let mults = solve_sized::<R>(
+        k,
+        |i, j| rows.get(i).jac.dot(&rows.get(j).response),
+        |i| -(rows.get(i).bias + rows.get(i).jac.dot(&free)),
+    )
     .unwrap_or([0.0; R]);
     for (i, &mult) in mults.iter().enumerate().take(k) {
         let r = rows.get(i);
         *qdd += mult * r.response;
         match r.kind {
             RowKind::Stick { contact, axis } => {
-                contacts[contact].force.set_reaction(forces, axis, mult);
+                contacts[contact as usize]
+                    .force
+                    .set_reaction(forces, axis as usize, mult);
             }
-            RowKind::Lock { link } => joint_torque[link] = mult,
+            RowKind::Lock { link } => joint_torque[link as usize] = mult,
             RowKind::Root => {}
         }
     }
@@ -234,15 +278,11 @@ fn project_rows<const N: usize, const R: usize>(
         *m = minv(&rows.get(i).jac);
     }
     let v = *qd;
-    let lam = solve_small::<R>(k, |(a, b)| {
-        for i in 0..k {
-            let ji = &rows.get(i).jac;
-            b[i] = ji.dot(&v) - rows.get(i).target;
-            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
-                *aij = ji.dot(&minv_jt[j]);
-            }
-        }
-    });
+    let lam = solve_sized::<R>(
+        k,
+        |i, j| rows.get(i).jac.dot(&minv_jt[j]),
+        |i| rows.get(i).jac.dot(&v) - rows.get(i).target,
+    );
     match lam {
         Some(lam) if lam[..k].iter().any(|&l| l != 0.0) => {
             for (l, m) in lam.iter().zip(&minv_jt).take(k) {
@@ -323,6 +363,67 @@ impl<const N: usize> Model<N> {
         })
     }
 
+    /// The impulse at one of the times of the table-driven joints: the smallest change of
+    /// the rates (M-orthogonal, `dqd = M^-1 J^T lambda`) that puts each joint of `targets`
+    /// (`(link, rate)`) on its new relative rate and keeps every other joint's and the
+    /// root's rows (a table joint without a time here keeps its rate). The sand's forces are
+    /// bounded and take no impulse: the contacts are left out (the run decides their modes
+    /// again). Returns, per joint of `targets`, `(link, impulse, energy)`: the angular
+    /// impulse the joint applies to its link [N m s] and the work it does,
+    /// `impulse (before + after) / 2` [J] (the rate moves linearly with the impulse).
+    pub fn drive_impulse(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &mut SVector<f64, N>,
+        targets: &[(usize, f64)],
+    ) -> Vec<(usize, f64, f64)> {
+        let pose = self.mechanism.pose(q);
+        let Some(chol) = self.mechanism.mass_matrix(&pose).cholesky() else {
+            return Vec::new();
+        };
+        let free: Modes = [ContactMode::default(); MAX_CONTACTS];
+        let mut rows = self.constraint_rows(&pose, q, qd, &free, &chol);
+        let k = rows.len;
+        for row in rows.rows.iter_mut().take(k).flatten() {
+            if let RowKind::Lock { link } = row.kind {
+                if let Some(&(_, rate)) = targets.iter().find(|(l, _)| *l == link as usize) {
+                    row.target = rate;
+                }
+            }
+        }
+        let mut minv_jt = [SVector::<f64, N>::zeros(); MAX_ROWS];
+        for (i, m) in minv_jt.iter_mut().enumerate().take(k) {
+            *m = chol.solve(&rows.get(i).jac);
+        }
+        let v = *qd;
+        let Some(lam) = solve_small::<MAX_ROWS>(k, |(a, b)| {
+            for i in 0..k {
+                let ji = &rows.get(i).jac;
+                b[i] = ji.dot(&v) - rows.get(i).target;
+                for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                    *aij = ji.dot(&minv_jt[j]);
+                }
+            }
+        }) else {
+            return Vec::new();
+        };
+        for (l, m) in lam.iter().zip(&minv_jt).take(k) {
+            *qd -= *l * m;
+        }
+        let mut out = Vec::with_capacity(targets.len());
+        for (i, l) in lam.iter().enumerate().take(k) {
+            let r = rows.get(i);
+            if let RowKind::Lock { link } = r.kind {
+                if targets.iter().any(|(t, _)| *t == link as usize) {
+                    let impulse = -l;
+                    let (before, after) = (r.jac.dot(&v), r.jac.dot(qd));
+                    out.push((link as usize, impulse, 0.5 * impulse * (before + after)));
+                }
+            }
+        }
+        out
+    }
+
     /// Whether any sticking component is in force under `modes`.
     #[inline]
     pub(super) fn any_stuck(&self, modes: &Modes) -> bool {
@@ -358,7 +459,7 @@ impl<const N: usize> Model<N> {
                 jac[c] = r.clock_coef;
             }
             rows.push(Row {
-                kind: RowKind::Lock { link: r.link },
+                kind: RowKind::Lock { link: r.link as u8 },
                 jac,
                 bias: r.bias,
                 response: chol.solve(&jac),
@@ -370,7 +471,7 @@ impl<const N: usize> Model<N> {
             let mut jac = SVector::<f64, N>::zeros();
             jac[2 + link] = 1.0;
             rows.push(Row {
-                kind: RowKind::Lock { link },
+                kind: RowKind::Lock { link: link as u8 },
                 jac,
                 bias: 0.0,
                 response: chol.solve(&jac),
@@ -432,8 +533,8 @@ impl<const N: usize> Model<N> {
                 self.mechanism.add_point_force(pose, link, p, u, &mut gen);
                 rows.push(Row {
                     kind: RowKind::Stick {
-                        contact: ci,
-                        axis: k,
+                        contact: ci as u8,
+                        axis: k as u8,
                     },
                     jac: (u.transpose() * jac_e).transpose(),
                     bias: u.dot(&a_bias),

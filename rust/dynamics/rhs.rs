@@ -353,7 +353,7 @@ impl<const N: usize> Model<N> {
                 out.joint_power = 0.0;
                 out.joint_torque = joint_torque;
             }
-            None => *out = self.eval_general(q, qd, modes),
+            None => self.eval_general_into(q, qd, modes, out),
         }
     }
 
@@ -406,6 +406,28 @@ impl<const N: usize> Model<N> {
         qd: &SVector<f64, N>,
         modes: &Modes,
     ) -> Eval<N> {
+        let mut e = Eval {
+            qdd: SVector::zeros(),
+            power: 0.0,
+            joint_power: 0.0,
+            joint_torque: [0.0; N],
+            contacts: [ContactEval::default(); MAX_CONTACTS],
+        };
+        self.eval_general_into(q, qd, modes, &mut e);
+        e
+    }
+
+    /// [`Model::eval_general`] into `out`, in place: the contacts' findings are written
+    /// where they stay (an `Eval` is about 1 kB; built aside and moved, it was copied
+    /// twice per evaluation). Only the body's contacts are written: the slots past them
+    /// keep their default (nothing writes there).
+    pub fn eval_general_into(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+        out_eval: &mut Eval<N>,
+    ) {
         let pose = self.mechanism.pose(q);
         let g = self.gravity();
         let mut rhs = self.mechanism.bias_forces(&pose, qd, g);
@@ -416,7 +438,10 @@ impl<const N: usize> Model<N> {
         } else {
             0.0
         };
-        let mut contacts = [ContactEval::default(); MAX_CONTACTS];
+        let contacts = &mut out_eval.contacts;
+        for c in contacts.iter_mut().take(self.contacts.len()) {
+            *c = ContactEval::default();
+        }
         let mut moment_power = 0.0;
         for (ci, c) in self.contacts.iter().enumerate() {
             let link = c.link();
@@ -442,7 +467,7 @@ impl<const N: usize> Model<N> {
             let is_rod = matches!(c.shape, Shape::Rod(_));
             // A box in contact with an edge on the surface (a flat sole at touchdown) takes
             // its forces' limit from inside: no area yet, but the drag's extent is the edge.
-            let on_surface = geom.sole.is_some_and(|sg| sg.n_vertices >= 3);
+            let on_surface = geom.sole.as_ref().is_some_and(|sg| sg.n_vertices >= 3);
             let at_entry = geom.depth <= 0.0 && !self.forces.reads_frame && !on_surface;
             if at_entry && !is_rod {
                 continue;
@@ -521,13 +546,11 @@ impl<const N: usize> Model<N> {
         // Positive masses give a positive definite M for any finite state; a state that has
         // already blown up (NaN) does not: return NaN and let the solver report it.
         let Some(chol) = mass.cholesky() else {
-            return Eval {
-                qdd: SVector::repeat(f64::NAN),
-                power: f64::NAN,
-                joint_power: f64::NAN,
-                joint_torque,
-                contacts,
-            };
+            out_eval.qdd = SVector::repeat(f64::NAN);
+            out_eval.power = f64::NAN;
+            out_eval.joint_power = f64::NAN;
+            out_eval.joint_torque = joint_torque;
+            return;
         };
         let mut qdd = chol.solve(&rhs);
         if self.mechanism.has_constraints() || self.any_stuck(modes) {
@@ -538,7 +561,7 @@ impl<const N: usize> Model<N> {
                 modes,
                 &chol,
                 &mut qdd,
-                &mut contacts,
+                contacts,
                 &mut joint_torque,
             );
         }
@@ -555,13 +578,10 @@ impl<const N: usize> Model<N> {
             };
             power += ce.force.total().dot(&p);
         }
-        Eval {
-            qdd,
-            power,
-            joint_power,
-            joint_torque,
-            contacts,
-        }
+        out_eval.qdd = qdd;
+        out_eval.power = power;
+        out_eval.joint_power = joint_power;
+        out_eval.joint_torque = joint_torque;
     }
 
     /// Force each link receives at its joint from its parent (or the root) [N], from the

@@ -445,6 +445,33 @@ impl Events {
         earliest
     }
 
+    /// A drive's impulse changed the rates at `y`: decide again every component held by a
+    /// stick (the sand takes no impulse, so it may move now; it slips the way it moves, or
+    /// sticks again if it does not), and list the switching functions anew.
+    pub(super) fn after_impulse<const N: usize>(
+        &mut self,
+        model: &Model<N>,
+        modes: &mut Modes,
+        y: &State<N>,
+        stats: &mut Stats,
+    ) {
+        self.listed = false;
+        if model.sign_model != SignModel::Modes {
+            return;
+        }
+        for ci in 0..model.contacts.len() {
+            if !modes[ci].in_contact {
+                continue;
+            }
+            if model.forces.owns(Switch::SlipX) && modes[ci].sx == Slip::Stick {
+                choose_slip(model, modes, ci, 0, y, y, stats);
+            }
+            if model.forces.owns(Switch::SlipY) && modes[ci].sy == Slip::Stick {
+                choose_slip(model, modes, ci, 1, y, y, stats);
+            }
+        }
+    }
+
     /// Whether the last [`Events::detect`] found no crossing.
     #[inline]
     pub(super) fn none(&self) -> bool {

@@ -5,16 +5,18 @@
 //! table of output fields [`OUTCOME_FIELDS`]).
 
 pub mod control;
+pub mod drives;
 pub mod events;
 pub mod observe;
 pub mod outcome;
 pub mod solve;
 pub mod stepper;
 
+pub use drives::Drives;
 pub use observe::{Record, DIVERGENCE_FACTOR, RK4_STABILITY_LIMIT};
 pub use outcome::{
-    ContactSummary, Field, FieldValue, JointSummary, Outcome, OutcomeFields, Series, Stats, Status,
-    OUTCOME_FIELDS,
+    ContactSummary, Field, FieldValue, Impulse, JointSummary, Outcome, OutcomeFields, Series,
+    Stats, Status, OUTCOME_FIELDS,
 };
-pub use solve::{solve, EndCondition, SolveOptions};
+pub use solve::{solve, solve_driven, EndCondition, SolveOptions};
 pub use stepper::Method;

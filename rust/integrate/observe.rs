@@ -8,7 +8,7 @@
 use nalgebra::{SVector, Vector2};
 
 use super::outcome::{
-    ContactSummary, JointSummary, Outcome, Series, Stats, Status, OUTCOME_FIELDS,
+    ContactSummary, Impulse, JointSummary, Outcome, Series, Stats, Status, OUTCOME_FIELDS,
 };
 use super::solve::SolveOptions;
 use super::stepper::{Method, State};
@@ -72,6 +72,7 @@ impl<const N: usize> Stiffest<N> {
 pub(super) struct Observer<const N: usize> {
     summaries: Vec<ContactSummary>,
     joints: Vec<JointSummary>,
+    impulses: Vec<Impulse>,
     /// The drag's stiffest moment: ((|F_d| / |v_E|)^2, the state, the contact, v_E), over
     /// the step ends, the events and the RK4 stages (within a step that does not resolve the
     /// contact, the stages meet a stiffness the ends do not). Squared norms: a square root
@@ -125,6 +126,7 @@ impl<const N: usize> Observer<N> {
         Observer {
             summaries,
             joints: vec![JointSummary::default(); n_links],
+            impulses: Vec::new(),
             stiffest: Stiffest {
                 best: DragStiffness::default(),
                 q: y.q,
@@ -179,6 +181,34 @@ impl<const N: usize> Observer<N> {
         modes: &Modes,
     ) {
         self.recorder.push(model, t, y, e, modes);
+    }
+
+    /// Record the state at `t` unless the last record is at `t` already (the state before
+    /// a drive's impulse, which a step's end may have recorded).
+    #[inline]
+    pub(super) fn record_new(
+        &mut self,
+        model: &Model<N>,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+        modes: &Modes,
+    ) {
+        if self.recorder.t.last() != Some(&t) {
+            self.recorder.push(model, t, y, e, modes);
+        }
+    }
+
+    /// A table-driven joint (carrying `link`) applied `impulse` [N m s], doing `energy` [J],
+    /// at `t`.
+    pub(super) fn impulse(&mut self, link: usize, t: f64, impulse: f64, energy: f64) {
+        self.joints[link].impulse_work += energy;
+        self.impulses.push(Impulse {
+            link,
+            t,
+            impulse,
+            energy,
+        });
     }
 
     /// Record the end of the `n`-th grid step, if it is one of every `stride`.
@@ -293,6 +323,7 @@ impl<const N: usize> Observer<N> {
             work_sand: y.work,
             dissipated: y.dissipated,
             joints: self.joints,
+            impulses: self.impulses,
             series: self.recorder.finish(),
             terms: model.forces.names.clone(),
         };

@@ -101,6 +101,22 @@ pub struct JointSummary {
     pub f_max: f64,
     /// Largest |torque| over the run [N m].
     pub torque_max: f64,
+    /// Work of the impulses of a table-driven joint over the run [J].
+    pub impulse_work: f64,
+}
+
+/// One impulse of a table-driven joint, at one of its table's times.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Impulse {
+    /// The link the joint carries (the model's order).
+    pub link: usize,
+    /// When [s].
+    pub t: f64,
+    /// The angular impulse the joint applies to its link (and the opposite to the parent)
+    /// [N m s].
+    pub impulse: f64,
+    /// The work it does, impulse times the mean of the relative rate before and after [J].
+    pub energy: f64,
 }
 
 /// Recorded time series, column by column (each the same length as `t`).
@@ -133,6 +149,8 @@ pub struct Outcome {
     pub dissipated: f64,
     /// Per link: the joint that carries it.
     pub joints: Vec<JointSummary>,
+    /// The impulses of the table-driven joints, in time order.
+    pub impulses: Vec<Impulse>,
     /// Largest `dt * lambda` of the drag over the run: the step times the drag's fastest
     /// rate, `2 |F_d| / |v_E|` times E's inverse effective mass (see
     /// [`Model::centroid_inverse_mass`]), at the state where the drag was stiffest (step
@@ -289,6 +307,7 @@ pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
     joint: &[
         real("F_max", "N", |j| Real(j.f_max)),
         real("torque_max", "N m", |j| Real(j.torque_max)),
+        real("impulse_work", "J", |j| Real(j.impulse_work)),
     ],
 };
 

@@ -11,6 +11,7 @@
 use nalgebra::SVector;
 
 use super::control::Control;
+use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
 use super::observe::{Observer, Record};
 use super::outcome::{Outcome, Stats, Status};
@@ -74,6 +75,19 @@ pub fn solve<const N: usize>(
     qd0: SVector<f64, N>,
     options: &SolveOptions,
 ) -> Result<Outcome> {
+    solve_driven(model, q0, qd0, options, &Drives::default())
+}
+
+/// [`solve`] with table-driven joints: a step ends on each of the tables' times (up to
+/// `t_end`), where the rates take the impulse of the new segments. The run records the
+/// state before and after each impulse (both at that time).
+pub fn solve_driven<const N: usize>(
+    model: &Model<N>,
+    q0: SVector<f64, N>,
+    qd0: SVector<f64, N>,
+    options: &SolveOptions,
+    drives: &Drives,
+) -> Result<Outcome> {
     let mut stats = Stats::default();
     let mut y = State {
         q: q0,
@@ -92,8 +106,28 @@ pub fn solve<const N: usize>(
     let mut cur = 0usize;
     stats.rhs_evals += 1;
     obs.record(model, t, &y, &evals[cur], &modes);
+    // The next time of the drive tables.
+    let mut next_time = 0usize;
 
     let status = loop {
+        // A time of the drive tables: the impulse onto the new segments.
+        if let Some(tb) = drives.time(next_time) {
+            if tb - t <= 1e-12 * options.dt {
+                next_time += 1;
+                obs.record_new(model, t, &y, &evals[cur], &modes);
+                for (link, impulse, energy) in
+                    model.drive_impulse(&y.q, &mut y.qd, &drives.targets(tb))
+                {
+                    obs.impulse(link, t, impulse, energy);
+                }
+                stats.events += 1;
+                events.after_impulse(model, &mut modes, &y, &mut stats);
+                model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
+                stats.rhs_evals += 1;
+                obs.record(model, t, &y, &evals[cur], &modes);
+                continue;
+            }
+        }
         if control.finished(t) {
             break if options.end == EndCondition::Time {
                 Status::EndTime
@@ -102,10 +136,14 @@ pub fn solve<const N: usize>(
             };
         }
 
-        // Step.
-        let t_next = control.next(t);
+        // Step: to the next grid point, or to a time of the drive tables before it.
+        let grid = control.next(t);
+        let (t_next, clamped) = match drives.time(next_time) {
+            Some(tb) if tb < grid => (tb, true),
+            _ => (grid, false),
+        };
         let h = t_next - t;
-        if control.landed(h) {
+        if !clamped && control.landed(h) {
             events.next_step();
             continue;
         }
@@ -156,11 +194,13 @@ pub fn solve<const N: usize>(
                 model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
             }
             t = t_next;
-            let n = control.advance();
-            events.next_step();
             stats.steps += 1;
             obs.step_end(model, &y, &evals[cur], &modes);
-            obs.record_step(n, model, t, &y, &evals[cur], &modes);
+            if !clamped {
+                let n = control.advance();
+                events.next_step();
+                obs.record_step(n, model, t, &y, &evals[cur], &modes);
+            }
             continue;
         }
 

@@ -275,6 +275,18 @@ pub fn body_linkage<'py>(
                     d.set_item("phase_deg", phase.to_degrees())?;
                 }
             }
+            Joint::Table => {
+                d.set_item("kind", "driven")?;
+                if let Some(t) = &j.table {
+                    let rows: Vec<(f64, f64)> = t
+                        .times
+                        .iter()
+                        .zip(&t.angles)
+                        .map(|(&t, &a)| (t, a.to_degrees()))
+                        .collect();
+                    d.set_item("table", rows)?;
+                }
+            }
         }
         joints.append(d)?;
     }

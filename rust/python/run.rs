@@ -78,6 +78,13 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
         joints.append(jd)?;
     }
     d.set_item("joints", joints)?;
+    // The table-driven joints' impulses: (link in the engine's order, t [s], impulse
+    // [N m s], energy [J]), in time order.
+    let impulses = PyList::empty(py);
+    for i in &out.impulses {
+        impulses.append((i.link, i.t, i.impulse, i.energy))?;
+    }
+    d.set_item("impulses", impulses)?;
     match out.series {
         None => d.set_item("series", py.None())?,
         Some(series) => {

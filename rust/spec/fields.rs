@@ -191,7 +191,7 @@ pub struct ElementField {
 
 /// Every field of a linkage's elements, by element (the one table: the core's parsing,
 /// `granrs.bodies`' dataclasses and docs, the TOML notes).
-pub static ELEMENT_FIELDS: [ElementField; 38] = {
+pub static ELEMENT_FIELDS: [ElementField; 39] = {
     const fn f(
         element: &'static str,
         name: &'static str,
@@ -219,13 +219,14 @@ pub static ELEMENT_FIELDS: [ElementField; 38] = {
         f("joint", "parent", "", "a link's name", "the link the joint sits on"),
         f("joint", "child", "", "a link's name", "the link the joint carries (its (s, n) origin is the joint)"),
         f("joint", "at", "m", "(s, n), finite", "where the joint sits on the parent, in the parent's (s, n) coordinates"),
-        f("joint", "kind", "", "free, locked, spring or driven", "\"free\" (frictionless), \"locked\", \"spring\" (a spring-damper k, c about rest_deg) or \"driven\" (its relative angle moves at rate)"),
+        f("joint", "kind", "", "free, locked, spring or driven", "\"free\" (frictionless), \"locked\", \"spring\" (a spring-damper k, c about rest_deg) or \"driven\" (its relative angle moves at rate, plus a sinusoid; or along a table)"),
         f("joint", "k", "N m/rad", ">= 0", "a spring's stiffness"),
         f("joint", "c", "N m s/rad", ">= 0", "a spring's damping"),
         f("joint", "rest_deg", "deg", "finite; left out: the initial angle", "a spring's rest angle, child relative to parent; None: the initial relative angle"),
         f("joint", "rate", "rad/s", "finite; left out: 0", "a driven joint's constant relative rate; its angle is the initial one plus rate t plus the sinusoid; the run reports the torque it takes"),
         f("joint", "amplitude_deg", "deg", "finite; left out: 0", "a driven joint's sinusoid: amplitude_deg (sin(2 pi frequency t + phase) - sin(phase)) added to its angle"),
         f("joint", "frequency", "Hz", "finite; needed with an amplitude", "the sinusoid's frequency"),
+        f("joint", "table", "s, deg", "(time, angle_deg) pairs: at least 2, finite, times strictly increasing; alone", "a driven joint's table of its relative angle child minus parent: the angle is its linear interpolation, held at the first angle before the first time and at the last after the last; its angle at t = 0 must be the initial relative angle (links' q_deg), and each time is a located event where the joint's rate jumps by an impulse the run reports (Result.impulses)"),
         f("joint", "phase_deg", "deg", "finite; left out: 0", "the sinusoid's phase at t = 0"),
         f("contact", "name", "", "text", "the contact's name"),
         f("contact", "shape", "", "rod, box or arc", "\"rod\" (a round rod meeting the sand with its tip: tip and outline), \"box\" (a sole, a plate) or \"arc\" (a thin circular arc, a C-shaped leg, cut into chords)"),

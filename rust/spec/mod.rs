@@ -15,7 +15,7 @@ use crate::bodies::{
     LinkageScene, RootKind, RootSpec, LEG_JOINTS,
 };
 use crate::body::rod::ApplyAt;
-use crate::body::{Joint, SoleModel};
+use crate::body::{DriveTable, Joint, SoleModel};
 use crate::dynamics::SignModel;
 use crate::error::{GranrsError, Result};
 use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
@@ -545,6 +545,49 @@ impl<'a> Element<'a> {
     }
 }
 
+/// A driven joint's table, `[(time [s], angle [deg]), ...]`, with its angles in radians
+/// (its values are checked by the linkage).
+fn drive_table(field: &str, v: &Value) -> Result<DriveTable> {
+    let rows: &[Value] = match v {
+        Value::List(rows) => rows,
+        Value::Names(n) if n.is_empty() => &[],
+        other => {
+            return Err(wrong(
+                field,
+                "a list of (time [s], angle [deg]) pairs",
+                other,
+            ))
+        }
+    };
+    let mut table = DriveTable {
+        times: Vec::with_capacity(rows.len()),
+        angles: Vec::with_capacity(rows.len()),
+    };
+    for (i, row) in rows.iter().enumerate() {
+        let pair = match row {
+            Value::List(p) if p.len() == 2 => p,
+            other => {
+                return Err(wrong(
+                    field,
+                    &format!("a list of (time [s], angle [deg]) pairs (row {i} is not one)"),
+                    other,
+                ))
+            }
+        };
+        let entry = |k: usize| match &pair[k] {
+            Value::Num(x) => Ok(*x),
+            other => Err(wrong(
+                field,
+                &format!("numbers (time [s], angle [deg]) in each row (row {i})"),
+                other,
+            )),
+        };
+        table.times.push(entry(0)?);
+        table.angles.push(entry(1)?.to_radians());
+    }
+    Ok(table)
+}
+
 /// The elements of one list of a linkage (`links`, `joints`, `contacts`).
 fn elements<'a>(entries: &'a [(Cow<'static, str>, Value)], k: &str) -> Result<&'a [Value]> {
     match map_get(entries, k) {
@@ -593,6 +636,29 @@ impl SceneSpec {
             };
             let parent = e.str("parent")?.to_string();
             let child = e.str("child")?.to_string();
+            let table = match e.get("table") {
+                None => None,
+                Some(v) => {
+                    let field = e.field("table");
+                    let clash = ["rate", "amplitude_deg", "frequency", "phase_deg"]
+                        .into_iter()
+                        .find(|k| e.get(k).is_some());
+                    if kind != "driven" || clash.is_some() {
+                        return Err(GranrsError::InvalidScene {
+                            field,
+                            message: match clash {
+                                Some(k) => format!(
+                                    "a table drives the joint alone: leave out {k} (or the table)"
+                                ),
+                                None => format!(
+                                    "a table drives a joint of kind \"driven\", not {kind:?}"
+                                ),
+                            },
+                        });
+                    }
+                    Some(drive_table(&field, v)?)
+                }
+            };
             let joint = match kind {
                 "free" => Joint::Free,
                 "locked" => Joint::Locked,
@@ -612,6 +678,7 @@ impl SceneSpec {
                         rest,
                     }
                 }
+                "driven" if table.is_some() => Joint::Table,
                 "driven" => {
                     let amplitude = e.num_or("amplitude_deg", 0.0)?;
                     Joint::Driven {
@@ -639,6 +706,7 @@ impl SceneSpec {
                 child,
                 at: e.point_or("at", Vector2::zeros())?,
                 joint,
+                table,
             });
         }
         let mut contacts = Vec::new();
