@@ -230,6 +230,7 @@ def sweep(
     progress: bool | None = None,
     client: Any = None,
     chunk_size: int | None = None,
+    lanes: bool = True,
     **axes: Any,
 ) -> pd.DataFrame:
     """Run many scenes in parallel and return one row of summaries per run.
@@ -244,6 +245,11 @@ def sweep(
             runs (default: about four chunks per worker thread), each run by the Rust batch
             on a worker with one thread. The result is the same DataFrame.
         chunk_size: runs per Dask task.
+        lanes: run free-link scenes under the thesis's terms (``drag``, ``static_h``,
+            ``static_v``, with or without ``gravity``; sign model ``"modes"``; RK4) four at
+            a time in SIMD lanes, with AVX2 where the CPU has it (default). The results are
+            the same bit for bit as with ``lanes=False``, which runs every scene alone on
+            the scalar path (for comparisons and benchmarks). Other scenes always run alone.
         **axes: field name = values (any Scene field but ``body``; a single value is an
             axis of one). The sweep runs their Cartesian product, the last axis varying
             fastest, as ``itertools.product``.
@@ -297,6 +303,9 @@ def sweep(
         kwargs = {"scenes": [s._plain() for s in scenes]}
         n = len(scenes)
         keep_axes = {}
+    if not isinstance(lanes, bool):
+        raise InvalidParameterError(f"lanes must be True or False; got {lanes!r}", field="lanes")
+    kwargs["lanes"] = lanes
     if client is not None:
         if chunk_size is not None and (not isinstance(chunk_size, int) or chunk_size < 1):
             raise InvalidParameterError(
@@ -306,7 +315,8 @@ def sweep(
             raw = run_chunk(kwargs, 0, 0, 1)
         else:
             # Validate everything here, before any task is sent.
-            _granrs.validate_sweep(**kwargs, threads=n_threads)
+            plain = {k: v for k, v in kwargs.items() if k != "lanes"}
+            _granrs.validate_sweep(**plain, threads=n_threads)
             raw = _run_dask(client, kwargs, n, chunk_size, progress)
     else:
         raw = _run_local(kwargs, 0, n, n_threads, progress)

@@ -6,6 +6,7 @@
 
 pub mod control;
 pub mod events;
+pub mod lanes;
 pub mod observe;
 pub mod outcome;
 pub mod solve;
@@ -16,5 +17,5 @@ pub use outcome::{
     ContactSummary, Field, FieldValue, JointSummary, Outcome, OutcomeFields, Series, Stats, Status,
     OUTCOME_FIELDS,
 };
-pub use solve::{solve, EndCondition, SolveOptions};
+pub use solve::{solve, EndCondition, Run, SolveOptions};
 pub use stepper::Method;
