@@ -20,6 +20,7 @@ use crate::bodies::AnyScene;
 use crate::error::{GranrsError, Result};
 use crate::integrate::lanes::{run_lanes, LaneIsa, LaneScene};
 use crate::integrate::{Outcome, Status, OUTCOME_FIELDS};
+use crate::simd::LANES;
 use crate::spec::{SceneSpec, Value};
 
 /// Status codes of the `status` column ([`Status::code`]).
@@ -247,8 +248,9 @@ pub enum Path {
     Scalar,
 }
 
-/// Scenes per rayon task on the lanes' path: each task keeps its four lanes full until its
-/// scenes run out, so a task's last steps run with idle lanes.
+/// Most scenes per rayon task on the lanes' path: each task keeps its four lanes full until
+/// its scenes run out (so its last steps run with idle lanes); a small batch takes smaller
+/// tasks, about eight per thread, so that the threads share it evenly.
 pub const LANE_CHUNK: usize = 64;
 
 /// Run every scene in `range` on the current rayon pool (call inside `pool.install`).
@@ -277,10 +279,11 @@ pub fn run(
     };
     if path == Path::Lanes && body == "free_link" {
         let isa = LaneIsa::detect();
-        data.par_chunks_mut(width * LANE_CHUNK)
+        let chunk = (range.len() / (8 * rayon::current_num_threads())).clamp(LANES, LANE_CHUNK);
+        data.par_chunks_mut(width * chunk)
             .enumerate()
             .for_each(|(c, rows)| {
-                let first = start + c * LANE_CHUNK;
+                let first = start + c * chunk;
                 let n = rows.len() / width;
                 let rows = RefCell::new(rows);
                 let mut k = 0;
