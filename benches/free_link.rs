@@ -353,6 +353,85 @@ fn impact(c: &mut Criterion) {
     g.finish();
 }
 
+/// libm's `sin_cos` against `_granrs::math`'s (the lanes' own, which the free link's
+/// scalar path calls too), over 1024 angles from -3 to 3 rad.
+fn math(c: &mut Criterion) {
+    let qs: Vec<f64> = (0..1024).map(|i| -3.0 + 6.0 * i as f64 / 1024.0).collect();
+    let mut g = c.benchmark_group("math");
+    g.throughput(Throughput::Elements(1024));
+    g.bench_function("sin_cos_libm", |b| {
+        b.iter(|| {
+            black_box(&qs)
+                .iter()
+                .map(|&q| {
+                    let (s, c) = q.sin_cos();
+                    s + c
+                })
+                .sum::<f64>()
+        })
+    });
+    g.bench_function("sin_cos_granrs", |b| {
+        b.iter(|| {
+            black_box(&qs)
+                .iter()
+                .map(|&q| {
+                    let (s, c) = _granrs::math::sin_cos(q);
+                    s + c
+                })
+                .sum::<f64>()
+        })
+    });
+    g.finish();
+}
+
+/// The Table 3.5 scenes as a sweep on one thread: in SIMD lanes against alone, each run
+/// as the batch runs it (no Python, no scene building).
+fn lanes(c: &mut Criterion) {
+    use _granrs::integrate::lanes::{run_lanes, LaneIsa};
+    let all = table_3_5_scenes();
+    let scenes: Vec<_> = all
+        .iter()
+        .map(|s| {
+            let (q0, qd0) = s.initial_state();
+            (s.model(), q0, qd0, s.options)
+        })
+        .collect();
+    let mut g = c.benchmark_group("sweep");
+    g.throughput(Throughput::Elements(scenes.len() as u64));
+    for (name, isa) in [
+        ("table_3_5_lanes", Some(LaneIsa::detect())),
+        ("table_3_5_lanes_baseline", Some(LaneIsa::Base)),
+        ("table_3_5_scalar", None),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut depth = 0.0;
+                match isa {
+                    Some(isa) => {
+                        let mut it = scenes.iter().enumerate();
+                        run_lanes(
+                            isa,
+                            || {
+                                it.next()
+                                    .map(|(i, (m, q, qd, o))| (i, m.clone(), *q, *qd, *o))
+                            },
+                            |_, out| depth += out.unwrap().contacts[0].depth,
+                        );
+                    }
+                    None => {
+                        for (m, q, qd, o) in &scenes {
+                            let out = _granrs::integrate::solve(&m.clone(), *q, *qd, o);
+                            depth += out.unwrap().contacts[0].depth;
+                        }
+                    }
+                }
+                black_box(depth)
+            })
+        });
+    }
+    g.finish();
+}
+
 fn config() -> Criterion {
     Criterion::default()
         .sample_size(30)
@@ -363,6 +442,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = force, rhs, impact
+    targets = force, rhs, impact, math, lanes
 }
 criterion_main!(benches);

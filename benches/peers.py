@@ -49,7 +49,9 @@ granrs itself is timed per impact, summary only (no time series):
 
 * ``granrs.sweep`` over the scenes (each ``SWEEP_COPIES`` times) on one and on two threads,
   against ``numba_scalar`` over the same scenes in a ``prange`` on one and two threads (a
-  perfectly parallel loop: the ceiling of what two cores give).
+  perfectly parallel loop: the ceiling of what two cores give). The sweep is timed with its
+  SIMD lanes (the default, ``lanes=True``: four scenes per lane group) and on the scalar
+  path (``lanes=False``), in the same loop.
 
 It prints a work-precision table and writes its figure (``--figure``, a PNG): every peer at
 several steps (solve_ivp at several rtols), the median over the scenes of the depth error
@@ -631,8 +633,8 @@ def time_sweeps(runs: list[SceneRun], repeats: int, copies: int) -> dict[str, fl
     out = np.empty(len(scenes))
     batch_scalar(y0s[:1], ps[:1], DT, T_END, out[:1])  # compile
 
-    def sweep(threads: int) -> None:
-        granrs.sweep(scenes, threads=threads, progress=False)
+    def sweep(threads: int, lanes: bool = True) -> None:
+        granrs.sweep(scenes, threads=threads, progress=False, lanes=lanes)
 
     def in_prange(threads: int) -> None:
         set_num_threads(threads)
@@ -641,6 +643,8 @@ def time_sweeps(runs: list[SceneRun], repeats: int, copies: int) -> dict[str, fl
     todo = {
         "sweep_1": lambda: sweep(1),
         "sweep_2": lambda: sweep(2),
+        "sweep_scalar_1": lambda: sweep(1, lanes=False),
+        "sweep_scalar_2": lambda: sweep(2, lanes=False),
         "numba_parallel_1": lambda: in_prange(1),
         "numba_parallel_2": lambda: in_prange(2),
     }
@@ -829,8 +833,10 @@ def summarize(
         "numba_scalar": "numba RK4, hand-tuned scalars",
         "numba_located": "numba RK4, hand-tuned scalars, stop located as granrs does",
         "solve_ivp": "scipy solve_ivp RK45, matched rtol",
-        "sweep_1": "granrs.sweep, 1 thread (per impact)",
-        "sweep_2": "granrs.sweep, 2 threads (per impact)",
+        "sweep_1": "granrs.sweep, SIMD lanes, 1 thread (per impact)",
+        "sweep_2": "granrs.sweep, SIMD lanes, 2 threads (per impact)",
+        "sweep_scalar_1": "granrs.sweep, scalar path (lanes=False), 1 thread (per impact)",
+        "sweep_scalar_2": "granrs.sweep, scalar path (lanes=False), 2 threads (per impact)",
         "numba_parallel_1": "numba scalars in a prange, 1 thread (per impact)",
         "numba_parallel_2": "numba scalars in a prange, 2 threads (per impact)",
     }
@@ -856,15 +862,24 @@ def summarize(
     ratio("granrs Rust only (criterion) / numba user", "rust", "numba_user", TARGET_NUMBA, True)
     ratio("granrs (simulate) / numba scalar", "granrs", "numba_scalar", TARGET_SCALAR, True)
     ratio("granrs run alone / numba scalar", "granrs_core", "numba_scalar", None, True)
-    ratio("granrs sweep 1 thread / numba scalar", "sweep_1", "numba_scalar", TARGET_SWEEP, True)
-    if all(k in t for k in ("sweep_1", "sweep_2", "numba_parallel_1", "numba_parallel_2")):
-        ours = t["sweep_1"] / t["sweep_2"]
-        theirs = t["numba_parallel_1"] / t["numba_parallel_2"]
-        lines.append(
-            f"| sweep speed-up 1 -> 2 threads ({ours:.2f}x) / numba prange's ({theirs:.2f}x) "
-            f"| {ours / theirs:.3g} | >= {TARGET_SCALING:g} | "
-            f"{'yes' if ours / theirs >= TARGET_SCALING else 'NO'} |"
-        )
+    ratio("granrs sweep (lanes) 1 thread / numba scalar", "sweep_1", "numba_scalar",
+          TARGET_SWEEP, True)  # fmt: skip
+    ratio("granrs sweep (lanes) 1 thread / numba prange 1 thread", "sweep_1",
+          "numba_parallel_1", TARGET_SWEEP, True)  # fmt: skip
+    ratio("granrs sweep (scalar) 1 thread / numba scalar", "sweep_scalar_1", "numba_scalar",
+          None, True)  # fmt: skip
+    ratio("granrs sweep lanes / scalar, 1 thread", "sweep_1", "sweep_scalar_1", None, True)
+    ratio("granrs sweep lanes / scalar, 2 threads", "sweep_2", "sweep_scalar_2", None, True)
+    for suffix, label in (("", "lanes"), ("_scalar", "scalar")):
+        one, two = f"sweep{suffix}_1", f"sweep{suffix}_2"
+        if all(k in t for k in (one, two, "numba_parallel_1", "numba_parallel_2")):
+            ours = t[one] / t[two]
+            theirs = t["numba_parallel_1"] / t["numba_parallel_2"]
+            lines.append(
+                f"| sweep ({label}) speed-up 1 -> 2 threads ({ours:.2f}x) / numba prange's "
+                f"({theirs:.2f}x) | {ours / theirs:.3g} | >= {TARGET_SCALING:g} | "
+                f"{'yes' if ours / theirs >= TARGET_SCALING else 'NO'} |"
+            )
     ratio("granrs Rust only / numba scalar", "rust", "numba_scalar", None, True)
     ratio("granrs raw Rust only / numba scalar", "rust_raw", "numba_scalar", None, True)
     ratio("solve_ivp / granrs (simulate), mean over the scenes it ran", "solve_ivp",

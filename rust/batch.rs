@@ -10,13 +10,17 @@
 //! batch from another thread; a cancelled batch stops after the runs in flight.
 
 use std::borrow::Cow;
+use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use crate::bodies::AnyScene;
 use crate::error::{GranrsError, Result};
+use crate::integrate::lanes::{run_lanes, LaneIsa, LaneScene};
 use crate::integrate::{Outcome, Status, OUTCOME_FIELDS};
+use crate::simd::LANES;
 use crate::spec::{SceneSpec, Value};
 
 /// Status codes of the `status` column ([`Status::code`]).
@@ -233,40 +237,106 @@ pub struct BatchOut {
     pub cancelled: bool,
 }
 
+/// How a batch runs its scenes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Path {
+    /// Free-link scenes under the thesis's terms four at a time in SIMD lanes
+    /// (`integrate::lanes`, with AVX2 where the CPU has it), every other scene alone. The
+    /// default; the results are the scalar path's bit for bit.
+    Lanes,
+    /// Every scene alone, on the scalar path (for tests and benchmarks).
+    Scalar,
+}
+
+/// Most scenes per rayon task on the lanes' path: each task keeps its four lanes full until
+/// its scenes run out (so its last steps run with idle lanes); a small batch takes smaller
+/// tasks, about eight per thread, so that the threads share it evenly.
+pub const LANE_CHUNK: usize = 64;
+
 /// Run every scene in `range` on the current rayon pool (call inside `pool.install`).
 /// `done` counts finished runs; setting `cancel` stops the batch after the runs in flight
 /// (the rest get status [`STATUS_CANCELLED`]). Validate first: a run whose scene does not
-/// build is recorded as failed.
+/// build is recorded as failed. `path` chooses the lanes or the scalar path.
 pub fn run(
     src: &Source,
     range: std::ops::Range<usize>,
     body: &str,
     done: &AtomicUsize,
     cancel: &AtomicBool,
+    path: Path,
 ) -> BatchOut {
     let columns = columns(body);
     let width = columns.len();
     let start = range.start;
     let mut data = vec![f64::NAN; range.len() * width];
     let failures = Mutex::new(Vec::new());
-    data.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
-        let i = start + k;
-        if cancel.load(Ordering::Relaxed) {
-            row[0] = STATUS_CANCELLED;
-            return;
-        }
-        match src.spec(i).build().and_then(|s| s.run()) {
-            Ok(out) => summarize(&out, row),
-            Err(e) => {
-                row[0] = STATUS_FAILED;
-                failures
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .push((i, e.to_string()));
+    let fail = |i: usize, row: &mut [f64], e: GranrsError| {
+        row[0] = STATUS_FAILED;
+        failures
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .push((i, e.to_string()));
+    };
+    if path == Path::Lanes && body == "free_link" {
+        let isa = LaneIsa::detect();
+        let chunk = (range.len() / (8 * rayon::current_num_threads())).clamp(LANES, LANE_CHUNK);
+        data.par_chunks_mut(width * chunk)
+            .enumerate()
+            .for_each(|(c, rows)| {
+                let first = start + c * chunk;
+                let n = rows.len() / width;
+                let rows = RefCell::new(rows);
+                let mut k = 0;
+                let next = || -> Option<LaneScene<usize>> {
+                    while k < n {
+                        let j = k;
+                        k += 1;
+                        let mut rows = rows.borrow_mut();
+                        let row = &mut rows[j * width..(j + 1) * width];
+                        if cancel.load(Ordering::Relaxed) {
+                            row[0] = STATUS_CANCELLED;
+                            continue;
+                        }
+                        match src.spec(first + j).build() {
+                            Ok(AnyScene::FreeLink(s)) => {
+                                let (q0, qd0) = s.initial_state();
+                                return Some((j, s.model(), q0, qd0, s.options));
+                            }
+                            Ok(other) => match other.run() {
+                                Ok(out) => summarize(&out, row),
+                                Err(e) => fail(first + j, row, e),
+                            },
+                            Err(e) => fail(first + j, row, e),
+                        }
+                        done.fetch_add(1, Ordering::Relaxed);
+                    }
+                    None
+                };
+                let finished = |j: usize, out: Result<Outcome>| {
+                    let mut rows = rows.borrow_mut();
+                    let row = &mut rows[j * width..(j + 1) * width];
+                    match out {
+                        Ok(out) => summarize(&out, row),
+                        Err(e) => fail(first + j, row, e),
+                    }
+                    done.fetch_add(1, Ordering::Relaxed);
+                };
+                run_lanes(isa, next, finished);
+            });
+    } else {
+        data.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
+            let i = start + k;
+            if cancel.load(Ordering::Relaxed) {
+                row[0] = STATUS_CANCELLED;
+                return;
             }
-        }
-        done.fetch_add(1, Ordering::Relaxed);
-    });
+            match src.spec(i).build().and_then(|s| s.run()) {
+                Ok(out) => summarize(&out, row),
+                Err(e) => fail(i, row, e),
+            }
+            done.fetch_add(1, Ordering::Relaxed);
+        });
+    }
     let mut failures = failures.into_inner().unwrap_or_else(|p| p.into_inner());
     failures.sort_by_key(|(i, _)| *i);
     BatchOut {
@@ -318,7 +388,7 @@ mod tests {
         let cancel = AtomicBool::new(false);
         let out = pool(2)
             .unwrap()
-            .install(|| run(&src, 0..src.len(), "free_link", &done, &cancel));
+            .install(|| run(&src, 0..src.len(), "free_link", &done, &cancel, Path::Lanes));
         assert_eq!(done.load(Ordering::Relaxed), 6);
         let width = out.columns.len();
         let depth = out.columns.iter().position(|c| c == "c0.depth").unwrap();
@@ -336,6 +406,58 @@ mod tests {
             );
             assert!(row[depth] > 0.0);
         }
+    }
+
+    /// The rows of a batch on `path`, as bits.
+    fn rows_bits(src: &Source, path: Path) -> Vec<u64> {
+        let done = AtomicUsize::new(0);
+        let cancel = AtomicBool::new(false);
+        let out = pool(2)
+            .unwrap()
+            .install(|| run(src, 0..src.len(), "free_link", &done, &cancel, path));
+        assert_eq!(done.load(Ordering::Relaxed), src.len());
+        assert!(out.failures.is_empty(), "{:?}", out.failures);
+        out.data.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// The lanes give the scalar path's rows bit for bit: scenes that end at different
+    /// times (angles from -85 to 89 deg, speeds from 0.05 to 5 m/s, spins), that stick,
+    /// slide and spin, that start in the sand, that end at `t_end` or at every stop, at
+    /// the tip and at the centroid; and scenes the lanes do not cover (the raw sign model),
+    /// mixed in, which run alone.
+    #[test]
+    fn lanes_rows_are_the_scalar_rows_bitwise() {
+        let num = |v: &[f64]| v.iter().map(|&x| Value::Num(x)).collect::<Vec<_>>();
+        let word = |v: &[&'static str]| {
+            v.iter()
+                .map(|&x| Value::Str(std::borrow::Cow::Borrowed(x)))
+                .collect::<Vec<_>>()
+        };
+        let src = Source::Product {
+            base: base(),
+            axes: vec![
+                ("apply_at".into(), word(&["tip", "centroid"])),
+                ("sign_model".into(), word(&["modes", "raw"])),
+                (
+                    "q_deg".into(),
+                    num(&[-85.0, -30.0, 0.0, 5.0, 45.0, 75.0, 89.0]),
+                ),
+                ("v0".into(), num(&[0.05, 1.12, 2.214, 5.0])),
+                ("omega0".into(), num(&[0.0, -7.0, 20.0])),
+            ],
+        };
+        assert_eq!(rows_bits(&src, Path::Lanes), rows_bits(&src, Path::Scalar));
+        let src = Source::Product {
+            base: base(),
+            axes: vec![
+                ("end".into(), word(&["all_stops", "time"])),
+                ("t_end".into(), num(&[0.004, 0.05])),
+                ("depth0".into(), num(&[0.0, 0.03])),
+                ("q_deg".into(), num(&[0.0, 15.0, 60.0])),
+                ("vx0".into(), num(&[-1.0, 0.0, 0.4])),
+            ],
+        };
+        assert_eq!(rows_bits(&src, Path::Lanes), rows_bits(&src, Path::Scalar));
     }
 
     #[test]
@@ -361,7 +483,7 @@ mod tests {
         let src = product();
         let done = AtomicUsize::new(0);
         let cancel = AtomicBool::new(true);
-        let out = run(&src, 0..src.len(), "free_link", &done, &cancel);
+        let out = run(&src, 0..src.len(), "free_link", &done, &cancel, Path::Lanes);
         assert!(out.cancelled);
         assert_eq!(done.load(Ordering::Relaxed), 0);
         assert!(out

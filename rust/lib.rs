@@ -17,6 +17,8 @@ pub mod error;
 pub mod evaluate;
 pub mod forces;
 pub mod integrate;
+pub mod math;
+pub mod simd;
 pub mod spec;
 
 #[cfg(feature = "python")]

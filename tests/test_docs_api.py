@@ -46,7 +46,7 @@ gen = _generator()
 #: Python blocks of the pages that are not run, by (page, index among its python blocks).
 NOT_RUN = {
     ("forces.md", 1): "a constructor to add to python/granrs/forces.py (a worked example)",
-    ("sweeps.md", 2): "needs a Dask scheduler",
+    ("sweeps.md", 3): "needs a Dask scheduler",
 }
 #: Blocks that show an error: the exception they must raise.
 RAISES = {("getting_started.md", 1): "InvalidParameterError"}

@@ -98,6 +98,7 @@ def sweep(
     stop: int | None = None,
     threads: int = 0,
     progress: Callable[[int], None] | None = None,
+    lanes: bool = True,
 ) -> dict[str, Any]:
     """Run runs start..stop of a batch (the product of axes over base, or a list of scene
     dicts) on `threads` threads (0: every core); return columns, data (rows x columns),

@@ -88,9 +88,9 @@ def _check_axes(scene: Scene, axes: dict[str, list[Any]]) -> None:
             scene.replace(**{name: v})
 
 
-def _frame(raw: dict[str, Any], body: str, axis_frame: pd.DataFrame | None) -> pd.DataFrame:
-    columns: list[str] = list(raw["columns"])
-    data = np.asarray(raw["data"])
+def _names(columns: Sequence[str], body: str) -> list[str]:
+    """The DataFrame's names of the core's columns (a free link drops ``c0.``; joints by
+    name)."""
     n_contacts = sum(1 for c in columns if c.endswith(".t_s"))
     joints = JOINT_NAMES.get(body, ())
     names = []
@@ -101,41 +101,120 @@ def _frame(raw: dict[str, Any], body: str, axis_frame: pd.DataFrame | None) -> p
             idx, _, rest = c[5:].partition(".")
             c = f"{joints[int(idx)]}.{rest}"
         names.append(c)
-    out: dict[str, Any] = {}
-    for j, name in enumerate(names):
-        col = data[:, j]
+    return names
+
+
+class _Table:
+    """A sweep's result columns, filled chunk by chunk from the core's tables (``rows x
+    columns`` floats) and then made a DataFrame without copying them: the floats are one
+    ``columns x rows`` block (the frame's own), the others one array each. The counters
+    are int32 (a run's stay far below 2^31; a column that does not fits is widened to
+    int64). So a sweep holds its result plus one chunk (issue 22: a summary-only sweep of
+    1e6 runs under 300 MB)."""
+
+    def __init__(self, columns: Sequence[str], body: str, n: int) -> None:
+        self.names = _names(columns, body)
+        self.floats = [j for j, c in enumerate(self.names) if self._kind(c) == "float"]
+        self.block = np.empty((len(self.floats), n))
+        self.other: dict[int, np.ndarray] = {}
+        for j, c in enumerate(self.names):
+            kind = self._kind(c)
+            if kind == "status":
+                self.other[j] = np.empty(n, dtype=np.int8)
+            elif kind == "bool":
+                self.other[j] = np.empty(n, dtype=bool)
+            elif kind == "int":
+                self.other[j] = np.empty(n, dtype=np.int32)
+
+    @staticmethod
+    def _kind(name: str) -> str:
         if name == "status":
-            codes = np.nan_to_num(col, nan=3).astype(np.int64)
-            out[name] = pd.Categorical.from_codes(codes, categories=list(STATUSES))
-        elif name.endswith("stopped"):
-            out[name] = col == 1.0
-        elif name in _INT_COLUMNS:
-            out[name] = np.nan_to_num(col, nan=0).astype(np.int64)
+            return "status"
+        if name.endswith("stopped"):
+            return "bool"
+        if name in _INT_COLUMNS:
+            return "int"
+        return "float"
+
+    def put(self, data: np.ndarray, offset: int) -> None:
+        """Rows ``offset .. offset + len(data)`` from a core table."""
+        rows = slice(offset, offset + len(data))
+        for k, j in enumerate(self.floats):
+            self.block[k, rows] = data[:, j]
+        for j, out in self.other.items():
+            col = data[:, j]
+            kind = self._kind(self.names[j])
+            if kind == "status":
+                out[rows] = np.nan_to_num(col, nan=3)
+            elif kind == "bool":
+                out[rows] = col == 1.0
+            else:
+                ints = np.nan_to_num(col, nan=0)
+                if out.dtype == np.int32 and len(ints) and ints.max() > np.iinfo(np.int32).max:
+                    out = self.other[j] = out.astype(np.int64)
+                out[rows] = ints
+
+    def frame(
+        self,
+        failures: Sequence[tuple[int, str]],
+        start: int,
+        axis_columns: dict[str, np.ndarray] | None,
+    ) -> pd.DataFrame:
+        """The DataFrame: the float block as it is, the other columns (and the axis columns,
+        taken from ``axis_columns``) inserted one at a time, each dropped here once the
+        frame has its copy."""
+        frame = pd.DataFrame(self.block.T, columns=[self.names[j] for j in self.floats], copy=False)
+        for j in sorted(self.other):
+            out = self.other.pop(j)
+            name = self.names[j]
+            if name == "status":
+                frame.insert(j, name, pd.Categorical.from_codes(out, categories=list(STATUSES)))
+            else:
+                frame.insert(j, name, out)
+            del out
+        if failures:
+            errors = np.full(len(frame), None, dtype=object)
+            for i, message in failures:
+                errors[i - start] = message
+            frame["error"] = errors
+        for k, name in enumerate(list(axis_columns or {})):
+            frame.insert(k, name, axis_columns.pop(name))  # type: ignore[union-attr]
+        return frame
+
+
+def _frame(
+    raw: dict[str, Any], body: str, axis_columns: dict[str, np.ndarray] | None
+) -> pd.DataFrame:
+    """The DataFrame of one core table (a local sweep fills its :class:`_Table` by chunks)."""
+    table = raw.pop("table", None)
+    if table is None:
+        data = np.asarray(raw.pop("data"))
+        table = _Table(raw["columns"], body, len(data))
+        table.put(data, 0)
+        del data
+    return table.frame(raw["failures"], raw["start"], axis_columns)
+
+
+def _axis_columns(axes: dict[str, list[Any]], start: int, stop: int) -> dict[str, np.ndarray]:
+    """The axis columns of runs ``start..stop``, filled a chunk at a time (no temporaries of
+    the sweep's length)."""
+    n = stop - start
+    cols: dict[str, np.ndarray] = {}
+    values: dict[str, np.ndarray] = {}
+    for name, vs in axes.items():
+        if all(isinstance(v, (int, float, np.number)) and not isinstance(v, bool) for v in vs):
+            values[name] = np.asarray(vs, dtype=float)
         else:
-            out[name] = col
-    frame = pd.DataFrame(out)
-    if raw["failures"]:
-        errors = np.full(len(frame), None, dtype=object)
-        for i, message in raw["failures"]:
-            errors[i - raw["start"]] = message
-        frame["error"] = errors
-    if axis_frame is not None:
-        frame = pd.concat([axis_frame.reset_index(drop=True), frame], axis=1)
-    return frame
-
-
-def _axis_frame(axes: dict[str, list[Any]], start: int, stop: int) -> pd.DataFrame:
+            values[name] = np.empty(len(vs), dtype=object)
+            values[name][:] = vs
+        cols[name] = np.empty(n, dtype=values[name].dtype)
     shape = [len(v) for v in axes.values()]
-    idx = np.unravel_index(np.arange(start, stop), shape) if shape else ()
-    cols: dict[str, Any] = {}
-    for (name, values), ix in zip(axes.items(), idx, strict=True):
-        if all(isinstance(v, (int, float, np.number)) and not isinstance(v, bool) for v in values):
-            cols[name] = np.asarray(values, dtype=float)[ix]
-        else:
-            arr = np.empty(len(values), dtype=object)
-            arr[:] = values
-            cols[name] = arr[ix]
-    return pd.DataFrame(cols)
+    for lo in range(start, stop, LOCAL_CHUNK):
+        hi = min(stop, lo + LOCAL_CHUNK)
+        idx = np.unravel_index(np.arange(lo, hi), shape)
+        for (name, vs), ix in zip(values.items(), idx, strict=True):
+            cols[name][lo - start : hi - start] = vs[ix]
+    return cols
 
 
 def _threads(threads: int | None) -> int:
@@ -158,23 +237,44 @@ def _progress_bar(total: int, progress: bool | None) -> Any:
     return tqdm(total=total, unit="run", desc="granrs sweep", disable=disable)
 
 
+#: Runs per call into the core in a local sweep: each call's table (about 250 B a run) is
+#: copied into the result's columns as it comes (:class:`_Table`).
+LOCAL_CHUNK = 1 << 13
+
+
 def _run_local(
     kwargs: dict[str, Any], start: int, stop: int, threads: int, progress: bool | None
 ) -> dict[str, Any]:
+    if stop - start > LOCAL_CHUNK:
+        # Every run is validated before the first chunk runs.
+        plain = {k: v for k, v in kwargs.items() if k != "lanes"}
+        _granrs.validate_sweep(**plain, threads=threads)
     bar = _progress_bar(stop - start, progress)
+    table: _Table | None = None
+    failures: list[tuple[int, str]] = []
+    body = ""
+    columns: list[str] = []
     try:
-        callback = None
-        if bar is not None:
+        for lo in range(start, max(stop, start + 1), LOCAL_CHUNK):
+            hi = min(stop, lo + LOCAL_CHUNK)
+            callback = None
+            if bar is not None:
+                done_before = lo - start
 
-            def callback(done: int) -> None:
-                bar.update(done - bar.n)
+                def callback(done: int, done_before: int = done_before) -> None:
+                    bar.update(done_before + done - bar.n)
 
-        raw = _granrs.sweep(**kwargs, start=start, stop=stop, threads=threads, progress=callback)
+            raw = _granrs.sweep(**kwargs, start=lo, stop=hi, threads=threads, progress=callback)
+            body, columns = raw["body"], list(raw["columns"])
+            if table is None:
+                table = _Table(columns, body, stop - start)
+            table.put(np.asarray(raw["data"]), lo - start)
+            failures += raw["failures"]
+            del raw
     finally:
         if bar is not None:
             bar.close()
-    raw["start"] = start
-    return dict(raw)
+    return {"table": table, "failures": failures, "body": body, "columns": columns, "start": start}
 
 
 def run_chunk(kwargs: dict[str, Any], start: int, stop: int, threads: int) -> dict[str, Any]:
@@ -230,6 +330,7 @@ def sweep(
     progress: bool | None = None,
     client: Any = None,
     chunk_size: int | None = None,
+    lanes: bool = True,
     **axes: Any,
 ) -> pd.DataFrame:
     """Run many scenes in parallel and return one row of summaries per run.
@@ -244,6 +345,11 @@ def sweep(
             runs (default: about four chunks per worker thread), each run by the Rust batch
             on a worker with one thread. The result is the same DataFrame.
         chunk_size: runs per Dask task.
+        lanes: run free-link scenes under the thesis's terms (``drag``, ``static_h``,
+            ``static_v``, with or without ``gravity``; sign model ``"modes"``; RK4) four at
+            a time in SIMD lanes, with AVX2 where the CPU has it (default). The results are
+            the same bit for bit as with ``lanes=False``, which runs every scene alone on
+            the scalar path (for comparisons and benchmarks). Other scenes always run alone.
         **axes: field name = values (any Scene field but ``body``; a single value is an
             axis of one). The sweep runs their Cartesian product, the last axis varying
             fastest, as ``itertools.product``.
@@ -270,7 +376,6 @@ def sweep(
         (6, ['q_deg', 'v0', 'status'])
     """
     n_threads = _threads(threads)
-    axis_frame: pd.DataFrame | None
     if isinstance(scene, Scene):
         plain_axes = {name: _axis_values(name, values) for name, values in axes.items()}
         _check_axes(scene, plain_axes)
@@ -297,6 +402,9 @@ def sweep(
         kwargs = {"scenes": [s._plain() for s in scenes]}
         n = len(scenes)
         keep_axes = {}
+    if not isinstance(lanes, bool):
+        raise InvalidParameterError(f"lanes must be True or False; got {lanes!r}", field="lanes")
+    kwargs["lanes"] = lanes
     if client is not None:
         if chunk_size is not None and (not isinstance(chunk_size, int) or chunk_size < 1):
             raise InvalidParameterError(
@@ -306,12 +414,15 @@ def sweep(
             raw = run_chunk(kwargs, 0, 0, 1)
         else:
             # Validate everything here, before any task is sent.
-            _granrs.validate_sweep(**kwargs, threads=n_threads)
+            plain = {k: v for k, v in kwargs.items() if k != "lanes"}
+            _granrs.validate_sweep(**plain, threads=n_threads)
             raw = _run_dask(client, kwargs, n, chunk_size, progress)
+        axis_columns = _axis_columns(keep_axes, 0, n) if keep_axes else None
     else:
+        axis_columns = _axis_columns(keep_axes, 0, n) if keep_axes else None
         raw = _run_local(kwargs, 0, n, n_threads, progress)
-    axis_frame = _axis_frame(keep_axes, 0, n) if keep_axes else None
-    frame = _frame(raw, raw["body"], axis_frame)
+    frame = _frame(raw, raw["body"], axis_columns)
+    del raw, axis_columns
     _warn_unresolved(frame)
     return frame
 
@@ -324,10 +435,14 @@ def _warn_unresolved(frame: pd.DataFrame) -> None:
     if "h_lambda" not in frame.columns:
         return
     h_lambda = frame["h_lambda"].to_numpy()
-    start, end = frame["energy_start"].to_numpy(), frame["energy_end"].to_numpy()
+    # The energy test only where a step was unresolved (few rows: no full-length temporaries).
+    maybe = np.flatnonzero(frame["unresolved"].to_numpy() > 0)
+    start = frame["energy_start"].to_numpy()[maybe]
+    end = frame["energy_end"].to_numpy()[maybe]
     with np.errstate(invalid="ignore"):
         rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
-    bad = np.flatnonzero((h_lambda > RK4_STABILITY_LIMIT) | ((frame["unresolved"] > 0) & rose))
+    flagged = np.flatnonzero(h_lambda > RK4_STABILITY_LIMIT)
+    bad = np.union1d(flagged, maybe[rose])
     if bad.size:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
         warnings.warn(

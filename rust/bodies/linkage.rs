@@ -791,7 +791,7 @@ impl LinkageScene {
         self.validate()?;
         with_size!(self.size(), N => {
             let (q0, qd0) = self.initial_state::<N>();
-            solve_driven(&self.model::<N>(), q0, qd0, &self.options, &self.drives())
+            solve_driven(&self.model::<N>(), q0, qd0, &self.options, self.drives())
         })
     }
 

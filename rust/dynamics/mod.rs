@@ -29,6 +29,7 @@ use crate::forces::{AnyTerm, ContactState, ForceSet, Medium, Switch};
 mod constraints;
 mod rhs;
 mod rigid_rod;
+pub mod rod_lanes;
 #[cfg(test)]
 mod tests;
 

@@ -22,7 +22,8 @@ use crate::forces::{
 };
 
 /// Position and velocity of a single rigid rod whose root is its centre of mass: what
-/// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation).
+/// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation,
+/// [`crate::math::sin_cos`]).
 #[derive(Debug, Clone, Copy)]
 struct RodFrame {
     root: Vector2<f64>,
@@ -35,7 +36,8 @@ struct RodFrame {
 impl RodFrame {
     #[inline]
     fn new<const N: usize>(q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Self {
-        let (s, c) = q[2].sin_cos();
+        // The lanes' own sin_cos (`dynamics::rod_lanes` reads the same).
+        let (s, c) = crate::math::sin_cos(q[2]);
         RodFrame {
             root: Vector2::new(q[0], q[1]),
             v_root: Vector2::new(qd[0], qd[1]),

@@ -64,7 +64,17 @@ impl Term for Drag {
 
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        let k = -(F::splat(self.eta_d) * m.rho_g * c.area_speed);
+        Drag::law(F::splat(self.eta_d), c, m)
+    }
+}
+
+impl Drag {
+    /// The term's arithmetic with its parameter as a number of type `F`: one scene's
+    /// ([`Term::contact_force`] splats it) or one per SIMD lane (the sweep's lanes,
+    /// `dynamics::rod_lanes`, whose scenes differ in their parameters).
+    #[inline(always)]
+    pub fn law<F: Real>(eta_d: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        let k = -(eta_d * m.rho_g * c.area_speed);
         TermForce::force([k * c.v[0], k * c.v[1]])
     }
 }

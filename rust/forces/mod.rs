@@ -24,7 +24,7 @@
 //! (`registry.rs`), one constructor in `python/granrs/forces.py`. See `docs/forces.md`.
 
 use std::fmt::Debug;
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, Div, Mul, Neg, Sub};
 
 #[cfg(test)]
 pub mod constant;
@@ -40,14 +40,23 @@ pub mod static_v;
 
 pub use registry::{AnyTerm, Coefficients, ForceSet, TermSpec, TERMS};
 
-/// The number type of a term's arithmetic: `f64` for one scene; a SIMD lane type for several
-/// scenes at once (later). Only the operations the terms use.
+/// The number type of a term's arithmetic: `f64` for one scene; [`crate::simd::F64x4`] for
+/// four scenes at once, one per SIMD lane (the sweep's lanes, `dynamics::rod_lanes`). Only
+/// the operations the terms and the free link's mechanics use; a lane type does each lane
+/// by lane with the same IEEE operation as `f64`, so that a lane's result is bit for bit the
+/// scalar one.
 pub trait Real:
-    Copy + Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+    Copy
+    + Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
 {
     /// The value `x` (in every lane).
     fn splat(x: f64) -> Self;
-    /// `self^e`.
+    /// `self^e` (libm's, in each lane).
     fn powf(self, e: Self) -> Self;
     /// `1 / self`.
     fn recip(self) -> Self;
@@ -63,6 +72,8 @@ pub trait Real:
     fn select_pos(self, a: Self, b: Self) -> Self;
     /// Whether it is zero (in every lane).
     fn all_zero(self) -> bool;
+    /// Sine and cosine ([`crate::math::sin_cos`] in each lane).
+    fn sin_cos(self) -> (Self, Self);
 }
 
 impl Real for f64 {
@@ -105,6 +116,11 @@ impl Real for f64 {
     #[inline(always)]
     fn all_zero(self) -> bool {
         self == 0.0
+    }
+    /// [`crate::math::sin_cos`] (see `powf`).
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        crate::math::sin_cos(self)
     }
 }
 

@@ -62,9 +62,17 @@ impl Term for StaticH {
 
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        StaticH::law(F::splat(self.eta_h), c, m)
+    }
+}
+
+impl StaticH {
+    /// The term's arithmetic with its parameter as a number of type `F` (see `Drag::law`).
+    #[inline(always)]
+    pub fn law<F: Real>(eta_h: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let rg = m.g * m.rho_g;
-        let bound = F::splat(self.eta_h) * rg * c.width * c.depth * c.depth;
+        let bound = eta_h * rg * c.width * c.depth * c.depth;
         TermForce {
             force: [-c.sign[0] * bound, zero],
             bound: [bound, zero],

@@ -78,11 +78,19 @@ impl Term for StaticV {
 
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        StaticV::law(F::splat(self.eta_v), F::splat(self.lam), c, m)
+    }
+}
+
+impl StaticV {
+    /// The term's arithmetic with its parameters as numbers of type `F` (see `Drag::law`).
+    #[inline(always)]
+    pub fn law<F: Real>(eta_v: F, lam: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let rg = m.g * m.rho_g;
         // d * (1 / L_ref): the division waits for L_ref alone, not for the depth.
-        let depth_factor = (c.depth * c.l_ref.recip()).powf(F::splat(self.lam));
-        let bound = F::splat(self.eta_v) * depth_factor * rg * c.volume;
+        let depth_factor = (c.depth * c.l_ref.recip()).powf(lam);
+        let bound = eta_v * depth_factor * rg * c.volume;
         TermForce {
             force: [zero, -c.sign[1] * bound],
             bound: [zero, bound],

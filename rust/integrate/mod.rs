@@ -7,6 +7,7 @@
 pub mod control;
 pub mod drives;
 pub mod events;
+pub mod lanes;
 pub mod observe;
 pub mod outcome;
 pub mod solve;
@@ -18,5 +19,5 @@ pub use outcome::{
     ContactSummary, Field, FieldValue, Impulse, JointSummary, Outcome, OutcomeFields, Series,
     Stats, Status, OUTCOME_FIELDS,
 };
-pub use solve::{solve, solve_driven, EndCondition, SolveOptions};
+pub use solve::{solve, solve_driven, EndCondition, Run, SolveOptions};
 pub use stepper::Method;

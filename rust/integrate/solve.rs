@@ -15,8 +15,8 @@ use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
 use super::observe::{Observer, Record};
 use super::outcome::{Outcome, Stats, Status};
-use super::stepper::{deriv_of, full_step, partial_step, Method, State};
-use crate::dynamics::{Eval, Model};
+use super::stepper::{deriv_of, full_step, partial_step, Deriv, Method, State};
+use crate::dynamics::{Eval, Model, Modes};
 use crate::error::{GranrsError, Result};
 
 /// When a run ends.
@@ -75,7 +75,7 @@ pub fn solve<const N: usize>(
     qd0: SVector<f64, N>,
     options: &SolveOptions,
 ) -> Result<Outcome> {
-    solve_driven(model, q0, qd0, options, &Drives::default())
+    solve_driven(model, q0, qd0, options, Drives::default())
 }
 
 /// [`solve`] with table-driven joints: a step ends on each of the tables' times (up to
@@ -86,86 +86,229 @@ pub fn solve_driven<const N: usize>(
     q0: SVector<f64, N>,
     qd0: SVector<f64, N>,
     options: &SolveOptions,
-    drives: &Drives,
+    drives: Drives,
 ) -> Result<Outcome> {
-    let mut stats = Stats::default();
-    let mut y = State {
-        q: q0,
-        qd: qd0,
-        work: 0.0,
-        dissipated: 0.0,
-    };
-    let mut modes = events::initial_modes(model, &y, options.dt, &mut stats);
-    let mut obs = Observer::new(model, &y, &modes, options.record);
-    let mut control = Control::new(options);
-    let mut events = Events::new();
-    let mut t = 0.0f64;
-    // The evaluations at the step's start (`evals[cur]`) and end: an accepted step swaps
-    // their roles instead of copying (an `Eval` holds every contact's findings).
-    let mut evals = [model.eval(&y.q, &y.qd, &modes); 2];
-    let mut cur = 0usize;
-    stats.rhs_evals += 1;
-    obs.record(model, t, &y, &evals[cur], &modes);
-    // The next time of the drive tables.
-    let mut next_time = 0usize;
+    let mut run = Run::new(model, q0, qd0, options).with_drives(drives);
+    while let Some(h) = run.next_step(model) {
+        run.step(model, h)?;
+    }
+    run.finish(model)
+}
 
-    let status = loop {
-        // A time of the drive tables: the impulse onto the new segments.
-        if let Some(tb) = drives.time(next_time) {
-            if tb - t <= 1e-12 * options.dt {
-                next_time += 1;
-                obs.record_new(model, t, &y, &evals[cur], &modes);
-                for (link, impulse, energy) in
-                    model.drive_impulse(&y.q, &mut y.qd, &drives.targets(tb))
-                {
-                    obs.impulse(link, t, impulse, energy);
+/// One run between its steps: the loop's state, so that a caller can drive the steps. The
+/// sweep's lanes ([`super::lanes`]) compute the stages of one step for several runs at once
+/// and hand each run its step's end ([`Run::end_eval`], [`Run::after_step`]); everything
+/// else (the events, the observer, the step-size control) is this run's own.
+pub struct Run<const N: usize> {
+    options: SolveOptions,
+    stats: Stats,
+    y: State<N>,
+    modes: Modes,
+    obs: Observer<N>,
+    control: Control,
+    events: Events,
+    t: f64,
+    /// The evaluations at the step's start (`evals[cur]`) and end: an accepted step swaps
+    /// their roles instead of copying (an `Eval` holds every contact's findings).
+    evals: [Eval<N>; 2],
+    cur: usize,
+    /// How the run ended, once it has.
+    status: Option<Status>,
+    /// The table-driven joints (none for most runs).
+    drives: Drives,
+    /// The next of the drives' times.
+    next_time: usize,
+    /// The end of the step [`Run::next_step`] gave, and whether a time of the drives (not
+    /// the grid) cut it there.
+    t_next: f64,
+    clamped: bool,
+}
+
+impl<const N: usize> Run<N> {
+    /// Start `model` from `(q0, qd0)` at `t = 0` with `options`.
+    pub fn new(
+        model: &Model<N>,
+        q0: SVector<f64, N>,
+        qd0: SVector<f64, N>,
+        options: &SolveOptions,
+    ) -> Self {
+        let mut stats = Stats::default();
+        let y = State {
+            q: q0,
+            qd: qd0,
+            work: 0.0,
+            dissipated: 0.0,
+        };
+        let modes = events::initial_modes(model, &y, options.dt, &mut stats);
+        let mut obs = Observer::new(model, &y, &modes, options.record);
+        let control = Control::new(options);
+        let events = Events::new();
+        let t = 0.0f64;
+        let evals = [model.eval(&y.q, &y.qd, &modes); 2];
+        stats.rhs_evals += 1;
+        obs.record(model, t, &y, &evals[0], &modes);
+        Run {
+            options: *options,
+            stats,
+            y,
+            modes,
+            obs,
+            control,
+            events,
+            t,
+            evals,
+            cur: 0,
+            status: None,
+            drives: Drives::default(),
+            next_time: 0,
+            t_next: 0.0,
+            clamped: false,
+        }
+    }
+
+    /// The same run with table-driven joints.
+    pub fn with_drives(mut self, drives: Drives) -> Self {
+        self.drives = drives;
+        self
+    }
+
+    /// The size of the next step, or `None` when the run has ended ([`Run::finish`]).
+    #[inline]
+    pub fn next_step(&mut self, model: &Model<N>) -> Option<f64> {
+        if self.status.is_some() {
+            return None;
+        }
+        loop {
+            // A time of the drive tables: the impulse onto the new segments.
+            if let Some(tb) = self.drives.time(self.next_time) {
+                if tb - self.t <= 1e-12 * self.options.dt {
+                    self.drive_impulse(model);
+                    continue;
                 }
-                stats.events += 1;
-                events.after_impulse(model, &mut modes, &y, &mut stats);
-                model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
-                stats.rhs_evals += 1;
-                obs.record(model, t, &y, &evals[cur], &modes);
+            }
+            if self.control.finished(self.t) {
+                self.status = Some(if self.options.end == EndCondition::Time {
+                    Status::EndTime
+                } else {
+                    Status::NotStopped
+                });
+                return None;
+            }
+            // Step: to the next grid point, or to a time of the drive tables before it.
+            let grid = self.control.next(self.t);
+            let (t_next, clamped) = match self.drives.time(self.next_time) {
+                Some(tb) if tb < grid => (tb, true),
+                _ => (grid, false),
+            };
+            let h = t_next - self.t;
+            if !clamped && self.control.landed(h) {
+                self.events.next_step();
                 continue;
             }
+            self.t_next = t_next;
+            self.clamped = clamped;
+            return Some(h);
         }
-        if control.finished(t) {
-            break if options.end == EndCondition::Time {
-                Status::EndTime
-            } else {
-                Status::NotStopped
-            };
-        }
+    }
 
-        // Step: to the next grid point, or to a time of the drive tables before it.
-        let grid = control.next(t);
-        let (t_next, clamped) = match drives.time(next_time) {
-            Some(tb) if tb < grid => (tb, true),
-            _ => (grid, false),
-        };
-        let h = t_next - t;
-        if !clamped && control.landed(h) {
-            events.next_step();
-            continue;
+    /// At a time of the drive tables: the rates take the impulse onto the new segments.
+    #[cold]
+    fn drive_impulse(&mut self, model: &Model<N>) {
+        let tb = self.drives.time(self.next_time).unwrap_or(self.t);
+        self.next_time += 1;
+        let (t, y, modes) = (self.t, &mut self.y, &mut self.modes);
+        let e = &mut self.evals[self.cur];
+        self.obs.record_new(model, t, y, e, modes);
+        for (link, impulse, energy) in
+            model.drive_impulse(&y.q, &mut y.qd, &self.drives.targets(tb))
+        {
+            self.obs.impulse(link, t, impulse, energy);
         }
-        let (e0, e1) = start_and_end(&mut evals, cur);
-        let k1 = deriv_of(&y, e0);
+        self.stats.events += 1;
+        self.events.after_impulse(model, modes, y, &mut self.stats);
+        model.eval_into(&y.q, &y.qd, modes, e);
+        self.stats.rhs_evals += 1;
+        self.obs.record(model, t, y, e, modes);
+    }
+
+    /// The state at the step's start, its derivative there (the first stage) and the modes
+    /// held through the step.
+    #[inline]
+    pub fn start(&self) -> (&State<N>, Deriv<N>, &Modes) {
+        (
+            &self.y,
+            deriv_of(&self.y, &self.evals[self.cur]),
+            &self.modes,
+        )
+    }
+
+    /// The slot of the step's end evaluation, for a caller that computes the step itself.
+    #[inline]
+    pub fn end_eval(&mut self) -> &mut Eval<N> {
+        &mut self.evals[1 - self.cur]
+    }
+
+    /// Show the run one RK4 stage's coordinates and the drag's stiffness there (see
+    /// [`super::stepper::step_sampling`]), for a caller that computes the step itself.
+    #[inline]
+    pub fn offer(&mut self, q: &SVector<f64, N>, stiff: &crate::dynamics::DragStiffness) {
+        self.obs.offer(q, stiff);
+    }
+
+    /// Count `n` evaluations of the right-hand side made for this run by its caller.
+    #[inline]
+    pub fn count_evals(&mut self, n: usize) {
+        self.stats.rhs_evals += n;
+    }
+
+    /// Take a whole step of size `h` (from [`Run::next_step`]) on the scalar path.
+    #[inline]
+    pub fn step(&mut self, model: &Model<N>, h: f64) -> Result<()> {
+        let (e0, e1) = start_and_end(&mut self.evals, self.cur);
+        let k1 = deriv_of(&self.y, e0);
+        let obs = &mut self.obs;
         let sample = |q: &SVector<f64, N>, s: &_| obs.offer(q, s);
         let (y1, err) = full_step(
             model,
-            options.method,
-            &modes,
-            &y,
+            self.options.method,
+            &self.modes,
+            &self.y,
             &k1,
             h,
             e1,
-            &mut stats,
+            &mut self.stats,
             sample,
         );
-        if !control.judge(h, err, t, &mut stats)? {
-            continue;
+        self.after_step(model, h, &k1, y1, err)
+    }
+
+    /// The rest of a step of size `h` whose first stage is `k1`, whose end is `y1` (its
+    /// evaluation in [`Run::end_eval`]) and whose error estimate is `err` (0 for RK4):
+    /// the step-size control, the events (located, and the step cut there), the observer.
+    #[inline]
+    pub fn after_step(
+        &mut self,
+        model: &Model<N>,
+        h: f64,
+        k1: &Deriv<N>,
+        y1: State<N>,
+        err: f64,
+    ) -> Result<()> {
+        let options = &self.options;
+        let stats = &mut self.stats;
+        let obs = &mut self.obs;
+        let modes = &mut self.modes;
+        let events = &mut self.events;
+        let control = &mut self.control;
+        let (y, t, cur) = (&mut self.y, &mut self.t, &mut self.cur);
+        let (t_next, clamped) = (self.t_next, self.clamped);
+        if !control.judge(h, err, *t, stats)? {
+            return Ok(());
         }
+        let (e0, e1) = start_and_end(&mut self.evals, *cur);
         let e1: &Eval<N> = e1;
         if !y1.is_finite() || !e1.qdd.iter().all(|v| v.is_finite()) {
+            let t = *t;
             return Err(GranrsError::NonFinite {
                 t,
                 message: format!("state became non-finite in the step from t = {t} s (h = {h} s)"),
@@ -174,65 +317,57 @@ pub fn solve_driven<const N: usize>(
 
         // Detect.
         let span = Span {
-            y0: &y,
-            k1: &k1,
+            y0: y,
+            k1,
             e0,
             y1: &y1,
             e1,
             h,
         };
-        let mut earliest = events.detect(model, &modes, &span, &mut stats);
+        let mut earliest = events.detect(model, modes, &span, stats);
         if events.none() {
             // Accept the whole step.
-            y = y1;
-            cur = 1 - cur;
+            *y = y1;
+            *cur = 1 - *cur;
+            let evals = &mut self.evals;
             // `evals[cur]` is the step's end: it tells when the projection has nothing to do.
-            if model.sticking_may_drift(&evals[cur], &modes)
-                && model.project_sticking(&y.q, &mut y.qd, &modes)
+            if model.sticking_may_drift(&evals[*cur], modes)
+                && model.project_sticking(&y.q, &mut y.qd, modes)
             {
                 stats.rhs_evals += 1;
-                model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
+                model.eval_into(&y.q, &y.qd, modes, &mut evals[*cur]);
             }
-            t = t_next;
+            *t = t_next;
             stats.steps += 1;
-            obs.step_end(model, &y, &evals[cur], &modes);
+            obs.step_end(model, y, &evals[*cur], modes);
             if !clamped {
                 let n = control.advance();
                 events.next_step();
-                obs.record_step(n, model, t, &y, &evals[cur], &modes);
+                obs.record_step(n, model, *t, y, &evals[*cur], modes);
             }
-            continue;
+            return Ok(());
         }
 
         // Handle: step to the earliest event, exactly (a real step of the located length),
         // and change the modes there.
         if options.method == Method::Rk4 {
-            earliest = events.polish(model, &modes, &span, earliest, &mut stats);
+            earliest = events.polish(model, modes, &span, earliest, stats);
         }
         let h_star = earliest * h;
         let y_star = if earliest >= 1.0 {
             y1
         } else if h_star > 0.0 {
             let sample = |q: &SVector<f64, N>, s: &_| obs.offer(q, s);
-            partial_step(
-                model,
-                options.method,
-                &modes,
-                &y,
-                &k1,
-                h_star,
-                &mut stats,
-                sample,
-            )
+            partial_step(model, options.method, modes, y, k1, h_star, stats, sample)
         } else {
-            y
+            *y
         };
-        let t_star = if earliest >= 1.0 { t_next } else { t + h_star };
-        let e_star = model.eval(&y_star.q, &y_star.qd, &modes);
+        let t_star = if earliest >= 1.0 { t_next } else { *t + h_star };
+        let e_star = model.eval(&y_star.q, &y_star.qd, modes);
         stats.rhs_evals += 1;
         if h_star > 0.0 {
             stats.steps += 1;
-            obs.step_end(model, &y_star, &e_star, &modes);
+            obs.step_end(model, &y_star, &e_star, modes);
         }
         // An event at the very start of the step is judged at the step's end.
         let probe = if h_star <= 1e-12 * options.dt {
@@ -247,27 +382,34 @@ pub fn solve_driven<const N: usize>(
             probe: &probe,
             lookahead: &y1,
         };
-        let terminal = events.handle(
-            model,
-            &mut modes,
-            earliest,
-            &at,
-            options.end,
-            &mut obs,
-            &mut stats,
-        );
-        y = y_star;
-        t = t_star;
+        let terminal = events.handle(model, modes, earliest, &at, options.end, obs, stats);
+        *y = y_star;
+        *t = t_star;
 
         // Observe.
         if terminal {
-            obs.record(model, t, &y, &e_star, &modes);
-            break Status::Stopped;
+            obs.record(model, *t, y, &e_star, modes);
+            self.status = Some(Status::Stopped);
+            return Ok(());
         }
-        model.project_sticking(&y.q, &mut y.qd, &modes);
-        model.eval_into(&y.q, &y.qd, &modes, &mut evals[cur]);
+        model.project_sticking(&y.q, &mut y.qd, modes);
+        model.eval_into(&y.q, &y.qd, modes, &mut self.evals[*cur]);
         stats.rhs_evals += 1;
-        obs.record(model, t, &y, &evals[cur], &modes);
-    };
-    obs.finish(model, status, t, &y, &modes, stats, options)
+        obs.record(model, *t, y, &self.evals[*cur], modes);
+        Ok(())
+    }
+
+    /// The outcome of a run that has ended ([`Run::next_step`] gave `None`).
+    pub fn finish(self, model: &Model<N>) -> Result<Outcome> {
+        let status = self.status.unwrap_or(Status::NotStopped);
+        self.obs.finish(
+            model,
+            status,
+            self.t,
+            &self.y,
+            &self.modes,
+            self.stats,
+            &self.options,
+        )
+    }
 }

@@ -71,8 +71,12 @@ pub(super) fn validate_sweep<'py>(
 /// second from the calling thread; Ctrl-C (or an exception in `progress`) cancels the batch
 /// after the runs in flight and raises. Returns a dict: `columns` (names), `data` (a
 /// rows x columns float array, input order), `failures` (list of (run, message)), `body`.
+///
+/// `lanes` (default true) runs the free-link scenes under the thesis's terms four at a time
+/// in SIMD lanes (`batch::Path::Lanes`; the same results bit for bit); false runs every
+/// scene alone on the scalar path.
 #[pyfunction]
-#[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None))]
+#[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None, lanes=true))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn sweep<'py>(
     py: Python<'py>,
@@ -83,7 +87,13 @@ pub(super) fn sweep<'py>(
     stop: Option<usize>,
     threads: usize,
     progress: Option<Bound<'py, PyAny>>,
+    lanes: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let path = if lanes {
+        batch::Path::Lanes
+    } else {
+        batch::Path::Scalar
+    };
     let err = |e: GranrsError| to_pyerr(py, e);
     let src = source_from_py(base, axes, scenes)?;
     let n = src.len();
@@ -99,7 +109,7 @@ pub(super) fn sweep<'py>(
     let caller = std::thread::current();
     let (out, interrupted) = std::thread::scope(|s| {
         let worker = s.spawn(|| {
-            let out = pool.install(|| batch::run(&src, range.clone(), &body, &done, &cancel));
+            let out = pool.install(|| batch::run(&src, range.clone(), &body, &done, &cancel, path));
             finished.store(true, Ordering::Release);
             caller.unpark();
             out

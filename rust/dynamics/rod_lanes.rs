@@ -1,0 +1,641 @@
+//! The free link under the thesis's terms for several scenes at once: [`Model::eval_rigid_rod`]
+//! written over [`Real`], so that `F = F64x4` evaluates four scenes, one per SIMD lane, in
+//! the same instructions (the sweep's lanes, `integrate::lanes`).
+//!
+//! The force law is not copied: the terms' own arithmetic ([`Drag::law`], [`StaticH::law`],
+//! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane.
+//! The mechanics (the rod's frame, its immersed geometry, the closed-form sticking row and
+//! the sums of [`super::rigid_rod`]) are written again without branches: each branch of the
+//! scalar path becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation
+//! is the scalar path's, in its order, so that a lane's results are the scalar path's bit for
+//! bit (a test holds them so over random states and modes).
+//!
+//! What the lanes cover: a free link ([`Model::rigid_rod`]) whose contact terms are exactly
+//! the thesis's three (`drag`, `static_h`, `static_v`, in that order; `gravity` on or off),
+//! under the `modes` sign model, applied at the tip or at the centroid ([`RodParams::of`]);
+//! and in modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
+//! sticks in both x and y, or whose one sticking row has a zero pivot
+//! ([`RodEval::pivot`]), is taken on the scalar path.
+
+use nalgebra::{SVector, Vector2};
+
+use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, SignModel, Slip};
+use crate::body::rod::ApplyAt;
+use crate::forces::drag::Drag;
+use crate::forces::static_h::StaticH;
+use crate::forces::static_v::StaticV;
+use crate::forces::{AnyTerm, ContactState, Medium, Real};
+use crate::simd::{F64x4, LANES};
+
+/// What the evaluation of one free link under the thesis's terms reads that is fixed
+/// through a run: its mass, geometry, medium and the terms' parameters (one lane per scene).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodParams<F> {
+    /// m + m_root [kg].
+    pub mass: F,
+    /// The acceleration of gravity on the body ([`Model::gravity`]) [m/s^2].
+    pub g: F,
+    /// 1 / (m + m_root) [1/kg].
+    pub inv_m: F,
+    /// 1 / I [1/(kg m^2)].
+    pub inv_i: F,
+    /// The tip's local coordinates [m].
+    pub tip: [F; 2],
+    /// L [m].
+    pub length: F,
+    /// d_c [m].
+    pub diameter: F,
+    /// pi / 4 d_c^2 [m^2]: the immersed volume per immersed length.
+    pub section: F,
+    /// 1 where the force acts at the centroid E, 0 at the tip T.
+    pub at_centroid: F,
+    /// The sand.
+    pub medium: Medium<F>,
+    /// drag.eta_d.
+    pub eta_d: F,
+    /// static_h.eta_h.
+    pub eta_h: F,
+    /// static_v.eta_v.
+    pub eta_v: F,
+    /// static_v.lam.
+    pub lam: F,
+}
+
+impl RodParams<f64> {
+    /// The parameters of `model`, or `None` when the lanes do not cover it (another body,
+    /// another term set, another sign model; see the module).
+    pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
+        let rod = model.rigid_rod()?;
+        if model.sign_model != SignModel::Modes || model.forces.reads_frame {
+            return None;
+        }
+        let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] =
+            model.forces.per_contact[0][..]
+        else {
+            return None;
+        };
+        if model.forces.sole_static_owner != [Some(1), Some(2)] {
+            return None;
+        }
+        let link = &model.mechanism.links[0];
+        let mass = link.mass + model.mechanism.root_mass;
+        Some(RodParams {
+            mass,
+            g: model.gravity(),
+            inv_m: 1.0 / (link.mass + model.mechanism.root_mass),
+            inv_i: 1.0 / link.inertia,
+            tip: [rod.tip.x, rod.tip.y],
+            length: rod.length,
+            diameter: rod.diameter,
+            section: std::f64::consts::FRAC_PI_4 * rod.diameter * rod.diameter,
+            at_centroid: match model.apply_at {
+                ApplyAt::Tip => 0.0,
+                ApplyAt::Centroid => 1.0,
+            },
+            medium: model.medium,
+            eta_d: d.eta_d,
+            eta_h: h.eta_h,
+            eta_v: v.eta_v,
+            lam: v.lam,
+        })
+    }
+}
+
+impl RodParams<F64x4> {
+    /// Every lane `p`.
+    pub fn splat(p: &RodParams<f64>) -> Self {
+        let s = F64x4::splat;
+        RodParams {
+            mass: s(p.mass),
+            g: s(p.g),
+            inv_m: s(p.inv_m),
+            inv_i: s(p.inv_i),
+            tip: [s(p.tip[0]), s(p.tip[1])],
+            length: s(p.length),
+            diameter: s(p.diameter),
+            section: s(p.section),
+            at_centroid: s(p.at_centroid),
+            medium: Medium {
+                rho_g: s(p.medium.rho_g),
+                g: s(p.medium.g),
+            },
+            eta_d: s(p.eta_d),
+            eta_h: s(p.eta_h),
+            eta_v: s(p.eta_v),
+            lam: s(p.lam),
+        }
+    }
+
+    /// Lane `i` becomes `p`.
+    pub fn set(&mut self, i: usize, p: &RodParams<f64>) {
+        self.mass.0[i] = p.mass;
+        self.g.0[i] = p.g;
+        self.inv_m.0[i] = p.inv_m;
+        self.inv_i.0[i] = p.inv_i;
+        self.tip[0].0[i] = p.tip[0];
+        self.tip[1].0[i] = p.tip[1];
+        self.length.0[i] = p.length;
+        self.diameter.0[i] = p.diameter;
+        self.section.0[i] = p.section;
+        self.at_centroid.0[i] = p.at_centroid;
+        self.medium.rho_g.0[i] = p.medium.rho_g;
+        self.medium.g.0[i] = p.medium.g;
+        self.eta_d.0[i] = p.eta_d;
+        self.eta_h.0[i] = p.eta_h;
+        self.eta_v.0[i] = p.eta_v;
+        self.lam.0[i] = p.lam;
+    }
+}
+
+/// The contact's mode as the lanes read it (held through a step), as numbers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodModes<F> {
+    /// 1 in contact, else 0.
+    pub in_contact: F,
+    /// The held signs of v_Ex and v_Ey (`Slip::sign`: -1, 0 sticking, +1).
+    pub sign: [F; 2],
+    /// The held sign of e x v_E (-1 or +1).
+    pub cross: F,
+    /// 1 where x sticks, else 0.
+    pub stuck_x: F,
+    /// 1 where y sticks, else 0.
+    pub stuck_y: F,
+}
+
+impl RodModes<f64> {
+    /// `mode` for the lanes, or `None` when it sticks in both x and y (two sticking rows:
+    /// the scalar path takes the step).
+    pub fn of(mode: &ContactMode) -> Option<Self> {
+        let (sx, sy) = (mode.sx == Slip::Stick, mode.sy == Slip::Stick);
+        if mode.in_contact && sx && sy {
+            return None;
+        }
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        Some(RodModes {
+            in_contact: flag(mode.in_contact),
+            sign: [mode.sx.sign(), mode.sy.sign()],
+            cross: if mode.cross == Slip::Neg { -1.0 } else { 1.0 },
+            stuck_x: flag(sx),
+            stuck_y: flag(sy),
+        })
+    }
+}
+
+impl RodModes<F64x4> {
+    /// Lane by lane.
+    pub fn gather(m: &[RodModes<f64>; LANES]) -> Self {
+        let g = |f: fn(&RodModes<f64>) -> f64| F64x4([f(&m[0]), f(&m[1]), f(&m[2]), f(&m[3])]);
+        RodModes {
+            in_contact: g(|m| m.in_contact),
+            sign: [g(|m| m.sign[0]), g(|m| m.sign[1])],
+            cross: g(|m| m.cross),
+            stuck_x: g(|m| m.stuck_x),
+            stuck_y: g(|m| m.stuck_y),
+        }
+    }
+}
+
+/// One evaluation of the free link in lanes: what [`Model::eval`] returns for it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodEval<F> {
+    /// Generalized accelerations.
+    pub qdd: [F; 3],
+    /// Power of the sand's force [W].
+    pub power: F,
+    /// The tip T and its velocity.
+    pub tip: [F; 2],
+    /// See `tip`.
+    pub v_tip: [F; 2],
+    /// The contact's depth (0 out of contact).
+    pub depth: F,
+    /// The lowest point (the tip's height).
+    pub lowest: F,
+    /// v_E (v_T out of contact).
+    pub v_centroid: [F; 2],
+    /// e x v_E (0 out of contact).
+    pub cross: F,
+    /// Margin to full immersion (0 out of contact).
+    pub margin: F,
+    /// Each term's force (drag, static_h, static_v), a reaction in place of a stuck one.
+    pub terms: [[F; 2]; 3],
+    /// F_d.
+    pub dynamic: [F; 2],
+    /// F_s (or its reaction).
+    pub statics: [F; 2],
+    /// The sticking bounds.
+    pub bound: [F; 2],
+    /// Where a sticking row acts: its pivot `1/m + lever_E lever_P / I`; 1 elsewhere. A
+    /// lane whose pivot is not clearly nonzero takes the step on the scalar path.
+    pub pivot: F,
+}
+
+/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms, in `F`: the same
+/// operations in the same order, with blends for branches (see the module).
+#[inline(always)]
+pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F; 3]) -> RodEval<F> {
+    let zero = F::splat(0.0);
+    let sel = |flag: F, a: F, b: F| flag.select_pos(a, b);
+    let sel2 = |flag: F, a: [F; 2], b: [F; 2]| [sel(flag, a[0], b[0]), sel(flag, a[1], b[1])];
+    // RodFrame.
+    let (s, c) = q[2].sin_cos();
+    let axis = [s, c];
+    let normal = [c, -s];
+    let omega = qd[2];
+    let at = |r: [F; 2]| {
+        [
+            q[0] + (r[0] * axis[0] + r[1] * normal[0]),
+            q[1] + (r[0] * axis[1] + r[1] * normal[1]),
+        ]
+    };
+    let lever = |r: [F; 2]| {
+        [
+            r[0] * normal[0] - r[1] * axis[0],
+            r[0] * normal[1] - r[1] * axis[1],
+        ]
+    };
+    let velocity = |r: [F; 2]| {
+        let l = lever(r);
+        [qd[0] + omega * l[0], qd[1] + omega * l[1]]
+    };
+    let gen1 = -p.mass * p.g;
+    let tip = at(p.tip);
+    let v_tip = velocity(p.tip);
+    // RodContact::geometry.
+    let depth = (-tip[1]).max(zero);
+    let full_at = p.length * axis[1];
+    let immersed = sel(full_at - depth, depth / axis[1], p.length);
+    let centroid = [p.tip[0] + F::splat(0.5) * immersed, p.tip[1]];
+    let inside = m.in_contact;
+    let depth_out = sel(inside, depth, zero);
+    let margin = sel(inside, full_at - depth, zero);
+    let v_in = velocity(centroid);
+    let v_centroid = sel2(inside, v_in, v_tip);
+    let cross = sel(inside, axis[0] * v_in[1] - axis[1] * v_in[0], zero);
+    // Forced: in contact and below the surface.
+    let forced = depth_out;
+    let area_speed = p.diameter * immersed * (m.cross * cross);
+    let p_local = sel2(p.at_centroid, centroid, p.tip);
+    let state = ContactState {
+        depth,
+        volume: p.section * immersed,
+        width: p.diameter,
+        l_ref: p.length,
+        v: v_centroid,
+        area_speed,
+        sign: m.sign,
+        boundary: None,
+    };
+    let fd = Drag::law(p.eta_d, &state, &p.medium);
+    let fh = StaticH::law(p.eta_h, &state, &p.medium);
+    let fv = StaticV::law(p.eta_v, p.lam, &state, &p.medium);
+    let dynamic = [zero + fd.force[0], zero + fd.force[1]];
+    let statics = [
+        (zero + fh.force[0]) + fv.force[0],
+        (zero + fh.force[1]) + fv.force[1],
+    ];
+    let bound = [
+        ((zero + fd.bound[0]) + fh.bound[0]) + fv.bound[0],
+        ((zero + fd.bound[1]) + fh.bound[1]) + fv.bound[1],
+    ];
+    let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
+    let lever_p = lever(p_local);
+    let torque = total[0] * lever_p[0] + total[1] * lever_p[1];
+    let gen = [
+        sel(forced, zero + total[0], zero),
+        sel(forced, gen1 + total[1], gen1),
+        sel(forced, zero + (torque - zero), zero),
+    ];
+    let qdd = [gen[0] * p.inv_m, gen[1] * p.inv_m, gen[2] * p.inv_i];
+    // The sticking row (rigid_rod_reactions with one row): x or y.
+    let row_x = sel(forced, m.stuck_x, zero);
+    let row_y = sel(forced, m.stuck_y, zero);
+    let row = row_x + row_y;
+    let lever_e = lever(centroid);
+    let l_rate = {
+        let depth_rate = -v_tip[1];
+        let e_y_rate = -axis[0] * omega;
+        let rate = depth_rate / axis[1] - depth * e_y_rate / (axis[1] * axis[1]);
+        sel(p.length - immersed, rate, zero)
+    };
+    let slide = [
+        (F::splat(0.5) * l_rate) * normal[0],
+        (F::splat(0.5) * l_rate) * normal[1],
+    ];
+    let spin = -(omega * omega);
+    let a_bias = [
+        spin * (centroid[0] * axis[0] + centroid[1] * normal[0]) + omega * slide[0],
+        spin * (centroid[0] * axis[1] + centroid[1] * normal[1]) + omega * slide[1],
+    ];
+    let a_bias = sel2(omega.abs(), a_bias, [zero, zero]);
+    let bias = sel(row_x, a_bias[0], a_bias[1]);
+    let le = sel(row_x, lever_e[0], lever_e[1]);
+    let lp = sel(row_x, lever_p[0], lever_p[1]);
+    let qdd_row = sel(row_x, qdd[0], qdd[1]);
+    let a = p.inv_m + le * (lp * p.inv_i);
+    let mult = -(bias + (qdd_row + le * qdd[2])) * a.recip();
+    let qdd = [
+        sel(row_x, qdd[0] + mult * p.inv_m, qdd[0]),
+        sel(row_y, qdd[1] + mult * p.inv_m, qdd[1]),
+        sel(row, qdd[2] + mult * (lp * p.inv_i), qdd[2]),
+    ];
+    let terms = [
+        sel2(forced, fd.force, [zero, zero]),
+        sel2(
+            forced,
+            [sel(row_x, mult, fh.force[0]), fh.force[1]],
+            [zero, zero],
+        ),
+        sel2(
+            forced,
+            [fv.force[0], sel(row_y, mult, fv.force[1])],
+            [zero, zero],
+        ),
+    ];
+    let statics = sel2(
+        forced,
+        [sel(row_x, mult, statics[0]), sel(row_y, mult, statics[1])],
+        [zero, zero],
+    );
+    let dynamic = sel2(forced, dynamic, [zero, zero]);
+    let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
+    let v_p = sel2(p.at_centroid, v_centroid, v_tip);
+    let power = sel(
+        forced,
+        (total[0] * v_p[0] + total[1] * v_p[1]) - zero * omega,
+        zero,
+    );
+    RodEval {
+        qdd,
+        power,
+        tip,
+        v_tip,
+        depth: depth_out,
+        lowest: tip[1],
+        v_centroid,
+        cross,
+        margin,
+        terms,
+        dynamic,
+        statics,
+        bound: sel2(forced, bound, [zero, zero]),
+        pivot: sel(row, a, F::splat(1.0)),
+    }
+}
+
+/// Whether a sticking row's pivot `a` ([`RodEval::pivot`]) is clearly nonzero, as the
+/// scalar path judges it (`rigid_rod_reactions`); else the scalar path takes the step.
+#[inline]
+pub fn pivot_ok(a: f64) -> bool {
+    a.abs() > 1e-13 * a.abs().max(f64::MIN_POSITIVE)
+}
+
+impl RodEval<f64> {
+    /// See [`pivot_ok`].
+    #[inline]
+    pub fn pivot_ok(&self) -> bool {
+        pivot_ok(self.pivot)
+    }
+
+    /// The drag's stiffness at this evaluation, as [`DragStiffness::of`] finds it.
+    #[inline]
+    pub fn stiffness(&self) -> DragStiffness {
+        let v = Vector2::new(self.v_centroid[0], self.v_centroid[1]);
+        DragStiffness {
+            drag2: Vector2::new(self.dynamic[0], self.dynamic[1]).norm_squared(),
+            speed2: v.norm_squared(),
+            contact: 0,
+            v,
+        }
+    }
+
+    /// Write this evaluation into `out` as [`Model::eval_into`] does.
+    #[inline]
+    pub fn write(&self, out: &mut Eval<3>) {
+        let v2 = |a: [f64; 2]| Vector2::new(a[0], a[1]);
+        let mut terms = [Vector2::zeros(); crate::forces::registry::MAX_TERMS];
+        for (k, t) in self.terms.iter().enumerate() {
+            terms[k] = v2(*t);
+        }
+        out.contacts[0] = ContactEval {
+            tip: v2(self.tip),
+            v_tip: v2(self.v_tip),
+            depth: self.depth,
+            lowest: self.lowest,
+            v_centroid: v2(self.v_centroid),
+            force: ContactForce {
+                terms,
+                dynamic: v2(self.dynamic),
+                statics: v2(self.statics),
+                moment: 0.0,
+            },
+            cross: self.cross,
+            immersion_margin: self.margin,
+            corners_y: [0.0; 4],
+            bound: self.bound,
+        };
+        out.qdd = SVector::<f64, 3>::new(self.qdd[0], self.qdd[1], self.qdd[2]);
+        out.power = self.power;
+        out.joint_power = 0.0;
+        out.joint_torque = [0.0; 3];
+    }
+}
+
+impl RodEval<F64x4> {
+    /// Lane `i`.
+    #[inline]
+    pub fn lane(&self, i: usize) -> RodEval<f64> {
+        let l = |x: F64x4| x.0[i];
+        let l2 = |x: [F64x4; 2]| [x[0].0[i], x[1].0[i]];
+        RodEval {
+            qdd: [l(self.qdd[0]), l(self.qdd[1]), l(self.qdd[2])],
+            power: l(self.power),
+            tip: l2(self.tip),
+            v_tip: l2(self.v_tip),
+            depth: l(self.depth),
+            lowest: l(self.lowest),
+            v_centroid: l2(self.v_centroid),
+            cross: l(self.cross),
+            margin: l(self.margin),
+            terms: [l2(self.terms[0]), l2(self.terms[1]), l2(self.terms[2])],
+            dynamic: l2(self.dynamic),
+            statics: l2(self.statics),
+            bound: l2(self.bound),
+            pivot: l(self.pivot),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bodies::FreeLinkScene;
+    use crate::dynamics::{Modes, MAX_CONTACTS};
+    use crate::forces::{ForceSet, TermSpec};
+    use proptest::prelude::*;
+
+    /// A free link with its own mass, length, law and point of application.
+    fn model(mass: f64, length: f64, eta: [f64; 4], centroid: bool, gravity: bool) -> Model<3> {
+        let mut specs = vec![
+            TermSpec::new("drag", &[("eta_d", eta[0])]),
+            TermSpec::new("static_h", &[("eta_h", eta[1])]),
+            TermSpec::new("static_v", &[("eta_v", eta[2]), ("lam", eta[3])]),
+        ];
+        if gravity {
+            specs.insert(0, TermSpec::new("gravity", &[]));
+        }
+        let scene = FreeLinkScene {
+            mass,
+            length,
+            apply_at: if centroid {
+                ApplyAt::Centroid
+            } else {
+                ApplyAt::Tip
+            },
+            forces: ForceSet::build(&specs, 1).unwrap(),
+            ..FreeLinkScene::default()
+        };
+        scene.model()
+    }
+
+    fn slip(i: u8) -> Slip {
+        [Slip::Neg, Slip::Pos, Slip::Stick][i as usize % 3]
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// One lane's scene: (mass, length, eta_d, eta_h, eta_v, lam, centroid, gravity).
+    fn scene() -> impl Strategy<Value = (f64, f64, f64, f64, f64, f64, bool, bool)> {
+        (
+            0.05f64..1.0,
+            0.05f64..0.4,
+            0.0f64..40.0,
+            0.0f64..20.0,
+            0.0f64..600.0,
+            0.0f64..1.0,
+            any::<bool>(),
+            any::<bool>(),
+        )
+    }
+
+    /// One lane's state and mode: (th, depth, vx, vy, w, sx, sy, cross, in_contact, spin).
+    fn state() -> impl Strategy<Value = (f64, f64, f64, f64, f64, u8, u8, bool, bool, bool)> {
+        (
+            -3.2f64..3.2,
+            -0.05f64..0.3,
+            -3.0f64..3.0,
+            -3.0f64..3.0,
+            -40.0f64..40.0,
+            0u8..3,
+            0u8..3,
+            any::<bool>(),
+            any::<bool>(),
+            any::<bool>(),
+        )
+    }
+
+    proptest! {
+        /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
+        /// the accelerations, the power and every finding of the contact (what the events
+        /// and the observer read), in every mode the lanes cover.
+        #[test]
+        fn lanes_are_the_scalar_evaluation_bitwise(
+            scenes in proptest::array::uniform4(scene()),
+            states in proptest::array::uniform4(state()),
+        ) {
+            let models: Vec<Model<3>> = scenes
+                .iter()
+                .map(|s| model(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7))
+                .collect();
+            let mut params = RodParams::splat(&RodParams::of(&models[0]).unwrap());
+            let mut modes = [RodModes::of(&ContactMode::default()).unwrap(); LANES];
+            let mut all_modes = [[ContactMode::default(); MAX_CONTACTS]; LANES];
+            let (mut q, mut qd) = ([F64x4::splat(0.0); 3], [F64x4::splat(0.0); 3]);
+            let mut covered = [true; LANES];
+            for i in 0..LANES {
+                params.set(i, &RodParams::of(&models[i]).unwrap());
+                let (th, depth, vx, vy, w, sx, sy, cross, inside, spin) = states[i];
+                let half = 0.5 * scenes[i].1;
+                let state_q = [half * th.sin(), half * th.cos() - depth, th];
+                let state_qd = [vx, vy, if spin { w } else { 0.0 }];
+                for k in 0..3 {
+                    q[k].0[i] = state_q[k];
+                    qd[k].0[i] = state_qd[k];
+                }
+                all_modes[i][0] = ContactMode {
+                    in_contact: inside,
+                    sx: slip(sx),
+                    sy: slip(sy),
+                    cross: if cross { Slip::Neg } else { Slip::Pos },
+                    ..ContactMode::default()
+                };
+                match RodModes::of(&all_modes[i][0]) {
+                    Some(m) => modes[i] = m,
+                    None => covered[i] = false,
+                }
+            }
+            let lanes = rod_eval(&params, &RodModes::gather(&modes), &q, &qd);
+            for i in 0..LANES {
+                if !covered[i] {
+                    continue;
+                }
+                let lane = lanes.lane(i);
+                let m: &Modes = &all_modes[i];
+                let sq = SVector::<f64, 3>::new(q[0].0[i], q[1].0[i], q[2].0[i]);
+                let sqd = SVector::<f64, 3>::new(qd[0].0[i], qd[1].0[i], qd[2].0[i]);
+                let scalar = models[i].eval(&sq, &sqd, m);
+                if !lane.pivot_ok() {
+                    continue;
+                }
+                let mut mine = scalar;
+                lane.write(&mut mine);
+                prop_assert_eq!(bits(mine.qdd.as_slice()), bits(scalar.qdd.as_slice()), "lane {}", i);
+                prop_assert_eq!(mine.power.to_bits(), scalar.power.to_bits());
+                let (a, b) = (mine.contacts[0], scalar.contacts[0]);
+                let flat = |c: &ContactEval| {
+                    let mut v = vec![
+                        c.tip.x, c.tip.y, c.v_tip.x, c.v_tip.y, c.depth, c.lowest,
+                        c.v_centroid.x, c.v_centroid.y, c.cross, c.immersion_margin,
+                        c.bound[0], c.bound[1], c.force.dynamic.x, c.force.dynamic.y,
+                        c.force.statics.x, c.force.statics.y, c.force.moment,
+                    ];
+                    for t in &c.force.terms {
+                        v.extend([t.x, t.y]);
+                    }
+                    v
+                };
+                prop_assert_eq!(bits(&flat(&a)), bits(&flat(&b)), "lane {}", i);
+                let st = lane.stiffness();
+                let sc = DragStiffness::of(0, &b);
+                prop_assert_eq!(bits(&[st.drag2, st.speed2]), bits(&[sc.drag2, sc.speed2]));
+            }
+        }
+    }
+
+    /// The lanes cover the thesis's set under `modes`, and nothing else.
+    #[test]
+    fn lanes_cover_the_thesis_set_only() {
+        let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
+        assert!(RodParams::of(&thesis).is_some());
+        let mut raw = thesis.clone();
+        raw.sign_model = SignModel::Raw;
+        assert!(RodParams::of(&raw).is_none());
+        let mut reordered = thesis.clone();
+        reordered.forces = ForceSet::build(
+            &[
+                TermSpec::new("static_h", &[("eta_h", 6.5)]),
+                TermSpec::new("drag", &[("eta_d", 15.2)]),
+                TermSpec::new("static_v", &[("eta_v", 248.0), ("lam", 0.106)]),
+            ],
+            1,
+        )
+        .unwrap();
+        assert!(RodParams::of(&reordered).is_none());
+        let both = ContactMode {
+            in_contact: true,
+            ..ContactMode::default()
+        };
+        assert!(RodModes::of(&both).is_none());
+    }
+}

@@ -1,0 +1,454 @@
+//! Several runs of the free link stepped at once, one per SIMD lane: the sweep's fast path.
+//!
+//! Layout (structure of arrays): each lane holds one scene; the state (q, q', work), the
+//! first stage, the step size, the held modes and the scene's parameters are each one
+//! `F64x4` (`RodParams<F64x4>`, `RodModes<F64x4>`), so one instruction advances the same
+//! quantity of four scenes. A step's four RK4 stages and its end evaluation run in the lanes
+//! ([`lane_step`], through `dynamics::rod_lanes`); everything else of the step is each run's
+//! own, on the scalar path ([`Run::after_step`]): the events are detected at the step's end,
+//! and a lane whose step meets one (an entry, a switch, the end of a stick, the stop) has it
+//! located, the step cut there and the modes changed by the same code as a lone run. A lane
+//! whose step the lanes do not cover (a mode that sticks in x and in y, a zero pivot) takes
+//! that step on the scalar path. A lane whose run ends takes the next scene at once, so
+//! lanes ending at different times never wait for each other.
+//!
+//! The lanes compute each operation of the scalar path in its order (`F64x4` is four
+//! IEEE f64 operations, with libm's `sin_cos` and `pow` per lane), so a run's outcome is the
+//! same bit for bit whether it ran in a lane or alone (tests).
+
+use nalgebra::{SVector, Vector2};
+
+use super::outcome::Outcome;
+use super::solve::{solve, Run, SolveOptions};
+use super::stepper::{Deriv, Method, State};
+use crate::dynamics::rod_lanes::{pivot_ok, rod_eval, RodEval, RodModes, RodParams};
+use crate::dynamics::{DragStiffness, Eval, Model};
+use crate::error::Result;
+use crate::forces::Real;
+use crate::simd::{F64x4, LANES};
+
+/// One step of several runs in lanes: its start, first stage and size, per lane.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneStart<F> {
+    /// Coordinates at the start.
+    pub q: [F; 3],
+    /// Rates at the start.
+    pub qd: [F; 3],
+    /// Work at the start.
+    pub work: F,
+    /// Dissipation at the start.
+    pub dissipated: F,
+    /// The first stage: q'' and the power.
+    pub qdd1: [F; 3],
+    /// See `qdd1`.
+    pub power1: F,
+    /// The joints' power at the first stage (0 for a free link, carried as the scalar path
+    /// carries it).
+    pub joint_power1: F,
+    /// Step size [s].
+    pub h: F,
+}
+
+/// What [`lane_step`] returns: the end state, its evaluation, each later stage's
+/// coordinates and evaluation (the observer is shown them), and whether every stage's
+/// pivot was clear (else the scalar path redoes the step).
+#[derive(Debug, Clone, Copy)]
+pub struct LaneEnd<F> {
+    /// Coordinates at the end.
+    pub q: [F; 3],
+    /// Rates at the end.
+    pub qd: [F; 3],
+    /// Work at the end.
+    pub work: F,
+    /// Dissipation at the end.
+    pub dissipated: F,
+    /// The evaluation at the end.
+    pub eval: RodEval<F>,
+    /// Stages 2, 3 and 4: what the observer is shown of them.
+    pub stages: [LaneStage<F>; 3],
+}
+
+/// What the observer is shown of an RK4 stage (see [`super::stepper::step_sampling`]),
+/// and whether its sticking row's pivot was clear.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneStage<F> {
+    /// The stage's coordinates.
+    pub q: [F; 3],
+    /// |F_d|^2 and |v_E|^2, as [`DragStiffness::of`] computes them.
+    pub drag2: F,
+    /// See `drag2`.
+    pub speed2: F,
+    /// v_E.
+    pub v: [F; 2],
+    /// The sticking row's pivot ([`RodEval::pivot`]).
+    pub pivot: F,
+}
+
+impl<F: Real> LaneStage<F> {
+    #[inline(always)]
+    fn of(q: [F; 3], e: &RodEval<F>) -> Self {
+        let zero = F::splat(0.0);
+        let (d, v) = (e.dynamic, e.v_centroid);
+        LaneStage {
+            q,
+            drag2: zero + (d[0] * d[0] + d[1] * d[1]),
+            speed2: zero + (v[0] * v[0] + v[1] * v[1]),
+            v,
+            pivot: e.pivot,
+        }
+    }
+}
+
+/// One RK4 step ([`super::stepper::step_sampling`] and the end evaluation of
+/// [`super::stepper::full_step`]) in `F`, in the scalar path's order of operations.
+#[inline(always)]
+pub fn lane_step<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -> LaneEnd<F> {
+    let h = s.h;
+    let half = F::splat(0.5) * h;
+    let zero = F::splat(0.0);
+    // A stage's state `y + c k`, as `State::add`.
+    let add = |c: F, k_q: &[F; 3], k_qd: &[F; 3], k_w: F, k_d: F| {
+        (
+            [
+                s.q[0] + c * k_q[0],
+                s.q[1] + c * k_q[1],
+                s.q[2] + c * k_q[2],
+            ],
+            [
+                s.qd[0] + c * k_qd[0],
+                s.qd[1] + c * k_qd[1],
+                s.qd[2] + c * k_qd[2],
+            ],
+            s.work + c * k_w,
+            s.dissipated + c * k_d,
+        )
+    };
+    // k1: (q' = qd, q'' = qdd1, power1, joint power).
+    let (q2, qd2, _, _) = add(half, &s.qd, &s.qdd1, s.power1, s.joint_power1);
+    let e2 = rod_eval(p, m, &q2, &qd2);
+    let (q3, qd3, _, _) = add(half, &qd2, &e2.qdd, e2.power, zero);
+    let e3 = rod_eval(p, m, &q3, &qd3);
+    let (q4, qd4, _, _) = add(h, &qd3, &e3.qdd, e3.power, zero);
+    let e4 = rod_eval(p, m, &q4, &qd4);
+    let s6 = h / F::splat(6.0);
+    let two = F::splat(2.0);
+    let comb = |y: F, k1: F, k2: F, k3: F, k4: F| y + s6 * (k1 + two * k2 + two * k3 + k4);
+    let q = [
+        comb(s.q[0], s.qd[0], qd2[0], qd3[0], qd4[0]),
+        comb(s.q[1], s.qd[1], qd2[1], qd3[1], qd4[1]),
+        comb(s.q[2], s.qd[2], qd2[2], qd3[2], qd4[2]),
+    ];
+    let qd = [
+        comb(s.qd[0], s.qdd1[0], e2.qdd[0], e3.qdd[0], e4.qdd[0]),
+        comb(s.qd[1], s.qdd1[1], e2.qdd[1], e3.qdd[1], e4.qdd[1]),
+        comb(s.qd[2], s.qdd1[2], e2.qdd[2], e3.qdd[2], e4.qdd[2]),
+    ];
+    let work = comb(s.work, s.power1, e2.power, e3.power, e4.power);
+    let dissipated = comb(s.dissipated, s.joint_power1, zero, zero, zero);
+    let eval = rod_eval(p, m, &q, &qd);
+    LaneEnd {
+        q,
+        qd,
+        work,
+        dissipated,
+        eval,
+        stages: [
+            LaneStage::of(q2, &e2),
+            LaneStage::of(q3, &e3),
+            LaneStage::of(q4, &e4),
+        ],
+    }
+}
+
+/// [`lane_step`] in four lanes, compiled for the baseline target.
+#[inline(never)]
+fn lane_step_base(
+    p: &RodParams<F64x4>,
+    m: &RodModes<F64x4>,
+    s: &LaneStart<F64x4>,
+) -> LaneEnd<F64x4> {
+    lane_step(p, m, s)
+}
+
+/// [`lane_step`] in four lanes, compiled with AVX2 (256-bit registers).
+///
+/// # Safety
+/// The CPU must have AVX2 ([`crate::simd::avx2`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+unsafe fn lane_step_avx2(
+    p: &RodParams<F64x4>,
+    m: &RodModes<F64x4>,
+    s: &LaneStart<F64x4>,
+) -> LaneEnd<F64x4> {
+    lane_step(p, m, s)
+}
+
+/// How the lanes run: with AVX2 where the CPU has it, else the baseline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LaneIsa {
+    /// The baseline target (SSE2 on x86-64, NEON on arm64).
+    Base,
+    /// AVX2.
+    Avx2,
+}
+
+impl LaneIsa {
+    /// The best this CPU runs.
+    pub fn detect() -> Self {
+        if crate::simd::avx2() {
+            LaneIsa::Avx2
+        } else {
+            LaneIsa::Base
+        }
+    }
+
+    #[inline]
+    fn step(
+        self,
+        p: &RodParams<F64x4>,
+        m: &RodModes<F64x4>,
+        s: &LaneStart<F64x4>,
+    ) -> LaneEnd<F64x4> {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU.
+            LaneIsa::Avx2 => unsafe { lane_step_avx2(p, m, s) },
+            _ => lane_step_base(p, m, s),
+        }
+    }
+}
+
+/// A scene for [`run_lanes`]: its tag (given back with its outcome), model, start and
+/// options.
+pub type LaneScene<T> = (T, Model<3>, SVector<f64, 3>, SVector<f64, 3>, SolveOptions);
+
+/// Whether the lanes cover a run of `model` with `options` (else it runs alone).
+pub fn covered(model: &Model<3>, options: &SolveOptions) -> bool {
+    options.method == Method::Rk4 && RodParams::of(model).is_some()
+}
+
+/// One lane's step as the runs give it: start, first stage, size, modes.
+type LaneInput = (State<3>, Deriv<3>, f64, RodModes<f64>);
+
+/// A run in a lane.
+struct Slot<T> {
+    tag: T,
+    model: Model<3>,
+    run: Run<3>,
+}
+
+/// Run every scene `next` gives, four at a time in lanes (`isa`), and hand each outcome
+/// to `done` with its tag as the run ends (not in input order). A scene the lanes do not
+/// cover ([`covered`]) runs alone, on the scalar path, as [`solve`] runs it.
+pub fn run_lanes<T>(
+    isa: LaneIsa,
+    mut next: impl FnMut() -> Option<LaneScene<T>>,
+    mut done: impl FnMut(T, Result<Outcome>),
+) {
+    let mut slots: [Option<Slot<T>>; LANES] = std::array::from_fn(|_| None);
+    let mut params: Option<RodParams<F64x4>> = None;
+    let mut empty = false;
+    loop {
+        // Fill the lanes and find each run's next step.
+        let mut h = [0.0; LANES];
+        let mut live = [false; LANES];
+        for i in 0..LANES {
+            loop {
+                if slots[i].is_none() {
+                    if empty {
+                        break;
+                    }
+                    let Some((tag, model, q0, qd0, options)) = next() else {
+                        empty = true;
+                        break;
+                    };
+                    let p = match RodParams::of(&model) {
+                        Some(p) if options.method == Method::Rk4 => p,
+                        _ => {
+                            let out = solve(&model, q0, qd0, &options);
+                            done(tag, out);
+                            continue;
+                        }
+                    };
+                    match &mut params {
+                        Some(lanes) => lanes.set(i, &p),
+                        None => params = Some(RodParams::splat(&p)),
+                    }
+                    let run = Run::new(&model, q0, qd0, &options);
+                    slots[i] = Some(Slot { tag, model, run });
+                }
+                let Some(slot) = slots[i].as_mut() else {
+                    break;
+                };
+                match slot.run.next_step(&slot.model) {
+                    Some(hi) => {
+                        h[i] = hi;
+                        live[i] = true;
+                        break;
+                    }
+                    None => {
+                        if let Some(s) = slots[i].take() {
+                            let out = s.run.finish(&s.model);
+                            done(s.tag, out);
+                        }
+                    }
+                }
+            }
+        }
+        if !live.iter().any(|&l| l) {
+            break;
+        }
+        let Some(params) = params.as_ref() else {
+            break;
+        };
+
+        // Gather the lanes whose mode the lanes cover; the others step alone.
+        let mut modes = [None; LANES];
+        let mut starts: [Option<(State<3>, Deriv<3>)>; LANES] = [None; LANES];
+        for i in 0..LANES {
+            if !live[i] {
+                continue;
+            }
+            let Some(slot) = slots[i].as_mut() else {
+                continue;
+            };
+            let (y, k1, m) = slot.run.start();
+            match RodModes::of(&m[0]) {
+                Some(rm) => {
+                    modes[i] = Some(rm);
+                    starts[i] = Some((*y, k1));
+                }
+                None => {
+                    if let Err(e) = slot.run.step(&slot.model, h[i]) {
+                        fail(&mut slots[i], e, &mut done);
+                    }
+                }
+            }
+        }
+        let Some(first) = (0..LANES).find(|&i| modes[i].is_some()) else {
+            continue;
+        };
+        // An idle lane repeats the first one's step (its results are dropped).
+        let input: [LaneInput; LANES] = std::array::from_fn(|i| {
+            let j = if modes[i].is_some() { i } else { first };
+            match (starts[j], modes[j]) {
+                (Some((y, k)), Some(m)) => (y, k, h[j], m),
+                _ => unreachable!("lane {j} has a start and a mode"),
+            }
+        });
+        let lanes = |f: fn(&LaneInput) -> f64| {
+            F64x4([f(&input[0]), f(&input[1]), f(&input[2]), f(&input[3])])
+        };
+        let start = LaneStart {
+            q: [
+                lanes(|x| x.0.q[0]),
+                lanes(|x| x.0.q[1]),
+                lanes(|x| x.0.q[2]),
+            ],
+            qd: [
+                lanes(|x| x.0.qd[0]),
+                lanes(|x| x.0.qd[1]),
+                lanes(|x| x.0.qd[2]),
+            ],
+            work: lanes(|x| x.0.work),
+            dissipated: lanes(|x| x.0.dissipated),
+            qdd1: [
+                lanes(|x| x.1.qd[0]),
+                lanes(|x| x.1.qd[1]),
+                lanes(|x| x.1.qd[2]),
+            ],
+            power1: lanes(|x| x.1.work),
+            joint_power1: lanes(|x| x.1.dissipated),
+            h: lanes(|x| x.2),
+        };
+        let lane_modes = RodModes::gather(&std::array::from_fn(|i| input[i].3));
+        // Idle lanes take the first lane's parameters.
+        let end = if modes.iter().all(|m| m.is_some()) {
+            isa.step(params, &lane_modes, &start)
+        } else {
+            let mut lane_params = *params;
+            for (i, m) in modes.iter().enumerate() {
+                if m.is_none() {
+                    copy_lane(&mut lane_params, i, first);
+                }
+            }
+            isa.step(&lane_params, &lane_modes, &start)
+        };
+
+        for i in 0..LANES {
+            if modes[i].is_none() {
+                continue;
+            }
+            let Some(slot) = slots[i].as_mut() else {
+                continue;
+            };
+            let Some((_, k1)) = starts[i] else {
+                continue;
+            };
+            let e1 = end.eval.lane(i);
+            let pivots_ok = end.stages.iter().all(|st| pivot_ok(st.pivot.0[i]));
+            let result = if pivots_ok && pivot_ok(e1.pivot) {
+                for st in &end.stages {
+                    let q = SVector::<f64, 3>::new(st.q[0].0[i], st.q[1].0[i], st.q[2].0[i]);
+                    let v = Vector2::new(st.v[0].0[i], st.v[1].0[i]);
+                    let stiff = DragStiffness {
+                        drag2: st.drag2.0[i],
+                        speed2: st.speed2.0[i],
+                        contact: 0,
+                        v,
+                    };
+                    slot.run.offer(&q, &stiff);
+                }
+                let y1 = State {
+                    q: SVector::<f64, 3>::new(end.q[0].0[i], end.q[1].0[i], end.q[2].0[i]),
+                    qd: SVector::<f64, 3>::new(end.qd[0].0[i], end.qd[1].0[i], end.qd[2].0[i]),
+                    work: end.work.0[i],
+                    dissipated: end.dissipated.0[i],
+                };
+                let slot_e1: &mut Eval<3> = slot.run.end_eval();
+                e1.write(slot_e1);
+                slot.run.count_evals(4);
+                slot.run.after_step(&slot.model, h[i], &k1, y1, 0.0)
+            } else {
+                slot.run.step(&slot.model, h[i])
+            };
+            if let Err(e) = result {
+                fail(&mut slots[i], e, &mut done);
+            }
+        }
+    }
+}
+
+/// Lane `i` of `p` takes lane `j`'s parameters.
+fn copy_lane(p: &mut RodParams<F64x4>, i: usize, j: usize) {
+    let one = |x: &mut F64x4| x.0[i] = x.0[j];
+    one(&mut p.mass);
+    one(&mut p.g);
+    one(&mut p.inv_m);
+    one(&mut p.inv_i);
+    one(&mut p.tip[0]);
+    one(&mut p.tip[1]);
+    one(&mut p.length);
+    one(&mut p.diameter);
+    one(&mut p.section);
+    one(&mut p.at_centroid);
+    one(&mut p.medium.rho_g);
+    one(&mut p.medium.g);
+    one(&mut p.eta_d);
+    one(&mut p.eta_h);
+    one(&mut p.eta_v);
+    one(&mut p.lam);
+}
+
+/// A run that failed leaves its lane with its error.
+fn fail<T>(
+    slot: &mut Option<Slot<T>>,
+    e: crate::GranrsError,
+    done: &mut impl FnMut(T, Result<Outcome>),
+) {
+    if let Some(s) = slot.take() {
+        done(s.tag, Err(e));
+    }
+}

@@ -1,0 +1,179 @@
+//! Four f64 lanes: the number type of the sweep's lanes ([`crate::dynamics::rod_lanes`]).
+//!
+//! `F64x4` is a plain `[f64; 4]` whose operations are written lane by lane with the same IEEE
+//! operation as `f64` (no fused multiply-add: Rust never contracts `a * b + c`), so a lane's
+//! result is bit for bit what the scalar path computes. The vector instructions come from
+//! the compiler: the sweep's lane loop is compiled twice, once for the baseline target and
+//! once with AVX2 enabled (`#[target_feature]`), and the CPU picks one at run time
+//! ([`avx2`]). One wheel thus runs on any x86-64 (SSE2, two lanes per instruction), uses
+//! 256-bit registers where the CPU has them, and builds unchanged for arm64 (NEON, two
+//! lanes per instruction). `sin_cos` is [`crate::math`]'s, written without branches so that
+//! it vectorizes too (libm has no vector version), and the free link's scalar path calls the
+//! same function; `powf` is libm's, lane by lane (see `crate::math` for why).
+//!
+//! Why no crate: `wide` picks its instructions when the crate is compiled
+//! (`cfg(target_feature)`), so a baseline x86-64 wheel would never use AVX2; `pulp` does
+//! dispatch at run time, but its vectors are values of an instruction-set token's
+//! associated types, with no arithmetic operators, so the terms' generic arithmetic
+//! (`a * b + c` over [`Real`]) could not run on them without wrapping every value with its
+//! token. Neither has a vector `pow` or `sin_cos` either.
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+use crate::forces::Real;
+use crate::math;
+
+/// Number of lanes.
+pub const LANES: usize = 4;
+
+/// Four f64 lanes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(32))]
+pub struct F64x4(pub [f64; LANES]);
+
+impl F64x4 {
+    /// Lane by lane `f(a_i)`.
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        let a = self.0;
+        F64x4([f(a[0]), f(a[1]), f(a[2]), f(a[3])])
+    }
+
+    /// Lane by lane `f(a_i, b_i)`.
+    #[inline(always)]
+    fn zip(self, b: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        let (a, b) = (self.0, b.0);
+        F64x4([f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2]), f(a[3], b[3])])
+    }
+}
+
+macro_rules! binary {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl $trait for F64x4 {
+            type Output = F64x4;
+            #[inline(always)]
+            fn $method(self, b: F64x4) -> F64x4 {
+                self.zip(b, |x, y| x $op y)
+            }
+        }
+    };
+}
+
+binary!(Add, add, +);
+binary!(Sub, sub, -);
+binary!(Mul, mul, *);
+binary!(Div, div, /);
+
+impl Neg for F64x4 {
+    type Output = F64x4;
+    #[inline(always)]
+    fn neg(self) -> F64x4 {
+        self.map(|x| -x)
+    }
+}
+
+impl Real for F64x4 {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        F64x4([x; LANES])
+    }
+    #[inline(always)]
+    fn powf(self, e: Self) -> Self {
+        self.zip(e, f64::powf)
+    }
+    #[inline(always)]
+    fn recip(self) -> Self {
+        self.map(|x| 1.0 / x)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        self.map(f64::sqrt)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        self.map(f64::abs)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        self.zip(other, f64::max)
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        self.zip(other, f64::min)
+    }
+    #[inline(always)]
+    fn select_pos(self, a: Self, b: Self) -> Self {
+        let (s, a, b) = (self.0, a.0, b.0);
+        let pick = |i: usize| if s[i] > 0.0 { a[i] } else { b[i] };
+        F64x4([pick(0), pick(1), pick(2), pick(3)])
+    }
+    #[inline(always)]
+    fn all_zero(self) -> bool {
+        self.0.iter().all(|&x| x == 0.0)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let a = self.0;
+        let (mut s, mut c) = math::sin_cos_core(self);
+        if !a.iter().all(|x| x.abs() <= math::SIN_COS_LIMIT) {
+            for (i, x) in a.iter().enumerate() {
+                if x.abs() > math::SIN_COS_LIMIT || x.is_nan() {
+                    (s.0[i], c.0[i]) = x.sin_cos();
+                }
+            }
+        }
+        (s, c)
+    }
+}
+
+/// Whether this CPU runs the lanes with AVX2 (256-bit) instructions: checked once at run
+/// time, so the same build runs on CPUs without it.
+#[inline]
+pub fn avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lanes_are_the_scalar_operations_bit_for_bit() {
+        let a = F64x4([0.3, -1.7, 2.5e-3, 7.0]);
+        let b = F64x4([1.1, 0.2, -3.0, 0.0]);
+        let check = |v: F64x4, f: &dyn Fn(f64, f64) -> f64| {
+            for i in 0..LANES {
+                assert_eq!(v.0[i].to_bits(), f(a.0[i], b.0[i]).to_bits(), "lane {i}");
+            }
+        };
+        check(a + b, &|x, y| x + y);
+        check(a - b, &|x, y| x - y);
+        check(a * b, &|x, y| x * y);
+        check(a / b, &|x, y| x / y);
+        check(-a, &|x, _| -x);
+        check(a.abs().powf(b), &|x, y| x.abs().powf(y));
+        check(a.max(b), &|x, y| x.max(y));
+        check(a.min(b), &|x, y| x.min(y));
+        check(a.recip(), &|x, _| 1.0 / x);
+        check(a.abs().sqrt(), &|x, _| x.abs().sqrt());
+        check(a.sin_cos().0, &|x, _| math::sin_cos(x).0);
+        check(a.sin_cos().1, &|x, _| math::sin_cos(x).1);
+        let far = F64x4([1e6, -0.5, f64::NAN, 3.0]);
+        let far_check = far.sin_cos();
+        for i in 0..LANES {
+            assert_eq!(
+                far_check.0 .0[i].to_bits(),
+                math::sin_cos(far.0[i]).0.to_bits()
+            );
+        }
+        assert!(F64x4::splat(0.0).all_zero());
+        assert!(!b.all_zero());
+    }
+}
