@@ -353,37 +353,6 @@ fn impact(c: &mut Criterion) {
     g.finish();
 }
 
-/// libm's `sin_cos` against `_granrs::math`'s (the lanes' own, which the free link's
-/// scalar path calls too), over 1024 angles from -3 to 3 rad.
-fn math(c: &mut Criterion) {
-    let qs: Vec<f64> = (0..1024).map(|i| -3.0 + 6.0 * i as f64 / 1024.0).collect();
-    let mut g = c.benchmark_group("math");
-    g.throughput(Throughput::Elements(1024));
-    g.bench_function("sin_cos_libm", |b| {
-        b.iter(|| {
-            black_box(&qs)
-                .iter()
-                .map(|&q| {
-                    let (s, c) = q.sin_cos();
-                    s + c
-                })
-                .sum::<f64>()
-        })
-    });
-    g.bench_function("sin_cos_granrs", |b| {
-        b.iter(|| {
-            black_box(&qs)
-                .iter()
-                .map(|&q| {
-                    let (s, c) = _granrs::math::sin_cos(q);
-                    s + c
-                })
-                .sum::<f64>()
-        })
-    });
-    g.finish();
-}
-
 /// The Table 3.5 scenes as a sweep on one thread: in SIMD lanes against alone, each run
 /// as the batch runs it (no Python, no scene building).
 fn lanes(c: &mut Criterion) {
@@ -442,6 +411,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = force, rhs, impact, math, lanes
+    targets = force, rhs, impact, lanes
 }
 criterion_main!(benches);

@@ -17,7 +17,6 @@ pub mod error;
 pub mod evaluate;
 pub mod forces;
 pub mod integrate;
-pub mod math;
 pub mod simd;
 pub mod spec;
 

@@ -22,8 +22,8 @@ use crate::forces::{
 };
 
 /// Position and velocity of a single rigid rod whose root is its centre of mass: what
-/// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation,
-/// [`crate::math::sin_cos`]).
+/// [`Model::eval_rigid_rod`] and its constraints need (one `sin_cos` per evaluation, libm's,
+/// as the lanes call it lane by lane).
 #[derive(Debug, Clone, Copy)]
 struct RodFrame {
     root: Vector2<f64>,
@@ -36,8 +36,7 @@ struct RodFrame {
 impl RodFrame {
     #[inline]
     fn new<const N: usize>(q: &SVector<f64, N>, qd: &SVector<f64, N>) -> Self {
-        // The lanes' own sin_cos (`dynamics::rod_lanes` reads the same).
-        let (s, c) = crate::math::sin_cos(q[2]);
+        let (s, c) = q[2].sin_cos();
         RodFrame {
             root: Vector2::new(q[0], q[1]),
             v_root: Vector2::new(qd[0], qd[1]),

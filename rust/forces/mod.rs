@@ -72,7 +72,7 @@ pub trait Real:
     fn select_pos(self, a: Self, b: Self) -> Self;
     /// Whether it is zero (in every lane).
     fn all_zero(self) -> bool;
-    /// Sine and cosine ([`crate::math::sin_cos`] in each lane).
+    /// Sine and cosine (libm's, in each lane).
     fn sin_cos(self) -> (Self, Self);
 }
 
@@ -117,10 +117,9 @@ impl Real for f64 {
     fn all_zero(self) -> bool {
         self == 0.0
     }
-    /// [`crate::math::sin_cos`] (see `powf`).
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
-        crate::math::sin_cos(self)
+        f64::sin_cos(self)
     }
 }
 
