@@ -15,6 +15,7 @@ import sys
 
 import numpy as np
 import pytest
+from rft_paper import alpha_paper as alpha
 
 import granrs
 from granrs import bodies, forces
@@ -23,28 +24,6 @@ from granrs.errors import InvalidParameterError, InvalidSceneError
 
 SCENES = pathlib.Path(__file__).parent.parent / "examples" / "scenes"
 ZETA = 1e6
-# Li, Zhang & Goldman 2013, generic coefficients (shared/LAWS.md).
-A00, A10, B11, B01, BM11 = 0.206, 0.169, 0.212, 0.358, 0.055
-C11, C01, CM11, D10 = -0.124, 0.253, 0.007, 0.088
-
-
-def alpha(beta: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(alpha_x, alpha_z) of eq. 1 (LAWS.md: beta the line's angle, gamma the velocity's
-    angle below +x)."""
-    az = (
-        A00
-        + A10 * np.cos(2 * beta)
-        + B11 * np.sin(2 * beta + gamma)
-        + B01 * np.sin(gamma)
-        + BM11 * np.sin(-2 * beta + gamma)
-    )
-    ax = (
-        C11 * np.cos(2 * beta + gamma)
-        + C01 * np.cos(gamma)
-        + CM11 * np.cos(-2 * beta + gamma)
-        + D10 * np.sin(2 * beta)
-    )
-    return ax, az
 
 
 def arc_leg(

@@ -14,35 +14,13 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from rft_paper import A00, A10, B01, B11, BM11, C11, CM11, D10, alpha_paper
 from scipy.integrate import quad
 from scipy.optimize import brentq
 from scipy.special import lambertw
 
 import granrs
 from granrs import forces as f
-
-# Li, Zhang & Goldman 2013, generic coefficients (shared/LAWS.md), typed here.
-A00, A10, B11, B01, BM11 = 0.206, 0.169, 0.212, 0.358, 0.055
-C11, C01, CM11, D10 = -0.124, 0.253, 0.007, 0.088
-
-
-def alpha_paper(beta: np.ndarray, gamma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The paper's Fourier series, written from its formula with numpy's trigonometry."""
-    az = (
-        A00
-        + A10 * np.cos(2 * beta)
-        + B11 * np.sin(2 * beta + gamma)
-        + B01 * np.sin(gamma)
-        + BM11 * np.sin(-2 * beta + gamma)
-    )
-    ax = (
-        C11 * np.cos(2 * beta + gamma)
-        + C01 * np.cos(gamma)
-        + CM11 * np.cos(-2 * beta + gamma)
-        + D10 * np.sin(2 * beta)
-    )
-    return ax, az
-
 
 # --- rft_alpha against its source ------------------------------------------------------
 
