@@ -173,7 +173,7 @@ impl<const N: usize> Run<N> {
     }
 
     /// The size of the next step, or `None` when the run has ended ([`Run::finish`]).
-    #[inline]
+    #[inline(always)]
     pub fn next_step(&mut self, model: &Model<N>) -> Option<f64> {
         if self.status.is_some() {
             return None;
@@ -262,7 +262,7 @@ impl<const N: usize> Run<N> {
     }
 
     /// Take a whole step of size `h` (from [`Run::next_step`]) on the scalar path.
-    #[inline]
+    #[inline(always)]
     pub fn step(&mut self, model: &Model<N>, h: f64) -> Result<()> {
         let (e0, e1) = start_and_end(&mut self.evals, self.cur);
         let k1 = deriv_of(&self.y, e0);
@@ -285,7 +285,7 @@ impl<const N: usize> Run<N> {
     /// The rest of a step of size `h` whose first stage is `k1`, whose end is `y1` (its
     /// evaluation in [`Run::end_eval`]) and whose error estimate is `err` (0 for RK4):
     /// the step-size control, the events (located, and the step cut there), the observer.
-    #[inline]
+    #[inline(always)]
     pub fn after_step(
         &mut self,
         model: &Model<N>,
