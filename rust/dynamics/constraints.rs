@@ -99,43 +99,6 @@ fn solve_small<const R: usize>(k: usize, fill: impl Fn(&mut Small<R>)) -> Option
     eliminate(&mut sys, k, 1e-13 * scale.max(f64::MIN_POSITIVE)).then_some(sys.1)
 }
 
-/// [`solve_small`] of the `k x k` system `a(i, j) x_j = b(i)`, assembled in the smallest of
-/// 4, 8 or `R` rows that holds it: the elimination touches only the first `k` rows and
-/// columns, so the result is the same to the bit, but zeroing, swapping and copying rows of
-/// a `MAX_ROWS`-wide array for a system of a few rows cost the leg a tenth of its time.
-#[inline]
-fn solve_sized<const R: usize>(
-    k: usize,
-    a: impl Fn(usize, usize) -> f64,
-    b: impl Fn(usize) -> f64,
-) -> Option<[f64; R]> {
-    #[inline(always)]
-    fn sized<const S: usize, const R: usize>(
-        k: usize,
-        a: &impl Fn(usize, usize) -> f64,
-        b: &impl Fn(usize) -> f64,
-    ) -> Option<[f64; R]> {
-        let x = solve_small::<S>(k, |sys| {
-            for i in 0..k {
-                sys.1[i] = b(i);
-                for (j, aij) in sys.0[i].iter_mut().enumerate().take(k) {
-                    *aij = a(i, j);
-                }
-            }
-        })?;
-        let mut out = [0.0; R];
-        out[..k].copy_from_slice(&x[..k]);
-        Some(out)
-    }
-    if k <= 4 && R >= 4 {
-        sized::<4, R>(k, &a, &b)
-    } else if k <= 8 && R >= 8 {
-        sized::<8, R>(k, &a, &b)
-    } else {
-        sized::<R, R>(k, &a, &b)
-    }
-}
-
 /// Gaussian elimination with partial pivoting in place (`b` becomes `x`); false at a pivot
 /// at or below `tiny`.
 fn eliminate<const R: usize>((a, b): &mut Small<R>, k: usize, tiny: f64) -> bool {
@@ -236,11 +199,15 @@ fn apply_rows<const N: usize, const R: usize>(
         return;
     }
     let free = *qdd;
-    let mults = solve_sized::<R>(
-        k,
-        |i, j| rows.get(i).jac.dot(&rows.get(j).response),
-        |i| -(rows.get(i).bias + rows.get(i).jac.dot(&free)),
-    )
+    let mults = solve_small::<R>(k, |(a, b)| {
+        for i in 0..k {
+            let ri = rows.get(i);
+            b[i] = -(ri.bias + ri.jac.dot(&free));
+            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                *aij = ri.jac.dot(&rows.get(j).response);
+            }
+        }
+    })
     .unwrap_or([0.0; R]);
     for (i, &mult) in mults.iter().enumerate().take(k) {
         let r = rows.get(i);
@@ -278,11 +245,15 @@ fn project_rows<const N: usize, const R: usize>(
         *m = minv(&rows.get(i).jac);
     }
     let v = *qd;
-    let lam = solve_sized::<R>(
-        k,
-        |i, j| rows.get(i).jac.dot(&minv_jt[j]),
-        |i| rows.get(i).jac.dot(&v) - rows.get(i).target,
-    );
+    let lam = solve_small::<R>(k, |(a, b)| {
+        for i in 0..k {
+            let ji = &rows.get(i).jac;
+            b[i] = ji.dot(&v) - rows.get(i).target;
+            for (j, aij) in a[i].iter_mut().enumerate().take(k) {
+                *aij = ji.dot(&minv_jt[j]);
+            }
+        }
+    });
     match lam {
         Some(lam) if lam[..k].iter().any(|&l| l != 0.0) => {
             for (l, m) in lam.iter().zip(&minv_jt).take(k) {
