@@ -460,6 +460,50 @@ mod tests {
         assert_eq!(rows_bits(&src, Path::Lanes), rows_bits(&src, Path::Scalar));
     }
 
+    /// The free link's lean steps (the lanes' arithmetic in `f64`, `Run::step`) give the
+    /// outcome of the general rigid-rod path (`full_step` through `Model::eval`) bit for bit,
+    /// over the scenes of the lanes' test: every field of the outcome, summaries and counts.
+    #[test]
+    fn lean_steps_are_the_general_path_bitwise() {
+        use crate::integrate::solve::{solve, Run};
+        let num = |v: &[f64]| v.iter().map(|&x| Value::Num(x)).collect::<Vec<_>>();
+        let word = |v: &[&'static str]| {
+            v.iter()
+                .map(|&x| Value::Str(std::borrow::Cow::Borrowed(x)))
+                .collect::<Vec<_>>()
+        };
+        let src = Source::Product {
+            base: base(),
+            axes: vec![
+                ("apply_at".into(), word(&["tip", "centroid"])),
+                ("end".into(), word(&["first_stop", "all_stops"])),
+                ("depth0".into(), num(&[0.0, 0.03])),
+                (
+                    "q_deg".into(),
+                    num(&[-85.0, -30.0, 0.0, 5.0, 45.0, 75.0, 89.0]),
+                ),
+                ("v0".into(), num(&[0.05, 1.12, 2.214, 5.0])),
+                ("omega0".into(), num(&[0.0, -7.0, 20.0])),
+            ],
+        };
+        let mut lean_steps = 0;
+        for i in 0..src.len() {
+            let Ok(AnyScene::FreeLink(s)) = src.spec(i).build() else {
+                panic!("run {i} is not a free link");
+            };
+            let (model, (q0, qd0)) = (s.model(), s.initial_state());
+            let lean = solve(&model, q0, qd0, &s.options).unwrap();
+            let mut run = Run::new(&model, q0, qd0, &s.options).general();
+            while let Some(h) = run.next_step(&model) {
+                run.step(&model, h).unwrap();
+            }
+            let general = run.finish(&model).unwrap();
+            assert_eq!(format!("{lean:?}"), format!("{general:?}"), "run {i}");
+            lean_steps += lean.stats.steps;
+        }
+        assert!(lean_steps > 100_000, "{lean_steps} steps");
+    }
+
     #[test]
     fn validation_names_the_first_bad_run() {
         let src = Source::Product {

@@ -1,21 +1,25 @@
-//! The free link under the thesis's terms for several scenes at once: [`Model::eval_rigid_rod`]
-//! written over [`Real`], so that `F = F64x4` evaluates four scenes, one per SIMD lane, in
-//! the same instructions (the sweep's lanes, `integrate::lanes`).
+//! The free link under the thesis's terms for one scene or several at once: [`Model::eval_rigid_rod`]
+//! written over [`Real`]. With `F = f64` it is the lean path of a lone run's RK4 steps
+//! (`integrate::solve::Run::step`: a stage computes only what the step reads, after
+//! inlining); with `F = F64x4` it evaluates four scenes, one per SIMD lane, in the same
+//! instructions (the sweep's lanes, `integrate::lanes`).
 //!
 //! The force law is not copied: the terms' own arithmetic ([`Drag::law`], [`StaticH::law`],
 //! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane.
 //! The mechanics (the rod's frame, its immersed geometry, the closed-form sticking row and
 //! the sums of [`super::rigid_rod`]) are written again without branches: each branch of the
 //! scalar path becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation
-//! is the scalar path's, in its order, so that a lane's results are the scalar path's bit for
-//! bit (a test holds them so over random states and modes).
+//! is the scalar path's, in its order, so that the results are [`Model::eval`]'s bit for bit
+//! (tests hold them so over random states and modes, and whole runs to the general path).
+//! Two blocks are skipped when every lane blends them away (the law out of the sand, the
+//! sticking row when nothing sticks): the same bits, less work.
 //!
-//! What the lanes cover: a free link ([`Model::rigid_rod`]) whose contact terms are exactly
+//! What it covers: a free link ([`Model::rigid_rod`]) whose contact terms are exactly
 //! the thesis's three (`drag`, `static_h`, `static_v`, in that order; `gravity` on or off),
 //! under the `modes` sign model, applied at the tip or at the centroid ([`RodParams::of`]);
 //! and in modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
 //! sticks in both x and y, or whose one sticking row has a zero pivot
-//! ([`RodEval::pivot`]), is taken on the scalar path.
+//! ([`RodEval::pivot`]), is taken on the general path.
 
 use nalgebra::{SVector, Vector2};
 
@@ -24,7 +28,7 @@ use crate::body::rod::ApplyAt;
 use crate::forces::drag::Drag;
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
-use crate::forces::{AnyTerm, ContactState, Medium, Real};
+use crate::forces::{AnyTerm, ContactState, Medium, Real, TermForce};
 use crate::simd::{F64x4, LANES};
 
 /// What the evaluation of one free link under the thesis's terms reads that is fixed
@@ -285,9 +289,22 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
         sign: m.sign,
         boundary: None,
     };
-    let fd = Drag::law(p.eta_d, &state, &p.medium);
-    let fh = StaticH::law(p.eta_h, &state, &p.medium);
-    let fv = StaticV::law(p.eta_v, p.lam, &state, &p.medium);
+    // Out of the sand in every lane, each use of the law below is blended away: skip it
+    // (its `pow`). The results are the same bit for bit.
+    let (fd, fh, fv) = if forced.all_zero() {
+        let none = TermForce {
+            force: [zero, zero],
+            bound: [zero, zero],
+            moment: zero,
+        };
+        (none, none, none)
+    } else {
+        (
+            Drag::law(p.eta_d, &state, &p.medium),
+            StaticH::law(p.eta_h, &state, &p.medium),
+            StaticV::law(p.eta_v, p.lam, &state, &p.medium),
+        )
+    };
     let dynamic = [zero + fd.force[0], zero + fd.force[1]];
     let statics = [
         (zero + fh.force[0]) + fv.force[0],
@@ -310,34 +327,46 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     let row_x = sel(forced, m.stuck_x, zero);
     let row_y = sel(forced, m.stuck_y, zero);
     let row = row_x + row_y;
-    let lever_e = lever(centroid);
-    let l_rate = {
-        let depth_rate = -v_tip[1];
-        let e_y_rate = -axis[0] * omega;
-        let rate = depth_rate / axis[1] - depth * e_y_rate / (axis[1] * axis[1]);
-        sel(p.length - immersed, rate, zero)
+    // No lane sticks: each use of the row below is blended away; skip it (its divisions).
+    let (qdd, mult, a) = if row.all_zero() {
+        (qdd, zero, F::splat(1.0))
+    } else {
+        let lever_e = lever(centroid);
+        // Without spin in every lane (the vertical drop) the bias is blended to zero: skip
+        // E's sliding rate (two divisions).
+        let a_bias = if omega.all_zero() {
+            [zero, zero]
+        } else {
+            let l_rate = {
+                let depth_rate = -v_tip[1];
+                let e_y_rate = -axis[0] * omega;
+                let rate = depth_rate / axis[1] - depth * e_y_rate / (axis[1] * axis[1]);
+                sel(p.length - immersed, rate, zero)
+            };
+            let slide = [
+                (F::splat(0.5) * l_rate) * normal[0],
+                (F::splat(0.5) * l_rate) * normal[1],
+            ];
+            let spin = -(omega * omega);
+            let a_bias = [
+                spin * (centroid[0] * axis[0] + centroid[1] * normal[0]) + omega * slide[0],
+                spin * (centroid[0] * axis[1] + centroid[1] * normal[1]) + omega * slide[1],
+            ];
+            sel2(omega.abs(), a_bias, [zero, zero])
+        };
+        let bias = sel(row_x, a_bias[0], a_bias[1]);
+        let le = sel(row_x, lever_e[0], lever_e[1]);
+        let lp = sel(row_x, lever_p[0], lever_p[1]);
+        let qdd_row = sel(row_x, qdd[0], qdd[1]);
+        let a = p.inv_m + le * (lp * p.inv_i);
+        let mult = -(bias + (qdd_row + le * qdd[2])) * a.recip();
+        let qdd = [
+            sel(row_x, qdd[0] + mult * p.inv_m, qdd[0]),
+            sel(row_y, qdd[1] + mult * p.inv_m, qdd[1]),
+            sel(row, qdd[2] + mult * (lp * p.inv_i), qdd[2]),
+        ];
+        (qdd, mult, a)
     };
-    let slide = [
-        (F::splat(0.5) * l_rate) * normal[0],
-        (F::splat(0.5) * l_rate) * normal[1],
-    ];
-    let spin = -(omega * omega);
-    let a_bias = [
-        spin * (centroid[0] * axis[0] + centroid[1] * normal[0]) + omega * slide[0],
-        spin * (centroid[0] * axis[1] + centroid[1] * normal[1]) + omega * slide[1],
-    ];
-    let a_bias = sel2(omega.abs(), a_bias, [zero, zero]);
-    let bias = sel(row_x, a_bias[0], a_bias[1]);
-    let le = sel(row_x, lever_e[0], lever_e[1]);
-    let lp = sel(row_x, lever_p[0], lever_p[1]);
-    let qdd_row = sel(row_x, qdd[0], qdd[1]);
-    let a = p.inv_m + le * (lp * p.inv_i);
-    let mult = -(bias + (qdd_row + le * qdd[2])) * a.recip();
-    let qdd = [
-        sel(row_x, qdd[0] + mult * p.inv_m, qdd[0]),
-        sel(row_y, qdd[1] + mult * p.inv_m, qdd[1]),
-        sel(row, qdd[2] + mult * (lp * p.inv_i), qdd[2]),
-    ];
     let terms = [
         sel2(forced, fd.force, [zero, zero]),
         sel2(
@@ -410,7 +439,7 @@ impl RodEval<f64> {
 
     /// Write this evaluation into `out` as [`Model::eval_into`] does.
     #[inline]
-    pub fn write(&self, out: &mut Eval<3>) {
+    pub fn write<const N: usize>(&self, out: &mut Eval<N>) {
         let v2 = |a: [f64; 2]| Vector2::new(a[0], a[1]);
         let mut terms = [Vector2::zeros(); crate::forces::registry::MAX_TERMS];
         for (k, t) in self.terms.iter().enumerate() {
@@ -433,10 +462,10 @@ impl RodEval<f64> {
             corners_y: [0.0; 4],
             bound: self.bound,
         };
-        out.qdd = SVector::<f64, 3>::new(self.qdd[0], self.qdd[1], self.qdd[2]);
+        out.qdd = SVector::from_fn(|i, _| self.qdd[i]);
         out.power = self.power;
         out.joint_power = 0.0;
-        out.joint_torque = [0.0; 3];
+        out.joint_torque = [0.0; N];
     }
 }
 

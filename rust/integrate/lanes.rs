@@ -22,7 +22,7 @@ use super::outcome::Outcome;
 use super::solve::{solve, Run, SolveOptions};
 use super::stepper::{Deriv, Method, State};
 use crate::dynamics::rod_lanes::{pivot_ok, rod_eval, RodEval, RodModes, RodParams};
-use crate::dynamics::{DragStiffness, Eval, Model};
+use crate::dynamics::{DragStiffness, Model};
 use crate::error::Result;
 use crate::forces::Real;
 use crate::simd::{F64x4, LANES};
@@ -157,6 +157,69 @@ pub fn lane_step<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -
             LaneStage::of(q3, &e3),
             LaneStage::of(q4, &e4),
         ],
+    }
+}
+
+impl LaneEnd<F64x4> {
+    /// Lane `i`.
+    #[inline]
+    pub fn lane(&self, i: usize) -> LaneEnd<f64> {
+        let l = |x: F64x4| x.0[i];
+        let l3 = |x: [F64x4; 3]| [x[0].0[i], x[1].0[i], x[2].0[i]];
+        let stage = |st: &LaneStage<F64x4>| LaneStage {
+            q: l3(st.q),
+            drag2: l(st.drag2),
+            speed2: l(st.speed2),
+            v: [st.v[0].0[i], st.v[1].0[i]],
+            pivot: l(st.pivot),
+        };
+        LaneEnd {
+            q: l3(self.q),
+            qd: l3(self.qd),
+            work: l(self.work),
+            dissipated: l(self.dissipated),
+            eval: self.eval.lane(i),
+            stages: [
+                stage(&self.stages[0]),
+                stage(&self.stages[1]),
+                stage(&self.stages[2]),
+            ],
+        }
+    }
+}
+
+impl LaneEnd<f64> {
+    /// Whether every stage's and the end's sticking pivot is clear ([`pivot_ok`]): else
+    /// the scalar path redoes the step.
+    #[inline]
+    pub fn pivots_ok(&self) -> bool {
+        self.stages.iter().all(|st| pivot_ok(st.pivot)) && pivot_ok(self.eval.pivot)
+    }
+
+    /// The end state (of a body with `N` = 3 coordinates).
+    #[inline]
+    pub fn state<const N: usize>(&self) -> State<N> {
+        State {
+            q: SVector::from_fn(|i, _| self.q[i]),
+            qd: SVector::from_fn(|i, _| self.qd[i]),
+            work: self.work,
+            dissipated: self.dissipated,
+        }
+    }
+
+    /// What the observer is shown of stage `k` (2, 3, 4): its coordinates and stiffness.
+    #[inline]
+    pub fn stage<const N: usize>(&self, k: usize) -> (SVector<f64, N>, DragStiffness) {
+        let st = &self.stages[k];
+        (
+            SVector::from_fn(|i, _| st.q[i]),
+            DragStiffness {
+                drag2: st.drag2,
+                speed2: st.speed2,
+                contact: 0,
+                v: Vector2::new(st.v[0], st.v[1]),
+            },
+        )
     }
 }
 
@@ -387,33 +450,10 @@ pub fn run_lanes<T>(
             let Some((_, k1)) = starts[i] else {
                 continue;
             };
-            let e1 = end.eval.lane(i);
-            let pivots_ok = end.stages.iter().all(|st| pivot_ok(st.pivot.0[i]));
-            let result = if pivots_ok && pivot_ok(e1.pivot) {
-                for st in &end.stages {
-                    let q = SVector::<f64, 3>::new(st.q[0].0[i], st.q[1].0[i], st.q[2].0[i]);
-                    let v = Vector2::new(st.v[0].0[i], st.v[1].0[i]);
-                    let stiff = DragStiffness {
-                        drag2: st.drag2.0[i],
-                        speed2: st.speed2.0[i],
-                        contact: 0,
-                        v,
-                    };
-                    slot.run.offer(&q, &stiff);
-                }
-                let y1 = State {
-                    q: SVector::<f64, 3>::new(end.q[0].0[i], end.q[1].0[i], end.q[2].0[i]),
-                    qd: SVector::<f64, 3>::new(end.qd[0].0[i], end.qd[1].0[i], end.qd[2].0[i]),
-                    work: end.work.0[i],
-                    dissipated: end.dissipated.0[i],
-                };
-                let slot_e1: &mut Eval<3> = slot.run.end_eval();
-                e1.write(slot_e1);
-                slot.run.count_evals(4);
-                slot.run.after_step(&slot.model, h[i], &k1, y1, 0.0)
-            } else {
-                slot.run.step(&slot.model, h[i])
-            };
+            let result = slot
+                .run
+                .lane_step_done(&slot.model, h[i], &k1, &end.lane(i))
+                .unwrap_or_else(|| slot.run.step(&slot.model, h[i]));
             if let Err(e) = result {
                 fail(&mut slots[i], e, &mut done);
             }

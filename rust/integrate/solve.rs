@@ -13,9 +13,11 @@ use nalgebra::SVector;
 use super::control::Control;
 use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
+use super::lanes::{lane_step, LaneEnd, LaneStart};
 use super::observe::{Observer, Record};
 use super::outcome::{Outcome, Stats, Status};
 use super::stepper::{deriv_of, full_step, partial_step, Deriv, Method, State};
+use crate::dynamics::rod_lanes::{RodModes, RodParams};
 use crate::dynamics::{Eval, Model, Modes};
 use crate::error::{GranrsError, Result};
 
@@ -122,6 +124,10 @@ pub struct Run<const N: usize> {
     /// the grid) cut it there.
     t_next: f64,
     clamped: bool,
+    /// The free link under the thesis's terms on RK4 ([`RodParams::of`]): its steps are
+    /// the lanes' arithmetic in one lane ([`lane_step`] in `f64`), which reads only what a
+    /// stage needs; `None` for every other run.
+    lean: Option<RodParams<f64>>,
 }
 
 impl<const N: usize> Run<N> {
@@ -163,7 +169,18 @@ impl<const N: usize> Run<N> {
             next_time: 0,
             t_next: 0.0,
             clamped: false,
+            lean: match options.method {
+                Method::Rk4 => RodParams::of(model),
+                Method::Dopri5 { .. } => None,
+            },
         }
+    }
+
+    /// The same run with every step on the general path ([`super::stepper::full_step`]):
+    /// the reference the lean steps are held to, bit for bit (tests).
+    pub fn general(mut self) -> Self {
+        self.lean = None;
+        self
     }
 
     /// The same run with table-driven joints.
@@ -242,28 +259,28 @@ impl<const N: usize> Run<N> {
         )
     }
 
-    /// The slot of the step's end evaluation, for a caller that computes the step itself.
-    #[inline]
-    pub fn end_eval(&mut self) -> &mut Eval<N> {
-        &mut self.evals[1 - self.cur]
-    }
-
-    /// Show the run one RK4 stage's coordinates and the drag's stiffness there (see
-    /// [`super::stepper::step_sampling`]), for a caller that computes the step itself.
-    #[inline]
-    pub fn offer(&mut self, q: &SVector<f64, N>, stiff: &crate::dynamics::DragStiffness) {
-        self.obs.offer(q, stiff);
-    }
-
-    /// Count `n` evaluations of the right-hand side made for this run by its caller.
-    #[inline]
-    pub fn count_evals(&mut self, n: usize) {
-        self.stats.rhs_evals += n;
-    }
-
     /// Take a whole step of size `h` (from [`Run::next_step`]) on the scalar path.
     #[inline(always)]
     pub fn step(&mut self, model: &Model<N>, h: f64) -> Result<()> {
+        if let Some(p) = &self.lean {
+            if let Some(m) = RodModes::of(&self.modes[0]) {
+                let (y, k1) = (&self.y, deriv_of(&self.y, &self.evals[self.cur]));
+                let start = LaneStart {
+                    q: [y.q[0], y.q[1], y.q[2]],
+                    qd: [y.qd[0], y.qd[1], y.qd[2]],
+                    work: y.work,
+                    dissipated: y.dissipated,
+                    qdd1: [k1.qd[0], k1.qd[1], k1.qd[2]],
+                    power1: k1.work,
+                    joint_power1: k1.dissipated,
+                    h,
+                };
+                let end = lane_step(p, &m, &start);
+                if let Some(done) = self.lane_step_done(model, h, &k1, &end) {
+                    return done;
+                }
+            }
+        }
         let (e0, e1) = start_and_end(&mut self.evals, self.cur);
         let k1 = deriv_of(&self.y, e0);
         let obs = &mut self.obs;
@@ -280,6 +297,30 @@ impl<const N: usize> Run<N> {
             sample,
         );
         self.after_step(model, h, &k1, y1, err)
+    }
+
+    /// A step of size `h` whose first stage is `k1` taken in the lanes (`end`, this run's
+    /// lane): the observer is shown its stages, its end evaluation takes the end slot, and
+    /// [`Run::after_step`] does the rest. `None` (nothing done) when a sticking pivot was not
+    /// clear: the scalar path must take the step.
+    #[inline(always)]
+    pub fn lane_step_done(
+        &mut self,
+        model: &Model<N>,
+        h: f64,
+        k1: &Deriv<N>,
+        end: &LaneEnd<f64>,
+    ) -> Option<Result<()>> {
+        if !end.pivots_ok() {
+            return None;
+        }
+        for k in 0..3 {
+            let (q, stiff) = end.stage::<N>(k);
+            self.obs.offer(&q, &stiff);
+        }
+        end.eval.write(&mut self.evals[1 - self.cur]);
+        self.stats.rhs_evals += 4;
+        Some(self.after_step(model, h, k1, end.state(), 0.0))
     }
 
     /// The rest of a step of size `h` whose first stage is `k1`, whose end is `y1` (its

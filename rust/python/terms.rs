@@ -186,10 +186,15 @@ pub fn terms_from_py<'py>(
             });
             continue;
         }
-        let name = item.getattr("name").ok()?;
+        let py = item.py();
+        let name = item.getattr(pyo3::intern!(py, "name")).ok()?;
         let name = name.cast::<PyString>().ok()?.to_str().ok()?.to_string();
         // Any mapping (a Term's params are read-only): its items as (key, value) pairs.
-        let items = item.getattr("params").ok()?.call_method0("items").ok()?;
+        let items = item
+            .getattr(pyo3::intern!(py, "params"))
+            .ok()?
+            .call_method0(pyo3::intern!(py, "items"))
+            .ok()?;
         let pairs: Vec<(Bound<'py, PyAny>, Bound<'py, PyAny>)> = items
             .try_iter()
             .ok()?
