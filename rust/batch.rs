@@ -10,7 +10,6 @@
 //! batch from another thread; a cancelled batch stops after the runs in flight.
 
 use std::borrow::Cow;
-use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -20,7 +19,6 @@ use crate::bodies::AnyScene;
 use crate::error::{GranrsError, Result};
 use crate::integrate::lanes::{run_lanes, LaneIsa, LaneScene};
 use crate::integrate::{Outcome, Status, OUTCOME_FIELDS};
-use crate::simd::LANES;
 use crate::spec::{SceneSpec, Value};
 
 /// Status codes of the `status` column ([`Status::code`]).
@@ -248,10 +246,37 @@ pub enum Path {
     Scalar,
 }
 
-/// Most scenes per rayon task on the lanes' path: each task keeps its four lanes full until
-/// its scenes run out (so its last steps run with idle lanes); a small batch takes smaller
-/// tasks, about eight per thread, so that the threads share it evenly.
-pub const LANE_CHUNK: usize = 64;
+/// The rows of a batch's table, shared by the threads that fill them: each row is written
+/// by the one lane that was handed its scene (an atomic counter hands out each once).
+struct Rows {
+    ptr: *mut f64,
+    width: usize,
+    len: usize,
+}
+
+// SAFETY: the threads write disjoint rows (`Rows::row`'s contract); the table outlives them.
+unsafe impl Sync for Rows {}
+
+impl Rows {
+    fn new(data: &mut [f64], width: usize) -> Self {
+        Rows {
+            ptr: data.as_mut_ptr(),
+            width,
+            len: data.len() / width.max(1),
+        }
+    }
+
+    /// Row `j`.
+    ///
+    /// # Safety
+    /// No other reference to row `j` may be alive while the returned one is.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn row(&self, j: usize) -> &mut [f64] {
+        assert!(j < self.len, "row {j} of {}", self.len);
+        // SAFETY: in bounds (above); exclusive by the caller's contract.
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(j * self.width), self.width) }
+    }
+}
 
 /// Run every scene in `range` on the current rayon pool (call inside `pool.install`).
 /// `done` counts finished runs; setting `cancel` stops the batch after the runs in flight
@@ -279,50 +304,50 @@ pub fn run(
     };
     if path == Path::Lanes && body == "free_link" {
         let isa = LaneIsa::detect();
-        let chunk = (range.len() / (8 * rayon::current_num_threads())).clamp(LANES, LANE_CHUNK);
-        data.par_chunks_mut(width * chunk)
-            .enumerate()
-            .for_each(|(c, rows)| {
-                let first = start + c * chunk;
-                let n = rows.len() / width;
-                let rows = RefCell::new(rows);
-                let mut k = 0;
-                let next = || -> Option<LaneScene<usize>> {
-                    while k < n {
-                        let j = k;
-                        k += 1;
-                        let mut rows = rows.borrow_mut();
-                        let row = &mut rows[j * width..(j + 1) * width];
-                        if cancel.load(Ordering::Relaxed) {
-                            row[0] = STATUS_CANCELLED;
-                            continue;
-                        }
-                        match src.spec(first + j).build() {
-                            Ok(AnyScene::FreeLink(s)) => {
-                                let (q0, qd0) = s.initial_state();
-                                return Some((j, s.model(), q0, qd0, s.options));
-                            }
-                            Ok(other) => match other.run() {
-                                Ok(out) => summarize(&out, row),
-                                Err(e) => fail(first + j, row, e),
-                            },
-                            Err(e) => fail(first + j, row, e),
-                        }
-                        done.fetch_add(1, Ordering::Relaxed);
+        let n = range.len();
+        // Every thread runs its own four lanes and takes the batch's next scene whenever a
+        // lane frees: no thread waits on another's tail, and no lane idles until the batch
+        // runs out (with fixed chunks, each chunk's last steps ran with idle lanes).
+        let next_scene = AtomicUsize::new(0);
+        let rows = Rows::new(&mut data, width);
+        rayon::broadcast(|_| {
+            let next = || -> Option<LaneScene<usize>> {
+                loop {
+                    let j = next_scene.fetch_add(1, Ordering::Relaxed);
+                    if j >= n {
+                        return None;
                     }
-                    None
-                };
-                let finished = |j: usize, out: Result<Outcome>| {
-                    let mut rows = rows.borrow_mut();
-                    let row = &mut rows[j * width..(j + 1) * width];
-                    match out {
-                        Ok(out) => summarize(&out, row),
-                        Err(e) => fail(first + j, row, e),
+                    // SAFETY: `next_scene` hands each scene to one lane of one thread once.
+                    let row = unsafe { rows.row(j) };
+                    if cancel.load(Ordering::Relaxed) {
+                        row[0] = STATUS_CANCELLED;
+                        continue;
+                    }
+                    match src.spec(start + j).build() {
+                        Ok(AnyScene::FreeLink(s)) => {
+                            let (q0, qd0) = s.initial_state();
+                            return Some((j, s.model(), q0, qd0, s.options));
+                        }
+                        Ok(other) => match other.run() {
+                            Ok(out) => summarize(&out, row),
+                            Err(e) => fail(start + j, row, e),
+                        },
+                        Err(e) => fail(start + j, row, e),
                     }
                     done.fetch_add(1, Ordering::Relaxed);
-                };
-                run_lanes(isa, next, finished);
-            });
+                }
+            };
+            let finished = |j: usize, out: Result<Outcome>| {
+                // SAFETY: scene `j`'s row, written by the lane that ran it alone.
+                let row = unsafe { rows.row(j) };
+                match out {
+                    Ok(out) => summarize(&out, row),
+                    Err(e) => fail(start + j, row, e),
+                }
+                done.fetch_add(1, Ordering::Relaxed);
+            };
+            run_lanes(isa, next, finished);
+        });
     } else {
         data.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
             let i = start + k;
