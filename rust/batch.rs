@@ -11,7 +11,7 @@
 
 use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
@@ -90,8 +90,8 @@ pub enum Source {
         /// Field name and its values, per axis.
         axes: Vec<(String, Vec<Value>)>,
     },
-    /// One spec per run.
-    List(Vec<SceneSpec>),
+    /// One spec per run (shared: a `granrs.Scene` converts its spec once and keeps it).
+    List(Vec<Arc<SceneSpec>>),
 }
 
 impl Source {
@@ -111,7 +111,7 @@ impl Source {
     /// The spec of run `i`.
     pub fn spec(&self, i: usize) -> Cow<'_, SceneSpec> {
         match self {
-            Source::List(specs) => Cow::Borrowed(&specs[i]),
+            Source::List(specs) => Cow::Borrowed(specs[i].as_ref()),
             Source::Product { base, axes } => {
                 let mut spec = base.clone();
                 let mut rest = i;

@@ -79,6 +79,34 @@ def test_list_of_scenes_chain_and_leg_equal_single_runs() -> None:
     assert list(legs["knee"]) == ["locked", "free"]
 
 
+def test_a_list_of_scenes_is_converted_once_per_scene() -> None:
+    """A list sweep reads each scene's compiled form (kept on the scene, as ``simulate``
+    keeps it): the rows equal the plain dicts' through the core, sweeping the same scenes
+    again converts nothing, and a scene that does not compile is named by its run."""
+    scenes = [cases.free_link(q_deg=q, v0=v) for q, v in ((0, 2.214), (45, 2.27), (85, 0.5))]
+    scenes.append(cases.chain(1).replace(end="first_stop"))  # another body: refused
+    with pytest.raises(InvalidSceneError) as err:
+        granrs.sweep(scenes, progress=False)
+    assert err.value.field == "body"
+    scenes.pop()
+    df = granrs.sweep(scenes, progress=False)
+    plain = _granrs.sweep(scenes=[s._plain() for s in scenes], threads=1)
+    columns = list(plain["columns"])
+    for i, s in enumerate(scenes):
+        assert "_compiled_cache" in s.__dict__
+        assert df.loc[i, "depth"] == plain["data"][i][columns.index("c0.depth")]
+        assert df.loc[i, "depth"] == granrs.simulate(s).depth
+    cached = [s.__dict__["_compiled_cache"] for s in scenes]
+    again = granrs.sweep(scenes, progress=False)
+    assert all(s.__dict__["_compiled_cache"] is c for s, c in zip(scenes, cached, strict=True))
+    pd.testing.assert_frame_equal(df, again)
+    bad = scenes[0].replace(mass=-1.0)
+    with pytest.raises(InvalidParameterError) as err:
+        granrs.sweep([scenes[0], bad], progress=False)
+    assert err.value.field == "mass"
+    assert "run 1" in str(err.value)
+
+
 def test_thread_count_does_not_change_results() -> None:
     base = cases.free_link(q_deg=0, v0=2.0)
     kw = {"q_deg": np.linspace(-80, 80, 17), "v0": [0.3, 3.0]}

@@ -93,7 +93,7 @@ def leg_segments(scene: dict[str, Any]) -> list[dict[str, Any]]:
 def sweep(
     base: dict[str, Any] | None = None,
     axes: list[tuple[str, list[Any]]] | None = None,
-    scenes: list[dict[str, Any]] | None = None,
+    scenes: list[dict[str, Any] | Compiled] | None = None,
     start: int = 0,
     stop: int | None = None,
     threads: int = 0,
@@ -101,13 +101,13 @@ def sweep(
     lanes: bool = True,
 ) -> dict[str, Any]:
     """Run runs start..stop of a batch (the product of axes over base, or a list of scene
-    dicts) on `threads` threads (0: every core); return columns, data (rows x columns),
-    failures [(run, message)] and body."""
+    dicts or compiled scenes) on `threads` threads (0: every core); return columns, data
+    (rows x columns), failures [(run, message)] and body."""
 
 def validate_sweep(
     base: dict[str, Any] | None = None,
     axes: list[tuple[str, list[Any]]] | None = None,
-    scenes: list[dict[str, Any]] | None = None,
+    scenes: list[dict[str, Any] | Compiled] | None = None,
     threads: int = 0,
 ) -> int:
     """Validate every run of a batch without running it; return the number of runs."""

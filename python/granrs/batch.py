@@ -24,7 +24,13 @@ import pandas as pd
 from . import _granrs
 from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
 from .coefficients import Coefficients
-from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
+from .errors import (
+    GranrsError,
+    InvalidParameterError,
+    InvalidSceneError,
+    StepSizeWarning,
+    UnknownNameError,
+)
 from .forces import Term
 from .result import JOINT_NAMES
 from .scene import Scene
@@ -217,6 +223,17 @@ def _axis_columns(axes: dict[str, list[Any]], start: int, stop: int) -> dict[str
     return cols
 
 
+def _compiled(scenes: list[Scene]) -> list[Any]:
+    """Each scene compiled by the core (``Scene._compiled()``, kept on the scene). A scene
+    that does not compile gets its typed error from the sweep's own validation, which names
+    the run."""
+    try:
+        return [s._compiled() for s in scenes]
+    except GranrsError:
+        _granrs.validate_sweep(scenes=[s._plain() for s in scenes])
+        raise
+
+
 def _threads(threads: int | None) -> int:
     if threads is None:
         return 0
@@ -399,7 +416,10 @@ def sweep(
                     f"{type(s).__name__}",
                     field="scene",
                 )
-        kwargs = {"scenes": [s._plain() for s in scenes]}
+        # Locally, each scene's compiled form (converted once per scene and kept, as
+        # `simulate` keeps it): sweeping the same scenes again converts nothing. A Dask task
+        # is pickled, so it takes the plain values.
+        kwargs = {"scenes": _compiled(scenes) if client is None else [s._plain() for s in scenes]}
         n = len(scenes)
         keep_axes = {}
     if not isinstance(lanes, bool):

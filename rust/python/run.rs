@@ -3,7 +3,7 @@
 //! stays in Rust ([`RunOutcome`]) until Python asks for its dict, whose summaries are read
 //! from the one table of output fields.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use numpy::IntoPyArray;
 use pyo3::exceptions::PyRuntimeError;
@@ -99,17 +99,29 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     Ok(d)
 }
 
-/// A scene converted and validated once (`compile`), to run many times without parsing.
+/// A scene converted and validated once (`compile`), to run many times without parsing: its
+/// spec (what a sweep over a list of scenes reads, shared) and the scene built from it.
 #[pyclass(frozen, module = "granrs._granrs")]
 pub(super) struct Compiled {
+    pub(super) spec: Arc<SceneSpec>,
     scene: AnyScene,
+}
+
+impl Compiled {
+    /// Build `spec` (the typed error of its first bad field).
+    fn of(py: Python<'_>, spec: SceneSpec) -> PyResult<Self> {
+        let scene = spec.build().map_err(|e| to_pyerr(py, e))?;
+        Ok(Compiled {
+            spec: Arc::new(spec),
+            scene,
+        })
+    }
 }
 
 /// Convert and validate a scene dict once; `run` it as often as wanted.
 #[pyfunction]
 pub(super) fn compile(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<Compiled> {
-    let scene = scene_from_dict(scene).map_err(|e| to_pyerr(py, e))?;
-    Ok(Compiled { scene })
+    Compiled::of(py, spec_from_dict(scene))
 }
 
 /// [`compile`] for a `granrs.Scene`, from its `__dict__` and its body's field names (see
@@ -120,10 +132,7 @@ pub(super) fn compile_fields(
     fields: &Bound<'_, PyDict>,
     names: &Bound<'_, PyTuple>,
 ) -> PyResult<Compiled> {
-    let scene = spec_from_fields(fields, names)
-        .build()
-        .map_err(|e| to_pyerr(py, e))?;
-    Ok(Compiled { scene })
+    Compiled::of(py, spec_from_fields(fields, names))
 }
 
 /// The compiled scene of a `granrs.Scene` from its `__dict__` (`fields`): the one cached

@@ -2,6 +2,7 @@
 //! and Ctrl-C) and `validate_sweep`.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -10,6 +11,7 @@ use pyo3::types::PyDict;
 
 use super::convert::{spec_from_dict, value_from_py};
 use super::errors::to_pyerr;
+use super::run::Compiled;
 use crate::batch::{self, Source};
 use crate::error::GranrsError;
 use crate::spec::Value;
@@ -18,7 +20,7 @@ use crate::spec::Value;
 fn source_from_py(
     base: Option<Bound<'_, PyDict>>,
     axes: Option<Vec<(String, Bound<'_, PyAny>)>>,
-    scenes: Option<Vec<Bound<'_, PyDict>>>,
+    scenes: Option<Vec<Bound<'_, PyAny>>>,
 ) -> PyResult<Source> {
     match (base, scenes) {
         (Some(base), None) => {
@@ -35,7 +37,16 @@ fn source_from_py(
                 axes: converted,
             })
         }
-        (None, Some(scenes)) => Ok(Source::List(scenes.iter().map(spec_from_dict).collect())),
+        // A compiled scene (`Scene._compiled()`) gives its spec as it is; a dict is converted.
+        (None, Some(scenes)) => Ok(Source::List(
+            scenes
+                .iter()
+                .map(|s| match s.cast::<Compiled>() {
+                    Ok(c) => Ok(Arc::clone(&c.get().spec)),
+                    Err(_) => Ok(Arc::new(spec_from_dict(s.cast::<PyDict>()?))),
+                })
+                .collect::<PyResult<_>>()?,
+        )),
         _ => Err(PyValueError::new_err(
             "sweep() takes either base (with axes) or scenes",
         )),
@@ -50,7 +61,7 @@ pub(super) fn validate_sweep<'py>(
     py: Python<'py>,
     base: Option<Bound<'py, PyDict>>,
     axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
-    scenes: Option<Vec<Bound<'py, PyDict>>>,
+    scenes: Option<Vec<Bound<'py, PyAny>>>,
     threads: usize,
 ) -> PyResult<usize> {
     let err = |e: GranrsError| to_pyerr(py, e);
@@ -82,7 +93,7 @@ pub(super) fn sweep<'py>(
     py: Python<'py>,
     base: Option<Bound<'py, PyDict>>,
     axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
-    scenes: Option<Vec<Bound<'py, PyDict>>>,
+    scenes: Option<Vec<Bound<'py, PyAny>>>,
     start: usize,
     stop: Option<usize>,
     threads: usize,
