@@ -186,15 +186,52 @@ impl RodModes<f64> {
 }
 
 impl RodModes<F64x4> {
+    /// Every lane `x`.
+    pub fn splat(x: f64) -> Self {
+        let s = F64x4::splat(x);
+        RodModes {
+            in_contact: s,
+            sign: [s; 2],
+            cross: s,
+            stuck_x: s,
+            stuck_y: s,
+        }
+    }
+
     /// Lane by lane.
     pub fn gather(m: &[RodModes<f64>; LANES]) -> Self {
-        let g = |f: fn(&RodModes<f64>) -> f64| F64x4([f(&m[0]), f(&m[1]), f(&m[2]), f(&m[3])]);
+        let mut out = Self::splat(0.0);
+        for (i, mi) in m.iter().enumerate() {
+            out.set(i, mi);
+        }
+        out
+    }
+
+    /// Lane `i` becomes `m`.
+    #[inline]
+    pub fn set(&mut self, i: usize, m: &RodModes<f64>) {
+        self.in_contact.0[i] = m.in_contact;
+        self.sign[0].0[i] = m.sign[0];
+        self.sign[1].0[i] = m.sign[1];
+        self.cross.0[i] = m.cross;
+        self.stuck_x.0[i] = m.stuck_x;
+        self.stuck_y.0[i] = m.stuck_y;
+    }
+
+    /// Lane `i` takes lane `j`'s modes.
+    pub fn copy_lane(&mut self, i: usize, j: usize) {
+        let m = self.lane(j);
+        self.set(i, &m);
+    }
+
+    /// Lane `i`.
+    pub fn lane(&self, i: usize) -> RodModes<f64> {
         RodModes {
-            in_contact: g(|m| m.in_contact),
-            sign: [g(|m| m.sign[0]), g(|m| m.sign[1])],
-            cross: g(|m| m.cross),
-            stuck_x: g(|m| m.stuck_x),
-            stuck_y: g(|m| m.stuck_y),
+            in_contact: self.in_contact.0[i],
+            sign: [self.sign[0].0[i], self.sign[1].0[i]],
+            cross: self.cross.0[i],
+            stuck_x: self.stuck_x.0[i],
+            stuck_y: self.stuck_y.0[i],
         }
     }
 }

@@ -49,6 +49,65 @@ pub struct LaneStart<F> {
     pub h: F,
 }
 
+impl LaneStart<F64x4> {
+    /// Every lane `x`.
+    fn splat(x: f64) -> Self {
+        let s = F64x4::splat(x);
+        LaneStart {
+            q: [s; 3],
+            qd: [s; 3],
+            work: s,
+            dissipated: s,
+            qdd1: [s; 3],
+            power1: s,
+            joint_power1: s,
+            h: s,
+        }
+    }
+
+    /// Every field's lane `i`, as `f` gives it from that field.
+    #[inline(always)]
+    fn each(&mut self, mut f: impl FnMut(&mut F64x4, usize)) {
+        for k in 0..3 {
+            f(&mut self.q[k], k);
+            f(&mut self.qd[k], 3 + k);
+            f(&mut self.qdd1[k], 6 + k);
+        }
+        f(&mut self.work, 9);
+        f(&mut self.dissipated, 10);
+        f(&mut self.power1, 11);
+        f(&mut self.joint_power1, 12);
+        f(&mut self.h, 13);
+    }
+
+    /// Lane `i` becomes `s`.
+    #[inline]
+    fn set(&mut self, i: usize, s: &LaneStart<f64>) {
+        let v = [
+            s.q[0],
+            s.q[1],
+            s.q[2],
+            s.qd[0],
+            s.qd[1],
+            s.qd[2],
+            s.qdd1[0],
+            s.qdd1[1],
+            s.qdd1[2],
+            s.work,
+            s.dissipated,
+            s.power1,
+            s.joint_power1,
+            s.h,
+        ];
+        self.each(|x, k| x.0[i] = v[k]);
+    }
+
+    /// Lane `i` takes lane `j`'s values.
+    fn copy_lane(&mut self, i: usize, j: usize) {
+        self.each(|x, _| x.0[i] = x.0[j]);
+    }
+}
+
 /// What [`lane_step`] returns: the end state, its evaluation, each later stage's
 /// coordinates and evaluation (the observer is shown them), and whether every stage's
 /// pivot was clear (else the scalar path redoes the step).
@@ -292,9 +351,6 @@ pub fn covered(model: &Model<3>, options: &SolveOptions) -> bool {
     options.method == Method::Rk4 && RodParams::of(model).is_some()
 }
 
-/// One lane's step as the runs give it: start, first stage, size, modes.
-type LaneInput = (State<3>, Deriv<3>, f64, RodModes<f64>);
-
 /// A run in a lane.
 struct Slot<T> {
     tag: T,
@@ -368,8 +424,9 @@ pub fn run_lanes<T>(
         };
 
         // Gather the lanes whose mode the lanes cover; the others step alone.
-        let mut modes = [None; LANES];
-        let mut starts: [Option<(State<3>, Deriv<3>)>; LANES] = [None; LANES];
+        let mut start = LaneStart::<F64x4>::splat(0.0);
+        let mut lane_modes = RodModes::<F64x4>::splat(0.0);
+        let mut k1s: [Option<Deriv<3>>; LANES] = [None; LANES];
         for i in 0..LANES {
             if !live[i] {
                 continue;
@@ -377,11 +434,11 @@ pub fn run_lanes<T>(
             let Some(slot) = slots[i].as_mut() else {
                 continue;
             };
-            let (y, k1, m) = slot.run.start();
-            match RodModes::of(&m[0]) {
-                Some(rm) => {
-                    modes[i] = Some(rm);
-                    starts[i] = Some((*y, k1));
+            match slot.run.lane_start(h[i]) {
+                Some((s, m, k1)) => {
+                    start.set(i, &s);
+                    lane_modes.set(i, &m);
+                    k1s[i] = Some(k1);
                 }
                 None => {
                     if let Err(e) = slot.run.step(&slot.model, h[i]) {
@@ -390,64 +447,28 @@ pub fn run_lanes<T>(
                 }
             }
         }
-        let Some(first) = (0..LANES).find(|&i| modes[i].is_some()) else {
+        let Some(first) = (0..LANES).find(|&i| k1s[i].is_some()) else {
             continue;
         };
-        // An idle lane repeats the first one's step (its results are dropped).
-        let input: [LaneInput; LANES] = std::array::from_fn(|i| {
-            let j = if modes[i].is_some() { i } else { first };
-            match (starts[j], modes[j]) {
-                (Some((y, k)), Some(m)) => (y, k, h[j], m),
-                _ => unreachable!("lane {j} has a start and a mode"),
-            }
-        });
-        let lanes = |f: fn(&LaneInput) -> f64| {
-            F64x4([f(&input[0]), f(&input[1]), f(&input[2]), f(&input[3])])
-        };
-        let start = LaneStart {
-            q: [
-                lanes(|x| x.0.q[0]),
-                lanes(|x| x.0.q[1]),
-                lanes(|x| x.0.q[2]),
-            ],
-            qd: [
-                lanes(|x| x.0.qd[0]),
-                lanes(|x| x.0.qd[1]),
-                lanes(|x| x.0.qd[2]),
-            ],
-            work: lanes(|x| x.0.work),
-            dissipated: lanes(|x| x.0.dissipated),
-            qdd1: [
-                lanes(|x| x.1.qd[0]),
-                lanes(|x| x.1.qd[1]),
-                lanes(|x| x.1.qd[2]),
-            ],
-            power1: lanes(|x| x.1.work),
-            joint_power1: lanes(|x| x.1.dissipated),
-            h: lanes(|x| x.2),
-        };
-        let lane_modes = RodModes::gather(&std::array::from_fn(|i| input[i].3));
-        // Idle lanes take the first lane's parameters.
-        let end = if modes.iter().all(|m| m.is_some()) {
+        // An idle lane repeats the first one's step, with its parameters (its results are
+        // dropped).
+        let end = if k1s.iter().all(|k| k.is_some()) {
             isa.step(params, &lane_modes, &start)
         } else {
             let mut lane_params = *params;
-            for (i, m) in modes.iter().enumerate() {
-                if m.is_none() {
-                    copy_lane(&mut lane_params, i, first);
-                }
+            for i in (0..LANES).filter(|&i| k1s[i].is_none()) {
+                copy_lane(&mut lane_params, i, first);
+                start.copy_lane(i, first);
+                lane_modes.copy_lane(i, first);
             }
             isa.step(&lane_params, &lane_modes, &start)
         };
 
         for i in 0..LANES {
-            if modes[i].is_none() {
-                continue;
-            }
-            let Some(slot) = slots[i].as_mut() else {
+            let Some(k1) = k1s[i] else {
                 continue;
             };
-            let Some((_, k1)) = starts[i] else {
+            let Some(slot) = slots[i].as_mut() else {
                 continue;
             };
             let result = slot

@@ -248,34 +248,12 @@ impl<const N: usize> Run<N> {
         self.obs.record(model, t, y, e, modes);
     }
 
-    /// The state at the step's start, its derivative there (the first stage) and the modes
-    /// held through the step.
-    #[inline]
-    pub fn start(&self) -> (&State<N>, Deriv<N>, &Modes) {
-        (
-            &self.y,
-            deriv_of(&self.y, &self.evals[self.cur]),
-            &self.modes,
-        )
-    }
-
     /// Take a whole step of size `h` (from [`Run::next_step`]) on the scalar path.
     #[inline(always)]
     pub fn step(&mut self, model: &Model<N>, h: f64) -> Result<()> {
-        if let Some(p) = &self.lean {
-            if let Some(m) = RodModes::of(&self.modes[0]) {
-                let (y, k1) = (&self.y, deriv_of(&self.y, &self.evals[self.cur]));
-                let start = LaneStart {
-                    q: [y.q[0], y.q[1], y.q[2]],
-                    qd: [y.qd[0], y.qd[1], y.qd[2]],
-                    work: y.work,
-                    dissipated: y.dissipated,
-                    qdd1: [k1.qd[0], k1.qd[1], k1.qd[2]],
-                    power1: k1.work,
-                    joint_power1: k1.dissipated,
-                    h,
-                };
-                let end = lane_step(p, &m, &start);
+        if let Some(p) = self.lean {
+            if let Some((start, m, k1)) = self.lane_start(h) {
+                let end = lane_step(&p, &m, &start);
                 if let Some(done) = self.lane_step_done(model, h, &k1, &end) {
                     return done;
                 }
@@ -297,6 +275,27 @@ impl<const N: usize> Run<N> {
             sample,
         );
         self.after_step(model, h, &k1, y1, err)
+    }
+
+    /// The start of a step of size `h` in one lane ([`lane_step`]): the state and first
+    /// stage, the modes held through it, and the first stage as a [`Deriv`] (for
+    /// [`Run::lane_step_done`]); `None` when the lanes do not cover this run or its modes.
+    #[inline(always)]
+    pub fn lane_start(&self, h: f64) -> Option<(LaneStart<f64>, RodModes<f64>, Deriv<N>)> {
+        self.lean?;
+        let m = RodModes::of(&self.modes[0])?;
+        let (y, k1) = (&self.y, deriv_of(&self.y, &self.evals[self.cur]));
+        let start = LaneStart {
+            q: [y.q[0], y.q[1], y.q[2]],
+            qd: [y.qd[0], y.qd[1], y.qd[2]],
+            work: y.work,
+            dissipated: y.dissipated,
+            qdd1: [k1.qd[0], k1.qd[1], k1.qd[2]],
+            power1: k1.work,
+            joint_power1: k1.dissipated,
+            h,
+        };
+        Some((start, m, k1))
     }
 
     /// A step of size `h` whose first stage is `k1` taken in the lanes (`end`, this run's
