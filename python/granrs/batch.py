@@ -166,26 +166,29 @@ class _Table:
         start: int,
         axis_columns: dict[str, np.ndarray] | None,
     ) -> pd.DataFrame:
-        """The DataFrame: the float block as it is, the other columns (and the axis columns,
-        taken from ``axis_columns``) inserted one at a time, each dropped here once the
-        frame has its copy."""
-        frame = pd.DataFrame(self.block.T, columns=[self.names[j] for j in self.floats], copy=False)
-        for j in sorted(self.other):
-            out = self.other.pop(j)
-            name = self.names[j]
-            if name == "status":
-                frame.insert(j, name, pd.Categorical.from_codes(out, categories=list(STATUSES)))
+        """The DataFrame, made without copying a column: the axis columns (taken from
+        ``axis_columns``) first, then each float column a row of the float block (one
+        allocation for them all) and the others their own arrays, as they are."""
+        columns: dict[str, Any] = {}
+        for name in list(axis_columns or {}):
+            columns[name] = axis_columns.pop(name)  # type: ignore[union-attr]
+        rows = iter(self.block)
+        for j, name in enumerate(self.names):
+            if name in columns:
+                raise ValueError(f"a sweep's axis and its output are both named {name!r}")
+            out = self.other.pop(j, None)
+            if out is None:
+                columns[name] = next(rows)
+            elif name == "status":
+                columns[name] = pd.Categorical.from_codes(out, categories=list(STATUSES))
             else:
-                frame.insert(j, name, out)
-            del out
+                columns[name] = out
         if failures:
-            errors = np.full(len(frame), None, dtype=object)
+            errors = np.full(self.block.shape[1], None, dtype=object)
             for i, message in failures:
                 errors[i - start] = message
-            frame["error"] = errors
-        for k, name in enumerate(list(axis_columns or {})):
-            frame.insert(k, name, axis_columns.pop(name))  # type: ignore[union-attr]
-        return frame
+            columns["error"] = errors
+        return pd.DataFrame(columns, copy=False)
 
 
 def _frame(
