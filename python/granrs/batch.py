@@ -12,6 +12,7 @@ Rust batch on a worker (``pip install 'granrs[dask]'``).
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 import uuid
 import warnings
@@ -110,6 +111,12 @@ def _names(columns: Sequence[str], body: str) -> list[str]:
     return names
 
 
+@functools.cache
+def _status_dtype() -> pd.CategoricalDtype:
+    """The ``status`` column's dtype (:data:`STATUSES`), checked once, not per sweep."""
+    return pd.CategoricalDtype(list(STATUSES))
+
+
 class _Table:
     """A sweep's result columns, filled chunk by chunk from the core's tables (``rows x
     columns`` floats) and then made a DataFrame without copying them: the floats are one
@@ -180,7 +187,7 @@ class _Table:
             if out is None:
                 columns[name] = next(rows)
             elif name == "status":
-                columns[name] = pd.Categorical.from_codes(out, categories=list(STATUSES))
+                columns[name] = pd.Categorical.from_codes(out, dtype=_status_dtype())
             else:
                 columns[name] = out
         if failures:
