@@ -381,6 +381,18 @@ mod tests {
         crate::spec::free_link_spec()
     }
 
+    /// Numbers as the values of a sweep axis.
+    fn num(v: &[f64]) -> Vec<Value> {
+        v.iter().map(|&x| Value::Num(x)).collect()
+    }
+
+    /// Words as the values of a sweep axis.
+    fn word(v: &[&'static str]) -> Vec<Value> {
+        v.iter()
+            .map(|&x| Value::Str(std::borrow::Cow::Borrowed(x)))
+            .collect()
+    }
+
     fn product() -> Source {
         Source::Product {
             base: base(),
@@ -452,12 +464,6 @@ mod tests {
     /// mixed in, which run alone.
     #[test]
     fn lanes_rows_are_the_scalar_rows_bitwise() {
-        let num = |v: &[f64]| v.iter().map(|&x| Value::Num(x)).collect::<Vec<_>>();
-        let word = |v: &[&'static str]| {
-            v.iter()
-                .map(|&x| Value::Str(std::borrow::Cow::Borrowed(x)))
-                .collect::<Vec<_>>()
-        };
         let src = Source::Product {
             base: base(),
             axes: vec![
@@ -491,12 +497,6 @@ mod tests {
     #[test]
     fn lean_steps_are_the_general_path_bitwise() {
         use crate::integrate::solve::{solve, Run};
-        let num = |v: &[f64]| v.iter().map(|&x| Value::Num(x)).collect::<Vec<_>>();
-        let word = |v: &[&'static str]| {
-            v.iter()
-                .map(|&x| Value::Str(std::borrow::Cow::Borrowed(x)))
-                .collect::<Vec<_>>()
-        };
         let src = Source::Product {
             base: base(),
             axes: vec![
