@@ -98,9 +98,11 @@ pub fn solve_driven<const N: usize>(
 }
 
 /// One run between its steps: the loop's state, so that a caller can drive the steps. The
-/// sweep's lanes ([`super::lanes`]) compute the stages of one step for several runs at once
-/// and hand each run its step's end ([`Run::end_eval`], [`Run::after_step`]); everything
-/// else (the events, the observer, the step-size control) is this run's own.
+/// sweep's lanes ([`super::lanes`]) take each run's step start ([`Run::lane_start`]),
+/// compute the stages of one step for several runs at once and hand each run its step's end
+/// ([`Run::lane_step_done`]); everything else (the events, the observer, the step-size
+/// control) is this run's own. A run's lean parameters come from the model it was started
+/// with: every later call must pass that model.
 pub struct Run<const N: usize> {
     options: SolveOptions,
     stats: Stats,
@@ -323,7 +325,7 @@ impl<const N: usize> Run<N> {
     }
 
     /// The rest of a step of size `h` whose first stage is `k1`, whose end is `y1` (its
-    /// evaluation in [`Run::end_eval`]) and whose error estimate is `err` (0 for RK4):
+    /// evaluation in the end slot, `evals[1 - cur]`) and whose error estimate is `err` (0 for RK4):
     /// the step-size control, the events (located, and the step cut there), the observer.
     #[inline(always)]
     pub fn after_step(
