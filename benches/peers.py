@@ -47,8 +47,9 @@ granrs itself is timed per impact, summary only (no time series):
   ``--no-criterion``; and, in the same interleaved loop as the peers, the run alone as the
   core times it (``_granrs.run(...).run_seconds``: no Python around it).
 
-* ``granrs.sweep`` over the scenes (each ``SWEEP_COPIES`` times) on one and on two threads,
-  against ``numba_scalar`` over the same scenes in a ``prange`` on one and two threads (a
+* ``granrs.sweep`` over the scenes (each ``SWEEP_COPIES`` times, or ``--sweep-copies``) on one
+  and on two threads, against ``numba_scalar`` over the same scenes in a ``prange`` on one
+  and two threads (a
   perfectly parallel loop: the ceiling of what two cores give). The sweep is timed with its
   SIMD lanes (the default, ``lanes=True``: four scenes per lane group) and on the scalar
   path (``lanes=False``), in the same loop.
@@ -68,7 +69,7 @@ at a kink of the force law and in how the stop is located); the script fails oth
 Usage::
 
     python benches/peers.py [--quick] [--repeats N] [--out results.csv|results.md]
-        [--no-criterion] [--figure work_precision.png] [--no-figure]
+        [--no-criterion] [--figure work_precision.png] [--no-figure] [--sweep-copies N]
 """
 
 from __future__ import annotations
@@ -812,7 +813,11 @@ def per_impact(runs: list[SceneRun], name: str) -> float:
 
 
 def summarize(
-    runs: list[SceneRun], crit: dict[str, float], sweeps: dict[str, float], agreement: float
+    runs: list[SceneRun],
+    crit: dict[str, float],
+    sweeps: dict[str, float],
+    agreement: float,
+    copies: int = SWEEP_COPIES,
 ) -> list[str]:
     """The report, as lines of Markdown."""
     t = {name: per_impact(runs, name) for name in runs[0].seconds}
@@ -826,7 +831,8 @@ def summarize(
     ivp_ratios = [r.seconds["solve_ivp"] / r.seconds["granrs"] for r in ran] or [math.nan]
     lines = [
         f"granrs {granrs.__version__}, {len(runs)} Table 3.5 scenes, dt = {DT:g} s; per impact, "
-        "single thread, mean over scenes of the best time per scene.",
+        "single thread, mean over scenes of the best time per scene; a sweep runs the scenes "
+        f"{copies} times ({copies * len(runs)} runs).",
         "",
         "| method | us / impact | / granrs (modes, simulate) |",
         "|---|---:|---:|",
@@ -968,6 +974,12 @@ def main(argv: list[str] | None = None) -> int:
         help="where to write the work-precision figure (PNG)",
     )
     parser.add_argument("--no-figure", action="store_true", help="skip the work-precision runs")
+    parser.add_argument(
+        "--sweep-copies",
+        type=int,
+        default=SWEEP_COPIES,
+        help=f"copies of the scenes in one timed sweep (default {SWEEP_COPIES})",
+    )
     args = parser.parse_args(argv)
     repeats = args.repeats or (3 if args.quick else 7)
     runs = build(args.quick)
@@ -985,9 +997,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"timing ({repeats} repeats) ...", file=sys.stderr)
     time_all(runs, repeats, ivp_repeats=min(repeats, 3))
     print("timing sweeps ...", file=sys.stderr)
-    sweeps = time_sweeps(runs, SWEEP_REPEATS * repeats, SWEEP_COPIES)
+    sweeps = time_sweeps(runs, SWEEP_REPEATS * repeats, args.sweep_copies)
     crit = {} if args.no_criterion else run_criterion(args.quick)
-    lines = summarize(runs, crit, sweeps, agreement)
+    lines = summarize(runs, crit, sweeps, agreement, args.sweep_copies)
     if not args.no_figure:
         print("work-precision runs ...", file=sys.stderr)
         points = work_precision(runs, min(repeats, 3))
