@@ -441,7 +441,7 @@ pub fn run_lanes<T>(
                     k1s[i] = Some(k1);
                 }
                 None => {
-                    if let Err(e) = slot.run.step(&slot.model, h[i]) {
+                    if let Err(e) = slot.run.step_general(&slot.model, h[i]) {
                         fail(&mut slots[i], e, &mut done);
                     }
                 }
@@ -474,7 +474,7 @@ pub fn run_lanes<T>(
             let result = slot
                 .run
                 .lane_step_done(&slot.model, h[i], &k1, &end.lane(i))
-                .unwrap_or_else(|| slot.run.step(&slot.model, h[i]));
+                .unwrap_or_else(|| slot.run.step_general(&slot.model, h[i]));
             if let Err(e) = result {
                 fail(&mut slots[i], e, &mut done);
             }

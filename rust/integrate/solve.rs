@@ -261,6 +261,13 @@ impl<const N: usize> Run<N> {
                 }
             }
         }
+        self.step_general(model, h)
+    }
+
+    /// [`Run::step`] on the general path ([`super::stepper::full_step`]): a step the lean
+    /// path does not cover (two sticking rows, a sticking pivot that is not clear).
+    #[inline(always)]
+    pub fn step_general(&mut self, model: &Model<N>, h: f64) -> Result<()> {
         let (e0, e1) = start_and_end(&mut self.evals, self.cur);
         let k1 = deriv_of(&self.y, e0);
         let obs = &mut self.obs;
