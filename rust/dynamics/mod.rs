@@ -116,6 +116,18 @@ impl Default for ContactMode {
     }
 }
 
+impl ContactMode {
+    /// The mode of the static term along `axis` (0: x, `sx`; 1: y, `sy`).
+    #[inline]
+    pub fn slip_mut(&mut self, axis: usize) -> &mut Slip {
+        if axis == 0 {
+            &mut self.sx
+        } else {
+            &mut self.sy
+        }
+    }
+}
+
 /// The modes of every contact.
 pub type Modes = [ContactMode; MAX_CONTACTS];
 

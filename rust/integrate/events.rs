@@ -168,11 +168,7 @@ fn choose_slip<const N: usize>(
     stats: &mut Stats,
 ) {
     let mut trial = *modes;
-    if axis == 0 {
-        trial[ci].sx = Slip::Stick;
-    } else {
-        trial[ci].sy = Slip::Stick;
-    }
+    *trial[ci].slip_mut(axis) = Slip::Stick;
     let judge = |s: &State<N>, stats: &mut Stats| {
         let e = model.eval(&s.q, &s.qd, &trial);
         stats.rhs_evals += 1;
@@ -184,43 +180,34 @@ fn choose_slip<const N: usize>(
         }
     };
     let (mut reaction, mut bound, v) = judge(at, stats);
-    if model.mechanism.prescribed() {
+    let slip = if model.mechanism.prescribed() {
         // A body whose every coordinate is prescribed does not stick: its E passes through
         // zero velocity the way the motion takes it (read at the step's end).
         let (_, _, ahead) = judge(lookahead, stats);
-        let slip = if ahead < 0.0 || (ahead == 0.0 && v < 0.0) {
-            Slip::Neg
-        } else {
-            Slip::Pos
-        };
-        if axis == 0 {
-            modes[ci].sx = slip;
-        } else {
-            modes[ci].sy = slip;
-        }
-        return;
-    }
-    if v.abs() <= SLIP_SPEED && bound == 0.0 {
-        (reaction, bound, _) = judge(lookahead, stats);
-    }
-    let slip = if v.abs() > SLIP_SPEED {
-        if v < 0.0 {
+        if ahead < 0.0 || (ahead == 0.0 && v < 0.0) {
             Slip::Neg
         } else {
             Slip::Pos
         }
-    } else if reaction.abs() <= bound {
-        Slip::Stick
-    } else if reaction > 0.0 {
-        Slip::Neg
     } else {
-        Slip::Pos
+        if v.abs() <= SLIP_SPEED && bound == 0.0 {
+            (reaction, bound, _) = judge(lookahead, stats);
+        }
+        if v.abs() > SLIP_SPEED {
+            if v < 0.0 {
+                Slip::Neg
+            } else {
+                Slip::Pos
+            }
+        } else if reaction.abs() <= bound {
+            Slip::Stick
+        } else if reaction > 0.0 {
+            Slip::Neg
+        } else {
+            Slip::Pos
+        }
     };
-    if axis == 0 {
-        modes[ci].sx = slip;
-    } else {
-        modes[ci].sy = slip;
-    }
+    *modes[ci].slip_mut(axis) = slip;
 }
 
 /// The modes at a state where contact `ci` has just entered the sand (or starts in it).
@@ -261,8 +248,7 @@ fn enter_contact<const N: usize>(
             None
         };
         match slip {
-            Some(s) if axis == 0 => modes[ci].sx = s,
-            Some(s) => modes[ci].sy = s,
+            Some(s) => *modes[ci].slip_mut(axis) = s,
             None => choose_slip(model, modes, ci, axis, y, probe, stats),
         }
     }

@@ -195,7 +195,7 @@ impl<const N: usize> Observer<N> {
         modes: &Modes,
     ) {
         if self.recorder.t.last() != Some(&t) {
-            self.recorder.push(model, t, y, e, modes);
+            self.record(model, t, y, e, modes);
         }
     }
 
