@@ -90,8 +90,29 @@ pub enum Source {
         /// Field name and its values, per axis.
         axes: Vec<(String, Vec<Value>)>,
     },
-    /// One spec per run (shared: a `granrs.Scene` converts its spec once and keeps it).
-    List(Vec<Arc<SceneSpec>>),
+    /// One scene per run (shared: a `granrs.Scene` converts its spec once and keeps it).
+    List(Vec<Listed>),
+}
+
+/// A run of a list batch: its spec, and the scene built and validated from it where the
+/// caller has that already (a compiled `granrs.Scene`), so that the batch neither validates
+/// nor builds it again.
+#[derive(Debug, Clone)]
+pub struct Listed {
+    /// The scene's spec.
+    pub spec: Arc<SceneSpec>,
+    /// The scene built from `spec` and validated.
+    pub built: Option<Arc<AnyScene>>,
+}
+
+impl Listed {
+    /// A spec still to be built (and validated) by the batch.
+    pub fn spec(spec: SceneSpec) -> Self {
+        Listed {
+            spec: Arc::new(spec),
+            built: None,
+        }
+    }
 }
 
 impl Source {
@@ -111,7 +132,7 @@ impl Source {
     /// The spec of run `i`.
     pub fn spec(&self, i: usize) -> Cow<'_, SceneSpec> {
         match self {
-            Source::List(specs) => Cow::Borrowed(specs[i].as_ref()),
+            Source::List(runs) => Cow::Borrowed(runs[i].spec.as_ref()),
             Source::Product { base, axes } => {
                 let mut spec = base.clone();
                 let mut rest = i;
@@ -122,6 +143,17 @@ impl Source {
                 }
                 Cow::Owned(spec)
             }
+        }
+    }
+
+    /// The scene of run `i`, built and validated (or as the caller built it).
+    pub fn scene(&self, i: usize) -> Result<Cow<'_, AnyScene>> {
+        match self {
+            Source::List(runs) => match &runs[i].built {
+                Some(scene) => Ok(Cow::Borrowed(scene.as_ref())),
+                None => runs[i].spec.build().map(Cow::Owned),
+            },
+            Source::Product { .. } => self.spec(i).build().map(Cow::Owned),
         }
     }
 
@@ -138,13 +170,13 @@ impl Source {
                 }
                 body_of(base)
             }
-            Source::List(specs) => {
-                let Some(first) = specs.first() else {
+            Source::List(runs) => {
+                let Some(first) = runs.first() else {
                     return Ok("free_link".into());
                 };
-                let body = body_of(first)?;
-                for (i, s) in specs.iter().enumerate() {
-                    let b = body_of(s).map_err(|e| in_run(i, e))?;
+                let body = body_of(&first.spec)?;
+                for (i, s) in runs.iter().enumerate() {
+                    let b = body_of(&s.spec).map_err(|e| in_run(i, e))?;
                     if b != body {
                         return Err(GranrsError::InvalidScene {
                             field: "body".into(),
@@ -198,15 +230,40 @@ pub fn in_run(i: usize, e: GranrsError) -> GranrsError {
     }
 }
 
-/// A rayon pool of `threads` threads (0: one per core).
-pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
+/// The rayon pool of `threads` threads (0: one per core), started on first use and kept
+/// for the process, one per thread count: a sweep neither starts nor stops threads.
+///
+/// Each pool carries the id of the process that started it. A forked child (multiprocessing's
+/// fork, a forking Dask worker) inherits the list but not the pools' threads, so it starts
+/// its own and forgets the parent's: never drops them, as dropping would wake threads that
+/// do not exist in the child.
+pub fn pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
+    type Kept = Vec<(usize, u32, Arc<rayon::ThreadPool>)>;
+    static POOLS: Mutex<Kept> = Mutex::new(Vec::new());
+    let pid = std::process::id();
+    let mut pools = POOLS.lock().unwrap_or_else(|p| p.into_inner());
+    if pools.iter().any(|(_, owner, _)| *owner != pid) {
+        for (n, owner, inherited) in std::mem::take(&mut *pools) {
+            if owner == pid {
+                pools.push((n, owner, inherited));
+            } else {
+                std::mem::forget(inherited);
+            }
+        }
+    }
+    if let Some((_, _, kept)) = pools.iter().find(|(n, _, _)| *n == threads) {
+        return Ok(Arc::clone(kept));
+    }
+    let started = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| GranrsError::InvalidScene {
             field: "threads".into(),
             message: format!("cannot start a thread pool: {e}"),
-        })
+        })?;
+    let started = Arc::new(started);
+    pools.push((threads, pid, Arc::clone(&started)));
+    Ok(started)
 }
 
 /// Build and validate every run in `range` (in parallel); the error of the first bad run,
@@ -214,7 +271,7 @@ pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 pub fn validate(src: &Source, range: std::ops::Range<usize>) -> Result<()> {
     let first = range
         .into_par_iter()
-        .filter_map(|i| src.spec(i).build().err().map(|e| (i, e)))
+        .filter_map(|i| src.scene(i).err().map(|e| (i, e)))
         .min_by_key(|(i, _)| *i);
     match first {
         None => Ok(()),
@@ -323,7 +380,7 @@ pub fn run(
                         row[0] = STATUS_CANCELLED;
                         continue;
                     }
-                    match src.spec(start + j).build() {
+                    match src.scene(start + j).as_deref() {
                         Ok(AnyScene::FreeLink(s)) => {
                             let (q0, qd0) = s.initial_state();
                             return Some((j, s.model(), q0, qd0, s.options));
@@ -332,7 +389,7 @@ pub fn run(
                             Ok(out) => summarize(&out, row),
                             Err(e) => fail(start + j, row, e),
                         },
-                        Err(e) => fail(start + j, row, e),
+                        Err(e) => fail(start + j, row, e.clone()),
                     }
                     done.fetch_add(1, Ordering::Relaxed);
                 }
@@ -355,7 +412,7 @@ pub fn run(
                 row[0] = STATUS_CANCELLED;
                 return;
             }
-            match src.spec(i).build().and_then(|s| s.run()) {
+            match src.scene(i).and_then(|s| s.run()) {
                 Ok(out) => summarize(&out, row),
                 Err(e) => fail(i, row, e),
             }

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import multiprocessing
 import os
 import signal
 import threading
@@ -113,6 +114,46 @@ def test_thread_count_does_not_change_results() -> None:
     one = granrs.sweep(base, threads=1, **kw)
     two = granrs.sweep(base, threads=2, **kw)
     pd.testing.assert_frame_equal(one, two)
+
+
+def _depths_in_a_child(queue: multiprocessing.Queue) -> None:  # type: ignore[type-arg]
+    df = granrs.sweep(cases.free_link(q_deg=0, v0=2.0), threads=2, progress=False, **POOL_AXES)
+    queue.put(df["depth"].tolist())
+
+
+POOL_AXES = {"q_deg": np.linspace(-60, 60, 9), "v0": [0.5, 2.5]}
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="fork")
+def test_the_kept_thread_pools_serve_concurrent_sweeps_and_a_forked_child() -> None:
+    """A sweep runs on a pool kept for the process (one per thread count): sweeps from
+    several Python threads at once share it and each gets the frame of a sweep alone, and a
+    forked child, which inherits the pools but not their threads, starts its own."""
+    base = cases.free_link(q_deg=0, v0=2.0)
+    reference = granrs.sweep(base, threads=1, progress=False, **POOL_AXES)
+    frames: list[pd.DataFrame | None] = [None] * 6
+
+    def work(k: int) -> None:
+        frames[k] = granrs.sweep(base, threads=2, progress=False, **POOL_AXES)
+
+    workers = [threading.Thread(target=work, args=(k,)) for k in range(len(frames))]
+    for w in workers:
+        w.start()
+    for w in workers:
+        w.join(60)
+    for frame in frames:
+        assert frame is not None
+        pd.testing.assert_frame_equal(frame, reference)
+    fork = multiprocessing.get_context("fork")
+    queue = fork.Queue()
+    child = fork.Process(target=_depths_in_a_child, args=(queue,))
+    child.start()
+    child.join(60)
+    if child.is_alive():
+        child.kill()
+        pytest.fail("a forked child's sweep did not finish within 60 s")
+    assert child.exitcode == 0
+    assert queue.get(timeout=5) == reference["depth"].tolist()
 
 
 def test_forces_axis() -> None:

@@ -117,55 +117,86 @@ def _status_dtype() -> pd.CategoricalDtype:
     return pd.CategoricalDtype(list(STATUSES))
 
 
+class _Layout:
+    """Where each of a core table's columns goes in a sweep's result, made once per body and
+    column list (:func:`_layout`): the DataFrame's names (:func:`_names`) and, by kind, the
+    core's column indices. Floats, counters and flags each fill one block (columns x rows),
+    whose rows become the frame's columns; ``status`` is its own array."""
+
+    def __init__(self, columns: tuple[str, ...], body: str) -> None:
+        self.names = tuple(_names(columns, body))
+        kinds = [_kind(c) for c in self.names]
+        self.status = kinds.index("status") if "status" in kinds else None
+        self.index = {
+            kind: np.array([j for j, k in enumerate(kinds) if k == kind], dtype=np.intp)
+            for kind in ("float", "int", "bool")
+        }
+        # Each name's block and row within it, in column order.
+        rank = dict.fromkeys(self.index, 0)
+        self.places: list[tuple[str, int]] = []
+        for k in kinds:
+            if k == "status":
+                self.places.append((k, 0))
+            else:
+                self.places.append((k, rank[k]))
+                rank[k] += 1
+        self.rows_of = {name: place for name, place in zip(self.names, self.places, strict=True)}
+
+
+@functools.lru_cache(maxsize=32)
+def _layout(columns: tuple[str, ...], body: str) -> _Layout:
+    return _Layout(columns, body)
+
+
+def _kind(name: str) -> str:
+    if name == "status":
+        return "status"
+    if name.endswith("stopped"):
+        return "bool"
+    if name in _INT_COLUMNS:
+        return "int"
+    return "float"
+
+
+#: The dtype of each kind's block.
+_DTYPES = {"float": np.float64, "int": np.int32, "bool": np.bool_}
+
+
 class _Table:
     """A sweep's result columns, filled chunk by chunk from the core's tables (``rows x
     columns`` floats) and then made a DataFrame without copying them: the floats are one
-    ``columns x rows`` block (the frame's own), the others one array each. The counters
-    are int32 (a run's stay far below 2^31; a column that does not fits is widened to
-    int64). So a sweep holds its result plus one chunk (issue 22: a summary-only sweep of
-    1e6 runs under 300 MB)."""
+    ``columns x rows`` block (the frame's own), the counters and the flags one block each,
+    ``status`` its own array. The counters are int32 (a run's stay far below 2^31; a block
+    that does not fit is widened to int64). So a sweep holds its result plus one chunk
+    (issue 22: a summary-only sweep of 1e6 runs under 300 MB)."""
 
     def __init__(self, columns: Sequence[str], body: str, n: int) -> None:
-        self.names = _names(columns, body)
-        self.floats = [j for j, c in enumerate(self.names) if self._kind(c) == "float"]
-        self.block = np.empty((len(self.floats), n))
-        self.other: dict[int, np.ndarray] = {}
-        for j, c in enumerate(self.names):
-            kind = self._kind(c)
-            if kind == "status":
-                self.other[j] = np.empty(n, dtype=np.int8)
-            elif kind == "bool":
-                self.other[j] = np.empty(n, dtype=bool)
-            elif kind == "int":
-                self.other[j] = np.empty(n, dtype=np.int32)
-
-    @staticmethod
-    def _kind(name: str) -> str:
-        if name == "status":
-            return "status"
-        if name.endswith("stopped"):
-            return "bool"
-        if name in _INT_COLUMNS:
-            return "int"
-        return "float"
+        self.layout = _layout(tuple(columns), body)
+        self.blocks = {
+            kind: np.empty((len(idx), n), dtype=_DTYPES[kind])
+            for kind, idx in self.layout.index.items()
+        }
+        self.status = np.empty(n, dtype=np.int8)
+        self.n = n
 
     def put(self, data: np.ndarray, offset: int) -> None:
-        """Rows ``offset .. offset + len(data)`` from a core table."""
+        """Rows ``offset .. offset + len(data)`` from a core table: one operation per kind."""
         rows = slice(offset, offset + len(data))
-        for k, j in enumerate(self.floats):
-            self.block[k, rows] = data[:, j]
-        for j, out in self.other.items():
-            col = data[:, j]
-            kind = self._kind(self.names[j])
-            if kind == "status":
-                out[rows] = np.nan_to_num(col, nan=3)
-            elif kind == "bool":
-                out[rows] = col == 1.0
-            else:
-                ints = np.nan_to_num(col, nan=0)
-                if out.dtype == np.int32 and len(ints) and ints.max() > np.iinfo(np.int32).max:
-                    out = self.other[j] = out.astype(np.int64)
-                out[rows] = ints
+        index = self.layout.index
+        self.blocks["float"][:, rows] = data[:, index["float"]].T
+        self.blocks["bool"][:, rows] = data[:, index["bool"]].T == 1.0
+        ints = np.nan_to_num(data[:, index["int"]].T, nan=0.0)
+        block = self.blocks["int"]
+        if block.dtype == np.int32 and ints.size and ints.max() > np.iinfo(np.int32).max:
+            block = self.blocks["int"] = block.astype(np.int64)
+        block[:, rows] = ints
+        if self.layout.status is not None:
+            self.status[rows] = np.nan_to_num(data[:, self.layout.status], nan=3)
+
+    def column(self, name: str) -> np.ndarray:
+        """The column ``name`` (the frame's name), a view of its block."""
+        kind, row = self.layout.rows_of[name]
+        return self.status if kind == "status" else self.blocks[kind][row]
 
     def frame(
         self,
@@ -174,41 +205,34 @@ class _Table:
         axis_columns: dict[str, np.ndarray] | None,
     ) -> pd.DataFrame:
         """The DataFrame, made without copying a column: the axis columns (taken from
-        ``axis_columns``) first, then each float column a row of the float block (one
-        allocation for them all) and the others their own arrays, as they are."""
+        ``axis_columns``) first, then each column a row of its block (``status`` a
+        categorical over its codes)."""
         columns: dict[str, Any] = {}
         for name in list(axis_columns or {}):
             columns[name] = axis_columns.pop(name)  # type: ignore[union-attr]
-        rows = iter(self.block)
-        for j, name in enumerate(self.names):
+        for name, (kind, row) in zip(self.layout.names, self.layout.places, strict=True):
             if name in columns:
                 raise ValueError(f"a sweep's axis and its output are both named {name!r}")
-            out = self.other.pop(j, None)
-            if out is None:
-                columns[name] = next(rows)
-            elif name == "status":
-                columns[name] = pd.Categorical.from_codes(out, dtype=_status_dtype())
+            if kind == "status":
+                columns[name] = pd.Categorical.from_codes(self.status, dtype=_status_dtype())
             else:
-                columns[name] = out
+                columns[name] = self.blocks[kind][row]
         if failures:
-            errors = np.full(self.block.shape[1], None, dtype=object)
+            errors = np.full(self.n, None, dtype=object)
             for i, message in failures:
                 errors[i - start] = message
             columns["error"] = errors
         return pd.DataFrame(columns, copy=False)
 
 
-def _frame(
-    raw: dict[str, Any], body: str, axis_columns: dict[str, np.ndarray] | None
-) -> pd.DataFrame:
-    """The DataFrame of one core table (a local sweep fills its :class:`_Table` by chunks)."""
+def _table(raw: dict[str, Any]) -> _Table:
+    """The :class:`_Table` of a sweep's raw result (a local sweep fills its own by chunks)."""
     table = raw.pop("table", None)
     if table is None:
         data = np.asarray(raw.pop("data"))
-        table = _Table(raw["columns"], body, len(data))
+        table = _Table(raw["columns"], raw["body"], len(data))
         table.put(data, 0)
-        del data
-    return table.frame(raw["failures"], raw["start"], axis_columns)
+    return table
 
 
 def _axis_columns(axes: dict[str, list[Any]], start: int, stop: int) -> dict[str, np.ndarray]:
@@ -451,24 +475,25 @@ def sweep(
     else:
         axis_columns = _axis_columns(keep_axes, 0, n) if keep_axes else None
         raw = _run_local(kwargs, 0, n, n_threads, progress)
-    frame = _frame(raw, raw["body"], axis_columns)
-    del raw, axis_columns
-    _warn_unresolved(frame)
+    table = _table(raw)
+    _warn_unresolved(table)
+    frame = table.frame(raw["failures"], raw["start"], axis_columns)
+    del raw, axis_columns, table
     return frame
 
 
-def _warn_unresolved(frame: pd.DataFrame) -> None:
+def _warn_unresolved(table: _Table) -> None:
     """One :class:`~granrs.errors.StepSizeWarning` for the runs whose step did not resolve
     their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, or steps the sign
     modes chattered through, ``unresolved`` > 0, with a rise in energy: see
     :func:`granrs.api.energy_rose`)."""
-    if "h_lambda" not in frame.columns:
+    if "h_lambda" not in table.layout.rows_of:
         return
-    h_lambda = frame["h_lambda"].to_numpy()
+    h_lambda = table.column("h_lambda")
     # The energy test only where a step was unresolved (few rows: no full-length temporaries).
-    maybe = np.flatnonzero(frame["unresolved"].to_numpy() > 0)
-    start = frame["energy_start"].to_numpy()[maybe]
-    end = frame["energy_end"].to_numpy()[maybe]
+    maybe = np.flatnonzero(table.column("unresolved") > 0)
+    start = table.column("energy_start")[maybe]
+    end = table.column("energy_end")[maybe]
     with np.errstate(invalid="ignore"):
         rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
     flagged = np.flatnonzero(h_lambda > RK4_STABILITY_LIMIT)
@@ -477,7 +502,7 @@ def _warn_unresolved(frame: pd.DataFrame) -> None:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
         warnings.warn(
             StepSizeWarning(
-                f"{bad.size} of {len(frame)} runs (rows {rows}) did not resolve their contact "
+                f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
                 f"(h_lambda above {RK4_STABILITY_LIMIT}, or 'unresolved' steps where the sign "
                 f"modes chattered and the energy rose); the largest h_lambda is "
                 f"{np.nanmax(h_lambda[bad]):.3g}. "

@@ -104,7 +104,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
 #[pyclass(frozen, module = "granrs._granrs")]
 pub(super) struct Compiled {
     pub(super) spec: Arc<SceneSpec>,
-    scene: AnyScene,
+    pub(super) scene: Arc<AnyScene>,
 }
 
 impl Compiled {
@@ -113,7 +113,7 @@ impl Compiled {
         let scene = spec.build().map_err(|e| to_pyerr(py, e))?;
         Ok(Compiled {
             spec: Arc::new(spec),
-            scene,
+            scene: Arc::new(scene),
         })
     }
 }

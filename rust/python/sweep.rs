@@ -12,7 +12,7 @@ use pyo3::types::PyDict;
 use super::convert::{spec_from_dict, value_from_py};
 use super::errors::to_pyerr;
 use super::run::Compiled;
-use crate::batch::{self, Source};
+use crate::batch::{self, Listed, Source};
 use crate::error::GranrsError;
 use crate::spec::Value;
 
@@ -37,13 +37,17 @@ fn source_from_py(
                 axes: converted,
             })
         }
-        // A compiled scene (`Scene._compiled()`) gives its spec as it is; a dict is converted.
+        // A compiled scene (`Scene._compiled()`) gives its spec and the scene built from it,
+        // as they are; a dict is converted, and the batch builds it.
         (None, Some(scenes)) => Ok(Source::List(
             scenes
                 .iter()
                 .map(|s| match s.cast::<Compiled>() {
-                    Ok(c) => Ok(Arc::clone(&c.get().spec)),
-                    Err(_) => Ok(Arc::new(spec_from_dict(s.cast::<PyDict>()?))),
+                    Ok(c) => Ok(Listed {
+                        spec: Arc::clone(&c.get().spec),
+                        built: Some(Arc::clone(&c.get().scene)),
+                    }),
+                    Err(_) => Ok(Listed::spec(spec_from_dict(s.cast::<PyDict>()?))),
                 })
                 .collect::<PyResult<_>>()?,
         )),
@@ -67,8 +71,8 @@ pub(super) fn validate_sweep<'py>(
     let err = |e: GranrsError| to_pyerr(py, e);
     let src = source_from_py(base, axes, scenes)?;
     src.body().map_err(err)?;
-    let pool = batch::pool(threads).map_err(err)?;
     let n = src.len();
+    let pool = batch::pool(threads).map_err(err)?;
     py.detach(|| pool.install(|| batch::validate(&src, 0..n)))
         .map_err(err)?;
     Ok(n)
@@ -112,18 +116,23 @@ pub(super) fn sweep<'py>(
     let range = start.min(stop)..stop;
     let body = src.body().map_err(err)?;
     let pool = batch::pool(threads).map_err(err)?;
-    py.detach(|| pool.install(|| batch::validate(&src, range.clone())))
-        .map_err(err)?;
     let done = AtomicUsize::new(0);
     let cancel = AtomicBool::new(false);
     let finished = AtomicBool::new(false);
     let caller = std::thread::current();
-    let (out, interrupted) = std::thread::scope(|s| {
-        let worker = s.spawn(|| {
-            let out = pool.install(|| batch::run(&src, range.clone(), &body, &done, &cancel, path));
+    let mut out = None;
+    // One job on the kept pool validates every run, then runs them; this thread meanwhile
+    // reports progress and watches for Ctrl-C, and waits with the GIL released.
+    let interrupted = pool.in_place_scope(|scope| {
+        scope.spawn(|_| {
+            // A panic is caught here, so that `finished` is always set.
+            out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                batch::validate(&src, range.clone())
+                    .map(|()| batch::run(&src, range.clone(), &body, &done, &cancel, path))
+            }))
+            .ok();
             finished.store(true, Ordering::Release);
             caller.unpark();
-            out
         });
         let mut interrupted: Option<PyErr> = None;
         let mut reported = usize::MAX;
@@ -152,13 +161,20 @@ pub(super) fn sweep<'py>(
                 break;
             }
         }
-        let out = py.detach(|| worker.join());
-        (out, interrupted)
+        // A cancelled batch ends after the runs in flight: wait for them without the GIL.
+        py.detach(|| {
+            while !finished.load(Ordering::Acquire) {
+                std::thread::park_timeout(std::time::Duration::from_millis(10));
+            }
+        });
+        interrupted
     });
     if let Some(e) = interrupted {
         return Err(e);
     }
-    let out = out.map_err(|_| PyRuntimeError::new_err("a sweep worker panicked"))?;
+    let out = out
+        .ok_or_else(|| PyRuntimeError::new_err("a sweep worker panicked"))?
+        .map_err(err)?;
     let rows = range.len();
     let width = out.columns.len();
     let d = PyDict::new(py);
