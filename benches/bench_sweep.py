@@ -19,6 +19,10 @@ Parts:
   summary only. Both must be measurably faster than the full scene with full recording.
 * ``force``: ``granrs.resistance_force`` on a million states against the same equations in
   numpy.
+* ``fixed``: a sweep's fixed cost: a one-scene sweep on 1 and 2 threads, timed whole and as
+  the core's call alone (``_granrs.sweep``: the pool's hand-off and the run, no DataFrame),
+  against the run alone as the core times it, in the same loop. No target; it is what a
+  small sweep pays beyond its runs (issue 22's two-thread line at 155 runs).
 
 Build in release first: ``maturin develop --release``.
 """
@@ -40,10 +44,10 @@ from collections.abc import Callable
 import numpy as np
 
 import granrs
-from granrs import cases
+from granrs import _granrs, cases
 from granrs.forces import select, thesis
 
-PARTS = ("sweep", "overhead", "prune", "force")
+PARTS = ("sweep", "overhead", "prune", "force", "fixed")
 
 
 def _median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -177,6 +181,45 @@ def part_overhead(repeat: int) -> list[str]:
     return lines
 
 
+# ---------------------------------------------------------------------------------- fixed
+def part_fixed(repeat: int) -> list[str]:
+    """A one-scene sweep timed whole and as the core's call, against the run alone, each
+    the best of ``300 * repeat`` tries taken in turn."""
+    scene = cases.free_link(q_deg=45.0, v0=2.27)
+    compiled = [scene._compiled()]
+    todo: dict[str, Callable[[], object]] = {"run": lambda: None}
+    for threads in (1, 2):
+        todo[f"sweep {threads}"] = lambda t=threads: granrs.sweep(
+            [scene], threads=t, progress=False
+        )
+        todo[f"core {threads}"] = lambda t=threads: _granrs.sweep(scenes=compiled, threads=t)
+    best = dict.fromkeys(todo, math.inf)
+    for _ in range(300 * repeat):
+        for name, fn in todo.items():
+            if name == "run":
+                best[name] = min(best[name], _granrs.run(compiled[0]).run_seconds)
+                continue
+            t0 = time.perf_counter()
+            fn()
+            best[name] = min(best[name], time.perf_counter() - t0)
+    run = best["run"]
+    lines = ["### A sweep's fixed cost (one scene: free link q = 45, v0 = 2.27)", ""]
+    lines += [
+        f"The run alone, as the core times it: {run * 1e6:.1f} us (best of {300 * repeat}).",
+        "",
+        "| threads | sweep() [us] | the core's call [us] | fixed cost of sweep() [us] "
+        "| of which the DataFrame and checks [us] | fixed cost / the run |",
+        "|---|---|---|---|---|---|",
+    ]
+    for threads in (1, 2):
+        whole, core = best[f"sweep {threads}"], best[f"core {threads}"]
+        lines.append(
+            f"| {threads} | {whole * 1e6:.0f} | {core * 1e6:.0f} | {(whole - run) * 1e6:.0f} "
+            f"| {(whole - core) * 1e6:.0f} | {(whole - run) / run:.1f} |"
+        )
+    return [*lines, ""]
+
+
 # ---------------------------------------------------------------------------------- prune
 def part_prune(repeat: int) -> list[str]:
     base = cases.free_link(q_deg=0.0, v0=2.214)
@@ -277,6 +320,8 @@ def main(argv: list[str] | None = None) -> int:
             lines += part_overhead(repeat)
         elif part == "prune":
             lines += part_prune(repeat)
+        elif part == "fixed":
+            lines += part_fixed(repeat)
         else:
             lines += part_force(repeat)
     print("\n".join(lines), flush=True)

@@ -450,6 +450,17 @@ pub fn run_lanes<T>(
         let Some(first) = (0..LANES).find(|&i| k1s[i].is_some()) else {
             continue;
         };
+        // One run left in the lanes (a batch's tail, a one-scene sweep): its step on the
+        // scalar path, the same arithmetic in one lane, without the idle lanes' `pow` and
+        // `sin_cos` (libm's, called lane by lane).
+        if k1s.iter().filter(|k| k.is_some()).count() == 1 {
+            if let Some(slot) = slots[first].as_mut() {
+                if let Err(e) = slot.run.step(&slot.model, h[first]) {
+                    fail(&mut slots[first], e, &mut done);
+                }
+            }
+            continue;
+        }
         // An idle lane repeats the first one's step, with its parameters (its results are
         // dropped).
         let end = if k1s.iter().all(|k| k.is_some()) {

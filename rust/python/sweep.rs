@@ -16,6 +16,11 @@ use crate::batch::{self, Listed, Source};
 use crate::error::GranrsError;
 use crate::spec::Value;
 
+/// How long a sweep's calling thread waits for the batch by yielding its core before it
+/// sleeps between progress reports (a one-scene sweep's core call 200 -> 185-200 us, and
+/// no slower a 155-run sweep on two threads: `benches/bench_sweep.py --part fixed`).
+const YIELD_WAIT: std::time::Duration = std::time::Duration::from_micros(200);
+
 /// The batch a `sweep` call describes.
 fn source_from_py(
     base: Option<Bound<'_, PyDict>>,
@@ -136,6 +141,14 @@ pub(super) fn sweep<'py>(
         });
         let mut interrupted: Option<PyErr> = None;
         let mut reported = usize::MAX;
+        // A small sweep is over within a fraction of a millisecond: wait for it yielding the
+        // core rather than asleep, whose wake-up added its latency to every small sweep.
+        py.detach(|| {
+            let t0 = std::time::Instant::now();
+            while !finished.load(Ordering::Acquire) && t0.elapsed() < YIELD_WAIT {
+                std::thread::yield_now();
+            }
+        });
         loop {
             py.detach(|| {
                 if !finished.load(Ordering::Acquire) {
