@@ -397,7 +397,7 @@ impl<const N: usize> Model<N> {
 
     /// Whether any sticking component is in force under `modes`.
     #[inline]
-    pub(super) fn any_stuck(&self, modes: &Modes) -> bool {
+    pub(crate) fn any_stuck(&self, modes: &Modes) -> bool {
         self.sign_model == SignModel::Modes
             && modes[..self.contacts.len()].iter().any(|m| self.stuck(m))
     }

@@ -9,7 +9,9 @@ use super::outcome::Stats;
 use super::solve::EndCondition;
 use super::stepper::{deriv_of, step, Deriv, Hermite, State};
 use crate::body::{SoleContact, SoleModel};
-use crate::dynamics::{ContactMode, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS};
+use crate::dynamics::{
+    ContactEval, ContactMode, Eval, Model, Modes, Shape, SignModel, Slip, MAX_CONTACTS,
+};
 use crate::forces::Switch;
 
 /// Relative tolerance of event location, in units of the step.
@@ -37,32 +39,94 @@ enum Kind {
     Corner(u8),
 }
 
+/// What the switching functions read of a contact's evaluation: a [`ContactEval`], or a
+/// lane of the sweep's lanes ([`super::lanes::LaneContact`]), so that both are judged by
+/// one definition ([`switching_of`]).
+pub(super) trait SwitchInputs {
+    /// The contact's lowest point's height [m].
+    fn lowest(&self) -> f64;
+    /// v_E.
+    fn v_centroid(&self) -> [f64; 2];
+    /// The static terms' bounds.
+    fn bound(&self) -> [f64; 2];
+    /// The static force.
+    fn statics(&self) -> [f64; 2];
+    /// The tip's vertical velocity.
+    fn v_tip_y(&self) -> f64;
+    /// e x v_E.
+    fn cross(&self) -> f64;
+    /// The full-immersion margin.
+    fn immersion_margin(&self) -> f64;
+    /// Corner `k`'s height (a box).
+    fn corner_y(&self, k: usize) -> f64;
+}
+
+impl SwitchInputs for ContactEval {
+    #[inline(always)]
+    fn lowest(&self) -> f64 {
+        self.lowest
+    }
+    #[inline(always)]
+    fn v_centroid(&self) -> [f64; 2] {
+        [self.v_centroid.x, self.v_centroid.y]
+    }
+    #[inline(always)]
+    fn bound(&self) -> [f64; 2] {
+        self.bound
+    }
+    #[inline(always)]
+    fn statics(&self) -> [f64; 2] {
+        [self.force.statics.x, self.force.statics.y]
+    }
+    #[inline(always)]
+    fn v_tip_y(&self) -> f64 {
+        self.v_tip.y
+    }
+    #[inline(always)]
+    fn cross(&self) -> f64 {
+        self.cross
+    }
+    #[inline(always)]
+    fn immersion_margin(&self) -> f64 {
+        self.immersion_margin
+    }
+    #[inline(always)]
+    fn corner_y(&self, k: usize) -> f64 {
+        self.corners_y[k]
+    }
+}
+
 /// The value of a switching function: non-negative while the mode holds; the event is
 /// where it turns negative (the stop: where -v_Ty reaches zero).
 #[inline]
 fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) -> f64 {
-    let c = &e.contacts[ci];
+    switching_of(kind, &e.contacts[ci], &modes[ci])
+}
+
+/// [`switching`] of a contact `c` in mode `m`.
+#[inline(always)]
+fn switching_of(kind: Kind, c: &impl SwitchInputs, m: &ContactMode) -> f64 {
     match kind {
-        Kind::Entry => c.lowest,
-        Kind::Exit => -c.lowest,
-        Kind::SlipX => modes[ci].sx.sign() * c.v_centroid.x,
-        Kind::SlipY => modes[ci].sy.sign() * c.v_centroid.y,
-        Kind::StickX => c.bound[0] - c.force.statics.x.abs(),
-        Kind::StickY => c.bound[1] - c.force.statics.y.abs(),
-        Kind::Stop => -c.v_tip.y,
-        Kind::Cross => modes[ci].cross.sign() * c.cross,
+        Kind::Entry => c.lowest(),
+        Kind::Exit => -c.lowest(),
+        Kind::SlipX => m.sx.sign() * c.v_centroid()[0],
+        Kind::SlipY => m.sy.sign() * c.v_centroid()[1],
+        Kind::StickX => c.bound()[0] - c.statics()[0].abs(),
+        Kind::StickY => c.bound()[1] - c.statics()[1].abs(),
+        Kind::Stop => -c.v_tip_y(),
+        Kind::Cross => m.cross.sign() * c.cross(),
         Kind::Immersion => {
-            if modes[ci].full {
-                -c.immersion_margin
+            if m.full {
+                -c.immersion_margin()
             } else {
-                c.immersion_margin
+                c.immersion_margin()
             }
         }
         Kind::Corner(k) => {
-            if modes[ci].corners & (1 << k) != 0 {
-                -c.corners_y[k as usize]
+            if m.corners & (1 << k) != 0 {
+                -c.corner_y(k as usize)
             } else {
-                c.corners_y[k as usize]
+                c.corner_y(k as usize)
             }
         }
     }
@@ -352,6 +416,22 @@ impl Events {
             in_step: 0,
             hits: Vec::new(),
         }
+    }
+
+    /// Whether a step that ends at `end` (the evaluation of a body's only contact) crosses
+    /// none of the switching functions active under `modes`: [`Events::detect`]'s finding
+    /// where it locates nothing. False, to be left to [`Events::detect`], also where that
+    /// would do more: the functions not yet listed for `modes`, or the step past
+    /// [`MAX_EVENTS_PER_STEP`] events.
+    #[inline]
+    pub(super) fn plain(&self, modes: &Modes, end: &impl SwitchInputs) -> bool {
+        debug_assert!(!self.listed || self.listed_for == Some(*modes));
+        self.listed
+            && self.in_step < MAX_EVENTS_PER_STEP
+            && self
+                .funcs
+                .iter()
+                .all(|&(kind, ci)| ci == 0 && !crossed(kind, switching_of(kind, end, &modes[0])))
     }
 
     /// The run moves on to the next grid step.

@@ -4,13 +4,18 @@
 //! first stage, the step size, the held modes and the scene's parameters are each one
 //! `F64x4` (`RodParams<F64x4>`, `RodModes<F64x4>`), so one instruction advances the same
 //! quantity of four scenes. A step's four RK4 stages and its end evaluation run in the lanes
-//! ([`lane_step`], through `dynamics::rod_lanes`); everything else of the step is each run's
-//! own, on the scalar path ([`Run::after_step`]): the events are detected at the step's end,
-//! and a lane whose step meets one (an entry, a switch, the end of a stick, the stop) has it
-//! located, the step cut there and the modes changed by the same code as a lone run. A lane
-//! whose step the lanes do not cover (a mode that sticks in x and in y, a zero pivot) takes
-//! that step on the scalar path. A lane whose run ends takes the next scene at once, so
-//! lanes ending at different times never wait for each other.
+//! ([`lane_step`], through `dynamics::rod_lanes`). A step that meets nothing is accepted
+//! there ([`Run::accept_plain`]: every pivot clear, the end finite, no switching function
+//! crossed, judged by the events' own functions on the lane's values): the observer is
+//! shown its stages and end, and the run's next step starts from its lane, with no round trip
+//! through the run's scalar state. Any other step is the run's own, on the scalar path
+//! ([`Run::after_step`]): a lane whose step meets an event (an entry, a switch, the end of a
+//! stick, the stop) has it located, the step cut there and the modes changed by the same
+//! code as a lone run. A lane whose step the lanes do not cover (a mode that sticks in x and
+//! in y, a zero pivot) takes that step on the scalar path, and so does a run that sticks,
+//! records series or has a drive ahead at every step (its accepted step needs more than the
+//! lanes keep). A lane whose run ends takes the next scene at once, so lanes ending at
+//! different times never wait for each other.
 //!
 //! The lanes compute each operation of the scalar path in its order (`F64x4` is four
 //! IEEE f64 operations, with libm's `sin_cos` and `pow` per lane), so a run's outcome is the
@@ -18,6 +23,7 @@
 
 use nalgebra::{SVector, Vector2};
 
+use super::events::SwitchInputs;
 use super::outcome::Outcome;
 use super::solve::{solve, Run, SolveOptions};
 use super::stepper::{Deriv, Method, State};
@@ -102,6 +108,22 @@ impl LaneStart<F64x4> {
         self.each(|x, k| x.0[i] = v[k]);
     }
 
+    /// Lane `i` starts the next step where `end`'s lane `i` ended (as [`Run::lane_start`]
+    /// would give it after the step was accepted; the step size is set apart).
+    #[inline]
+    fn take_end(&mut self, i: usize, end: &LaneEnd<F64x4>) {
+        for k in 0..3 {
+            self.q[k].0[i] = end.q[k].0[i];
+            self.qd[k].0[i] = end.qd[k].0[i];
+            self.qdd1[k].0[i] = end.eval.qdd[k].0[i];
+        }
+        self.work.0[i] = end.work.0[i];
+        self.dissipated.0[i] = end.dissipated.0[i];
+        self.power1.0[i] = end.eval.power.0[i];
+        // `RodEval::write` gives the end's evaluation no joint power.
+        self.joint_power1.0[i] = 0.0;
+    }
+
     /// Lane `i` takes lane `j`'s values.
     fn copy_lane(&mut self, i: usize, j: usize) {
         self.each(|x, _| x.0[i] = x.0[j]);
@@ -125,6 +147,9 @@ pub struct LaneEnd<F> {
     pub eval: RodEval<F>,
     /// Stages 2, 3 and 4: what the observer is shown of them.
     pub stages: [LaneStage<F>; 3],
+    /// What the observer is shown of the end (read when the lanes accept the step,
+    /// [`Run::accept_plain`]).
+    pub last: LaneStage<F>,
 }
 
 /// What the observer is shown of an RK4 stage (see [`super::stepper::step_sampling`]),
@@ -216,6 +241,7 @@ pub fn lane_step<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -
             LaneStage::of(q3, &e3),
             LaneStage::of(q4, &e4),
         ],
+        last: LaneStage::of(q, &eval),
     }
 }
 
@@ -225,13 +251,6 @@ impl LaneEnd<F64x4> {
     pub fn lane(&self, i: usize) -> LaneEnd<f64> {
         let l = |x: F64x4| x.0[i];
         let l3 = |x: [F64x4; 3]| [x[0].0[i], x[1].0[i], x[2].0[i]];
-        let stage = |st: &LaneStage<F64x4>| LaneStage {
-            q: l3(st.q),
-            drag2: l(st.drag2),
-            speed2: l(st.speed2),
-            v: [st.v[0].0[i], st.v[1].0[i]],
-            pivot: l(st.pivot),
-        };
         LaneEnd {
             q: l3(self.q),
             qd: l3(self.qd),
@@ -239,11 +258,121 @@ impl LaneEnd<F64x4> {
             dissipated: l(self.dissipated),
             eval: self.eval.lane(i),
             stages: [
-                stage(&self.stages[0]),
-                stage(&self.stages[1]),
-                stage(&self.stages[2]),
+                self.stages[0].lane(i),
+                self.stages[1].lane(i),
+                self.stages[2].lane(i),
             ],
+            last: self.last.lane(i),
         }
+    }
+}
+
+impl LaneStage<F64x4> {
+    /// What the observer is shown of lane `i`: the drag's stiffness, and the coordinates
+    /// (read only when asked for).
+    #[inline(always)]
+    pub fn seen_in_lane<const N: usize>(
+        &self,
+        i: usize,
+    ) -> (impl FnOnce() -> SVector<f64, N> + '_, DragStiffness) {
+        let l = move |x: F64x4| x.0[i];
+        (
+            move || SVector::from_fn(|k, _| l(self.q[k])),
+            DragStiffness {
+                drag2: l(self.drag2),
+                speed2: l(self.speed2),
+                contact: 0,
+                v: Vector2::new(l(self.v[0]), l(self.v[1])),
+            },
+        )
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> LaneStage<f64> {
+        let l = |x: F64x4| x.0[i];
+        LaneStage {
+            q: [l(self.q[0]), l(self.q[1]), l(self.q[2])],
+            drag2: l(self.drag2),
+            speed2: l(self.speed2),
+            v: [l(self.v[0]), l(self.v[1])],
+            pivot: l(self.pivot),
+        }
+    }
+}
+
+impl LaneStage<f64> {
+    /// What the observer is shown: the coordinates and the drag's stiffness.
+    #[inline(always)]
+    pub fn seen<const N: usize>(&self) -> (SVector<f64, N>, DragStiffness) {
+        (
+            SVector::from_fn(|i, _| self.q[i]),
+            DragStiffness {
+                drag2: self.drag2,
+                speed2: self.speed2,
+                contact: 0,
+                v: Vector2::new(self.v[0], self.v[1]),
+            },
+        )
+    }
+}
+
+/// Lane `i` of an evaluation in the lanes, as the switching functions read its contact
+/// ([`RodEval::write`] gives a [`crate::dynamics::ContactEval`] these same values).
+pub(super) struct LaneContact<'a> {
+    eval: &'a RodEval<F64x4>,
+    i: usize,
+}
+
+impl<'a> LaneContact<'a> {
+    /// Lane `i` of `eval`.
+    #[inline(always)]
+    pub(super) fn new(eval: &'a RodEval<F64x4>, i: usize) -> Self {
+        LaneContact { eval, i }
+    }
+
+    #[inline(always)]
+    fn at(&self, x: F64x4) -> f64 {
+        x.0[self.i]
+    }
+}
+
+impl SwitchInputs for LaneContact<'_> {
+    #[inline(always)]
+    fn lowest(&self) -> f64 {
+        self.at(self.eval.lowest)
+    }
+    #[inline(always)]
+    fn v_centroid(&self) -> [f64; 2] {
+        [
+            self.at(self.eval.v_centroid[0]),
+            self.at(self.eval.v_centroid[1]),
+        ]
+    }
+    #[inline(always)]
+    fn bound(&self) -> [f64; 2] {
+        [self.at(self.eval.bound[0]), self.at(self.eval.bound[1])]
+    }
+    #[inline(always)]
+    fn statics(&self) -> [f64; 2] {
+        [self.at(self.eval.statics[0]), self.at(self.eval.statics[1])]
+    }
+    #[inline(always)]
+    fn v_tip_y(&self) -> f64 {
+        self.at(self.eval.v_tip[1])
+    }
+    #[inline(always)]
+    fn cross(&self) -> f64 {
+        self.at(self.eval.cross)
+    }
+    #[inline(always)]
+    fn immersion_margin(&self) -> f64 {
+        self.at(self.eval.margin)
+    }
+    #[inline(always)]
+    fn corner_y(&self, _k: usize) -> f64 {
+        // A rod has no corners (`RodEval::write` writes zeros).
+        0.0
     }
 }
 
@@ -269,16 +398,7 @@ impl LaneEnd<f64> {
     /// What the observer is shown of stage `k` (2, 3, 4): its coordinates and stiffness.
     #[inline]
     pub fn stage<const N: usize>(&self, k: usize) -> (SVector<f64, N>, DragStiffness) {
-        let st = &self.stages[k];
-        (
-            SVector::from_fn(|i, _| st.q[i]),
-            DragStiffness {
-                drag2: st.drag2,
-                speed2: st.speed2,
-                contact: 0,
-                v: Vector2::new(st.v[0], st.v[1]),
-            },
-        )
+        self.stages[k].seen()
     }
 }
 
@@ -356,11 +476,20 @@ struct Slot<T> {
     tag: T,
     model: Model<3>,
     run: Run<3>,
+    /// Whether the lanes may accept its plain steps ([`Run::may_stay_in_lanes`]), as of its
+    /// last step on its own (it holds while the lanes accept its steps: nothing changes
+    /// then that it depends on).
+    may_stay: bool,
 }
 
 /// Run every scene `next` gives, four at a time in lanes (`isa`), and hand each outcome
 /// to `done` with its tag as the run ends (not in input order). A scene the lanes do not
 /// cover ([`covered`]) runs alone, on the scalar path, as [`solve`] runs it.
+///
+/// A step that meets nothing (no event, every pivot clear) of a run that
+/// [`Run::may_stay_in_lanes`] is accepted by the lanes ([`Run::accept_plain`]): the run's next
+/// step starts where its lane ended, and the run takes back the end's evaluation
+/// ([`Run::resume`]) only when it next steps on its own, or ends.
 pub fn run_lanes<T>(
     isa: LaneIsa,
     mut next: impl FnMut() -> Option<LaneScene<T>>,
@@ -369,6 +498,16 @@ pub fn run_lanes<T>(
     let mut slots: [Option<Slot<T>>; LANES] = std::array::from_fn(|_| None);
     let mut params: Option<RodParams<F64x4>> = None;
     let mut empty = false;
+    // Each lane's step start and held modes; a run the lanes keep ([`Run::in_lanes`]) starts
+    // its next step from its lane here, and `kept` holds its last end's evaluation.
+    let mut start = LaneStart::<F64x4>::splat(0.0);
+    let mut lane_modes = RodModes::<F64x4>::splat(0.0);
+    let mut kept: Option<RodEval<F64x4>> = None;
+    let resume = |run: &mut Run<3>, kept: &Option<RodEval<F64x4>>, i: usize| {
+        if let (true, Some(e)) = (run.in_lanes(), kept) {
+            run.resume(&e.lane(i));
+        }
+    };
     loop {
         // Fill the lanes and find each run's next step.
         let mut h = [0.0; LANES];
@@ -396,7 +535,12 @@ pub fn run_lanes<T>(
                         None => params = Some(RodParams::splat(&p)),
                     }
                     let run = Run::new(&model, q0, qd0, &options);
-                    slots[i] = Some(Slot { tag, model, run });
+                    slots[i] = Some(Slot {
+                        tag,
+                        model,
+                        run,
+                        may_stay: false,
+                    });
                 }
                 let Some(slot) = slots[i].as_mut() else {
                     break;
@@ -408,7 +552,8 @@ pub fn run_lanes<T>(
                         break;
                     }
                     None => {
-                        if let Some(s) = slots[i].take() {
+                        if let Some(mut s) = slots[i].take() {
+                            resume(&mut s.run, &kept, i);
                             let out = s.run.finish(&s.model);
                             done(s.tag, out);
                         }
@@ -423,10 +568,10 @@ pub fn run_lanes<T>(
             break;
         };
 
-        // Gather the lanes whose mode the lanes cover; the others step alone.
-        let mut start = LaneStart::<F64x4>::splat(0.0);
-        let mut lane_modes = RodModes::<F64x4>::splat(0.0);
+        // Gather the lanes whose mode the lanes cover (a run the lanes keep is there
+        // already); the others step alone.
         let mut k1s: [Option<Deriv<3>>; LANES] = [None; LANES];
+        let mut stepped = [false; LANES];
         for i in 0..LANES {
             if !live[i] {
                 continue;
@@ -434,11 +579,18 @@ pub fn run_lanes<T>(
             let Some(slot) = slots[i].as_mut() else {
                 continue;
             };
+            if slot.run.in_lanes() {
+                start.h.0[i] = h[i];
+                stepped[i] = true;
+                continue;
+            }
             match slot.run.lane_start(h[i]) {
                 Some((s, m, k1)) => {
                     start.set(i, &s);
                     lane_modes.set(i, &m);
                     k1s[i] = Some(k1);
+                    stepped[i] = true;
+                    slot.may_stay = slot.run.may_stay_in_lanes(&slot.model);
                 }
                 None => {
                     if let Err(e) = slot.run.step_general(&slot.model, h[i]) {
@@ -447,14 +599,15 @@ pub fn run_lanes<T>(
                 }
             }
         }
-        let Some(first) = (0..LANES).find(|&i| k1s[i].is_some()) else {
+        let Some(first) = (0..LANES).find(|&i| stepped[i]) else {
             continue;
         };
         // One run left in the lanes (a batch's tail, a one-scene sweep): its step on the
         // scalar path, the same arithmetic in one lane, without the idle lanes' `pow` and
         // `sin_cos` (libm's, called lane by lane).
-        if k1s.iter().filter(|k| k.is_some()).count() == 1 {
+        if stepped.iter().filter(|&&s| s).count() == 1 {
             if let Some(slot) = slots[first].as_mut() {
+                resume(&mut slot.run, &kept, first);
                 if let Err(e) = slot.run.step(&slot.model, h[first]) {
                     fail(&mut slots[first], e, &mut done);
                 }
@@ -463,11 +616,11 @@ pub fn run_lanes<T>(
         }
         // An idle lane repeats the first one's step, with its parameters (its results are
         // dropped).
-        let end = if k1s.iter().all(|k| k.is_some()) {
+        let end = if stepped.iter().all(|&s| s) {
             isa.step(params, &lane_modes, &start)
         } else {
             let mut lane_params = *params;
-            for i in (0..LANES).filter(|&i| k1s[i].is_none()) {
+            for i in (0..LANES).filter(|&i| !stepped[i]) {
                 copy_lane(&mut lane_params, i, first);
                 start.copy_lane(i, first);
                 lane_modes.copy_lane(i, first);
@@ -476,12 +629,18 @@ pub fn run_lanes<T>(
         };
 
         for i in 0..LANES {
-            let Some(k1) = k1s[i] else {
+            if !stepped[i] {
                 continue;
-            };
+            }
             let Some(slot) = slots[i].as_mut() else {
                 continue;
             };
+            if slot.may_stay && slot.run.accept_plain(&slot.model, &end, i) {
+                start.take_end(i, &end);
+                continue;
+            }
+            resume(&mut slot.run, &kept, i);
+            let k1 = k1s[i].unwrap_or_else(|| slot.run.first_stage());
             let result = slot
                 .run
                 .lane_step_done(&slot.model, h[i], &k1, &end.lane(i))
@@ -490,6 +649,7 @@ pub fn run_lanes<T>(
                 fail(&mut slots[i], e, &mut done);
             }
         }
+        kept = Some(end.eval);
     }
 }
 
@@ -522,5 +682,51 @@ fn fail<T>(
 ) {
     if let Some(s) = slot.take() {
         done(s.tag, Err(e));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bodies::AnyScene;
+    use crate::spec::Value;
+
+    /// The lanes accept a run's step ([`Run::accept_plain`]) only where the scalar path
+    /// would accept it whole: a lane whose end is not finite, whose pivot is not clear or
+    /// whose end crosses a switching function (here the stop's) is refused, and the run is
+    /// left as it was for the scalar path.
+    #[test]
+    fn the_lanes_accept_only_a_plain_finite_step() {
+        let mut spec = crate::spec::free_link_spec();
+        spec.set("q_deg", Value::Num(45.0));
+        let Ok(AnyScene::FreeLink(s)) = spec.build() else {
+            panic!("not a free link");
+        };
+        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+        let mut run = Run::new(&model, q0, qd0, &s.options);
+        // Into the sand, alone: the run's switching functions are listed.
+        for _ in 0..50 {
+            let h = run.next_step(&model).unwrap();
+            run.step(&model, h).unwrap();
+        }
+        assert!(run.may_stay_in_lanes(&model));
+        let h = run.next_step(&model).unwrap();
+        let (one, m, _) = run.lane_start(h).unwrap();
+        let mut start = LaneStart::<F64x4>::splat(0.0);
+        for i in 0..LANES {
+            start.set(i, &one);
+        }
+        let p = RodParams::splat(&RodParams::of(&model).unwrap());
+        let end = lane_step(&p, &RodModes::gather(&[m; LANES]), &start);
+        let mut bad = end;
+        bad.qd[0].0[1] = f64::NAN;
+        bad.stages[1].pivot.0[2] = 0.0;
+        bad.eval.v_tip[1].0[3] = 1e-3;
+        for i in 1..LANES {
+            assert!(!run.accept_plain(&model, &bad, i), "lane {i} accepted");
+            assert!(!run.in_lanes());
+        }
+        assert!(run.accept_plain(&model, &end, 0));
+        assert!(run.in_lanes());
     }
 }

@@ -58,11 +58,12 @@ struct Stiffest<const N: usize> {
 }
 
 impl<const N: usize> Stiffest<N> {
-    #[inline]
-    fn offer(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
+    /// `s` at the coordinates `q()`, read only when `s` is the stiffest yet.
+    #[inline(always)]
+    fn offer(&mut self, q: impl FnOnce() -> SVector<f64, N>, s: &DragStiffness) {
         if s.beats(&self.best) {
             self.best = *s;
-            self.q = *q;
+            self.q = q();
         }
     }
 }
@@ -140,9 +141,35 @@ impl<const N: usize> Observer<N> {
         }
     }
 
+    /// A step's end at coordinates `q` where a contact not yet stopped has the drag `s`
+    /// ([`Observer::step_end`]'s part for that contact): its largest drag and stiffness.
+    #[inline(always)]
+    pub(super) fn drag_at(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
+        let f_d_max = &mut self.summaries[s.contact].f_d_max;
+        if s.drag2 > *f_d_max * *f_d_max {
+            *f_d_max = s.drag2.sqrt();
+        }
+        self.stiffest.offer(|| *q, s);
+    }
+
+    /// Whether [`Observer::step_end`] and [`Observer::record_step`] need nothing of a step's
+    /// end but each contact's drag ([`Observer::drag_at`]): nothing is recorded and the body
+    /// reports no joint loads.
+    #[inline]
+    pub(super) fn drag_only(&self, model: &Model<N>) -> bool {
+        !self.recorder.on.any() && !joint_loads(model)
+    }
+
     /// Show the drag's stiffness at an RK4 stage with coordinates `q`.
     #[inline]
     pub(super) fn offer(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
+        self.stiffest.offer(|| *q, s);
+    }
+
+    /// [`Observer::offer`] of a stage whose coordinates `q()` are read only when its
+    /// stiffness `s` is the stiffest yet.
+    #[inline(always)]
+    pub(super) fn offer_with(&mut self, q: impl FnOnce() -> SVector<f64, N>, s: &DragStiffness) {
         self.stiffest.offer(q, s);
     }
 
@@ -150,14 +177,10 @@ impl<const N: usize> Observer<N> {
     /// stopped, the drag's stiffness there, and the joints' largest loads.
     #[inline(always)]
     pub(super) fn step_end(&mut self, model: &Model<N>, y: &State<N>, e: &Eval<N>, modes: &Modes) {
-        for (ci, s) in self.summaries.iter_mut().enumerate() {
-            if !modes[ci].stopped {
-                let c = &e.contacts[ci];
-                let drag2 = c.force.dynamic.norm_squared();
-                if drag2 > s.f_d_max * s.f_d_max {
-                    s.f_d_max = drag2.sqrt();
-                }
-                self.stiffest.offer(&y.q, &DragStiffness::of(ci, c));
+        let n = self.summaries.len();
+        for (ci, (m, c)) in modes.iter().zip(&e.contacts).take(n).enumerate() {
+            if !m.stopped {
+                self.drag_at(&y.q, &DragStiffness::of(ci, c));
             }
         }
         if !joint_loads(model) {

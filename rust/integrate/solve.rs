@@ -13,11 +13,11 @@ use nalgebra::SVector;
 use super::control::Control;
 use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
-use super::lanes::{lane_step, LaneEnd, LaneStart};
+use super::lanes::{lane_step, LaneContact, LaneEnd, LaneStart};
 use super::observe::{Observer, Record};
 use super::outcome::{Outcome, Stats, Status};
 use super::stepper::{deriv_of, full_step, partial_step, Deriv, Method, State};
-use crate::dynamics::rod_lanes::{RodModes, RodParams};
+use crate::dynamics::rod_lanes::{pivot_ok, RodEval, RodModes, RodParams};
 use crate::dynamics::{Eval, Model, Modes};
 use crate::error::{GranrsError, Result};
 
@@ -130,6 +130,9 @@ pub struct Run<const N: usize> {
     /// the lanes' arithmetic in one lane ([`lane_step`] in `f64`), which reads only what a
     /// stage needs; `None` for every other run.
     lean: Option<RodParams<f64>>,
+    /// Whether the lanes accepted this run's last step ([`Run::accept_plain`]) and keep its
+    /// end's evaluation: the run must [`Run::resume`] it before it steps itself.
+    in_lanes: bool,
 }
 
 impl<const N: usize> Run<N> {
@@ -175,6 +178,7 @@ impl<const N: usize> Run<N> {
                 Method::Rk4 => RodParams::of(model),
                 Method::Dopri5 { .. } => None,
             },
+            in_lanes: false,
         }
     }
 
@@ -268,6 +272,7 @@ impl<const N: usize> Run<N> {
     /// path does not cover (two sticking rows, a sticking pivot that is not clear).
     #[inline(always)]
     pub fn step_general(&mut self, model: &Model<N>, h: f64) -> Result<()> {
+        debug_assert!(!self.in_lanes, "resume the run first");
         let (e0, e1) = start_and_end(&mut self.evals, self.cur);
         let k1 = deriv_of(&self.y, e0);
         let obs = &mut self.obs;
@@ -291,6 +296,7 @@ impl<const N: usize> Run<N> {
     /// [`Run::lane_step_done`]); `None` when the lanes do not cover this run or its modes.
     #[inline(always)]
     pub fn lane_start(&self, h: f64) -> Option<(LaneStart<f64>, RodModes<f64>, Deriv<N>)> {
+        debug_assert!(!self.in_lanes, "resume the run first");
         self.lean?;
         let m = RodModes::of(&self.modes[0])?;
         let (y, k1) = (&self.y, deriv_of(&self.y, &self.evals[self.cur]));
@@ -343,6 +349,7 @@ impl<const N: usize> Run<N> {
         y1: State<N>,
         err: f64,
     ) -> Result<()> {
+        debug_assert!(!self.in_lanes, "resume the run first");
         let options = &self.options;
         let stats = &mut self.stats;
         let obs = &mut self.obs;
@@ -448,8 +455,98 @@ impl<const N: usize> Run<N> {
         Ok(())
     }
 
+    /// Whether the lanes may accept this run's plain steps themselves ([`Run::accept_plain`]):
+    /// a lean run, not ended, with no drive time ahead, no component held by a stick (whose
+    /// projection an accepted step would need) and a step end that the observer reads only
+    /// for the drag.
+    #[inline]
+    pub fn may_stay_in_lanes(&self, model: &Model<N>) -> bool {
+        self.lean.is_some()
+            && self.status.is_none()
+            && self.drives.time(self.next_time).is_none()
+            && !model.any_stuck(&self.modes)
+            && self.obs.drag_only(model)
+    }
+
+    /// Accept the step (of the size [`Run::next_step`] gave) taken in lane `i` of `end` if it
+    /// meets nothing, as [`Run::lane_step_done`] and [`Run::after_step`] would: every pivot
+    /// clear, the end finite, no switching function crossed; then the observer is shown its
+    /// stages and its end, and the run moves to the end. The end's evaluation stays in the
+    /// lanes: the run must [`Run::resume`] it before it steps itself. Returns false, with
+    /// nothing done, for any other step. Only for a run that
+    /// [`Run::may_stay_in_lanes`].
+    #[inline(always)]
+    pub fn accept_plain(
+        &mut self,
+        model: &Model<N>,
+        end: &LaneEnd<crate::simd::F64x4>,
+        i: usize,
+    ) -> bool {
+        debug_assert!(self.may_stay_in_lanes(model) && !self.clamped);
+        let lane = |x: crate::simd::F64x4| x.0[i];
+        if !(end.stages.iter().all(|st| pivot_ok(lane(st.pivot))) && pivot_ok(lane(end.eval.pivot)))
+        {
+            return false;
+        }
+        let y1 = State {
+            q: SVector::from_fn(|k, _| lane(end.q[k])),
+            qd: SVector::from_fn(|k, _| lane(end.qd[k])),
+            work: lane(end.work),
+            dissipated: lane(end.dissipated),
+        };
+        if !y1.is_finite() || !end.eval.qdd.iter().all(|&a| lane(a).is_finite()) {
+            return false;
+        }
+        if !self
+            .events
+            .plain(&self.modes, &LaneContact::new(&end.eval, i))
+        {
+            return false;
+        }
+        for st in &end.stages {
+            let (q, stiff) = st.seen_in_lane::<N>(i);
+            self.obs.offer_with(q, &stiff);
+        }
+        self.stats.rhs_evals += 4;
+        self.y = y1;
+        self.t = self.t_next;
+        self.stats.steps += 1;
+        if !self.modes[0].stopped {
+            let (_, stiff) = end.last.seen_in_lane::<N>(i);
+            self.obs.drag_at(&self.y.q, &stiff);
+        }
+        self.control.advance();
+        self.events.next_step();
+        self.in_lanes = true;
+        true
+    }
+
+    /// Take back a run whose last steps the lanes accepted ([`Run::accept_plain`]): `end` is
+    /// the evaluation at its state, that of the last step's end.
+    #[inline]
+    pub fn resume(&mut self, end: &RodEval<f64>) {
+        if self.in_lanes {
+            end.write(&mut self.evals[self.cur]);
+            self.in_lanes = false;
+        }
+    }
+
+    /// The first stage of the next step: the derivative at the run's state.
+    #[inline]
+    pub fn first_stage(&self) -> Deriv<N> {
+        debug_assert!(!self.in_lanes, "resume the run first");
+        deriv_of(&self.y, &self.evals[self.cur])
+    }
+
+    /// Whether the lanes hold this run's last evaluation ([`Run::resume`]).
+    #[inline]
+    pub fn in_lanes(&self) -> bool {
+        self.in_lanes
+    }
+
     /// The outcome of a run that has ended ([`Run::next_step`] gave `None`).
     pub fn finish(self, model: &Model<N>) -> Result<Outcome> {
+        debug_assert!(!self.in_lanes, "resume the run first");
         let status = self.status.unwrap_or(Status::NotStopped);
         self.obs.finish(
             model,
