@@ -17,7 +17,7 @@ use crate::error::GranrsError;
 use crate::spec::Value;
 
 /// How long a sweep's calling thread waits for the batch by yielding its core before it
-/// sleeps between progress reports (a one-scene sweep's core call 200 -> 185-200 us, and
+/// sleeps between progress reports (a one-scene sweep's core call 215-229 -> 202-205 us, and
 /// no slower a 155-run sweep on two threads: `benches/bench_sweep.py --part fixed`).
 const YIELD_WAIT: std::time::Duration = std::time::Duration::from_micros(200);
 
