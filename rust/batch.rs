@@ -242,14 +242,12 @@ pub fn pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
     static POOLS: Mutex<Kept> = Mutex::new(Vec::new());
     let pid = std::process::id();
     let mut pools = POOLS.lock().unwrap_or_else(|p| p.into_inner());
-    if pools.iter().any(|(_, owner, _)| *owner != pid) {
-        for (n, owner, inherited) in std::mem::take(&mut *pools) {
-            if owner == pid {
-                pools.push((n, owner, inherited));
-            } else {
-                std::mem::forget(inherited);
-            }
-        }
+    // The list is the parent's whole or this process's whole: the first call in a child
+    // forgets it.
+    if pools.first().is_some_and(|(_, owner, _)| *owner != pid) {
+        pools
+            .drain(..)
+            .for_each(|(_, _, inherited)| std::mem::forget(inherited));
     }
     if let Some((_, _, kept)) = pools.iter().find(|(n, _, _)| *n == threads) {
         return Ok(Arc::clone(kept));
@@ -380,16 +378,18 @@ pub fn run(
                         row[0] = STATUS_CANCELLED;
                         continue;
                     }
-                    match src.scene(start + j).as_deref() {
-                        Ok(AnyScene::FreeLink(s)) => {
-                            let (q0, qd0) = s.initial_state();
-                            return Some((j, s.model(), q0, qd0, s.options));
-                        }
-                        Ok(other) => match other.run() {
-                            Ok(out) => summarize(&out, row),
-                            Err(e) => fail(start + j, row, e),
+                    match src.scene(start + j) {
+                        Ok(scene) => match &*scene {
+                            AnyScene::FreeLink(s) => {
+                                let (q0, qd0) = s.initial_state();
+                                return Some((j, s.model(), q0, qd0, s.options));
+                            }
+                            other => match other.run() {
+                                Ok(out) => summarize(&out, row),
+                                Err(e) => fail(start + j, row, e),
+                            },
                         },
-                        Err(e) => fail(start + j, row, e.clone()),
+                        Err(e) => fail(start + j, row, e),
                     }
                     done.fetch_add(1, Ordering::Relaxed);
                 }

@@ -160,16 +160,10 @@ impl<const N: usize> Observer<N> {
         !self.recorder.on.any() && !joint_loads(model)
     }
 
-    /// Show the drag's stiffness at an RK4 stage with coordinates `q`.
-    #[inline]
-    pub(super) fn offer(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
-        self.stiffest.offer(|| *q, s);
-    }
-
-    /// [`Observer::offer`] of a stage whose coordinates `q()` are read only when its
-    /// stiffness `s` is the stiffest yet.
+    /// Show the drag's stiffness `s` at an RK4 stage with coordinates `q()` (read only when
+    /// `s` is the stiffest yet).
     #[inline(always)]
-    pub(super) fn offer_with(&mut self, q: impl FnOnce() -> SVector<f64, N>, s: &DragStiffness) {
+    pub(super) fn offer(&mut self, q: impl FnOnce() -> SVector<f64, N>, s: &DragStiffness) {
         self.stiffest.offer(q, s);
     }
 

@@ -276,7 +276,7 @@ impl<const N: usize> Run<N> {
         let (e0, e1) = start_and_end(&mut self.evals, self.cur);
         let k1 = deriv_of(&self.y, e0);
         let obs = &mut self.obs;
-        let sample = |q: &SVector<f64, N>, s: &_| obs.offer(q, s);
+        let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
         let (y1, err) = full_step(
             model,
             self.options.method,
@@ -330,7 +330,7 @@ impl<const N: usize> Run<N> {
         }
         for k in 0..3 {
             let (q, stiff) = end.stage::<N>(k);
-            self.obs.offer(&q, &stiff);
+            self.obs.offer(|| q, &stiff);
         }
         end.eval.write(&mut self.evals[1 - self.cur]);
         self.stats.rhs_evals += 4;
@@ -413,7 +413,7 @@ impl<const N: usize> Run<N> {
         let y_star = if earliest >= 1.0 {
             y1
         } else if h_star > 0.0 {
-            let sample = |q: &SVector<f64, N>, s: &_| obs.offer(q, s);
+            let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
             partial_step(model, options.method, modes, y, k1, h_star, stats, sample)
         } else {
             *y
@@ -505,7 +505,7 @@ impl<const N: usize> Run<N> {
         }
         for st in &end.stages {
             let (q, stiff) = st.seen_in_lane::<N>(i);
-            self.obs.offer_with(q, &stiff);
+            self.obs.offer(q, &stiff);
         }
         self.stats.rhs_evals += 4;
         self.y = y1;
