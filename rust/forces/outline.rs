@@ -24,13 +24,19 @@ use super::{Frame, Outline, Real};
 /// Most plates of a rod's or a box's outline (an arc's chords are made as they are walked).
 pub const MAX_PLATES: usize = 3;
 
-/// One plate: from `a` to `b` [m] (world coordinates), `width` [m] out of the plane.
+/// One plate: from `a` to `b` [m] (world coordinates), `width` [m] out of the plane, with
+/// its direction and length. A rod's plates take theirs from its frame (the axis is a unit
+/// vector already); others from their ends ([`Plate::between`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plate<F> {
     /// One end [m].
     pub a: [F; 2],
     /// The other end [m].
     pub b: [F; 2],
+    /// The unit vector from `a` to `b` (zeros for a plate of no length).
+    pub u: [F; 2],
+    /// Its length [m].
+    pub length: F,
     /// Width out of the plane [m].
     pub width: F,
 }
@@ -80,11 +86,11 @@ impl<F: Real> Outline<F> {
             let mut r = [first[0] - centre[0], first[1] - centre[1]];
             for _ in 0..chords {
                 let q = [c * r[0] - s * r[1], s * r[0] + c * r[1]];
-                f(&Plate {
-                    a: [centre[0] + r[0], centre[1] + r[1]],
-                    b: [centre[0] + q[0], centre[1] + q[1]],
+                f(&Plate::between(
+                    [centre[0] + r[0], centre[1] + r[1]],
+                    [centre[0] + q[0], centre[1] + q[1]],
                     width,
-                });
+                ));
                 r = q;
             }
             return;
@@ -103,6 +109,8 @@ impl<F: Real> Outline<F> {
         let none = Plate {
             a: [zero; 2],
             b: [zero; 2],
+            u: [zero; 2],
+            length: zero,
             width: zero,
         };
         let mut out = [none; MAX_PLATES];
@@ -113,35 +121,28 @@ impl<F: Real> Outline<F> {
                 let half = F::splat(0.5) * diameter;
                 // The normal to the axis, (-e_y, e_x).
                 let n = [-e[1], e[0]];
+                // Directions and lengths from the frame: no square root, no division.
                 out[0] = Plate {
                     a: t,
                     b: [t[0] + immersed * e[0], t[1] + immersed * e[1]],
+                    u: e,
+                    length: immersed,
                     width: diameter,
                 };
                 out[1] = Plate {
                     a: [t[0] - half * n[0], t[1] - half * n[1]],
                     b: [t[0] + half * n[0], t[1] + half * n[1]],
+                    u: n,
+                    length: diameter,
                     width: diameter,
                 };
                 (out, 2)
             }
             Outline::Box { corners, width } => {
                 let [heel, toe, toe_top, heel_top] = corners;
-                out[0] = Plate {
-                    a: heel,
-                    b: toe,
-                    width,
-                };
-                out[1] = Plate {
-                    a: heel,
-                    b: heel_top,
-                    width,
-                };
-                out[2] = Plate {
-                    a: toe,
-                    b: toe_top,
-                    width,
-                };
+                out[0] = Plate::between(heel, toe, width);
+                out[1] = Plate::between(heel, heel_top, width);
+                out[2] = Plate::between(toe, toe_top, width);
                 (out, 3)
             }
             Outline::Arc { .. } => (out, 0),
@@ -150,11 +151,20 @@ impl<F: Real> Outline<F> {
 }
 
 impl<F: Real> Plate<F> {
-    /// Its length [m].
+    /// The plate from `a` to `b`, its direction and length from its ends (one square root
+    /// and one division).
     #[inline(always)]
-    pub fn length(&self) -> F {
-        let d = [self.b[0] - self.a[0], self.b[1] - self.a[1]];
-        (d[0] * d[0] + d[1] * d[1]).sqrt()
+    pub fn between(a: [F; 2], b: [F; 2], width: F) -> Self {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let length = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        let inv = length.select_pos(length.recip(), F::splat(0.0));
+        Plate {
+            a,
+            b,
+            u: [d[0] * inv, d[1] * inv],
+            length,
+            width,
+        }
     }
 
     /// Its part below the surface y = 0 (a plate of no length when none is), clipped once:
@@ -179,6 +189,8 @@ impl<F: Real> Plate<F> {
         Plate {
             a: [self.a[0] + t0 * d[0], self.a[1] + t0 * d[1]],
             b: [self.a[0] + t1 * d[0], self.a[1] + t1 * d[1]],
+            u: self.u,
+            length: (t1 - t0) * self.length,
             width: self.width,
         }
     }
@@ -195,7 +207,7 @@ impl<F: Real> Plate<F> {
         Elements {
             start: part.a,
             step,
-            length: part.length() * inv_n,
+            length: part.length * inv_n,
             width: self.width,
         }
     }
@@ -206,7 +218,7 @@ mod tests {
     use super::*;
 
     fn plate(a: [f64; 2], b: [f64; 2]) -> Plate<f64> {
-        Plate { a, b, width: 2.0 }
+        Plate::between(a, b, 2.0)
     }
 
     /// int |z| dA over the elements (midpoint rule).

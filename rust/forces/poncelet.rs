@@ -67,7 +67,7 @@ impl Poncelet {
             }
             Outline::Box { width, .. } => {
                 let (plates, _) = b.outline.fixed_plates(&b.frame);
-                let immersed = |i: usize| plates[i].immersed().length();
+                let immersed = |i: usize| plates[i].immersed().length;
                 let bottom = immersed(0);
                 let face = immersed(1).max(immersed(2));
                 width * (bottom * across + face * along)

@@ -121,9 +121,7 @@ pub fn alpha_at(k: &[f64; 9], beta: f64, gamma: f64) -> (f64, f64) {
 /// `(cos 2 beta, sin 2 beta)` of a plate's line, or zeros for a plate of no length.
 #[inline(always)]
 fn line_angle<F: Real>(p: &Plate<F>) -> (F, F) {
-    let len = p.length();
-    let inv = len.select_pos(len.recip(), F::splat(0.0));
-    let u = [(p.b[0] - p.a[0]) * inv, (p.b[1] - p.a[1]) * inv];
+    let u = p.u;
     (u[0] * u[0] - u[1] * u[1], F::splat(2.0) * u[0] * u[1])
 }
 
@@ -377,28 +375,44 @@ impl Term for Rft {
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
         };
-        let (mut force, mut moment) = self.integrate(b, None);
-        let mut bound = [zero; 2];
+        let (force, moment) = self.integrate(b, None);
         let [held_x, held_y] = b.held;
-        if !(held_x + held_y).all_zero() {
-            // Held at zero along an axis: the reaction stands in for that component, up to
-            // the sand's resistance to sinking straight down (y) and the smaller of its
-            // resistances to sliding either way (x). Rotation is not held: the moment stays
-            // the moving elements' while one axis moves, and is zero at rest.
-            let one = F::splat(1.0);
-            if !held_y.all_zero() {
-                let (down, _) = self.integrate(b, Some([zero, -one]));
-                bound[1] = held_y * down[1].max(zero);
-                force[1] = (one - held_y) * force[1];
-            }
-            if !held_x.all_zero() {
-                let (right, _) = self.integrate(b, Some([one, zero]));
-                let (left, _) = self.integrate(b, Some([-one, zero]));
-                bound[0] = held_x * (-right[0]).max(zero).min(left[0].max(zero));
-                force[0] = (one - held_x) * force[0];
-            }
-            moment = (one - held_x * held_y) * moment;
+        if (held_x + held_y).all_zero() {
+            return TermForce {
+                force,
+                bound: [zero; 2],
+                moment,
+            };
         }
+        self.held(b, force, moment)
+    }
+}
+
+impl Rft {
+    /// [`Rft::contact_force`] along an axis held at zero: the reaction stands in for that
+    /// component, up to the sand's resistance to sinking straight down (y) and the smaller
+    /// of its resistances to sliding either way (x). Rotation is not held: the moment stays
+    /// the moving elements' while one axis moves, and is zero at rest. Out of line: the
+    /// moving contact's path stays one copy of [`Rft::integrate`].
+    #[inline(never)]
+    fn held<F: Real>(&self, b: &Boundary<F>, force: [F; 2], moment: F) -> TermForce<F> {
+        let zero = F::splat(0.0);
+        let one = F::splat(1.0);
+        let [held_x, held_y] = b.held;
+        let (mut force, mut moment) = (force, moment);
+        let mut bound = [zero; 2];
+        if !held_y.all_zero() {
+            let (down, _) = self.integrate(b, Some([zero, -one]));
+            bound[1] = held_y * down[1].max(zero);
+            force[1] = (one - held_y) * force[1];
+        }
+        if !held_x.all_zero() {
+            let (right, _) = self.integrate(b, Some([one, zero]));
+            let (left, _) = self.integrate(b, Some([-one, zero]));
+            bound[0] = held_x * (-right[0]).max(zero).min(left[0].max(zero));
+            force[0] = (one - held_x) * force[0];
+        }
+        moment = (one - held_x * held_y) * moment;
         TermForce {
             force,
             bound,
@@ -468,10 +482,8 @@ impl Term for RftInertial {
         let mut f = [zero; 2];
         let mut moment = zero;
         b.outline.for_each_plate(&b.frame, |p| {
-            let len = p.length();
-            let inv = len.select_pos(len.recip(), zero);
             // The plate's normal (-u_y, u_x); either face leads, by the sign of v_n.
-            let n = [-(p.b[1] - p.a[1]) * inv, (p.b[0] - p.a[0]) * inv];
+            let n = [-p.u[1], p.u[0]];
             let el = p.elements(self.elements);
             let area = el.length * el.width;
             // v_n at t = k + 1/2 from the start is affine in t (a rigid link): vn0 + t dvn.
