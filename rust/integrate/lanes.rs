@@ -402,28 +402,25 @@ impl LaneEnd<f64> {
     }
 }
 
-/// [`lane_step`] in four lanes, compiled for the baseline target.
+/// [`lane_step`] compiled for the baseline target.
 #[inline(never)]
-fn lane_step_base(
-    p: &RodParams<F64x4>,
-    m: &RodModes<F64x4>,
-    s: &LaneStart<F64x4>,
-) -> LaneEnd<F64x4> {
+fn lane_step_base<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -> LaneEnd<F> {
     lane_step(p, m, s)
 }
 
-/// [`lane_step`] in four lanes, compiled with AVX2 (256-bit registers).
+/// [`lane_step`] compiled with AVX2 (256-bit registers for the lanes; for one lane, the
+/// three-operand encodings).
 ///
 /// # Safety
 /// The CPU must have AVX2 ([`crate::simd::avx2`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-unsafe fn lane_step_avx2(
-    p: &RodParams<F64x4>,
-    m: &RodModes<F64x4>,
-    s: &LaneStart<F64x4>,
-) -> LaneEnd<F64x4> {
+unsafe fn lane_step_avx2<F: Real>(
+    p: &RodParams<F>,
+    m: &RodModes<F>,
+    s: &LaneStart<F>,
+) -> LaneEnd<F> {
     lane_step(p, m, s)
 }
 
@@ -446,13 +443,10 @@ impl LaneIsa {
         }
     }
 
+    /// [`lane_step`] in `F` (four lanes, or one for a run's scalar path) as this CPU runs
+    /// it best.
     #[inline]
-    fn step(
-        self,
-        p: &RodParams<F64x4>,
-        m: &RodModes<F64x4>,
-        s: &LaneStart<F64x4>,
-    ) -> LaneEnd<F64x4> {
+    pub fn step<F: Real>(self, p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -> LaneEnd<F> {
         match self {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU.
@@ -690,6 +684,48 @@ mod tests {
     use super::*;
     use crate::bodies::AnyScene;
     use crate::spec::Value;
+
+    /// A step gives the same bits compiled for the baseline target as with AVX2 (the CPU's
+    /// pick, [`LaneIsa::detect`]), in one lane (`f64`: the scalar path's lean step) and in
+    /// four, on steps of runs at several angles and speeds through entry, sinking and
+    /// stopping. On a CPU without AVX2 both are the baseline and this checks nothing new.
+    #[test]
+    fn a_step_is_the_same_bits_on_every_instruction_set() {
+        let mut starts = Vec::new();
+        for (q, v0) in [(0.0, 2.2), (5.0, 1.1), (45.0, 2.27), (85.0, 0.7)] {
+            let mut spec = crate::spec::free_link_spec();
+            spec.set("q_deg", Value::Num(q));
+            spec.set("v0", Value::Num(v0));
+            let Ok(AnyScene::FreeLink(s)) = spec.build() else {
+                panic!("not a free link");
+            };
+            let (model, (q0, qd0)) = (s.model(), s.initial_state());
+            let mut run = Run::new(&model, q0, qd0, &s.options);
+            let p = RodParams::of(&model).unwrap();
+            while let Some(h) = run.next_step(&model) {
+                if let Some((one, m, _)) = run.lane_start(h) {
+                    starts.push((p, m, one));
+                }
+                run.step(&model, h).unwrap();
+            }
+        }
+        assert!(starts.len() > 400, "{} steps", starts.len());
+        let isa = LaneIsa::detect();
+        for (p, m, s) in &starts {
+            let (a, b) = (LaneIsa::Base.step(p, m, s), isa.step(p, m, s));
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+        for group in starts.chunks_exact(LANES) {
+            let mut s = LaneStart::<F64x4>::splat(0.0);
+            for (i, (_, _, one)) in group.iter().enumerate() {
+                s.set(i, one);
+            }
+            let p = RodParams::splat(&group[0].0);
+            let m = RodModes::gather(&[group[0].1; LANES]);
+            let (a, b) = (LaneIsa::Base.step(&p, &m, &s), isa.step(&p, &m, &s));
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+    }
 
     /// The lanes accept a run's step ([`Run::accept_plain`]) only where the scalar path
     /// would accept it whole: a lane whose end is not finite, whose pivot is not clear or

@@ -13,7 +13,7 @@ use nalgebra::SVector;
 use super::control::Control;
 use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
-use super::lanes::{lane_step, LaneContact, LaneEnd, LaneStart};
+use super::lanes::{LaneContact, LaneEnd, LaneIsa, LaneStart};
 use super::observe::{Observer, Record};
 use super::outcome::{Outcome, Stats, Status};
 use super::stepper::{deriv_of, full_step, partial_step, Deriv, Method, State};
@@ -130,6 +130,9 @@ pub struct Run<const N: usize> {
     /// the lanes' arithmetic in one lane ([`lane_step`] in `f64`), which reads only what a
     /// stage needs; `None` for every other run.
     lean: Option<RodParams<f64>>,
+    /// How this CPU runs a lean step: compiled with AVX2 where it has it (one binary for
+    /// every x86-64; the same IEEE operations, so the same bits).
+    isa: LaneIsa,
     /// Whether the lanes accepted this run's last step ([`Run::accept_plain`]) and keep its
     /// end's evaluation: the run must [`Run::resume`] it before it steps itself.
     in_lanes: bool,
@@ -178,6 +181,7 @@ impl<const N: usize> Run<N> {
                 Method::Rk4 => RodParams::of(model),
                 Method::Dopri5 { .. } => None,
             },
+            isa: LaneIsa::detect(),
             in_lanes: false,
         }
     }
@@ -259,7 +263,7 @@ impl<const N: usize> Run<N> {
     pub fn step(&mut self, model: &Model<N>, h: f64) -> Result<()> {
         if let Some(p) = self.lean {
             if let Some((start, m, k1)) = self.lane_start(h) {
-                let end = lane_step(&p, &m, &start);
+                let end = self.isa.step(&p, &m, &start);
                 if let Some(done) = self.lane_step_done(model, h, &k1, &end) {
                     return done;
                 }
