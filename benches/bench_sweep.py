@@ -23,6 +23,9 @@ Parts:
   the core's call alone (``_granrs.sweep``: the pool's hand-off and the run, no DataFrame),
   against the run alone as the core times it, in the same loop. No target; it is what a
   small sweep pays beyond its runs (issue 22's two-thread line at 155 runs).
+* ``lanes``: 1000 free links (40 angles x 25 speeds) on one thread, with the SIMD lanes
+  (``lanes=True``) and on the scalar path (``lanes=False``), taken in turn. No target; the
+  lanes' gain over the scalar path (``docs/sweeps.md``).
 
 Build in release first: ``maturin develop --release``.
 """
@@ -47,7 +50,7 @@ import granrs
 from granrs import _granrs, cases
 from granrs.forces import select, thesis
 
-PARTS = ("sweep", "overhead", "prune", "force", "fixed")
+PARTS = ("sweep", "overhead", "prune", "force", "fixed", "lanes")
 
 
 def _median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -220,6 +223,30 @@ def part_fixed(repeat: int) -> list[str]:
     return [*lines, ""]
 
 
+# ---------------------------------------------------------------------------------- lanes
+def part_lanes(repeat: int) -> list[str]:
+    """1000 free links on one thread, lanes and scalar path in turn, best of ``repeat``."""
+    base = cases.free_link(q_deg=0.0, v0=2.0)
+    axes = {"q_deg": np.linspace(0.0, 75.0, 40), "v0": np.linspace(0.5, 4.0, 25)}
+    best = {True: math.inf, False: math.inf}
+    for _ in range(repeat):
+        for lanes in best:
+            t0 = time.perf_counter()
+            granrs.sweep(base, lanes=lanes, threads=1, progress=False, **axes)
+            best[lanes] = min(best[lanes], time.perf_counter() - t0)
+    return [
+        "### SIMD lanes against the scalar path (1000 free links, one thread)",
+        "",
+        "| path | sweep [ms] = per impact [us] |",
+        "|---|---|",
+        f"| lanes | {best[True] * 1e3:.1f} |",
+        f"| scalar | {best[False] * 1e3:.1f} |",
+        "",
+        f"lanes / scalar: **{best[True] / best[False]:.3f}** (best of {repeat}).",
+        "",
+    ]
+
+
 # ---------------------------------------------------------------------------------- prune
 def part_prune(repeat: int) -> list[str]:
     base = cases.free_link(q_deg=0.0, v0=2.214)
@@ -322,6 +349,8 @@ def main(argv: list[str] | None = None) -> int:
             lines += part_prune(repeat)
         elif part == "fixed":
             lines += part_fixed(repeat)
+        elif part == "lanes":
+            lines += part_lanes(repeat)
         else:
             lines += part_force(repeat)
     print("\n".join(lines), flush=True)
