@@ -590,6 +590,8 @@ def match_tolerance(runs: list[SceneRun], ref_dt: float, progress: bool) -> None
 def methods(runs: list[SceneRun]) -> dict[str, Callable[[SceneRun], Any]]:
     """Name -> one impact of a scene (what is timed)."""
     raw = {id(r): r.scene.replace(sign_model="raw") for r in runs}
+    for scene in raw.values():
+        scene._compiled()  # compiled once here, as the default scenes are, not in the timing
     return {
         "granrs": lambda r: granrs.simulate(r.scene),
         "granrs_raw": lambda r: granrs.simulate(raw[id(r)]),

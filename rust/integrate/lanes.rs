@@ -446,10 +446,16 @@ impl LaneIsa {
     /// [`lane_step`] in `F` (four lanes, or one for a run's scalar path) as this CPU runs
     /// it best.
     #[inline]
-    pub fn step<F: Real>(self, p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -> LaneEnd<F> {
+    pub(crate) fn step<F: Real>(
+        self,
+        p: &RodParams<F>,
+        m: &RodModes<F>,
+        s: &LaneStart<F>,
+    ) -> LaneEnd<F> {
         match self {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU.
+            // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU (this method
+            // is the crate's own, so no caller outside it picks the variant).
             LaneIsa::Avx2 => unsafe { lane_step_avx2(p, m, s) },
             _ => lane_step_base(p, m, s),
         }

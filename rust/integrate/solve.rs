@@ -127,8 +127,8 @@ pub struct Run<const N: usize> {
     t_next: f64,
     clamped: bool,
     /// The free link under the thesis's terms on RK4 ([`RodParams::of`]): its steps are
-    /// the lanes' arithmetic in one lane ([`lane_step`] in `f64`), which reads only what a
-    /// stage needs; `None` for every other run.
+    /// the lanes' arithmetic in one lane ([`super::lanes::lane_step`] in `f64`), which
+    /// reads only what a stage needs; `None` for every other run.
     lean: Option<RodParams<f64>>,
     /// How this CPU runs a lean step: compiled with AVX2 where it has it (one binary for
     /// every x86-64; the same IEEE operations, so the same bits).
@@ -295,8 +295,8 @@ impl<const N: usize> Run<N> {
         self.after_step(model, h, &k1, y1, err)
     }
 
-    /// The start of a step of size `h` in one lane ([`lane_step`]): the state and first
-    /// stage, the modes held through it, and the first stage as a [`Deriv`] (for
+    /// The start of a step of size `h` in one lane ([`super::lanes::lane_step`]): the state
+    /// and first stage, the modes held through it, and the first stage as a [`Deriv`] (for
     /// [`Run::lane_step_done`]); `None` when the lanes do not cover this run or its modes.
     #[inline(always)]
     pub fn lane_start(&self, h: f64) -> Option<(LaneStart<f64>, RodModes<f64>, Deriv<N>)> {
