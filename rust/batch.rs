@@ -517,15 +517,15 @@ mod tests {
     /// The lanes give the scalar path's rows bit for bit: scenes that end at different
     /// times (angles from -85 to 89 deg, speeds from 0.05 to 5 m/s, spins), that stick,
     /// slide and spin, that start in the sand, that end at `t_end` or at every stop, at
-    /// the tip and at the centroid; and scenes the lanes do not cover (the raw sign model),
-    /// mixed in, which run alone.
+    /// the tip and at the centroid, under `modes` and the plain sign; and scenes the lanes
+    /// do not cover (the smooth sign model), mixed in, which run alone.
     #[test]
     fn lanes_rows_are_the_scalar_rows_bitwise() {
         let src = Source::Product {
             base: base(),
             axes: vec![
                 ("apply_at".into(), word(&["tip", "centroid"])),
-                ("sign_model".into(), word(&["modes", "raw"])),
+                ("sign_model".into(), word(&["modes", "raw", "smooth"])),
                 (
                     "q_deg".into(),
                     num(&[-85.0, -30.0, 0.0, 5.0, 45.0, 75.0, 89.0]),
@@ -550,13 +550,14 @@ mod tests {
 
     /// The free link's lean steps (the lanes' arithmetic in `f64`, `Run::step`) give the
     /// outcome of the general rigid-rod path (`full_step` through `Model::eval`) bit for bit,
-    /// over the scenes of the lanes' test: every field of the outcome, summaries and counts.
+    /// under `modes` and the plain sign: every field of the outcome, summaries and counts.
     #[test]
     fn lean_steps_are_the_general_path_bitwise() {
         use crate::integrate::solve::{solve, Run};
         let src = Source::Product {
             base: base(),
             axes: vec![
+                ("sign_model".into(), word(&["modes", "raw"])),
                 ("apply_at".into(), word(&["tip", "centroid"])),
                 ("end".into(), word(&["first_stop", "all_stops"])),
                 ("depth0".into(), num(&[0.0, 0.03])),

@@ -48,8 +48,9 @@ def _table_3_5() -> list[granrs.Scene]:
     return [cases.free_link(q_deg=float(q), v0=float(v)) for q, v in rows]
 
 
-def test_table_3_5_in_lanes_equals_the_scalar_path() -> None:
-    scenes = _table_3_5()
+@pytest.mark.parametrize("sign_model", ["modes", "raw"])
+def test_table_3_5_in_lanes_equals_the_scalar_path(sign_model: str) -> None:
+    scenes = [s.replace(sign_model=sign_model) for s in _table_3_5()]
     assert len(scenes) == 31
     lanes = granrs.sweep(scenes, threads=1, progress=False)
     scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
@@ -63,8 +64,8 @@ def test_table_3_5_in_lanes_equals_the_scalar_path() -> None:
 
 
 def test_uncovered_scenes_mixed_in_run_alone_with_the_same_rows() -> None:
-    """The raw and smooth sign models, another term set and Dopri5 (run alone), gravity off
-    and the centroid as the point of application (in lanes), in one sweep."""
+    """The smooth sign model, another term set and Dopri5 (run alone); the plain sign, gravity
+    off and the centroid as the point of application (in lanes), in one sweep."""
     base = cases.free_link(q_deg=30, v0=2.0)
     law = [drag(eta_d=15.2), static_h(eta_h=6.5), static_v(eta_v=248.0, lam=0.106)]
     scenes = [

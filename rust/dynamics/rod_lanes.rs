@@ -16,8 +16,9 @@
 //!
 //! What it covers: a free link ([`Model::rigid_rod`]) whose contact terms are exactly
 //! the thesis's three (`drag`, `static_h`, `static_v`, in that order; `gravity` on or off),
-//! under the `modes` sign model, applied at the tip or at the centroid ([`RodParams::of`]);
-//! and in modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
+//! under the `modes` sign model or the thesis's plain sign (`raw`: each evaluation's own
+//! signs, no sticking), applied at the tip or at the centroid ([`RodParams::of`]); and in
+//! modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
 //! sticks in both x and y, or whose one sticking row has a zero pivot
 //! ([`RodEval::pivot`]), is taken on the general path.
 
@@ -63,6 +64,9 @@ pub struct RodParams<F> {
     pub eta_v: F,
     /// static_v.lam.
     pub lam: F,
+    /// 1 under the plain sign (`raw`: the signs of v_E and of e x v_E are each
+    /// evaluation's own), 0 under `modes` (held through a step).
+    pub raw: F,
 }
 
 impl RodParams<f64> {
@@ -70,7 +74,12 @@ impl RodParams<f64> {
     /// another term set, another sign model; see the module).
     pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
         let rod = model.rigid_rod()?;
-        if model.sign_model != SignModel::Modes || model.forces.reads_frame {
+        let raw = match model.sign_model {
+            SignModel::Modes => 0.0,
+            SignModel::Raw => 1.0,
+            SignModel::Smooth { .. } => return None,
+        };
+        if model.forces.reads_frame {
             return None;
         }
         let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] =
@@ -101,6 +110,7 @@ impl RodParams<f64> {
             eta_h: h.eta_h,
             eta_v: v.eta_v,
             lam: v.lam,
+            raw,
         })
     }
 }
@@ -127,6 +137,7 @@ impl RodParams<F64x4> {
             eta_h: s(p.eta_h),
             eta_v: s(p.eta_v),
             lam: s(p.lam),
+            raw: s(p.raw),
         }
     }
 
@@ -148,6 +159,7 @@ impl RodParams<F64x4> {
         self.eta_h.0[i] = p.eta_h;
         self.eta_v.0[i] = p.eta_v;
         self.lam.0[i] = p.lam;
+        self.raw.0[i] = p.raw;
     }
 }
 
@@ -167,10 +179,13 @@ pub struct RodModes<F> {
 }
 
 impl RodModes<f64> {
-    /// `mode` for the lanes, or `None` when it sticks in both x and y (two sticking rows:
-    /// the scalar path takes the step).
-    pub fn of(mode: &ContactMode) -> Option<Self> {
-        let (sx, sy) = (mode.sx == Slip::Stick, mode.sy == Slip::Stick);
+    /// `mode` for the lanes of a run with `params` ([`RodParams::of`]), or `None` when it
+    /// sticks in both x and y (two sticking rows: the scalar path takes the step). Under the
+    /// plain sign nothing sticks (`Model::eval_rigid_rod` takes no reaction there).
+    pub fn of(mode: &ContactMode, params: &RodParams<f64>) -> Option<Self> {
+        let plain = params.raw > 0.0;
+        let stick = |s: Slip| !plain && s == Slip::Stick;
+        let (sx, sy) = (stick(mode.sx), stick(mode.sy));
         if mode.in_contact && sx && sy {
             return None;
         }
@@ -270,6 +285,13 @@ pub struct RodEval<F> {
     pub pivot: F,
 }
 
+/// [`super::raw_sign`] in `F`: -1, 0 or +1 (0 for a NaN, as there).
+#[inline(always)]
+fn plain_sign<F: Real>(v: F) -> F {
+    let (zero, one) = (F::splat(0.0), F::splat(1.0));
+    v.select_pos(one, (-v).select_pos(-one, zero))
+}
+
 /// [`Model::eval_rigid_rod`] of the free link under the thesis's terms, in `F`: the same
 /// operations in the same order, with blends for branches (see the module).
 #[inline(always)]
@@ -314,7 +336,24 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     let cross = sel(inside, axis[0] * v_in[1] - axis[1] * v_in[0], zero);
     // Forced: in contact and below the surface.
     let forced = depth_out;
-    let area_speed = p.diameter * immersed * (m.cross * cross);
+    // |e x v_E| as the drag reads it and the signs of v_E: the held ones under `modes`,
+    // each evaluation's own under `raw` (`Model::held_cross`, `Model::signs`). Under `modes`
+    // in every lane the plain ones are blended away: skip them (the same bits).
+    let plain = !p.raw.all_zero();
+    let held = if plain {
+        sel(p.raw, cross.abs(), m.cross * cross)
+    } else {
+        m.cross * cross
+    };
+    let sign = if plain {
+        [
+            sel(p.raw, plain_sign(v_centroid[0]), m.sign[0]),
+            sel(p.raw, plain_sign(v_centroid[1]), m.sign[1]),
+        ]
+    } else {
+        m.sign
+    };
+    let area_speed = p.diameter * immersed * held;
     let p_local = sel2(p.at_centroid, centroid, p.tip);
     let state = ContactState {
         depth,
@@ -323,7 +362,7 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
         l_ref: p.length,
         v: v_centroid,
         area_speed,
-        sign: m.sign,
+        sign,
         boundary: None,
     };
     // Out of the sand in every lane, each use of the law below is blended away: skip it
@@ -541,6 +580,18 @@ mod tests {
 
     /// A free link with its own mass, length, law and point of application.
     fn model(mass: f64, length: f64, eta: [f64; 4], centroid: bool, gravity: bool) -> Model<3> {
+        model_signed(mass, length, eta, centroid, gravity, false)
+    }
+
+    /// [`model`] under the plain sign (`raw`) or `modes`.
+    fn model_signed(
+        mass: f64,
+        length: f64,
+        eta: [f64; 4],
+        centroid: bool,
+        gravity: bool,
+        raw: bool,
+    ) -> Model<3> {
         let mut specs = vec![
             TermSpec::new("drag", &[("eta_d", eta[0])]),
             TermSpec::new("static_h", &[("eta_h", eta[1])]),
@@ -560,7 +611,11 @@ mod tests {
             forces: ForceSet::build(&specs, 1).unwrap(),
             ..FreeLinkScene::default()
         };
-        scene.model()
+        let mut model = scene.model();
+        if raw {
+            model.sign_model = SignModel::Raw;
+        }
+        model
     }
 
     fn slip(i: u8) -> Slip {
@@ -571,8 +626,9 @@ mod tests {
         v.iter().map(|x| x.to_bits()).collect()
     }
 
-    /// One lane's scene: (mass, length, eta_d, eta_h, eta_v, lam, centroid, gravity).
-    fn scene() -> impl Strategy<Value = (f64, f64, f64, f64, f64, f64, bool, bool)> {
+    /// One lane's scene: (mass, length, eta_d, eta_h, eta_v, lam, centroid, gravity, raw).
+    #[allow(clippy::type_complexity)]
+    fn scene() -> impl Strategy<Value = (f64, f64, f64, f64, f64, f64, bool, bool, bool)> {
         (
             0.05f64..1.0,
             0.05f64..0.4,
@@ -580,6 +636,7 @@ mod tests {
             0.0f64..20.0,
             0.0f64..600.0,
             0.0f64..1.0,
+            any::<bool>(),
             any::<bool>(),
             any::<bool>(),
         )
@@ -604,7 +661,8 @@ mod tests {
     proptest! {
         /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
         /// the accelerations, the power and every finding of the contact (what the events
-        /// and the observer read), in every mode the lanes cover.
+        /// and the observer read), in every mode the lanes cover, under `modes` and the
+        /// plain sign, mixed across the lanes.
         #[test]
         fn lanes_are_the_scalar_evaluation_bitwise(
             scenes in proptest::array::uniform4(scene()),
@@ -612,15 +670,16 @@ mod tests {
         ) {
             let models: Vec<Model<3>> = scenes
                 .iter()
-                .map(|s| model(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7))
+                .map(|s| model_signed(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7, s.8))
                 .collect();
-            let mut params = RodParams::splat(&RodParams::of(&models[0]).unwrap());
-            let mut modes = [RodModes::of(&ContactMode::default()).unwrap(); LANES];
+            let params_of = |i: usize| RodParams::of(&models[i]).unwrap();
+            let mut params = RodParams::splat(&params_of(0));
+            let mut modes = [RodModes::of(&ContactMode::default(), &params_of(0)).unwrap(); LANES];
             let mut all_modes = [[ContactMode::default(); MAX_CONTACTS]; LANES];
             let (mut q, mut qd) = ([F64x4::splat(0.0); 3], [F64x4::splat(0.0); 3]);
             let mut covered = [true; LANES];
             for i in 0..LANES {
-                params.set(i, &RodParams::of(&models[i]).unwrap());
+                params.set(i, &params_of(i));
                 let (th, depth, vx, vy, w, sx, sy, cross, inside, spin) = states[i];
                 let half = 0.5 * scenes[i].1;
                 let state_q = [half * th.sin(), half * th.cos() - depth, th];
@@ -636,7 +695,7 @@ mod tests {
                     cross: if cross { Slip::Neg } else { Slip::Pos },
                     ..ContactMode::default()
                 };
-                match RodModes::of(&all_modes[i][0]) {
+                match RodModes::of(&all_modes[i][0], &params_of(i)) {
                     Some(m) => modes[i] = m,
                     None => covered[i] = false,
                 }
@@ -679,14 +738,17 @@ mod tests {
         }
     }
 
-    /// The lanes cover the thesis's set under `modes`, and nothing else.
+    /// The lanes cover the thesis's set under `modes` and the plain sign, and nothing else.
     #[test]
     fn lanes_cover_the_thesis_set_only() {
         let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
-        assert!(RodParams::of(&thesis).is_some());
+        assert_eq!(RodParams::of(&thesis).map(|p| p.raw), Some(0.0));
         let mut raw = thesis.clone();
         raw.sign_model = SignModel::Raw;
-        assert!(RodParams::of(&raw).is_none());
+        assert_eq!(RodParams::of(&raw).map(|p| p.raw), Some(1.0));
+        let mut smooth = thesis.clone();
+        smooth.sign_model = SignModel::Smooth { eps: 1e-3 };
+        assert!(RodParams::of(&smooth).is_none());
         let mut reordered = thesis.clone();
         reordered.forces = ForceSet::build(
             &[
@@ -702,6 +764,9 @@ mod tests {
             in_contact: true,
             ..ContactMode::default()
         };
-        assert!(RodModes::of(&both).is_none());
+        assert!(RodModes::of(&both, &RodParams::of(&thesis).unwrap()).is_none());
+        // Under the plain sign nothing sticks: the same mode is covered, with no row.
+        let plain = RodModes::of(&both, &RodParams::of(&raw).unwrap()).unwrap();
+        assert_eq!((plain.stuck_x, plain.stuck_y), (0.0, 0.0));
     }
 }

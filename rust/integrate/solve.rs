@@ -301,8 +301,7 @@ impl<const N: usize> Run<N> {
     #[inline(always)]
     pub fn lane_start(&self, h: f64) -> Option<(LaneStart<f64>, RodModes<f64>, Deriv<N>)> {
         debug_assert!(!self.in_lanes, "resume the run first");
-        self.lean?;
-        let m = RodModes::of(&self.modes[0])?;
+        let m = RodModes::of(&self.modes[0], self.lean.as_ref()?)?;
         let (y, k1) = (&self.y, deriv_of(&self.y, &self.evals[self.cur]));
         let start = LaneStart {
             q: [y.q[0], y.q[1], y.q[2]],
