@@ -23,9 +23,9 @@ Parts:
   the core's call alone (``_granrs.sweep``: the pool's hand-off and the run, no DataFrame),
   against the run alone as the core times it, in the same loop. No target; it is what a
   small sweep pays beyond its runs (issue 22's two-thread line at 155 runs).
-* ``lanes``: 1000 free links (40 angles x 25 speeds) on one thread, under ``modes`` and
-  the plain sign (``raw``), with the SIMD lanes (``lanes=True``) and on the scalar path
-  (``lanes=False``), taken in turn. No target; the lanes' gain over the scalar path
+* ``lanes``: 1000 free links (40 angles x 25 speeds) on one thread under each sign model
+  (``modes``, ``raw``, ``smooth``), with the SIMD lanes (``lanes=True``) and on the scalar
+  path (``lanes=False``), taken in turn. No target; the lanes' gain over the scalar path
   (``docs/sweeps.md``).
 
 Build in release first: ``maturin develop --release``.
@@ -229,7 +229,7 @@ def part_lanes(repeat: int) -> list[str]:
     """1000 free links on one thread under each sign model the lanes cover, lanes and
     scalar path in turn, best of ``repeat``."""
     axes = {"q_deg": np.linspace(0.0, 75.0, 40), "v0": np.linspace(0.5, 4.0, 25)}
-    models = ("modes", "raw")
+    models = ("modes", "raw", "smooth")
     best = {(m, lanes): math.inf for m in models for lanes in (True, False)}
     for _ in range(repeat):
         for m, lanes in best:

@@ -517,8 +517,7 @@ mod tests {
     /// The lanes give the scalar path's rows bit for bit: scenes that end at different
     /// times (angles from -85 to 89 deg, speeds from 0.05 to 5 m/s, spins), that stick,
     /// slide and spin, that start in the sand, that end at `t_end` or at every stop, at
-    /// the tip and at the centroid, under `modes` and the plain sign; and scenes the lanes
-    /// do not cover (the smooth sign model), mixed in, which run alone.
+    /// the tip and at the centroid, under every sign model.
     #[test]
     fn lanes_rows_are_the_scalar_rows_bitwise() {
         let src = Source::Product {
@@ -550,14 +549,14 @@ mod tests {
 
     /// The free link's lean steps (the lanes' arithmetic in `f64`, `Run::step`) give the
     /// outcome of the general rigid-rod path (`full_step` through `Model::eval`) bit for bit,
-    /// under `modes` and the plain sign: every field of the outcome, summaries and counts.
+    /// under every sign model: every field of the outcome, summaries and counts.
     #[test]
     fn lean_steps_are_the_general_path_bitwise() {
         use crate::integrate::solve::{solve, Run};
         let src = Source::Product {
             base: base(),
             axes: vec![
-                ("sign_model".into(), word(&["modes", "raw"])),
+                ("sign_model".into(), word(&["modes", "raw", "smooth"])),
                 ("apply_at".into(), word(&["tip", "centroid"])),
                 ("end".into(), word(&["first_stop", "all_stops"])),
                 ("depth0".into(), num(&[0.0, 0.03])),

@@ -122,6 +122,10 @@ impl Real for F64x4 {
         let r = self.0.map(f64::sin_cos);
         (F64x4(r.map(|x| x.0)), F64x4(r.map(|x| x.1)))
     }
+    #[inline(always)]
+    fn tanh(self) -> Self {
+        self.map(f64::tanh)
+    }
 }
 
 /// Whether this CPU runs the lanes with AVX2 (256-bit) instructions: checked once at run
@@ -163,6 +167,7 @@ mod tests {
         check(a.abs().sqrt(), &|x, _| x.abs().sqrt());
         check(a.sin_cos().0, &|x, _| x.sin_cos().0);
         check(a.sin_cos().1, &|x, _| x.sin_cos().1);
+        check(a.tanh(), &|x, _| x.tanh());
         assert!(F64x4::splat(0.0).all_zero());
         assert!(!b.all_zero());
     }

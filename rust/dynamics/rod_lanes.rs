@@ -16,9 +16,10 @@
 //!
 //! What it covers: a free link ([`Model::rigid_rod`]) whose contact terms are exactly
 //! the thesis's three (`drag`, `static_h`, `static_v`, in that order; `gravity` on or off),
-//! under the `modes` sign model or the thesis's plain sign (`raw`: each evaluation's own
-//! signs, no sticking), applied at the tip or at the centroid ([`RodParams::of`]); and in
-//! modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
+//! under any sign model (`modes`, held through a step; the thesis's plain sign `raw` and
+//! `smooth`'s tanh, each evaluation's own, with no sticking), applied at the tip or at the
+//! centroid ([`RodParams::of`]); and in modes with at most one sticking row
+//! ([`RodModes::of`]). A step in a mode that
 //! sticks in both x and y, or whose one sticking row has a zero pivot
 //! ([`RodEval::pivot`]), is taken on the general path.
 
@@ -64,9 +65,13 @@ pub struct RodParams<F> {
     pub eta_v: F,
     /// static_v.lam.
     pub lam: F,
-    /// 1 under the plain sign (`raw`: the signs of v_E and of e x v_E are each
-    /// evaluation's own), 0 under `modes` (held through a step).
-    pub raw: F,
+    /// 1 where the signs of v_E and of e x v_E are each evaluation's own (`raw`, `smooth`),
+    /// 0 under `modes` (held through a step).
+    pub unheld: F,
+    /// 1 under `smooth` (the signs of v_E are tanh(v / eps)), else 0.
+    pub smooth: F,
+    /// `smooth`'s eps [m/s] (1 under the other sign models).
+    pub eps: F,
 }
 
 impl RodParams<f64> {
@@ -74,10 +79,10 @@ impl RodParams<f64> {
     /// another term set, another sign model; see the module).
     pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
         let rod = model.rigid_rod()?;
-        let raw = match model.sign_model {
-            SignModel::Modes => 0.0,
-            SignModel::Raw => 1.0,
-            SignModel::Smooth { .. } => return None,
+        let (unheld, smooth, eps) = match model.sign_model {
+            SignModel::Modes => (0.0, 0.0, 1.0),
+            SignModel::Raw => (1.0, 0.0, 1.0),
+            SignModel::Smooth { eps } => (1.0, 1.0, eps),
         };
         if model.forces.reads_frame {
             return None;
@@ -110,7 +115,9 @@ impl RodParams<f64> {
             eta_h: h.eta_h,
             eta_v: v.eta_v,
             lam: v.lam,
-            raw,
+            unheld,
+            smooth,
+            eps,
         })
     }
 }
@@ -137,7 +144,9 @@ impl RodParams<F64x4> {
             eta_h: s(p.eta_h),
             eta_v: s(p.eta_v),
             lam: s(p.lam),
-            raw: s(p.raw),
+            unheld: s(p.unheld),
+            smooth: s(p.smooth),
+            eps: s(p.eps),
         }
     }
 
@@ -159,7 +168,9 @@ impl RodParams<F64x4> {
         self.eta_h.0[i] = p.eta_h;
         self.eta_v.0[i] = p.eta_v;
         self.lam.0[i] = p.lam;
-        self.raw.0[i] = p.raw;
+        self.unheld.0[i] = p.unheld;
+        self.smooth.0[i] = p.smooth;
+        self.eps.0[i] = p.eps;
     }
 }
 
@@ -180,10 +191,10 @@ pub struct RodModes<F> {
 
 impl RodModes<f64> {
     /// `mode` for the lanes of a run with `params` ([`RodParams::of`]), or `None` when it
-    /// sticks in both x and y (two sticking rows: the scalar path takes the step). Under the
-    /// plain sign nothing sticks (`Model::eval_rigid_rod` takes no reaction there).
+    /// sticks in both x and y (two sticking rows: the scalar path takes the step). Where
+    /// the signs are not held nothing sticks (`Model::eval_rigid_rod` takes no reaction).
     pub fn of(mode: &ContactMode, params: &RodParams<f64>) -> Option<Self> {
-        let plain = params.raw > 0.0;
+        let plain = params.unheld > 0.0;
         let stick = |s: Slip| !plain && s == Slip::Stick;
         let (sx, sy) = (stick(mode.sx), stick(mode.sy));
         if mode.in_contact && sx && sy {
@@ -337,21 +348,27 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     // Forced: in contact and below the surface.
     let forced = depth_out;
     // |e x v_E| as the drag reads it and the signs of v_E: the held ones under `modes`,
-    // each evaluation's own under `raw` (`Model::held_cross`, `Model::signs`). Under `modes`
-    // in every lane the plain ones are blended away: skip them (the same bits).
-    let plain = !p.raw.all_zero();
-    let held = if plain {
-        sel(p.raw, cross.abs(), m.cross * cross)
-    } else {
+    // each evaluation's own under `raw` and `smooth` (`Model::held_cross`, `Model::signs`).
+    // What every lane blends away is skipped (the same bits, less work: `tanh` is libm's).
+    let held = if p.unheld.all_zero() {
         m.cross * cross
-    };
-    let sign = if plain {
-        [
-            sel(p.raw, plain_sign(v_centroid[0]), m.sign[0]),
-            sel(p.raw, plain_sign(v_centroid[1]), m.sign[1]),
-        ]
     } else {
+        sel(p.unheld, cross.abs(), m.cross * cross)
+    };
+    let own = |v: F| {
+        if p.smooth.all_zero() {
+            plain_sign(v)
+        } else {
+            sel(p.smooth, (v / p.eps).tanh(), plain_sign(v))
+        }
+    };
+    let sign = if p.unheld.all_zero() {
         m.sign
+    } else {
+        [
+            sel(p.unheld, own(v_centroid[0]), m.sign[0]),
+            sel(p.unheld, own(v_centroid[1]), m.sign[1]),
+        ]
     };
     let area_speed = p.diameter * immersed * held;
     let p_local = sel2(p.at_centroid, centroid, p.tip);
@@ -580,17 +597,17 @@ mod tests {
 
     /// A free link with its own mass, length, law and point of application.
     fn model(mass: f64, length: f64, eta: [f64; 4], centroid: bool, gravity: bool) -> Model<3> {
-        model_signed(mass, length, eta, centroid, gravity, false)
+        model_signed(mass, length, eta, centroid, gravity, SignModel::Modes)
     }
 
-    /// [`model`] under the plain sign (`raw`) or `modes`.
+    /// [`model`] under a sign model of its own.
     fn model_signed(
         mass: f64,
         length: f64,
         eta: [f64; 4],
         centroid: bool,
         gravity: bool,
-        raw: bool,
+        sign_model: SignModel,
     ) -> Model<3> {
         let mut specs = vec![
             TermSpec::new("drag", &[("eta_d", eta[0])]),
@@ -612,9 +629,7 @@ mod tests {
             ..FreeLinkScene::default()
         };
         let mut model = scene.model();
-        if raw {
-            model.sign_model = SignModel::Raw;
-        }
+        model.sign_model = sign_model;
         model
     }
 
@@ -626,9 +641,18 @@ mod tests {
         v.iter().map(|x| x.to_bits()).collect()
     }
 
-    /// One lane's scene: (mass, length, eta_d, eta_h, eta_v, lam, centroid, gravity, raw).
+    /// A sign model: `modes`, `raw` or `smooth` with an eps of 1e-3 .. 0.5 m/s.
+    fn sign_model() -> impl Strategy<Value = SignModel> {
+        prop_oneof![
+            Just(SignModel::Modes),
+            Just(SignModel::Raw),
+            (1e-3f64..0.5).prop_map(|eps| SignModel::Smooth { eps }),
+        ]
+    }
+
+    /// One lane's scene: (mass, length, eta_d, eta_h, eta_v, lam, centroid, gravity, signs).
     #[allow(clippy::type_complexity)]
-    fn scene() -> impl Strategy<Value = (f64, f64, f64, f64, f64, f64, bool, bool, bool)> {
+    fn scene() -> impl Strategy<Value = (f64, f64, f64, f64, f64, f64, bool, bool, SignModel)> {
         (
             0.05f64..1.0,
             0.05f64..0.4,
@@ -638,7 +662,7 @@ mod tests {
             0.0f64..1.0,
             any::<bool>(),
             any::<bool>(),
-            any::<bool>(),
+            sign_model(),
         )
     }
 
@@ -661,8 +685,8 @@ mod tests {
     proptest! {
         /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
         /// the accelerations, the power and every finding of the contact (what the events
-        /// and the observer read), in every mode the lanes cover, under `modes` and the
-        /// plain sign, mixed across the lanes.
+        /// and the observer read), in every mode the lanes cover, under every sign model,
+        /// mixed across the lanes.
         #[test]
         fn lanes_are_the_scalar_evaluation_bitwise(
             scenes in proptest::array::uniform4(scene()),
@@ -738,17 +762,18 @@ mod tests {
         }
     }
 
-    /// The lanes cover the thesis's set under `modes` and the plain sign, and nothing else.
+    /// The lanes cover the thesis's set under every sign model, and nothing else.
     #[test]
     fn lanes_cover_the_thesis_set_only() {
         let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
-        assert_eq!(RodParams::of(&thesis).map(|p| p.raw), Some(0.0));
+        let flags = |m: &Model<3>| RodParams::of(m).map(|p| (p.unheld, p.smooth, p.eps));
+        assert_eq!(flags(&thesis), Some((0.0, 0.0, 1.0)));
         let mut raw = thesis.clone();
         raw.sign_model = SignModel::Raw;
-        assert_eq!(RodParams::of(&raw).map(|p| p.raw), Some(1.0));
+        assert_eq!(flags(&raw), Some((1.0, 0.0, 1.0)));
         let mut smooth = thesis.clone();
         smooth.sign_model = SignModel::Smooth { eps: 1e-3 };
-        assert!(RodParams::of(&smooth).is_none());
+        assert_eq!(flags(&smooth), Some((1.0, 1.0, 1e-3)));
         let mut reordered = thesis.clone();
         reordered.forces = ForceSet::build(
             &[

@@ -74,6 +74,8 @@ pub trait Real:
     fn all_zero(self) -> bool;
     /// Sine and cosine (libm's, in each lane).
     fn sin_cos(self) -> (Self, Self);
+    /// Hyperbolic tangent (libm's, in each lane).
+    fn tanh(self) -> Self;
 }
 
 impl Real for f64 {
@@ -120,6 +122,10 @@ impl Real for f64 {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         f64::sin_cos(self)
+    }
+    #[inline(always)]
+    fn tanh(self) -> Self {
+        f64::tanh(self)
     }
 }
 
