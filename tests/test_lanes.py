@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 import granrs
 from granrs import cases
 from granrs.errors import InvalidParameterError
-from granrs.forces import drag, gravity, static_h, static_v
+from granrs.forces import drag, gravity, select, static_h, static_v, thesis
 
 #: The issue's tolerance between a lane and the scalar path.
 RTOL = 1e-12
@@ -65,14 +65,17 @@ def test_table_3_5_in_lanes_equals_the_scalar_path(sign_model: str) -> None:
 
 
 def test_uncovered_scenes_mixed_in_run_alone_with_the_same_rows() -> None:
-    """Another term set and Dopri5 (run alone); the raw and smooth sign models, gravity off
-    and the centroid as the point of application (in lanes), in one sweep."""
+    """The thesis's terms out of its order and Dopri5 (run alone); some of its terms, the raw
+    and smooth sign models, gravity off and the centroid as the point of application (in
+    lanes), in one sweep."""
     base = cases.free_link(q_deg=30, v0=2.0)
     law = [drag(eta_d=15.2), static_h(eta_h=6.5), static_v(eta_v=248.0, lam=0.106)]
     scenes = [
         base,
         base.replace(sign_model="raw"),
         base.replace(forces=[gravity(), drag(eta_d=15.2), static_v(eta_v=248.0, lam=0.106)]),
+        base.replace(forces=[gravity(), static_v(eta_v=248.0, lam=0.106), drag(eta_d=15.2)]),
+        base.replace(forces=[gravity(), static_h(eta_h=6.5)]),
         base.replace(forces=law),
         base.replace(apply_at="centroid"),
         base.replace(method="dopri5"),
@@ -113,6 +116,19 @@ def test_random_sweeps_in_lanes_equal_the_scalar_path(
     lanes = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False)
     scalar = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False, lanes=False)
     _assert_same(lanes, scalar)
+
+
+@pytest.mark.parametrize("keep", [("static_v",), ("drag", "static_v"), ("static_h", "static_v")])
+def test_some_of_the_thesis_terms_in_lanes_equal_the_scalar_path(keep: tuple[str, ...]) -> None:
+    """A pruned law (some of the thesis's terms, with gravity) runs in the lanes: the same
+    rows bit for bit as the scalar path and as simulate()."""
+    law = select(thesis(), "gravity", *keep)
+    scenes = [s.replace(forces=law) for s in _table_3_5()]
+    lanes = granrs.sweep(scenes, threads=1, progress=False)
+    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
+    _assert_same(lanes, scalar)
+    for row, scene in zip(lanes.itertuples(index=False), scenes, strict=True):
+        assert row.depth == granrs.simulate(scene).summary["depth"]
 
 
 def test_lanes_must_be_a_bool() -> None:
