@@ -93,7 +93,9 @@ impl RodLayout {
     /// The layout of `model`'s contact terms, where [`RodParams::of`] covers it.
     #[inline(never)]
     pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
-        let (slot, _) = thesis_slots(&model.forces.per_contact[0])?;
+        // A free link (one contact) only: other bodies may list no contact at all.
+        model.rigid_rod()?;
+        let (slot, _) = thesis_slots(model.forces.per_contact.first()?)?;
         Some(RodLayout {
             slot,
             owns: [slot[1] != usize::MAX, slot[2] != usize::MAX],
@@ -902,6 +904,17 @@ mod tests {
             }
         }
         assert!(lean_steps > 50_000, "{lean_steps} steps");
+    }
+
+    /// A body the lean path does not cover has no layout, even one with no contact at all
+    /// (a linkage with none: `Run::new` asks every model).
+    #[test]
+    fn only_a_free_link_has_a_layout() {
+        let mut pendulum = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
+        pendulum.forces.per_contact.clear();
+        pendulum.contacts.clear();
+        assert!(RodLayout::of(&pendulum).is_none());
+        assert!(RodParams::of(&pendulum).is_none());
     }
 
     /// The lanes cover the thesis's set under every sign model, and nothing else.
