@@ -5,11 +5,11 @@
 //! result is bit for bit what the scalar path computes. The vector instructions come from
 //! the compiler: the lanes' step is compiled twice, once for the baseline target and once
 //! with AVX2 enabled (`#[target_feature]`), and the CPU picks one at run time ([`avx2`]).
-//! The scalar path's lean step (the same step in one lane, `f64`) is dispatched the same way:
-//! with AVX2's three-operand encodings it needs fewer register copies (a thesis-law impact
-//! about 8 % faster, bit for bit the same). One wheel thus runs on any x86-64 (SSE2, two lanes per instruction), uses
-//! 256-bit registers where the CPU has them, and builds unchanged for arm64 (NEON, two
-//! lanes per instruction). `sin_cos` and `powf` are libm's, lane by lane (libm has no vector
+//! The scalar path's lean step (the same step in one lane, `f64`) is dispatched the same
+//! way: with AVX2's three-operand encodings it needs fewer register copies (a thesis-law
+//! impact about 8 % faster, bit for bit the same). One wheel thus runs on any x86-64 (SSE2,
+//! two lanes per instruction), uses 256-bit registers where the CPU has them, and builds
+//! unchanged for arm64 (NEON, two lanes per instruction). `sin_cos` and `powf` are libm's, lane by lane (libm has no vector
 //! versions). Vectorized ones were written and measured: a `sin_cos` (range reduction and a
 //! series, within 1 ulp of glibc) made the lanes 8 % faster but the scalar path, which must
 //! call the same function for the lanes to stay bit for bit, 22 % slower; a `pow` within 1

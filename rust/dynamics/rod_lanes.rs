@@ -17,13 +17,12 @@
 //! What it covers: a free link ([`Model::rigid_rod`]) whose contact terms are the thesis's
 //! three or any of them (`drag`, `static_h`, `static_v`, in that order; `gravity` on or off:
 //! an absent term is one with a zero coefficient, whose force is exactly zero, so every sum
-//! has the general path's bits),
-//! under any sign model (`modes`, held through a step; the thesis's plain sign `raw` and
-//! `smooth`'s tanh, each evaluation's own, with no sticking), applied at the tip or at the
-//! centroid ([`RodParams::of`]); and in modes with at most one sticking row
-//! ([`RodModes::of`]). A step in a mode that
-//! sticks in both x and y, or whose one sticking row has a zero pivot
-//! ([`RodEval::pivot`]), is taken on the general path.
+//! has the general path's bits), under any sign model (`modes`, held through a step; the
+//! thesis's plain sign `raw` and `smooth`'s tanh, each evaluation's own, with no sticking),
+//! applied at the tip or at the centroid ([`RodParams::of`], [`RodLayout::of`]); and in modes
+//! with at most one sticking row ([`RodModes::of`]). A step in a mode that sticks in both x
+//! and y, or whose one sticking row has a zero pivot ([`RodEval::pivot`]), is taken on the
+//! general path.
 
 use nalgebra::{SVector, Vector2};
 
@@ -89,6 +88,16 @@ pub struct RodLayout {
     pub owns: [bool; 2],
 }
 
+impl Default for RodLayout {
+    /// No term placed and no axis owned: the layout of a run off the lean path (never read).
+    fn default() -> Self {
+        RodLayout {
+            slot: [usize::MAX; 3],
+            owns: [false; 2],
+        }
+    }
+}
+
 impl RodLayout {
     /// The layout of `model`'s contact terms, where [`RodParams::of`] covers it.
     #[inline(never)]
@@ -103,7 +112,7 @@ impl RodLayout {
     }
 }
 
-/// Where each of the thesis's terms stands in `terms` ([`RodParams::slot`]), when `terms`
+/// Where each of the thesis's terms stands in `terms` ([`RodLayout::slot`]), when `terms`
 /// lists only those, each at most once and in the thesis's order.
 #[inline(never)]
 fn thesis_slots(terms: &[AnyTerm]) -> Option<([usize; 3], [Option<&AnyTerm>; 3])> {

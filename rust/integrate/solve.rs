@@ -183,10 +183,7 @@ impl<const N: usize> Run<N> {
                 Method::Rk4 => RodParams::of(model),
                 Method::Dopri5 { .. } => None,
             },
-            layout: RodLayout::of(model).unwrap_or(RodLayout {
-                slot: [usize::MAX; 3],
-                owns: [false; 2],
-            }),
+            layout: RodLayout::of(model).unwrap_or_default(),
             isa: LaneIsa::detect(),
             in_lanes: false,
         }
