@@ -24,9 +24,9 @@ Parts:
   against the run alone as the core times it, in the same loop. No target; it is what a
   small sweep pays beyond its runs (issue 22's two-thread line at 155 runs).
 * ``lanes``: 1000 free links (40 angles x 25 speeds) on one thread under each sign model
-  (``modes``, ``raw``, ``smooth``), with the SIMD lanes (``lanes=True``) and on the scalar
-  path (``lanes=False``), taken in turn. No target; the lanes' gain over the scalar path
-  (``docs/sweeps.md``).
+  (``modes``, ``raw``, ``smooth``) and under ``rft`` alone, with the SIMD lanes
+  (``lanes=True``) and on the scalar path (``lanes=False``), taken in turn. No target; the
+  lanes' gain over the scalar path (``docs/sweeps.md``).
 
 Build in release first: ``maturin develop --release``.
 """
@@ -226,24 +226,27 @@ def part_fixed(repeat: int) -> list[str]:
 
 # ---------------------------------------------------------------------------------- lanes
 def part_lanes(repeat: int) -> list[str]:
-    """1000 free links on one thread under each sign model the lanes cover, lanes and
-    scalar path in turn, best of ``repeat``."""
+    """1000 free links on one thread under each sign model the lanes cover, and under
+    ``rft`` alone, lanes and scalar path in turn, best of ``repeat``."""
+    from granrs import forces
+
     axes = {"q_deg": np.linspace(0.0, 75.0, 40), "v0": np.linspace(0.5, 4.0, 25)}
-    models = ("modes", "raw", "smooth")
-    best = {(m, lanes): math.inf for m in models for lanes in (True, False)}
+    base = cases.free_link(q_deg=0.0, v0=2.0)
+    laws = {m: base.replace(sign_model=m) for m in ("modes", "raw", "smooth")}
+    laws["rft (modes)"] = base.replace(forces=[forces.gravity(), forces.rft(zeta=1e6)])
+    best = {(m, lanes): math.inf for m in laws for lanes in (True, False)}
     for _ in range(repeat):
         for m, lanes in best:
-            base = cases.free_link(q_deg=0.0, v0=2.0).replace(sign_model=m)
             t0 = time.perf_counter()
-            granrs.sweep(base, lanes=lanes, threads=1, progress=False, **axes)
+            granrs.sweep(laws[m], lanes=lanes, threads=1, progress=False, **axes)
             best[(m, lanes)] = min(best[(m, lanes)], time.perf_counter() - t0)
     lines = [
         "### SIMD lanes against the scalar path (1000 free links, one thread)",
         "",
-        "| sign model | lanes [ms] | scalar path [ms] | lanes / scalar |",
+        "| law | lanes [ms] | scalar path [ms] | lanes / scalar |",
         "|---|---|---|---|",
     ]
-    for m in models:
+    for m in laws:
         on, off = best[(m, True)], best[(m, False)]
         lines.append(f"| {m} | {on * 1e3:.1f} | {off * 1e3:.1f} | {on / off:.3f} |")
     return [*lines, "", f"Best of {repeat}; a sweep's ms are its us per impact.", ""]

@@ -76,6 +76,7 @@ impl Neg for F64x4 {
 }
 
 impl Real for F64x4 {
+    const LANES: usize = LANES;
     #[inline(always)]
     fn splat(x: f64) -> Self {
         F64x4([x; LANES])

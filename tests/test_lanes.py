@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 import granrs
 from granrs import cases
 from granrs.errors import InvalidParameterError
-from granrs.forces import drag, gravity, select, static_h, static_v, thesis
+from granrs.forces import drag, gravity, rft, select, static_h, static_v, thesis
 
 #: The issue's tolerance between a lane and the scalar path.
 RTOL = 1e-12
@@ -129,6 +129,80 @@ def test_some_of_the_thesis_terms_in_lanes_equal_the_scalar_path(keep: tuple[str
     _assert_same(lanes, scalar)
     for row, scene in zip(lanes.itertuples(index=False), scenes, strict=True):
         assert row.depth == granrs.simulate(scene).summary["depth"]
+
+
+@pytest.mark.parametrize(
+    ("sign_model", "law"),
+    [
+        ("modes", {"zeta": 1e6}),
+        ("raw", {"zeta": 1e6}),
+        ("smooth", {"zeta": 5e5, "elements": 3}),
+        ("modes", {"zeta": 2e6, "elements": 13, "coefficients": {"A10": 0.3, "D10": -0.1}}),
+    ],
+)
+def test_rft_in_lanes_equals_the_scalar_path(sign_model: str, law: dict[str, object]) -> None:
+    """`rft` alone runs in the lanes (one law for the four): the Table 3.5 scenes give the
+    scalar path's rows bit for bit, and simulate()'s."""
+    term = rft(**law)  # type: ignore[arg-type]
+    scenes = [s.replace(forces=[gravity(), term], sign_model=sign_model) for s in _table_3_5()]
+    lanes = granrs.sweep(scenes, threads=1, progress=False)
+    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
+    _assert_same(lanes, scalar)
+    assert lanes["t_s"].nunique() > 20 or sign_model == "smooth"
+    for row, scene in zip(lanes.itertuples(index=False), scenes, strict=True):
+        assert row.depth == granrs.simulate(scene).summary["depth"]
+
+
+def test_a_sweep_that_mixes_rft_laws_and_the_thesis_has_the_scalar_rows() -> None:
+    """The lanes run one `rft` law at a time: a scene under another law (another zeta, the
+    thesis's terms) takes the lanes over when they are idle, else runs alone; the rows are
+    the scalar path's whatever the order."""
+    base = cases.free_link(q_deg=0.0, v0=2.0)
+    laws = [
+        [gravity(), rft(zeta=1e6)],
+        [gravity(), rft(zeta=3e5, elements=4)],
+        list(thesis()),
+    ]
+    rng = np.random.default_rng(3)
+    scenes = [
+        base.replace(forces=laws[k], q_deg=float(q), v0=float(v))
+        for k, q, v in zip(
+            rng.integers(0, 3, 40), rng.uniform(-80, 80, 40), rng.uniform(0.2, 4, 40), strict=True
+        )
+    ]
+    lanes = granrs.sweep(scenes, threads=1, progress=False)
+    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
+    _assert_same(lanes, scalar)
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    qs=st.lists(st.floats(-88.0, 88.0), min_size=1, max_size=4),
+    vs=st.lists(st.floats(0.05, 5.0), min_size=1, max_size=3),
+    omega0=st.floats(-15.0, 15.0),
+    vx0=st.floats(-3.0, 3.0),
+    zeta=st.floats(1e4, 3e6),
+    elements=st.integers(1, 12),
+    sign_model=st.sampled_from(["modes", "raw"]),
+)
+def test_random_rft_sweeps_in_lanes_equal_the_scalar_path(
+    qs: list[float],
+    vs: list[float],
+    omega0: float,
+    vx0: float,
+    zeta: float,
+    elements: int,
+    sign_model: str,
+) -> None:
+    base = cases.free_link(q_deg=0.0, v0=1.0).replace(
+        omega0=omega0,
+        vx0=vx0,
+        sign_model=sign_model,
+        forces=[gravity(), rft(zeta=zeta, elements=elements)],
+    )
+    lanes = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False)
+    scalar = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False, lanes=False)
+    _assert_same(lanes, scalar)
 
 
 def test_lanes_must_be_a_bool() -> None:

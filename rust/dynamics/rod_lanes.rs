@@ -1,11 +1,13 @@
-//! The free link under the thesis's terms for one scene or several at once: [`Model::eval_rigid_rod`]
-//! written over [`Real`]. With `F = f64` it is the lean path of a lone run's RK4 steps
+//! The free link under the thesis's terms or `rft` alone, for one scene or several at once:
+//! [`Model::eval_rigid_rod`] written over [`Real`]. With `F = f64` it is the lean path of a lone run's RK4 steps
 //! (`integrate::solve::Run::step`: a stage computes only what the step reads, after
 //! inlining); with `F = F64x4` it evaluates four scenes, one per SIMD lane, in the same
 //! instructions (the sweep's lanes, `integrate::lanes`).
 //!
 //! The force law is not copied: the terms' own arithmetic ([`Drag::law`], [`StaticH::law`],
-//! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane.
+//! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane,
+//! and `rft`'s own `contact_force` on the boundary the general path gives it (one law for
+//! the four lanes: its element count sets the loop).
 //! The mechanics (the rod's frame, its immersed geometry, the closed-form sticking row and
 //! the sums of [`super::rigid_rod`]) are written again without branches: each branch of the
 //! scalar path becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation
@@ -19,8 +21,11 @@
 //! an absent term is one with a zero coefficient, whose force is exactly zero, so every sum
 //! has the general path's bits), under any sign model (`modes`, held through a step; the
 //! thesis's plain sign `raw` and `smooth`'s tanh, each evaluation's own, with no sticking),
-//! applied at the tip or at the centroid ([`RodParams::of`], [`RodLayout::of`]); and in modes
-//! with at most one sticking row ([`RodModes::of`]). A step in a mode that sticks in both x
+//! applied at the tip or at the centroid ([`RodParams::of`], [`RodLayout::of`]); or whose one
+//! contact term is `rft` (any coefficients and element count; its moment, its held sign's
+//! shift of the frame and its bounded reaction in y, from depth 0 while in contact, as the
+//! general path reads a law that reads the frame); and in modes with at most one sticking
+//! row ([`RodModes::of`]). A step in a mode that sticks in both x
 //! and y, or whose one sticking row has a zero pivot ([`RodEval::pivot`]), is taken on the
 //! general path.
 
@@ -29,9 +34,12 @@ use nalgebra::{SVector, Vector2};
 use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, SignModel, Slip};
 use crate::body::rod::ApplyAt;
 use crate::forces::drag::Drag;
+use crate::forces::rft::Rft;
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
-use crate::forces::{AnyTerm, ContactState, Medium, Real, TermForce};
+use crate::forces::{
+    AnyTerm, Boundary, ContactState, Frame, Medium, Outline, Real, Term, TermForce,
+};
 use crate::simd::{F64x4, LANES};
 
 /// What the evaluation of one free link under the thesis's terms reads that is fixed
@@ -73,6 +81,9 @@ pub struct RodParams<F> {
     pub smooth: F,
     /// `smooth`'s eps [m/s] (1 under the other sign models).
     pub eps: F,
+    /// The law when it is `rft` alone (then the thesis's coefficients are zero): one for
+    /// every lane (the lanes take only runs with the same, [`RodParams::set`]).
+    pub rft: Option<Rft>,
 }
 
 /// Where a run's listed terms stand among the thesis's, read on the scalar side only (kept
@@ -104,7 +115,15 @@ impl RodLayout {
     pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
         // A free link (one contact) only: other bodies may list no contact at all.
         model.rigid_rod()?;
-        let (slot, _) = thesis_slots(model.forces.per_contact.first()?)?;
+        let terms = model.forces.per_contact.first()?;
+        if rft_alone(terms).is_some() {
+            // Its force in the y owner's place (it owns the slip switch of y, not of x).
+            return Some(RodLayout {
+                slot: [usize::MAX, usize::MAX, 0],
+                owns: [false, true],
+            });
+        }
+        let (slot, _) = thesis_slots(terms)?;
         Some(RodLayout {
             slot,
             owns: [slot[1] != usize::MAX, slot[2] != usize::MAX],
@@ -136,6 +155,15 @@ fn thesis_slots(terms: &[AnyTerm]) -> Option<([usize; 3], [Option<&AnyTerm>; 3])
     Some((slot, found))
 }
 
+/// The `rft` term of a law that lists it alone.
+#[inline]
+fn rft_alone(terms: &[AnyTerm]) -> Option<Rft> {
+    match terms {
+        [AnyTerm::Rft(r)] => Some(*r),
+        _ => None,
+    }
+}
+
 impl RodParams<f64> {
     /// The parameters of `model`, or `None` when the lanes do not cover it (another body,
     /// another term set, another sign model; see the module).
@@ -147,10 +175,17 @@ impl RodParams<f64> {
             SignModel::Raw => (1.0, 0.0, 1.0),
             SignModel::Smooth { eps } => (1.0, 1.0, eps),
         };
-        if model.forces.reads_frame {
+        let terms = &model.forces.per_contact[0];
+        let rft = rft_alone(terms);
+        if model.forces.reads_frame && rft.is_none() {
             return None;
         }
-        let (slot, found) = thesis_slots(&model.forces.per_contact[0])?;
+        // `rft` alone: no thesis term, and it owns the slip switch of y as the lanes place
+        // it ([`RodLayout::of`]).
+        let (slot, found) = match rft {
+            Some(_) => ([usize::MAX, usize::MAX, 0], [None; 3]),
+            None => thesis_slots(terms)?,
+        };
         let listed = |c: usize| (slot[c] != usize::MAX).then_some(slot[c]);
         // The sticking reaction replaces its owner's component: the lanes' owners are
         // `static_h` (x) and `static_v` (y), as the general path finds them.
@@ -189,6 +224,7 @@ impl RodParams<f64> {
             unheld,
             smooth,
             eps,
+            rft,
         })
     }
 }
@@ -218,11 +254,13 @@ impl RodParams<F64x4> {
             unheld: s(p.unheld),
             smooth: s(p.smooth),
             eps: s(p.eps),
+            rft: p.rft,
         }
     }
 
-    /// Lane `i` becomes `p`.
+    /// Lane `i` becomes `p`, whose `rft` must be the lanes' (one law's arithmetic for all).
     pub fn set(&mut self, i: usize, p: &RodParams<f64>) {
+        debug_assert_eq!(self.rft, p.rft, "the lanes run one `rft` law");
         self.mass.0[i] = p.mass;
         self.g.0[i] = p.g;
         self.inv_m.0[i] = p.inv_m;
@@ -365,6 +403,8 @@ pub struct RodEval<F> {
     pub dynamic: [F; 2],
     /// F_s (or its reaction).
     pub statics: [F; 2],
+    /// The terms' moment about P (`rft`'s; zero under the thesis's terms).
+    pub moment: F,
     /// The sticking bounds.
     pub bound: [F; 2],
     /// Where a sticking row acts: its pivot `1/m + lever_E lever_P / I`; 1 elsewhere. A
@@ -379,10 +419,28 @@ fn plain_sign<F: Real>(v: F) -> F {
     v.select_pos(one, (-v).select_pos(-one, zero))
 }
 
-/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms, in `F`: the same
-/// operations in the same order, with blends for branches (see the module).
+/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms or `rft` alone
+/// (`p.rft`), in `F`: [`rod_eval_law`] for the law at hand.
 #[inline(always)]
 pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F; 3]) -> RodEval<F> {
+    if p.rft.is_some() {
+        rod_eval_law::<F, true>(p, m, q, qd)
+    } else {
+        rod_eval_law::<F, false>(p, m, q, qd)
+    }
+}
+
+/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms (`RFT` false) or
+/// `rft` alone (`RFT` true, `p.rft` set), in `F`: the same operations in the same order,
+/// with blends for branches (see the module). One compiled step per law, so that the
+/// thesis's carries no `rft` code (measured: 4 % slower lanes with both in one).
+#[inline(always)]
+pub fn rod_eval_law<F: Real, const RFT: bool>(
+    p: &RodParams<F>,
+    m: &RodModes<F>,
+    q: &[F; 3],
+    qd: &[F; 3],
+) -> RodEval<F> {
     let zero = F::splat(0.0);
     let sel = |flag: F, a: F, b: F| flag.select_pos(a, b);
     let sel2 = |flag: F, a: [F; 2], b: [F; 2]| [sel(flag, a[0], b[0]), sel(flag, a[1], b[1])];
@@ -421,8 +479,9 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     let v_in = velocity(centroid);
     let v_centroid = sel2(inside, v_in, v_tip);
     let cross = sel(inside, axis[0] * v_in[1] - axis[1] * v_in[0], zero);
-    // Forced: in contact and below the surface.
-    let forced = depth_out;
+    // Forced: in contact and below the surface; in contact for a law that reads the frame
+    // (`rft`: `Model::eval_rigid_rod`).
+    let forced = if RFT { inside } else { depth_out };
     // |e x v_E| as the drag reads it and the signs of v_E: the held ones under `modes`,
     // each evaluation's own under `raw` and `smooth` (`Model::held_cross`, `Model::signs`).
     // What every lane blends away is skipped (the same bits, less work: `tanh` is libm's).
@@ -460,13 +519,50 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     };
     // Out of the sand in every lane, each use of the law below is blended away: skip it
     // (its `pow`). The results are the same bit for bit.
+    let none = TermForce {
+        force: [zero, zero],
+        bound: [zero, zero],
+        moment: zero,
+    };
     let (fd, fh, fv) = if forced.all_zero() {
-        let none = TermForce {
-            force: [zero, zero],
-            bound: [zero, zero],
-            moment: zero,
-        };
         (none, none, none)
+    } else if let (true, Some(rft)) = (RFT, &p.rft) {
+        // `rft` alone, in static_v's place (the owner of y's slip switch), on the boundary
+        // `Model::eval_rigid_rod` gives it: T's and E's velocities held on the side of the
+        // held sign of v_Ey, the one slip switch it owns (`held_shift`: x's shift is +0),
+        // P and E in the world, y held while it sticks.
+        let shift = (-(sign[1] * v_centroid[1])).select_pos(F::splat(-2.0) * v_centroid[1], zero);
+        let b = Boundary {
+            frame: Frame {
+                origin: tip,
+                v: [v_tip[0] + zero, v_tip[1] + shift],
+                // q turns clockwise: the counter-clockwise rate is -dq/dt.
+                omega: -omega,
+                axis,
+            },
+            outline: Outline::Rod {
+                diameter: p.diameter,
+                immersed,
+            },
+            apply: at(p_local),
+            centroid: at(centroid),
+            v_centroid: [v_centroid[0] + zero, v_centroid[1] + shift],
+            held: [m.stuck_x, m.stuck_y],
+        };
+        let state = ContactState {
+            area_speed: zero,
+            boundary: Some(&b),
+            ..state
+        };
+        // In the lanes, inlined into their step (AVX2 where the CPU has it); a lone run
+        // calls the general path's own copy (inlined into the AVX2 step, the group of
+        // eight elements was slower: measured).
+        let f = if F::LANES > 1 {
+            rft.force_inline(&state)
+        } else {
+            rft.contact_force(&state, &p.medium)
+        };
+        (none, none, f)
     } else {
         (
             Drag::law(p.eta_d, &state, &p.medium),
@@ -483,13 +579,14 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
         ((zero + fd.bound[0]) + fh.bound[0]) + fv.bound[0],
         ((zero + fd.bound[1]) + fh.bound[1]) + fv.bound[1],
     ];
+    let moment = zero + fv.moment;
     let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
     let lever_p = lever(p_local);
     let torque = total[0] * lever_p[0] + total[1] * lever_p[1];
     let gen = [
         sel(forced, zero + total[0], zero),
         sel(forced, gen1 + total[1], gen1),
-        sel(forced, zero + (torque - zero), zero),
+        sel(forced, zero + (torque - moment), zero),
     ];
     let qdd = [gen[0] * p.inv_m, gen[1] * p.inv_m, gen[2] * p.inv_i];
     // The sticking row (rigid_rod_reactions with one row): x or y.
@@ -510,7 +607,9 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
                 let depth_rate = -v_tip[1];
                 let e_y_rate = -axis[0] * omega;
                 let rate = depth_rate / axis[1] - depth * e_y_rate / (axis[1] * axis[1]);
-                sel(p.length - immersed, rate, zero)
+                // Zero out of the sand (a law that reads the frame sticks from depth 0) and
+                // once fully immersed (`RodContact::immersed_length_rate`).
+                sel(depth, sel(p.length - immersed, rate, zero), zero)
             };
             let slide = [
                 (F::splat(0.5) * l_rate) * normal[0],
@@ -559,7 +658,7 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     let v_p = sel2(p.at_centroid, v_centroid, v_tip);
     let power = sel(
         forced,
-        (total[0] * v_p[0] + total[1] * v_p[1]) - zero * omega,
+        (total[0] * v_p[0] + total[1] * v_p[1]) - moment * omega,
         zero,
     );
     RodEval {
@@ -575,6 +674,7 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
         terms,
         dynamic,
         statics,
+        moment: sel(forced, moment, zero),
         bound: sel2(forced, bound, [zero, zero]),
         pivot: sel(row, a, F::splat(1.0)),
     }
@@ -635,7 +735,7 @@ impl RodEval<f64> {
                 terms,
                 dynamic: v2(self.dynamic),
                 statics: v2(self.statics),
-                moment: 0.0,
+                moment: self.moment,
             },
             cross: self.cross,
             immersion_margin: self.margin,
@@ -668,6 +768,7 @@ impl RodEval<F64x4> {
             terms: [l2(self.terms[0]), l2(self.terms[1]), l2(self.terms[2])],
             dynamic: l2(self.dynamic),
             statics: l2(self.statics),
+            moment: l(self.moment),
             bound: l2(self.bound),
             pivot: l(self.pivot),
         }
@@ -724,6 +825,22 @@ mod tests {
         };
         let mut model = scene.model();
         model.sign_model = sign_model;
+        model
+    }
+
+    /// [`model_signed`] under `rft` alone, with `zeta` and `elements`.
+    fn model_rft(base: (f64, f64, bool, bool, SignModel), zeta: f64, elements: usize) -> Model<3> {
+        let (mass, length, centroid, gravity, sign_model) = base;
+        let mut model = model_signed(mass, length, [0.0; 4], centroid, gravity, sign_model, 0);
+        let mut specs = vec![];
+        if gravity {
+            specs.push(TermSpec::new("gravity", &[]));
+        }
+        specs.push(TermSpec::new(
+            "rft",
+            &[("zeta", zeta), ("elements", elements as f64)],
+        ));
+        model.forces = ForceSet::build(&specs, 1).unwrap();
         model
     }
 
@@ -794,17 +911,21 @@ mod tests {
         /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
         /// the accelerations, the power and every finding of the contact (what the events
         /// and the observer read), in every mode the lanes cover, under every sign model and
-        /// with any of the thesis's terms, mixed across the lanes.
+        /// with any of the thesis's terms, mixed across the lanes, or under one `rft` law.
         #[test]
         fn lanes_are_the_scalar_evaluation_bitwise(
             scenes in proptest::array::uniform4(scene()),
             states in proptest::array::uniform4(state()),
             terms in proptest::array::uniform4(0u8..8),
+            rft in prop_oneof![Just(None), (1e4f64..3e6, 1usize..14).prop_map(Some)],
         ) {
             let models: Vec<Model<3>> = scenes
                 .iter()
                 .zip(terms)
-                .map(|(s, t)| model_signed(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7, s.8, t))
+                .map(|(s, t)| match rft {
+                    Some((zeta, n)) => model_rft((s.0, s.1, s.6, s.7, s.8), zeta, n),
+                    None => model_signed(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7, s.8, t),
+                })
                 .collect();
             let params_of = |i: usize| RodParams::of(&models[i]).unwrap();
             let layout_of = |i: usize| RodLayout::of(&models[i]).unwrap();
@@ -915,6 +1036,79 @@ mod tests {
         assert!(lean_steps > 50_000, "{lean_steps} steps");
     }
 
+    /// A free link under `rft` alone runs its lean steps to the general path's outcome bit
+    /// for bit: its moment, its held reaction in y (a vertical drop comes to rest and
+    /// sticks), the held sign's shift of the frame, under each sign model, at the tip and
+    /// the centroid, with the paper's and other coefficients and element counts.
+    #[test]
+    fn lean_runs_under_rft_are_the_general_path_bitwise() {
+        use crate::integrate::solve::{solve, Run};
+        use crate::spec::Value;
+        let mut lean_steps = 0;
+        let mut stuck = 0;
+        let laws: [&[(&str, f64)]; 3] = [
+            &[("zeta", 1e6)],
+            &[("zeta", 3e5), ("elements", 3.0)],
+            &[
+                ("zeta", 2e6),
+                ("elements", 13.0),
+                ("A10", 0.3),
+                ("C01", 0.4),
+                ("D10", -0.1),
+            ],
+        ];
+        for (k, law) in laws.iter().enumerate() {
+            for sign in ["modes", "raw", "smooth"] {
+                for at in ["tip", "centroid"] {
+                    for (q, v0, vx0) in [
+                        (0.0, 2.214, 0.0),
+                        (5.0, 1.12, 0.0),
+                        (45.0, 2.27, 0.0),
+                        (85.0, 0.7, 0.0),
+                        (0.0, 0.3, 2.0),
+                        (-30.0, 0.5, 3.0),
+                        (60.0, 0.2, -2.5),
+                    ] {
+                        let mut spec = crate::spec::free_link_spec();
+                        spec.set("q_deg", Value::Num(q));
+                        spec.set("v0", Value::Num(v0));
+                        spec.set("vx0", Value::Num(vx0));
+                        spec.set("sign_model", Value::Str(sign.into()));
+                        spec.set("apply_at", Value::Str(at.into()));
+                        let Ok(crate::bodies::AnyScene::FreeLink(mut s)) = spec.build() else {
+                            panic!("not a free link");
+                        };
+                        let specs = [TermSpec::new("gravity", &[]), TermSpec::new("rft", law)];
+                        s.forces = ForceSet::build(&specs, 1).unwrap();
+                        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+                        assert!(RodParams::of(&model).is_some(), "{k} {sign}");
+                        let lean = solve(&model, q0, qd0, &s.options).unwrap();
+                        let mut run = Run::new(&model, q0, qd0, &s.options).general();
+                        while let Some(h) = run.next_step(&model) {
+                            run.step(&model, h).unwrap();
+                        }
+                        let general = run.finish(&model).unwrap();
+                        let what = format!("law {k} {sign} {at} q {q}");
+                        assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
+                        lean_steps += lean.stats.steps;
+                        // Steps the lean path takes with y stuck (its sticking row).
+                        let mut run = Run::new(&model, q0, qd0, &s.options);
+                        while let Some(h) = run.next_step(&model) {
+                            if let Some((_, m, _)) = run.lane_start(h) {
+                                stuck += usize::from(m.stuck_y > 0.0);
+                            }
+                            run.step(&model, h).unwrap();
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            lean_steps > 20_000 && stuck > 100,
+            "{lean_steps} steps, {stuck} stuck"
+        );
+    }
+
     /// A body the lean path does not cover has no layout, even one with no contact at all
     /// (a linkage with none: `Run::new` asks every model).
     #[test]
@@ -926,9 +1120,10 @@ mod tests {
         assert!(RodParams::of(&pendulum).is_none());
     }
 
-    /// The lanes cover the thesis's set under every sign model, and nothing else.
+    /// The lanes cover the thesis's set under every sign model and `rft` alone, and nothing
+    /// else.
     #[test]
-    fn lanes_cover_the_thesis_set_only() {
+    fn lanes_cover_the_thesis_set_and_rft_alone() {
         let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
         let flags = |m: &Model<3>| RodParams::of(m).map(|p| (p.unheld, p.smooth, p.eps));
         assert_eq!(flags(&thesis), Some((0.0, 0.0, 1.0)));
@@ -976,5 +1171,35 @@ mod tests {
         // Under the plain sign nothing sticks: the same mode is covered, with no row.
         let plain = RodModes::of(&both, &RodParams::of(&raw).unwrap(), &layout).unwrap();
         assert_eq!((plain.stuck_x, plain.stuck_y), (0.0, 0.0));
+        // `rft` alone: in static_v's place, owning y; x never sticks, so the mode that
+        // sticks in both is covered with y's row alone.
+        let base = (0.184, 0.19, false, true, SignModel::Modes);
+        let rft = model_rft(base, 1e6, 8);
+        let (p, l) = (RodParams::of(&rft).unwrap(), RodLayout::of(&rft).unwrap());
+        assert_eq!(
+            (l.slot, l.owns),
+            ([usize::MAX, usize::MAX, 0], [false, true])
+        );
+        assert_eq!(
+            (p.eta_d, p.eta_h, p.eta_v, p.rft.map(|r| r.zeta)),
+            (0.0, 0.0, 0.0, Some(1e6))
+        );
+        let m = RodModes::of(&both, &p, &l).unwrap();
+        assert_eq!((m.stuck_x, m.stuck_y), (0.0, 1.0));
+        // Not `rft` with another contact term, nor the other terms that read the frame.
+        let other = |specs: &[TermSpec]| {
+            let mut m = thesis.clone();
+            m.forces = ForceSet::build(specs, 1).unwrap();
+            RodParams::of(&m).is_none() && RodLayout::of(&m).is_none()
+        };
+        let rft_spec = TermSpec::new("rft", &[("zeta", 1e6)]);
+        let static_v = TermSpec::new("static_v", &[("eta_v", 248.0), ("lam", 0.106)]);
+        assert!(other(&[rft_spec.clone(), static_v]));
+        assert!(other(&[rft_spec, TermSpec::new("rft_inertial", &[])]));
+        assert!(other(&[TermSpec::new("rft_inertial", &[])]));
+        assert!(other(&[TermSpec::new(
+            "poncelet",
+            &[("c", 0.8), ("k", 150.0)]
+        )]));
     }
 }

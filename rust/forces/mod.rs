@@ -54,6 +54,8 @@ pub trait Real:
     + Div<Output = Self>
     + Neg<Output = Self>
 {
+    /// Scenes per value: 1 for `f64`, 4 for the lanes' `F64x4`.
+    const LANES: usize;
     /// The value `x` (in every lane).
     fn splat(x: f64) -> Self;
     /// `self^e` (libm's, in each lane).
@@ -79,6 +81,7 @@ pub trait Real:
 }
 
 impl Real for f64 {
+    const LANES: usize = 1;
     #[inline(always)]
     fn splat(x: f64) -> Self {
         x

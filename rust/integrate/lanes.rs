@@ -1,4 +1,6 @@
 //! Several runs of the free link stepped at once, one per SIMD lane: the sweep's fast path.
+//! The lanes run one law's arithmetic at a time: the thesis's terms (any of them, with any
+//! coefficients per lane) or one `rft` law (its parameters shared by the four lanes).
 //!
 //! Layout (structure of arrays): each lane holds one scene; the state (q, q', work), the
 //! first stage, the step size, the held modes and the scene's parameters are each one
@@ -27,7 +29,7 @@ use super::events::SwitchInputs;
 use super::outcome::Outcome;
 use super::solve::{solve, Run, SolveOptions};
 use super::stepper::{Deriv, Method, State};
-use crate::dynamics::rod_lanes::{pivot_ok, rod_eval, RodEval, RodModes, RodParams};
+use crate::dynamics::rod_lanes::{pivot_ok, rod_eval_law, RodEval, RodModes, RodParams};
 use crate::dynamics::{DragStiffness, Model};
 use crate::error::Result;
 use crate::forces::Real;
@@ -186,7 +188,12 @@ impl<F: Real> LaneStage<F> {
 /// One RK4 step ([`super::stepper::step_sampling`] and the end evaluation of
 /// [`super::stepper::full_step`]) in `F`, in the scalar path's order of operations.
 #[inline(always)]
-pub fn lane_step<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -> LaneEnd<F> {
+pub fn lane_step<F: Real, const RFT: bool>(
+    p: &RodParams<F>,
+    m: &RodModes<F>,
+    s: &LaneStart<F>,
+) -> LaneEnd<F> {
+    let rod_eval = rod_eval_law::<F, RFT>;
     let h = s.h;
     let half = F::splat(0.5) * h;
     let zero = F::splat(0.0);
@@ -404,8 +411,12 @@ impl LaneEnd<f64> {
 
 /// [`lane_step`] compiled for the baseline target.
 #[inline(never)]
-fn lane_step_base<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) -> LaneEnd<F> {
-    lane_step(p, m, s)
+fn lane_step_base<F: Real, const RFT: bool>(
+    p: &RodParams<F>,
+    m: &RodModes<F>,
+    s: &LaneStart<F>,
+) -> LaneEnd<F> {
+    lane_step::<F, RFT>(p, m, s)
 }
 
 /// [`lane_step`] compiled with AVX2 (256-bit registers for the lanes; for one lane, the
@@ -416,12 +427,12 @@ fn lane_step_base<F: Real>(p: &RodParams<F>, m: &RodModes<F>, s: &LaneStart<F>) 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-unsafe fn lane_step_avx2<F: Real>(
+unsafe fn lane_step_avx2<F: Real, const RFT: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    lane_step(p, m, s)
+    lane_step::<F, RFT>(p, m, s)
 }
 
 /// How the lanes run: with AVX2 where the CPU has it, else the baseline.
@@ -456,8 +467,11 @@ impl LaneIsa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU (this method
             // is the crate's own, so no caller outside it picks the variant).
-            LaneIsa::Avx2 => unsafe { lane_step_avx2(p, m, s) },
-            _ => lane_step_base(p, m, s),
+            LaneIsa::Avx2 if p.rft.is_some() => unsafe { lane_step_avx2::<F, true>(p, m, s) },
+            // SAFETY: as above.
+            LaneIsa::Avx2 => unsafe { lane_step_avx2::<F, false>(p, m, s) },
+            _ if p.rft.is_some() => lane_step_base::<F, true>(p, m, s),
+            _ => lane_step_base::<F, false>(p, m, s),
         }
     }
 }
@@ -530,8 +544,18 @@ pub fn run_lanes<T>(
                             continue;
                         }
                     };
+                    // The lanes run one law's arithmetic: a run under another `rft` law
+                    // than the lanes' (a sweep that mixes laws) takes them over when they
+                    // are idle, else runs alone.
+                    let idle = slots.iter().all(Option::is_none);
                     match &mut params {
-                        Some(lanes) => lanes.set(i, &p),
+                        Some(lanes) if lanes.rft == p.rft => lanes.set(i, &p),
+                        Some(lanes) if idle => *lanes = RodParams::splat(&p),
+                        Some(_) => {
+                            let out = solve(&model, q0, qd0, &options);
+                            done(tag, out);
+                            continue;
+                        }
                         None => params = Some(RodParams::splat(&p)),
                     }
                     let run = Run::new(&model, q0, qd0, &options);
@@ -759,7 +783,7 @@ mod tests {
             start.set(i, &one);
         }
         let p = RodParams::splat(&RodParams::of(&model).unwrap());
-        let end = lane_step(&p, &RodModes::gather(&[m; LANES]), &start);
+        let end = lane_step::<_, false>(&p, &RodModes::gather(&[m; LANES]), &start);
         let mut bad = end;
         bad.qd[0].0[1] = f64::NAN;
         bad.stages[1].pivot.0[2] = 0.0;
