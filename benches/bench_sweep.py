@@ -24,9 +24,10 @@ Parts:
   against the run alone as the core times it, in the same loop. No target; it is what a
   small sweep pays beyond its runs (issue 22's two-thread line at 155 runs).
 * ``lanes``: 1000 free links (40 angles x 25 speeds) on one thread under each sign model
-  (``modes``, ``raw``, ``smooth``) and under ``rft`` alone, with the SIMD lanes
-  (``lanes=True``) and on the scalar path (``lanes=False``), taken in turn. No target; the
-  lanes' gain over the scalar path (``docs/sweeps.md``).
+  (``modes``, ``raw``, ``smooth``) and under ``rft``, ``rft`` + ``rft_inertial`` and
+  ``poncelet``, with the SIMD lanes (``lanes=True``) and on the scalar path
+  (``lanes=False``), taken in turn. No target; the lanes' gain over the scalar path
+  (``docs/sweeps.md``).
 
 Build in release first: ``maturin develop --release``.
 """
@@ -227,13 +228,19 @@ def part_fixed(repeat: int) -> list[str]:
 # ---------------------------------------------------------------------------------- lanes
 def part_lanes(repeat: int) -> list[str]:
     """1000 free links on one thread under each sign model the lanes cover, and under
-    ``rft`` alone, lanes and scalar path in turn, best of ``repeat``."""
+    ``rft``, dynamic RFT and ``poncelet``, lanes and scalar path in turn, best of
+    ``repeat``."""
     from granrs import forces
 
     axes = {"q_deg": np.linspace(0.0, 75.0, 40), "v0": np.linspace(0.5, 4.0, 25)}
     base = cases.free_link(q_deg=0.0, v0=2.0)
     laws = {m: base.replace(sign_model=m) for m in ("modes", "raw", "smooth")}
-    laws["rft (modes)"] = base.replace(forces=[forces.gravity(), forces.rft(zeta=1e6)])
+    g = forces.gravity()
+    laws["rft (modes)"] = base.replace(forces=[g, forces.rft(zeta=1e6)])
+    laws["rft + rft_inertial"] = base.replace(
+        forces=[g, forces.rft(zeta=1e6), forces.rft_inertial()]
+    )
+    laws["poncelet"] = base.replace(forces=[g, forces.poncelet(c=0.8, k=150.0)])
     best = {(m, lanes): math.inf for m in laws for lanes in (True, False)}
     for _ in range(repeat):
         for m, lanes in best:

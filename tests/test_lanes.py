@@ -20,7 +20,17 @@ from hypothesis import strategies as st
 import granrs
 from granrs import cases
 from granrs.errors import InvalidParameterError
-from granrs.forces import drag, gravity, rft, select, static_h, static_v, thesis
+from granrs.forces import (
+    drag,
+    gravity,
+    poncelet,
+    rft,
+    rft_inertial,
+    select,
+    static_h,
+    static_v,
+    thesis,
+)
 
 #: The issue's tolerance between a lane and the scalar path.
 RTOL = 1e-12
@@ -131,20 +141,30 @@ def test_some_of_the_thesis_terms_in_lanes_equal_the_scalar_path(keep: tuple[str
         assert row.depth == granrs.simulate(scene).summary["depth"]
 
 
+#: Laws of terms that read the contact's frame, as the lanes run them (one per lanes).
+FRAME_LAWS = {
+    "rft": lambda: [gravity(), rft(zeta=1e6)],
+    "rft, 3 elements": lambda: [gravity(), rft(zeta=5e5, elements=3)],
+    "rft, 13 elements, own coefficients": lambda: [
+        gravity(),
+        rft(zeta=2e6, elements=13, coefficients={"A10": 0.3, "D10": -0.1}),
+    ],
+    "poncelet": lambda: [gravity(), poncelet(c=0.8, k=150.0)],
+    "rft + rft_inertial": lambda: [gravity(), rft(zeta=1e6), rft_inertial()],
+    "rft_inertial + rft": lambda: [gravity(), rft_inertial(lam=0.5), rft(zeta=1e6)],
+    "poncelet + rft_inertial": lambda: [gravity(), poncelet(c=0.8, k=150.0), rft_inertial()],
+}
+
+
 @pytest.mark.parametrize(
     ("sign_model", "law"),
-    [
-        ("modes", {"zeta": 1e6}),
-        ("raw", {"zeta": 1e6}),
-        ("smooth", {"zeta": 5e5, "elements": 3}),
-        ("modes", {"zeta": 2e6, "elements": 13, "coefficients": {"A10": 0.3, "D10": -0.1}}),
-    ],
+    [("modes", name) for name in FRAME_LAWS] + [("raw", "rft"), ("smooth", "rft, 3 elements")],
 )
-def test_rft_in_lanes_equals_the_scalar_path(sign_model: str, law: dict[str, object]) -> None:
-    """`rft` alone runs in the lanes (one law for the four): the Table 3.5 scenes give the
-    scalar path's rows bit for bit, and simulate()'s."""
-    term = rft(**law)  # type: ignore[arg-type]
-    scenes = [s.replace(forces=[gravity(), term], sign_model=sign_model) for s in _table_3_5()]
+def test_frame_laws_in_lanes_equal_the_scalar_path(sign_model: str, law: str) -> None:
+    """`rft`, `poncelet` and `rft_inertial` run in the lanes (one law for the four): the
+    Table 3.5 scenes give the scalar path's rows bit for bit, and simulate()'s."""
+    terms = FRAME_LAWS[law]()
+    scenes = [s.replace(forces=terms, sign_model=sign_model) for s in _table_3_5()]
     lanes = granrs.sweep(scenes, threads=1, progress=False)
     scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
     _assert_same(lanes, scalar)
@@ -153,21 +173,27 @@ def test_rft_in_lanes_equals_the_scalar_path(sign_model: str, law: dict[str, obj
         assert row.depth == granrs.simulate(scene).summary["depth"]
 
 
-def test_a_sweep_that_mixes_rft_laws_and_the_thesis_has_the_scalar_rows() -> None:
-    """The lanes run one `rft` law at a time: a scene under another law (another zeta, the
-    thesis's terms) takes the lanes over when they are idle, else runs alone; the rows are
-    the scalar path's whatever the order."""
+def test_a_sweep_that_mixes_frame_laws_and_the_thesis_has_the_scalar_rows() -> None:
+    """The lanes run one frame law at a time: a scene under another law (another zeta,
+    `poncelet`, the thesis's terms) takes the lanes over when they are idle, else runs
+    alone; the rows are the scalar path's whatever the order."""
     base = cases.free_link(q_deg=0.0, v0=2.0)
     laws = [
         [gravity(), rft(zeta=1e6)],
         [gravity(), rft(zeta=3e5, elements=4)],
+        [gravity(), poncelet(c=0.8, k=150.0)],
+        [gravity(), rft(zeta=1e6), rft_inertial()],
         list(thesis()),
     ]
     rng = np.random.default_rng(3)
+    n = 60
     scenes = [
         base.replace(forces=laws[k], q_deg=float(q), v0=float(v))
         for k, q, v in zip(
-            rng.integers(0, 3, 40), rng.uniform(-80, 80, 40), rng.uniform(0.2, 4, 40), strict=True
+            rng.integers(0, len(laws), n),
+            rng.uniform(-80, 80, n),
+            rng.uniform(0.2, 4, n),
+            strict=True,
         )
     ]
     lanes = granrs.sweep(scenes, threads=1, progress=False)
@@ -184,8 +210,9 @@ def test_a_sweep_that_mixes_rft_laws_and_the_thesis_has_the_scalar_rows() -> Non
     zeta=st.floats(1e4, 3e6),
     elements=st.integers(1, 12),
     sign_model=st.sampled_from(["modes", "raw"]),
+    law=st.sampled_from(["rft", "poncelet", "rft + rft_inertial"]),
 )
-def test_random_rft_sweeps_in_lanes_equal_the_scalar_path(
+def test_random_frame_law_sweeps_in_lanes_equal_the_scalar_path(
     qs: list[float],
     vs: list[float],
     omega0: float,
@@ -193,12 +220,19 @@ def test_random_rft_sweeps_in_lanes_equal_the_scalar_path(
     zeta: float,
     elements: int,
     sign_model: str,
+    law: str,
 ) -> None:
+    terms = {
+        "rft": [gravity(), rft(zeta=zeta, elements=elements)],
+        "poncelet": [gravity(), poncelet(c=zeta * 1e-6, k=zeta * 1e-4)],
+        "rft + rft_inertial": [
+            gravity(),
+            rft(zeta=zeta, elements=elements),
+            rft_inertial(elements=elements),
+        ],
+    }[law]
     base = cases.free_link(q_deg=0.0, v0=1.0).replace(
-        omega0=omega0,
-        vx0=vx0,
-        sign_model=sign_model,
-        forces=[gravity(), rft(zeta=zeta, elements=elements)],
+        omega0=omega0, vx0=vx0, sign_model=sign_model, forces=terms
     )
     lanes = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False)
     scalar = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False, lanes=False)

@@ -1,40 +1,45 @@
-//! The free link under the thesis's terms or `rft` alone, for one scene or several at once:
-//! [`Model::eval_rigid_rod`] written over [`Real`]. With `F = f64` it is the lean path of a lone run's RK4 steps
-//! (`integrate::solve::Run::step`: a stage computes only what the step reads, after
-//! inlining); with `F = F64x4` it evaluates four scenes, one per SIMD lane, in the same
-//! instructions (the sweep's lanes, `integrate::lanes`).
+//! The free link under the thesis's terms or a law of terms that read the contact's frame
+//! (`rft`, `poncelet`, `rft_inertial`), for one scene or several at once:
+//! [`Model::eval_rigid_rod`] written over [`Real`]. With `F = f64` it is the lean path of a
+//! lone run's RK4 steps (`integrate::solve::Run::step`: a stage computes only what the step
+//! reads, after inlining); with `F = F64x4` it evaluates four scenes, one per SIMD lane, in
+//! the same instructions (the sweep's lanes, `integrate::lanes`).
 //!
 //! The force law is not copied: the terms' own arithmetic ([`Drag::law`], [`StaticH::law`],
 //! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane,
-//! and `rft`'s own `contact_force` on the boundary the general path gives it (one law for
-//! the four lanes: its element count sets the loop).
-//! The mechanics (the rod's frame, its immersed geometry, the closed-form sticking row and
-//! the sums of [`super::rigid_rod`]) are written again without branches: each branch of the
-//! scalar path becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation
-//! is the scalar path's, in its order, so that the results are [`Model::eval`]'s bit for bit
-//! (tests hold them so over random states and modes, and whole runs to the general path).
-//! Two blocks are skipped when every lane blends them away (the law out of the sand, the
+//! and the frame terms' own `contact_force` on the boundary the general path gives them (one
+//! law for the four lanes: `rft`'s element count sets its loop). The mechanics (the rod's
+//! frame, its immersed geometry, the closed-form sticking row and the sums of
+//! [`super::rigid_rod`]) are written again without branches: each branch of the scalar path
+//! becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation is the
+//! scalar path's, in its order, so that the results are [`Model::eval`]'s bit for bit (tests
+//! hold them so over random states and modes, and whole runs to the general path). Two
+//! blocks are skipped when every lane blends them away (the law out of the sand, the
 //! sticking row when nothing sticks): the same bits, less work.
 //!
-//! What it covers: a free link ([`Model::rigid_rod`]) whose contact terms are the thesis's
-//! three or any of them (`drag`, `static_h`, `static_v`, in that order; `gravity` on or off:
-//! an absent term is one with a zero coefficient, whose force is exactly zero, so every sum
-//! has the general path's bits), under any sign model (`modes`, held through a step; the
-//! thesis's plain sign `raw` and `smooth`'s tanh, each evaluation's own, with no sticking),
-//! applied at the tip or at the centroid ([`RodParams::of`], [`RodLayout::of`]); or whose one
-//! contact term is `rft` (any coefficients and element count; its moment, its held sign's
-//! shift of the frame and its bounded reaction in y, from depth 0 while in contact, as the
-//! general path reads a law that reads the frame); and in modes with at most one sticking
-//! row ([`RodModes::of`]). A step in a mode that sticks in both x
-//! and y, or whose one sticking row has a zero pivot ([`RodEval::pivot`]), is taken on the
-//! general path.
+//! What it covers: a free link ([`Model::rigid_rod`]), applied at the tip or at the centroid,
+//! under any sign model (`modes`, held through a step; the thesis's plain sign `raw` and
+//! `smooth`'s tanh, each evaluation's own, with no sticking), whose contact terms are
+//! ([`RodParams::of`], [`RodLayout::of`]):
+//! - the thesis's three or any of them (`drag`, `static_h`, `static_v`, in that order;
+//!   `gravity` on or off: an absent term is one with a zero coefficient, whose force is
+//!   exactly zero, so every sum has the general path's bits); or
+//! - a [`FrameLaw`]: `rft` or `poncelet`, `rft_inertial`, or one of the first two with the
+//!   third, in either order (their moments, the held sign's shift of the frame and the
+//!   bounded reaction in y, from depth 0 while in contact, as the general path reads a law
+//!   that reads the frame);
+//!
+//! and in modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
+//! sticks in both x and y, or whose one sticking row has a zero pivot ([`RodEval::pivot`]),
+//! is taken on the general path.
 
 use nalgebra::{SVector, Vector2};
 
 use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, SignModel, Slip};
 use crate::body::rod::ApplyAt;
 use crate::forces::drag::Drag;
-use crate::forces::rft::Rft;
+use crate::forces::poncelet::Poncelet;
+use crate::forces::rft::{Rft, RftInertial};
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
 use crate::forces::{
@@ -81,9 +86,61 @@ pub struct RodParams<F> {
     pub smooth: F,
     /// `smooth`'s eps [m/s] (1 under the other sign models).
     pub eps: F,
-    /// The law when it is `rft` alone (then the thesis's coefficients are zero): one for
-    /// every lane (the lanes take only runs with the same, [`RodParams::set`]).
-    pub rft: Option<Rft>,
+    /// The law when its terms read the contact's frame ([`FrameLaw`]; then the thesis's
+    /// coefficients are zero): one for every lane (the lanes take only runs with the same,
+    /// [`RodParams::set`]).
+    pub frame: Option<FrameLaw>,
+}
+
+/// A law of terms that read the contact's frame, as the lean path runs it: at most one
+/// static term (`rft` or `poncelet`, the owner of y's slip switch, in `static_v`'s place)
+/// and at most one dynamic one (`rft_inertial`, in `drag`'s place), in either order (two
+/// terms' sums are the same in either).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameLaw {
+    /// The static term.
+    pub statics: Option<FrameStatic>,
+    /// `rft_inertial`.
+    pub inertial: Option<RftInertial>,
+}
+
+/// The static term of a [`FrameLaw`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FrameStatic {
+    /// Resistive force theory.
+    Rft(Rft),
+    /// The Poncelet / Katsuragi-Durian law.
+    Poncelet(Poncelet),
+}
+
+impl FrameLaw {
+    /// The law `terms` make, with where each stands ([`RodLayout::slot`]), when they are
+    /// terms that read the frame as [`FrameLaw`] allows.
+    fn of(terms: &[AnyTerm]) -> Option<(Self, [usize; 3])> {
+        let mut law = FrameLaw {
+            statics: None,
+            inertial: None,
+        };
+        let mut slot = [usize::MAX; 3];
+        for (k, t) in terms.iter().enumerate() {
+            let statics = match t {
+                AnyTerm::Rft(r) => FrameStatic::Rft(*r),
+                AnyTerm::Poncelet(p) => FrameStatic::Poncelet(*p),
+                AnyTerm::RftInertial(r) if law.inertial.is_none() => {
+                    law.inertial = Some(*r);
+                    slot[0] = k;
+                    continue;
+                }
+                _ => return None,
+            };
+            if law.statics.is_some() {
+                return None;
+            }
+            law.statics = Some(statics);
+            slot[2] = k;
+        }
+        (!terms.is_empty()).then_some((law, slot))
+    }
 }
 
 /// Where a run's listed terms stand among the thesis's, read on the scalar side only (kept
@@ -116,11 +173,11 @@ impl RodLayout {
         // A free link (one contact) only: other bodies may list no contact at all.
         model.rigid_rod()?;
         let terms = model.forces.per_contact.first()?;
-        if rft_alone(terms).is_some() {
-            // Its force in the y owner's place (it owns the slip switch of y, not of x).
+        if let Some((law, slot)) = FrameLaw::of(terms) {
+            // The static term owns the slip switch of y, not of x.
             return Some(RodLayout {
-                slot: [usize::MAX, usize::MAX, 0],
-                owns: [false, true],
+                slot,
+                owns: [false, law.statics.is_some()],
             });
         }
         let (slot, _) = thesis_slots(terms)?;
@@ -155,15 +212,6 @@ fn thesis_slots(terms: &[AnyTerm]) -> Option<([usize; 3], [Option<&AnyTerm>; 3])
     Some((slot, found))
 }
 
-/// The `rft` term of a law that lists it alone.
-#[inline]
-fn rft_alone(terms: &[AnyTerm]) -> Option<Rft> {
-    match terms {
-        [AnyTerm::Rft(r)] => Some(*r),
-        _ => None,
-    }
-}
-
 impl RodParams<f64> {
     /// The parameters of `model`, or `None` when the lanes do not cover it (another body,
     /// another term set, another sign model; see the module).
@@ -176,14 +224,14 @@ impl RodParams<f64> {
             SignModel::Smooth { eps } => (1.0, 1.0, eps),
         };
         let terms = &model.forces.per_contact[0];
-        let rft = rft_alone(terms);
-        if model.forces.reads_frame && rft.is_none() {
+        let frame = FrameLaw::of(terms);
+        if model.forces.reads_frame && frame.is_none() {
             return None;
         }
-        // `rft` alone: no thesis term, and it owns the slip switch of y as the lanes place
-        // it ([`RodLayout::of`]).
-        let (slot, found) = match rft {
-            Some(_) => ([usize::MAX, usize::MAX, 0], [None; 3]),
+        // A law of frame terms: no thesis term, its static term owning the slip switch of
+        // y as the lanes place it ([`RodLayout::of`]).
+        let (slot, found) = match frame {
+            Some((_, slot)) => (slot, [None; 3]),
             None => thesis_slots(terms)?,
         };
         let listed = |c: usize| (slot[c] != usize::MAX).then_some(slot[c]);
@@ -224,7 +272,7 @@ impl RodParams<f64> {
             unheld,
             smooth,
             eps,
-            rft,
+            frame: frame.map(|(law, _)| law),
         })
     }
 }
@@ -254,13 +302,13 @@ impl RodParams<F64x4> {
             unheld: s(p.unheld),
             smooth: s(p.smooth),
             eps: s(p.eps),
-            rft: p.rft,
+            frame: p.frame,
         }
     }
 
-    /// Lane `i` becomes `p`, whose `rft` must be the lanes' (one law's arithmetic for all).
+    /// Lane `i` becomes `p`, whose [`FrameLaw`] must be the lanes' (one law's arithmetic).
     pub fn set(&mut self, i: usize, p: &RodParams<f64>) {
-        debug_assert_eq!(self.rft, p.rft, "the lanes run one `rft` law");
+        debug_assert_eq!(self.frame, p.frame, "the lanes run one frame law");
         self.mass.0[i] = p.mass;
         self.g.0[i] = p.g;
         self.inv_m.0[i] = p.inv_m;
@@ -419,23 +467,24 @@ fn plain_sign<F: Real>(v: F) -> F {
     v.select_pos(one, (-v).select_pos(-one, zero))
 }
 
-/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms or `rft` alone
-/// (`p.rft`), in `F`: [`rod_eval_law`] for the law at hand.
+/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms or a [`FrameLaw`]
+/// (`p.frame`), in `F`: [`rod_eval_law`] for the law at hand.
 #[inline(always)]
 pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F; 3]) -> RodEval<F> {
-    if p.rft.is_some() {
+    if p.frame.is_some() {
         rod_eval_law::<F, true>(p, m, q, qd)
     } else {
         rod_eval_law::<F, false>(p, m, q, qd)
     }
 }
 
-/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms (`RFT` false) or
-/// `rft` alone (`RFT` true, `p.rft` set), in `F`: the same operations in the same order,
-/// with blends for branches (see the module). One compiled step per law, so that the
-/// thesis's carries no `rft` code (measured: 4 % slower lanes with both in one).
+/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms (`FRAME` false) or
+/// a [`FrameLaw`] (`FRAME` true, `p.frame` set), in `F`: the same operations in the same
+/// order, with blends for branches (see the module). One compiled step per kind of law, so
+/// that the thesis's carries no code of the others (measured: 4 % slower lanes with `rft`
+/// in the same step).
 #[inline(always)]
-pub fn rod_eval_law<F: Real, const RFT: bool>(
+pub fn rod_eval_law<F: Real, const FRAME: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     q: &[F; 3],
@@ -481,7 +530,7 @@ pub fn rod_eval_law<F: Real, const RFT: bool>(
     let cross = sel(inside, axis[0] * v_in[1] - axis[1] * v_in[0], zero);
     // Forced: in contact and below the surface; in contact for a law that reads the frame
     // (`rft`: `Model::eval_rigid_rod`).
-    let forced = if RFT { inside } else { depth_out };
+    let forced = if FRAME { inside } else { depth_out };
     // |e x v_E| as the drag reads it and the signs of v_E: the held ones under `modes`,
     // each evaluation's own under `raw` and `smooth` (`Model::held_cross`, `Model::signs`).
     // What every lane blends away is skipped (the same bits, less work: `tanh` is libm's).
@@ -524,14 +573,18 @@ pub fn rod_eval_law<F: Real, const RFT: bool>(
         bound: [zero, zero],
         moment: zero,
     };
-    let (fd, fh, fv) = if forced.all_zero() {
-        (none, none, none)
-    } else if let (true, Some(rft)) = (RFT, &p.rft) {
-        // `rft` alone, in static_v's place (the owner of y's slip switch), on the boundary
-        // `Model::eval_rigid_rod` gives it: T's and E's velocities held on the side of the
-        // held sign of v_Ey, the one slip switch it owns (`held_shift`: x's shift is +0),
-        // P and E in the world, y held while it sticks.
-        let shift = (-(sign[1] * v_centroid[1])).select_pos(F::splat(-2.0) * v_centroid[1], zero);
+    let (fd, fh, fv, moment) = if forced.all_zero() {
+        (none, none, none, zero)
+    } else if let (true, Some(law)) = (FRAME, &p.frame) {
+        // The frame law's terms on the boundary `Model::eval_rigid_rod` gives them: T's and
+        // E's velocities held on the side of the held sign of v_Ey where the static term
+        // owns its slip switch (`held_shift`: +0 otherwise, and always in x), P and E in
+        // the world, y held while it sticks.
+        let shift = if law.statics.is_some() {
+            (-(sign[1] * v_centroid[1])).select_pos(F::splat(-2.0) * v_centroid[1], zero)
+        } else {
+            zero
+        };
         let b = Boundary {
             frame: Frame {
                 origin: tip,
@@ -554,20 +607,30 @@ pub fn rod_eval_law<F: Real, const RFT: bool>(
             boundary: Some(&b),
             ..state
         };
-        // In the lanes, inlined into their step (AVX2 where the CPU has it); a lone run
-        // calls the general path's own copy (inlined into the AVX2 step, the group of
-        // eight elements was slower: measured).
-        let f = if F::LANES > 1 {
-            rft.force_inline(&state)
-        } else {
-            rft.contact_force(&state, &p.medium)
+        let fs = match law.statics {
+            // In the lanes `rft` is inlined into their step (AVX2 where the CPU has it); a
+            // lone run calls the general path's own copy (inlined into the AVX2 step, the
+            // group of eight elements was slower: measured).
+            Some(FrameStatic::Rft(r)) if F::LANES > 1 => r.force_inline(&state),
+            Some(FrameStatic::Rft(r)) => r.contact_force(&state, &p.medium),
+            Some(FrameStatic::Poncelet(t)) => t.contact_force(&state, &p.medium),
+            None => none,
         };
-        (none, none, f)
+        let fi = match law.inertial {
+            Some(t) => t.contact_force(&state, &p.medium),
+            None => none,
+        };
+        // `terms_on` sums the moments in the list's order from +0: the same bits either
+        // way (IEEE addition commutes; only a -0 first becomes +0, in both).
+        let moment = (zero + fs.moment) + fi.moment;
+        (fi, none, fs, moment)
     } else {
+        let fv = StaticV::law(p.eta_v, p.lam, &state, &p.medium);
         (
             Drag::law(p.eta_d, &state, &p.medium),
             StaticH::law(p.eta_h, &state, &p.medium),
-            StaticV::law(p.eta_v, p.lam, &state, &p.medium),
+            fv,
+            zero + fv.moment,
         )
     };
     let dynamic = [zero + fd.force[0], zero + fd.force[1]];
@@ -579,7 +642,6 @@ pub fn rod_eval_law<F: Real, const RFT: bool>(
         ((zero + fd.bound[0]) + fh.bound[0]) + fv.bound[0],
         ((zero + fd.bound[1]) + fh.bound[1]) + fv.bound[1],
     ];
-    let moment = zero + fv.moment;
     let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
     let lever_p = lever(p_local);
     let torque = total[0] * lever_p[0] + total[1] * lever_p[1];
@@ -828,20 +890,34 @@ mod tests {
         model
     }
 
-    /// [`model_signed`] under `rft` alone, with `zeta` and `elements`.
-    fn model_rft(base: (f64, f64, bool, bool, SignModel), zeta: f64, elements: usize) -> Model<3> {
+    /// [`model_signed`] under the frame terms `law` (and `gravity` as it says).
+    fn model_frame(base: (f64, f64, bool, bool, SignModel), law: &[TermSpec]) -> Model<3> {
         let (mass, length, centroid, gravity, sign_model) = base;
         let mut model = model_signed(mass, length, [0.0; 4], centroid, gravity, sign_model, 0);
         let mut specs = vec![];
         if gravity {
             specs.push(TermSpec::new("gravity", &[]));
         }
-        specs.push(TermSpec::new(
-            "rft",
-            &[("zeta", zeta), ("elements", elements as f64)],
-        ));
+        specs.extend_from_slice(law);
         model.forces = ForceSet::build(&specs, 1).unwrap();
         model
+    }
+
+    /// Frame laws the lean path covers, by number (the proptest's and the runs' axis): `rft`
+    /// (`zeta`, elements), `poncelet` (`c`, `k`), `rft_inertial` alone, and `rft` with
+    /// `rft_inertial` in either order, `poncelet` with it.
+    fn frame_law(kind: u8, a: f64, n: usize) -> Vec<TermSpec> {
+        let rft = TermSpec::new("rft", &[("zeta", a), ("elements", n as f64)]);
+        let poncelet = TermSpec::new("poncelet", &[("c", 1e-6 * a), ("k", 1e-4 * a)]);
+        let inertial = TermSpec::new("rft_inertial", &[("lam", 1e-6 * a), ("elements", n as f64)]);
+        match kind % 6 {
+            0 => vec![rft],
+            1 => vec![poncelet],
+            2 => vec![inertial],
+            3 => vec![rft, inertial],
+            4 => vec![inertial, rft],
+            _ => vec![poncelet, inertial],
+        }
     }
 
     /// The thesis's terms with coefficients `eta` that `terms` lists (see [`model_signed`]).
@@ -911,19 +987,24 @@ mod tests {
         /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
         /// the accelerations, the power and every finding of the contact (what the events
         /// and the observer read), in every mode the lanes cover, under every sign model and
-        /// with any of the thesis's terms, mixed across the lanes, or under one `rft` law.
+        /// with any of the thesis's terms, mixed across the lanes, or under one frame law.
         #[test]
         fn lanes_are_the_scalar_evaluation_bitwise(
             scenes in proptest::array::uniform4(scene()),
             states in proptest::array::uniform4(state()),
             terms in proptest::array::uniform4(0u8..8),
-            rft in prop_oneof![Just(None), (1e4f64..3e6, 1usize..14).prop_map(Some)],
+            frame in prop_oneof![
+                Just(None),
+                (0u8..6, 1e4f64..3e6, 1usize..14).prop_map(Some),
+            ],
         ) {
             let models: Vec<Model<3>> = scenes
                 .iter()
                 .zip(terms)
-                .map(|(s, t)| match rft {
-                    Some((zeta, n)) => model_rft((s.0, s.1, s.6, s.7, s.8), zeta, n),
+                .map(|(s, t)| match frame {
+                    Some((kind, a, n)) => {
+                        model_frame((s.0, s.1, s.6, s.7, s.8), &frame_law(kind, a, n))
+                    }
                     None => model_signed(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7, s.8, t),
                 })
                 .collect();
@@ -1036,26 +1117,34 @@ mod tests {
         assert!(lean_steps > 50_000, "{lean_steps} steps");
     }
 
-    /// A free link under `rft` alone runs its lean steps to the general path's outcome bit
-    /// for bit: its moment, its held reaction in y (a vertical drop comes to rest and
-    /// sticks), the held sign's shift of the frame, under each sign model, at the tip and
-    /// the centroid, with the paper's and other coefficients and element counts.
+    /// A free link under a frame law (`rft`, `poncelet`, `rft_inertial`, alone or paired)
+    /// runs its lean steps to the general path's outcome bit for bit: the moments, the held
+    /// reaction in y, the held sign's shift of the frame, under each sign model, at the tip
+    /// and the centroid, with the paper's and other coefficients and element counts, through
+    /// drops with sideways speed.
     #[test]
-    fn lean_runs_under_rft_are_the_general_path_bitwise() {
+    fn lean_runs_under_frame_laws_are_the_general_path_bitwise() {
         use crate::integrate::solve::{solve, Run};
         use crate::spec::Value;
         let mut lean_steps = 0;
         let mut stuck = 0;
-        let laws: [&[(&str, f64)]; 3] = [
-            &[("zeta", 1e6)],
-            &[("zeta", 3e5), ("elements", 3.0)],
-            &[
+        let rft = |law: &[(&str, f64)]| TermSpec::new("rft", law);
+        let inertial = TermSpec::new("rft_inertial", &[("lam", 0.7)]);
+        let poncelet = TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]);
+        let laws: Vec<Vec<TermSpec>> = vec![
+            vec![rft(&[("zeta", 1e6)])],
+            vec![rft(&[("zeta", 3e5), ("elements", 3.0)])],
+            vec![rft(&[
                 ("zeta", 2e6),
                 ("elements", 13.0),
                 ("A10", 0.3),
                 ("C01", 0.4),
                 ("D10", -0.1),
-            ],
+            ])],
+            vec![poncelet.clone()],
+            vec![rft(&[("zeta", 1e6)]), inertial.clone()],
+            vec![inertial.clone(), rft(&[("zeta", 3e5), ("elements", 5.0)])],
+            vec![poncelet, inertial],
         ];
         for (k, law) in laws.iter().enumerate() {
             for sign in ["modes", "raw", "smooth"] {
@@ -1078,7 +1167,8 @@ mod tests {
                         let Ok(crate::bodies::AnyScene::FreeLink(mut s)) = spec.build() else {
                             panic!("not a free link");
                         };
-                        let specs = [TermSpec::new("gravity", &[]), TermSpec::new("rft", law)];
+                        let mut specs = vec![TermSpec::new("gravity", &[])];
+                        specs.extend_from_slice(law);
                         s.forces = ForceSet::build(&specs, 1).unwrap();
                         let (model, (q0, qd0)) = (s.model(), s.initial_state());
                         assert!(RodParams::of(&model).is_some(), "{k} {sign}");
@@ -1120,10 +1210,10 @@ mod tests {
         assert!(RodParams::of(&pendulum).is_none());
     }
 
-    /// The lanes cover the thesis's set under every sign model and `rft` alone, and nothing
-    /// else.
+    /// The lanes cover the thesis's set under every sign model and the frame laws, and
+    /// nothing else.
     #[test]
-    fn lanes_cover_the_thesis_set_and_rft_alone() {
+    fn lanes_cover_the_thesis_set_and_the_frame_laws() {
         let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
         let flags = |m: &Model<3>| RodParams::of(m).map(|p| (p.unheld, p.smooth, p.eps));
         assert_eq!(flags(&thesis), Some((0.0, 0.0, 1.0)));
@@ -1174,32 +1264,53 @@ mod tests {
         // `rft` alone: in static_v's place, owning y; x never sticks, so the mode that
         // sticks in both is covered with y's row alone.
         let base = (0.184, 0.19, false, true, SignModel::Modes);
-        let rft = model_rft(base, 1e6, 8);
+        let rft = model_frame(base, &frame_law(0, 1e6, 8));
         let (p, l) = (RodParams::of(&rft).unwrap(), RodLayout::of(&rft).unwrap());
         assert_eq!(
             (l.slot, l.owns),
             ([usize::MAX, usize::MAX, 0], [false, true])
         );
-        assert_eq!(
-            (p.eta_d, p.eta_h, p.eta_v, p.rft.map(|r| r.zeta)),
-            (0.0, 0.0, 0.0, Some(1e6))
-        );
+        assert_eq!((p.eta_d, p.eta_h, p.eta_v), (0.0, 0.0, 0.0));
+        let law = p.frame.unwrap();
+        assert!(matches!(law.statics, Some(FrameStatic::Rft(r)) if r.zeta == 1e6));
+        assert!(law.inertial.is_none());
         let m = RodModes::of(&both, &p, &l).unwrap();
         assert_eq!((m.stuck_x, m.stuck_y), (0.0, 1.0));
-        // Not `rft` with another contact term, nor the other terms that read the frame.
+        // `rft_inertial` in drag's place, before or after the static term; alone it owns
+        // nothing, so nothing sticks.
+        let slots = |kind: u8| {
+            let m = model_frame(base, &frame_law(kind, 1e6, 8));
+            let (p, l) = (RodParams::of(&m).unwrap(), RodLayout::of(&m).unwrap());
+            (l.slot, l.owns, p.frame.unwrap().inertial.is_some())
+        };
+        let none = usize::MAX;
+        assert_eq!(slots(1), ([none, none, 0], [false, true], false));
+        assert_eq!(slots(2), ([0, none, none], [false, false], true));
+        assert_eq!(slots(3), ([1, none, 0], [false, true], true));
+        assert_eq!(slots(4), ([0, none, 1], [false, true], true));
+        assert_eq!(slots(5), ([1, none, 0], [false, true], true));
+        let alone = model_frame(base, &frame_law(2, 1e6, 8));
+        let m = RodModes::of(
+            &both,
+            &RodParams::of(&alone).unwrap(),
+            &RodLayout::of(&alone).unwrap(),
+        );
+        assert_eq!(m.map(|m| (m.stuck_x, m.stuck_y)), Some((0.0, 0.0)));
+        // Not two static frame terms (both own y), nor a frame term with a thesis term (a
+        // term listed twice is refused before: `ForceSet::build`).
         let other = |specs: &[TermSpec]| {
             let mut m = thesis.clone();
             m.forces = ForceSet::build(specs, 1).unwrap();
             RodParams::of(&m).is_none() && RodLayout::of(&m).is_none()
         };
         let rft_spec = TermSpec::new("rft", &[("zeta", 1e6)]);
+        let poncelet = TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]);
         let static_v = TermSpec::new("static_v", &[("eta_v", 248.0), ("lam", 0.106)]);
         assert!(other(&[rft_spec.clone(), static_v]));
-        assert!(other(&[rft_spec, TermSpec::new("rft_inertial", &[])]));
-        assert!(other(&[TermSpec::new("rft_inertial", &[])]));
-        assert!(other(&[TermSpec::new(
-            "poncelet",
-            &[("c", 0.8), ("k", 150.0)]
-        )]));
+        assert!(other(&[rft_spec.clone(), poncelet]));
+        assert!(other(&[
+            rft_spec,
+            TermSpec::new("drag", &[("eta_d", 15.2)])
+        ]));
     }
 }

@@ -1,6 +1,7 @@
 //! Several runs of the free link stepped at once, one per SIMD lane: the sweep's fast path.
 //! The lanes run one law's arithmetic at a time: the thesis's terms (any of them, with any
-//! coefficients per lane) or one `rft` law (its parameters shared by the four lanes).
+//! coefficients per lane) or one law of terms that read the frame (`rft`, `poncelet`,
+//! `rft_inertial`: `dynamics::rod_lanes::FrameLaw`, its parameters shared by the four).
 //!
 //! Layout (structure of arrays): each lane holds one scene; the state (q, q', work), the
 //! first stage, the step size, the held modes and the scene's parameters are each one
@@ -188,12 +189,12 @@ impl<F: Real> LaneStage<F> {
 /// One RK4 step ([`super::stepper::step_sampling`] and the end evaluation of
 /// [`super::stepper::full_step`]) in `F`, in the scalar path's order of operations.
 #[inline(always)]
-pub fn lane_step<F: Real, const RFT: bool>(
+pub fn lane_step<F: Real, const FRAME: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    let rod_eval = rod_eval_law::<F, RFT>;
+    let rod_eval = rod_eval_law::<F, FRAME>;
     let h = s.h;
     let half = F::splat(0.5) * h;
     let zero = F::splat(0.0);
@@ -411,12 +412,12 @@ impl LaneEnd<f64> {
 
 /// [`lane_step`] compiled for the baseline target.
 #[inline(never)]
-fn lane_step_base<F: Real, const RFT: bool>(
+fn lane_step_base<F: Real, const FRAME: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    lane_step::<F, RFT>(p, m, s)
+    lane_step::<F, FRAME>(p, m, s)
 }
 
 /// [`lane_step`] compiled with AVX2 (256-bit registers for the lanes; for one lane, the
@@ -427,12 +428,12 @@ fn lane_step_base<F: Real, const RFT: bool>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-unsafe fn lane_step_avx2<F: Real, const RFT: bool>(
+unsafe fn lane_step_avx2<F: Real, const FRAME: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    lane_step::<F, RFT>(p, m, s)
+    lane_step::<F, FRAME>(p, m, s)
 }
 
 /// How the lanes run: with AVX2 where the CPU has it, else the baseline.
@@ -467,10 +468,10 @@ impl LaneIsa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU (this method
             // is the crate's own, so no caller outside it picks the variant).
-            LaneIsa::Avx2 if p.rft.is_some() => unsafe { lane_step_avx2::<F, true>(p, m, s) },
+            LaneIsa::Avx2 if p.frame.is_some() => unsafe { lane_step_avx2::<F, true>(p, m, s) },
             // SAFETY: as above.
             LaneIsa::Avx2 => unsafe { lane_step_avx2::<F, false>(p, m, s) },
-            _ if p.rft.is_some() => lane_step_base::<F, true>(p, m, s),
+            _ if p.frame.is_some() => lane_step_base::<F, true>(p, m, s),
             _ => lane_step_base::<F, false>(p, m, s),
         }
     }
@@ -544,12 +545,12 @@ pub fn run_lanes<T>(
                             continue;
                         }
                     };
-                    // The lanes run one law's arithmetic: a run under another `rft` law
-                    // than the lanes' (a sweep that mixes laws) takes them over when they
-                    // are idle, else runs alone.
+                    // The lanes run one law's arithmetic: a run under another frame law
+                    // (`rft`, `poncelet`, `rft_inertial`) than the lanes' (a sweep that
+                    // mixes laws) takes them over when they are idle, else runs alone.
                     let idle = slots.iter().all(Option::is_none);
                     match &mut params {
-                        Some(lanes) if lanes.rft == p.rft => lanes.set(i, &p),
+                        Some(lanes) if lanes.frame == p.frame => lanes.set(i, &p),
                         Some(lanes) if idle => *lanes = RodParams::splat(&p),
                         Some(_) => {
                             let out = solve(&model, q0, qd0, &options);

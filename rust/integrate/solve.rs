@@ -264,9 +264,9 @@ impl<const N: usize> Run<N> {
     /// Take a whole step of size `h` (from [`Run::next_step`]) on the scalar path.
     #[inline(always)]
     pub fn step(&mut self, model: &Model<N>, h: f64) -> Result<()> {
-        if let Some(p) = self.lean {
+        if let Some(p) = &self.lean {
             if let Some((start, m, k1)) = self.lane_start(h) {
-                let end = self.isa.step(&p, &m, &start);
+                let end = self.isa.step(p, &m, &start);
                 if let Some(done) = self.lane_step_done(model, h, &k1, &end) {
                     return done;
                 }
