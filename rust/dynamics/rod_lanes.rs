@@ -607,16 +607,19 @@ pub fn rod_eval_law<F: Real, const FRAME: bool>(
             boundary: Some(&b),
             ..state
         };
+        // In the lanes the terms are inlined into their step (AVX2 where the CPU has it); a
+        // lone run calls the general path's own copies (inlined into its AVX2 step, `rft`'s
+        // group of eight elements was slower: measured).
+        let lanes = F::LANES > 1;
         let fs = match law.statics {
-            // In the lanes `rft` is inlined into their step (AVX2 where the CPU has it); a
-            // lone run calls the general path's own copy (inlined into the AVX2 step, the
-            // group of eight elements was slower: measured).
-            Some(FrameStatic::Rft(r)) if F::LANES > 1 => r.force_inline(&state),
+            Some(FrameStatic::Rft(r)) if lanes => r.force_inline(&state),
             Some(FrameStatic::Rft(r)) => r.contact_force(&state, &p.medium),
+            Some(FrameStatic::Poncelet(t)) if lanes => t.force_inline(&state, &p.medium),
             Some(FrameStatic::Poncelet(t)) => t.contact_force(&state, &p.medium),
             None => none,
         };
         let fi = match law.inertial {
+            Some(t) if lanes => t.force_inline(&state, &p.medium),
             Some(t) => t.contact_force(&state, &p.medium),
             None => none,
         };

@@ -131,6 +131,15 @@ impl Term for Poncelet {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        self.force_inline(c, m)
+    }
+}
+
+impl Poncelet {
+    /// [`Poncelet::contact_force`], inlined where it is called: the SIMD lanes
+    /// ([`crate::dynamics::rod_lanes`]) compile it into their AVX2 step.
+    #[inline(always)]
+    pub fn force_inline<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);

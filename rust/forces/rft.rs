@@ -483,6 +483,15 @@ impl Term for RftInertial {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        self.force_inline(c, m)
+    }
+}
+
+impl RftInertial {
+    /// [`RftInertial::contact_force`], inlined where it is called: the SIMD lanes
+    /// ([`crate::dynamics::rod_lanes`]) compile it into their AVX2 step.
+    #[inline(always)]
+    pub fn force_inline<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
