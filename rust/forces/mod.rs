@@ -153,7 +153,9 @@ impl Default for Medium {
 
 /// What a contact term reads: one contact's geometry and kinematics below the surface
 /// (`shared/MODEL.md`, "Contact geometry"). The engine fills it once per contact and
-/// evaluation, and evaluates a contact term only where `depth > 0`.
+/// evaluation, and evaluates the contact terms where `depth > 0`, or from the moment of
+/// entry when a listed term reads the frame ([`TermInfo::reads_frame`]: `rft`, `poncelet`,
+/// `rft_inertial` are finite at depth 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactState<'a, F> {
     /// Depth of the contact d [m] (a rod's tip depth; a sole's immersed area / f_s).

@@ -30,7 +30,7 @@ use super::events::SwitchInputs;
 use super::outcome::Outcome;
 use super::solve::{solve, Run, SolveOptions};
 use super::stepper::{Deriv, Method, State};
-use crate::dynamics::rod_lanes::{pivot_ok, rod_eval_law, RodEval, RodModes, RodParams};
+use crate::dynamics::rod_lanes::{pivot_ok, rod_eval_law, same_law, RodEval, RodModes, RodParams};
 use crate::dynamics::{DragStiffness, Model};
 use crate::error::Result;
 use crate::forces::Real;
@@ -497,9 +497,29 @@ struct Slot<T> {
     may_stay: bool,
 }
 
+/// Scenes that wait for the lanes to take their law, at most (beyond this, a scene under
+/// another law than the lanes' leaves its lane empty until the lanes have drained).
+const WAITING: usize = 4 * LANES;
+
+/// What [`run_lanes`] did with its scenes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LaneCounts {
+    /// Runs it ran alone from start to end (not covered, or not RK4).
+    pub alone: usize,
+    /// Runs it took into the lanes.
+    pub in_lanes: usize,
+    /// Times the lanes took another law (a sweep that mixes laws).
+    pub law_changes: usize,
+}
+
 /// Run every scene `next` gives, four at a time in lanes (`isa`), and hand each outcome
 /// to `done` with its tag as the run ends (not in input order). A scene the lanes do not
 /// cover ([`covered`]) runs alone, on the scalar path, as [`solve`] runs it.
+///
+/// The lanes run one law's arithmetic at a time (the thesis's terms with any coefficients
+/// per lane, or one [`crate::dynamics::rod_lanes::FrameLaw`]). A scene under another law
+/// waits (up to [`WAITING`] of them; its lane stays empty) until the lanes have drained,
+/// and then they take its law.
 ///
 /// A step that meets nothing (no event, every pivot clear) of a run that
 /// [`Run::may_stay_in_lanes`] is accepted by the lanes ([`Run::accept_plain`]): the run's next
@@ -509,10 +529,14 @@ pub fn run_lanes<T>(
     isa: LaneIsa,
     mut next: impl FnMut() -> Option<LaneScene<T>>,
     mut done: impl FnMut(T, Result<Outcome>),
-) {
+) -> LaneCounts {
     let mut slots: [Option<Slot<T>>; LANES] = std::array::from_fn(|_| None);
     let mut params: Option<RodParams<F64x4>> = None;
-    let mut empty = false;
+    let mut feed = Feed {
+        waiting: std::collections::VecDeque::new(),
+        empty: false,
+        counts: LaneCounts::default(),
+    };
     // Each lane's step start and held modes; a run the lanes keep ([`Run::in_lanes`]) starts
     // its next step from its lane here, and `kept` holds its last end's evaluation.
     let mut start = LaneStart::<F64x4>::splat(0.0);
@@ -530,42 +554,10 @@ pub fn run_lanes<T>(
         for i in 0..LANES {
             loop {
                 if slots[i].is_none() {
-                    if empty {
-                        break;
+                    match feed.take(i, &slots, &mut params, &mut next, &mut done) {
+                        Some(slot) => slots[i] = Some(slot),
+                        None => break,
                     }
-                    let Some((tag, model, q0, qd0, options)) = next() else {
-                        empty = true;
-                        break;
-                    };
-                    let p = match RodParams::of(&model) {
-                        Some(p) if options.method == Method::Rk4 => p,
-                        _ => {
-                            let out = solve(&model, q0, qd0, &options);
-                            done(tag, out);
-                            continue;
-                        }
-                    };
-                    // The lanes run one law's arithmetic: a run under another frame law
-                    // (`rft`, `poncelet`, `rft_inertial`) than the lanes' (a sweep that
-                    // mixes laws) takes them over when they are idle, else runs alone.
-                    let idle = slots.iter().all(Option::is_none);
-                    match &mut params {
-                        Some(lanes) if lanes.frame == p.frame => lanes.set(i, &p),
-                        Some(lanes) if idle => *lanes = RodParams::splat(&p),
-                        Some(_) => {
-                            let out = solve(&model, q0, qd0, &options);
-                            done(tag, out);
-                            continue;
-                        }
-                        None => params = Some(RodParams::splat(&p)),
-                    }
-                    let run = Run::new(&model, q0, qd0, &options);
-                    slots[i] = Some(Slot {
-                        tag,
-                        model,
-                        run,
-                        may_stay: false,
-                    });
                 }
                 let Some(slot) = slots[i].as_mut() else {
                     break;
@@ -587,7 +579,10 @@ pub fn run_lanes<T>(
             }
         }
         if !live.iter().any(|&l| l) {
-            break;
+            if feed.waiting.is_empty() {
+                break;
+            }
+            continue;
         }
         let Some(params) = params.as_ref() else {
             break;
@@ -676,6 +671,90 @@ pub fn run_lanes<T>(
         }
         kept = Some(end.eval);
     }
+    feed.counts
+}
+
+/// Where [`run_lanes`]'s lanes take their scenes from: the batch, and the scenes that wait
+/// for the lanes to take their law.
+struct Feed<T> {
+    waiting: std::collections::VecDeque<(LaneScene<T>, RodParams<f64>)>,
+    /// Whether the batch has run dry.
+    empty: bool,
+    counts: LaneCounts,
+}
+
+impl<T> Feed<T> {
+    /// The run lane `i` takes (its slot is empty; `slots` are the lanes', `params` their
+    /// parameters): a waiting scene under the lanes' law, or, the lanes idle, the first
+    /// waiting one (its law becomes theirs); else the batch's next, if under the lanes'
+    /// law. A scene the lanes do not cover runs alone here. `None`: the lane stays empty
+    /// this step (the batch is dry, or a scene under another law now waits). Out of line:
+    /// it runs once a scene, not once a step.
+    #[inline(never)]
+    fn take(
+        &mut self,
+        i: usize,
+        slots: &[Option<Slot<T>>; LANES],
+        params: &mut Option<RodParams<F64x4>>,
+        next: &mut impl FnMut() -> Option<LaneScene<T>>,
+        done: &mut impl FnMut(T, Result<Outcome>),
+    ) -> Option<Slot<T>> {
+        let idle = slots.iter().all(Option::is_none);
+        loop {
+            let waited = match params.as_ref().map(|p| p.frame) {
+                _ if idle && !self.waiting.is_empty() => self.waiting.pop_front(),
+                Some(f) => self
+                    .waiting
+                    .iter()
+                    .position(|(_, p)| same_law(&p.frame, &f))
+                    .and_then(|k| self.waiting.remove(k)),
+                None => None,
+            };
+            let ((tag, model, q0, qd0, options), p) = match waited {
+                Some(w) => w,
+                None => {
+                    if self.empty || self.waiting.len() >= WAITING {
+                        return None;
+                    }
+                    let Some(scene) = next() else {
+                        self.empty = true;
+                        return None;
+                    };
+                    match RodParams::of(&scene.1) {
+                        Some(p) if scene.4.method == Method::Rk4 => (scene, p),
+                        _ => {
+                            let (tag, model, q0, qd0, options) = scene;
+                            done(tag, solve(&model, q0, qd0, &options));
+                            self.counts.alone += 1;
+                            continue;
+                        }
+                    }
+                }
+            };
+            match params {
+                Some(lanes) if same_law(&lanes.frame, &p.frame) => lanes.set(i, &p),
+                Some(lanes) if idle => {
+                    *lanes = RodParams::splat(&p);
+                    self.counts.law_changes += 1;
+                }
+                Some(_) => {
+                    // Another law: it waits, and this lane stays empty, so that the lanes
+                    // drain and can take it.
+                    self.waiting.push_back(((tag, model, q0, qd0, options), p));
+                    return None;
+                }
+                None => *params = Some(RodParams::splat(&p)),
+            }
+            self.counts.in_lanes += 1;
+            let run = Run::new(&model, q0, qd0, &options);
+            return Some(Slot {
+                tag,
+                model,
+                run,
+                may_stay: false,
+            });
+        }
+    }
 }
 
 /// Lane `i` of `p` takes lane `j`'s parameters.
@@ -714,33 +793,105 @@ fn fail<T>(
 mod tests {
     use super::*;
     use crate::bodies::AnyScene;
+    use crate::forces::{ForceSet, TermSpec};
     use crate::spec::Value;
+
+    /// A frame law: `rft` with `rft_inertial`, or `poncelet` (with `gravity`).
+    fn frame_law(rft: bool) -> Vec<TermSpec> {
+        let mut law = vec![TermSpec::new("gravity", &[])];
+        if rft {
+            law.push(TermSpec::new("rft", &[("zeta", 1e6)]));
+            law.push(TermSpec::new("rft_inertial", &[]));
+        } else {
+            law.push(TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]));
+        }
+        law
+    }
+
+    /// The free link at `q` deg and `v0` m/s under `law` (the thesis's by default).
+    fn scene(q: f64, v0: f64, law: Option<&[TermSpec]>) -> crate::bodies::FreeLinkScene {
+        let mut spec = crate::spec::free_link_spec();
+        spec.set("q_deg", Value::Num(q));
+        spec.set("v0", Value::Num(v0));
+        let Ok(AnyScene::FreeLink(mut s)) = spec.build() else {
+            panic!("not a free link");
+        };
+        if let Some(law) = law {
+            s.forces = ForceSet::build(law, 1).unwrap();
+        }
+        s
+    }
+
+    /// Each lean step's start of a run of [`scene`], with its parameters and modes.
+    fn lane_starts(
+        q: f64,
+        v0: f64,
+        law: Option<&[TermSpec]>,
+    ) -> Vec<(RodParams<f64>, RodModes<f64>, LaneStart<f64>)> {
+        let s = scene(q, v0, law);
+        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+        let mut run = Run::new(&model, q0, qd0, &s.options);
+        let p = RodParams::of(&model).unwrap();
+        let mut starts = Vec::new();
+        while let Some(h) = run.next_step(&model) {
+            if let Some((one, m, _)) = run.lane_start(h) {
+                starts.push((p, m, one));
+            }
+            run.step(&model, h).unwrap();
+        }
+        starts
+    }
+
+    /// A sweep that mixes laws runs every covered scene in the lanes (none alone): a scene
+    /// under another law than the lanes' waits for them to drain and take it, and each
+    /// outcome is the lone run's bit for bit.
+    #[test]
+    fn a_sweep_that_mixes_laws_runs_them_all_in_the_lanes() {
+        let laws = [None, Some(frame_law(true)), Some(frame_law(false))];
+        let mut scenes = Vec::new();
+        // Runs of one law, then interleaved laws.
+        for k in 0..40usize {
+            let law = if k < 6 { 1 } else { (k * 7 + k / 3) % 3 };
+            let s = scene(
+                -80.0 + 4.0 * k as f64,
+                0.5 + 0.05 * k as f64,
+                laws[law].as_deref(),
+            );
+            let (model, (q0, qd0)) = (s.model(), s.initial_state());
+            scenes.push((k, model, q0, qd0, s.options));
+        }
+        let expected: Vec<String> = scenes
+            .iter()
+            .map(|(_, m, q0, qd0, o)| format!("{:?}", solve(m, *q0, *qd0, o)))
+            .collect();
+        let mut queue = scenes.into_iter();
+        let mut got = vec![String::new(); expected.len()];
+        let counts = run_lanes(
+            LaneIsa::detect(),
+            || queue.next(),
+            |k, out| {
+                got[k] = format!("{out:?}");
+            },
+        );
+        assert_eq!(got, expected);
+        assert_eq!((counts.alone, counts.in_lanes), (0, 40), "{counts:?}");
+        assert!(counts.law_changes >= 2, "{counts:?}");
+    }
 
     /// A step gives the same bits compiled for the baseline target as with AVX2 (the CPU's
     /// pick, [`LaneIsa::detect`]), in one lane (`f64`: the scalar path's lean step) and in
     /// four, on steps of runs at several angles and speeds through entry, sinking and
-    /// stopping. On a CPU without AVX2 both are the baseline and this checks nothing new.
+    /// stopping, under the thesis's law and two frame laws (their forces inlined into the
+    /// lanes' step). On a CPU without AVX2 both are the baseline and this checks nothing new.
     #[test]
     fn a_step_is_the_same_bits_on_every_instruction_set() {
         let mut starts = Vec::new();
-        for (q, v0) in [(0.0, 2.2), (5.0, 1.1), (45.0, 2.27), (85.0, 0.7)] {
-            let mut spec = crate::spec::free_link_spec();
-            spec.set("q_deg", Value::Num(q));
-            spec.set("v0", Value::Num(v0));
-            let Ok(AnyScene::FreeLink(s)) = spec.build() else {
-                panic!("not a free link");
-            };
-            let (model, (q0, qd0)) = (s.model(), s.initial_state());
-            let mut run = Run::new(&model, q0, qd0, &s.options);
-            let p = RodParams::of(&model).unwrap();
-            while let Some(h) = run.next_step(&model) {
-                if let Some((one, m, _)) = run.lane_start(h) {
-                    starts.push((p, m, one));
-                }
-                run.step(&model, h).unwrap();
+        for law in [None, Some(frame_law(true)), Some(frame_law(false))] {
+            for (q, v0) in [(0.0, 2.2), (5.0, 1.1), (45.0, 2.27), (85.0, 0.7)] {
+                starts.extend(lane_starts(q, v0, law.as_deref()));
             }
         }
-        assert!(starts.len() > 400, "{} steps", starts.len());
+        assert!(starts.len() > 1200, "{} steps", starts.len());
         let isa = LaneIsa::detect();
         for (p, m, s) in &starts {
             let (a, b) = (LaneIsa::Base.step(p, m, s), isa.step(p, m, s));

@@ -126,11 +126,11 @@ pub struct Run<const N: usize> {
     /// the grid) cut it there.
     t_next: f64,
     clamped: bool,
-    /// The free link under the thesis's terms on RK4 ([`RodParams::of`]): its steps are
-    /// the lanes' arithmetic in one lane ([`super::lanes::lane_step`] in `f64`), which
-    /// reads only what a stage needs; `None` for every other run.
+    /// The free link under the thesis's terms or a frame law on RK4 ([`RodParams::of`]):
+    /// its steps are the lanes' arithmetic in one lane ([`super::lanes::lane_step`] in
+    /// `f64`), which reads only what a stage needs; `None` for every other run.
     lean: Option<RodParams<f64>>,
-    /// Where a lean run's listed terms stand among the thesis's ([`RodLayout`]).
+    /// Where a lean run's listed terms stand in the lean path's places ([`RodLayout`]).
     layout: RodLayout,
     /// How this CPU runs a lean step: compiled with AVX2 where it has it (one binary for
     /// every x86-64; the same IEEE operations, so the same bits).
