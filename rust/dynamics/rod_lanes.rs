@@ -1108,40 +1108,63 @@ mod tests {
         }
     }
 
+    /// The free link dropped at `[q_deg, v0, vx0]` under `sign` model, applied `at`, with
+    /// `gravity` and the contact terms `law`.
+    fn drop_scene(
+        start: [f64; 3],
+        sign: &'static str,
+        at: &'static str,
+        law: &[TermSpec],
+    ) -> FreeLinkScene {
+        use crate::spec::Value;
+        let mut spec = crate::spec::free_link_spec();
+        for (field, x) in ["q_deg", "v0", "vx0"].into_iter().zip(start) {
+            spec.set(field, Value::Num(x));
+        }
+        spec.set("sign_model", Value::Str(sign.into()));
+        spec.set("apply_at", Value::Str(at.into()));
+        let Ok(crate::bodies::AnyScene::FreeLink(mut s)) = spec.build() else {
+            panic!("not a free link");
+        };
+        let mut specs = vec![TermSpec::new("gravity", &[])];
+        specs.extend_from_slice(law);
+        s.forces = ForceSet::build(&specs, 1).unwrap();
+        s
+    }
+
+    /// Run scene `s` on the lean path ([`solve`]) and on the general path alone, assert the
+    /// outcomes are the same bit for bit (every field; `what` names the case) and return it.
+    fn lean_run_is_the_general_one(
+        s: &FreeLinkScene,
+        what: &str,
+    ) -> crate::integrate::outcome::Outcome {
+        use crate::integrate::solve::{solve, Run};
+        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+        assert!(RodParams::of(&model).is_some(), "{what}");
+        let lean = solve(&model, q0, qd0, &s.options).unwrap();
+        let mut run = Run::new(&model, q0, qd0, &s.options).general();
+        while let Some(h) = run.next_step(&model) {
+            run.step(&model, h).unwrap();
+        }
+        let general = run.finish(&model).unwrap();
+        assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
+        lean
+    }
+
     /// A free link with any of the thesis's terms runs its lean steps to the general path's
     /// outcome bit for bit (every field, summaries and counts): the terms it lists, under
     /// each sign model, at the tip and the centroid, through entry, sticking and stops.
     #[test]
     fn lean_runs_with_any_of_the_thesis_terms_are_the_general_path_bitwise() {
-        use crate::integrate::solve::{solve, Run};
-        use crate::spec::Value;
         let mut lean_steps = 0;
         for terms in 0u8..8 {
             for sign in ["modes", "raw", "smooth"] {
                 for at in ["tip", "centroid"] {
                     for (q, v0) in [(0.0, 2.214), (5.0, 1.12), (45.0, 2.27), (85.0, 0.7)] {
-                        let mut spec = crate::spec::free_link_spec();
-                        spec.set("q_deg", Value::Num(q));
-                        spec.set("v0", Value::Num(v0));
-                        spec.set("sign_model", Value::Str(sign.into()));
-                        spec.set("apply_at", Value::Str(at.into()));
-                        let Ok(crate::bodies::AnyScene::FreeLink(mut s)) = spec.build() else {
-                            panic!("not a free link");
-                        };
-                        let mut specs = vec![TermSpec::new("gravity", &[])];
-                        specs.extend(thesis_subset([15.2, 6.5, 248.0, 0.106], terms));
-                        s.forces = ForceSet::build(&specs, 1).unwrap();
-                        let (model, (q0, qd0)) = (s.model(), s.initial_state());
-                        assert!(RodParams::of(&model).is_some(), "{terms} {sign}");
-                        let lean = solve(&model, q0, qd0, &s.options).unwrap();
-                        let mut run = Run::new(&model, q0, qd0, &s.options).general();
-                        while let Some(h) = run.next_step(&model) {
-                            run.step(&model, h).unwrap();
-                        }
-                        let general = run.finish(&model).unwrap();
+                        let law = thesis_subset([15.2, 6.5, 248.0, 0.106], terms);
+                        let s = drop_scene([q, v0, 0.0], sign, at, &law);
                         let what = format!("terms {terms:03b} {sign} {at} q {q}");
-                        assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
-                        lean_steps += lean.stats.steps;
+                        lean_steps += lean_run_is_the_general_one(&s, &what).stats.steps;
                     }
                 }
             }
@@ -1212,8 +1235,7 @@ mod tests {
     /// drops with sideways speed.
     #[test]
     fn lean_runs_under_frame_laws_are_the_general_path_bitwise() {
-        use crate::integrate::solve::{solve, Run};
-        use crate::spec::Value;
+        use crate::integrate::solve::Run;
         let mut lean_steps = 0;
         let mut stuck = 0;
         let rft = |law: &[(&str, f64)]| TermSpec::new("rft", law);
@@ -1247,29 +1269,10 @@ mod tests {
                         (-30.0, 0.5, 3.0),
                         (60.0, 0.2, -2.5),
                     ] {
-                        let mut spec = crate::spec::free_link_spec();
-                        spec.set("q_deg", Value::Num(q));
-                        spec.set("v0", Value::Num(v0));
-                        spec.set("vx0", Value::Num(vx0));
-                        spec.set("sign_model", Value::Str(sign.into()));
-                        spec.set("apply_at", Value::Str(at.into()));
-                        let Ok(crate::bodies::AnyScene::FreeLink(mut s)) = spec.build() else {
-                            panic!("not a free link");
-                        };
-                        let mut specs = vec![TermSpec::new("gravity", &[])];
-                        specs.extend_from_slice(law);
-                        s.forces = ForceSet::build(&specs, 1).unwrap();
-                        let (model, (q0, qd0)) = (s.model(), s.initial_state());
-                        assert!(RodParams::of(&model).is_some(), "{k} {sign}");
-                        let lean = solve(&model, q0, qd0, &s.options).unwrap();
-                        let mut run = Run::new(&model, q0, qd0, &s.options).general();
-                        while let Some(h) = run.next_step(&model) {
-                            run.step(&model, h).unwrap();
-                        }
-                        let general = run.finish(&model).unwrap();
+                        let s = drop_scene([q, v0, vx0], sign, at, law);
                         let what = format!("law {k} {sign} {at} q {q}");
-                        assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
-                        lean_steps += lean.stats.steps;
+                        lean_steps += lean_run_is_the_general_one(&s, &what).stats.steps;
+                        let (model, (q0, qd0)) = (s.model(), s.initial_state());
                         // Steps the lean path takes with y stuck (its sticking row).
                         let mut run = Run::new(&model, q0, qd0, &s.options);
                         while let Some(h) = run.next_step(&model) {
