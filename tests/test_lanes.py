@@ -206,6 +206,25 @@ def test_a_sweep_that_mixes_frame_laws_and_the_thesis_has_the_scalar_rows() -> N
     _assert_same(lanes, scalar)
 
 
+def test_a_sweep_over_a_frame_laws_numbers_runs_in_the_lanes() -> None:
+    """Scenes that list the same frame terms with the same element counts share the lanes
+    whatever their numbers (zeta, the coefficients, c and k, lam: one per lane); the rows
+    are the scalar path's bit for bit."""
+    base = cases.free_link(q_deg=20.0, v0=1.5)
+    scenes = []
+    for k, zeta in enumerate(np.linspace(2e5, 3e6, 12)):
+        coefficients = {"A10": 0.1 + 0.02 * k, "C01": 0.3 - 0.01 * k}
+        scenes.append(base.replace(forces=[gravity(), rft(zeta=zeta, coefficients=coefficients)]))
+        scenes.append(
+            base.replace(forces=[gravity(), rft(zeta=zeta), rft_inertial(lam=0.2 + 0.1 * k)])
+        )
+        scenes.append(base.replace(forces=[gravity(), poncelet(c=0.2 + 0.1 * k, k=50.0 + 10 * k)]))
+    lanes = granrs.sweep(scenes, threads=1, progress=False)
+    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
+    _assert_same(lanes, scalar)
+    assert lanes["depth"].nunique() == len(scenes)
+
+
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     qs=st.lists(st.floats(-88.0, 88.0), min_size=1, max_size=4),

@@ -7,8 +7,9 @@
 //!
 //! The force law is not copied: the terms' own arithmetic ([`Drag::law`], [`StaticH::law`],
 //! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane,
-//! and the frame terms' own `contact_force` on the boundary the general path gives them (one
-//! law for the four lanes: `rft`'s element count sets its loop). The mechanics (the rod's
+//! and the frame terms' own arithmetic (`force_with`, what their `contact_force` runs) on
+//! the boundary the general path gives them, with one number per lane (the four lanes share
+//! the terms and element counts: `rft`'s sets its loop). The mechanics (the rod's
 //! frame, its immersed geometry, the closed-form sticking row and the sums of
 //! [`super::rigid_rod`]) are written again without branches: each branch of the scalar path
 //! becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation is the
@@ -39,7 +40,7 @@ use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, 
 use crate::body::rod::ApplyAt;
 use crate::forces::drag::Drag;
 use crate::forces::poncelet::Poncelet;
-use crate::forces::rft::{Rft, RftInertial};
+use crate::forces::rft::{Rft, RftCoefficients, RftInertial};
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
 use crate::forces::{
@@ -88,9 +89,85 @@ pub struct RodParams<F> {
     /// `smooth`'s eps [m/s] (1 under the other sign models).
     pub eps: F,
     /// The law when its terms read the contact's frame ([`FrameLaw`]; then the thesis's
-    /// coefficients are zero): one for every lane (the lanes take only runs with the same,
-    /// [`RodParams::set`]).
+    /// coefficients are zero): its terms and element counts one for every lane (the lanes
+    /// take only runs with the same, [`same_law`], [`RodParams::set`]), its numbers in
+    /// `frame_numbers`.
     pub frame: Option<FrameLaw>,
+    /// The frame law's numbers, one per lane (zero for a term it does not list).
+    pub frame_numbers: FrameNumbers<F>,
+}
+
+/// A [`FrameLaw`]'s numbers in `F`, one per lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameNumbers<F> {
+    /// `rft`'s `zeta` and coefficients.
+    pub rft: RftCoefficients<F>,
+    /// `poncelet`'s `c` and `k`.
+    pub poncelet: [F; 2],
+    /// `rft_inertial`'s `lam`.
+    pub lam: F,
+}
+
+impl FrameNumbers<f64> {
+    /// The numbers of `law` (zeros without one).
+    fn of(law: Option<&FrameLaw>) -> Self {
+        let mut n = FrameNumbers {
+            rft: RftCoefficients {
+                zeta: 0.0,
+                k: [0.0; 9],
+            },
+            poncelet: [0.0; 2],
+            lam: 0.0,
+        };
+        match law.and_then(|l| l.statics) {
+            Some(FrameStatic::Rft(r)) => n.rft = r.coefficients_in(),
+            Some(FrameStatic::Poncelet(t)) => n.poncelet = [t.c, t.k],
+            None => {}
+        }
+        if let Some(r) = law.and_then(|l| l.inertial) {
+            n.lam = r.lam;
+        }
+        n
+    }
+
+    /// Its values in a fixed order ([`FrameNumbers::each`]'s).
+    fn values(&self) -> [f64; 13] {
+        let mut v = [0.0; 13];
+        v[0] = self.rft.zeta;
+        v[1..10].copy_from_slice(&self.rft.k);
+        v[10..12].copy_from_slice(&self.poncelet);
+        v[12] = self.lam;
+        v
+    }
+}
+
+impl FrameNumbers<F64x4> {
+    /// Every lane `n`.
+    fn splat(n: &FrameNumbers<f64>) -> Self {
+        let s = F64x4::splat;
+        FrameNumbers {
+            rft: RftCoefficients {
+                zeta: s(n.rft.zeta),
+                k: n.rft.k.map(s),
+            },
+            poncelet: n.poncelet.map(s),
+            lam: s(n.lam),
+        }
+    }
+
+    /// Each value, in the order of [`FrameNumbers::values`].
+    pub fn each(&mut self, mut f: impl FnMut(&mut F64x4)) {
+        f(&mut self.rft.zeta);
+        self.rft.k.iter_mut().for_each(&mut f);
+        self.poncelet.iter_mut().for_each(&mut f);
+        f(&mut self.lam);
+    }
+
+    /// Lane `i` becomes `n`.
+    fn set(&mut self, i: usize, n: &FrameNumbers<f64>) {
+        let mut v = n.values().into_iter();
+        self.each(|x| x.0[i] = v.next().unwrap_or(0.0));
+    }
 }
 
 /// A law of terms that read the contact's frame, as the lean path runs it: at most one
@@ -114,24 +191,20 @@ pub enum FrameStatic {
     Poncelet(Poncelet),
 }
 
-/// Whether two runs' frame laws are the same bit for bit (so that the lanes run both: a
-/// -0 and a +0 coefficient are different laws here, as they may give different zeros).
+/// Whether two runs' frame laws can share the lanes: the same terms with the same element
+/// counts (their numbers are per lane, [`FrameNumbers`]).
 pub fn same_law(a: &Option<FrameLaw>, b: &Option<FrameLaw>) -> bool {
-    let bits = |law: &Option<FrameLaw>| -> Vec<u64> {
-        let Some(law) = law else {
-            return vec![];
-        };
-        let mut v = match law.statics {
-            Some(FrameStatic::Rft(r)) => [vec![1.0], r.params()].concat(),
-            Some(FrameStatic::Poncelet(p)) => [vec![2.0], p.params()].concat(),
-            None => vec![0.0],
-        };
-        if let Some(r) = law.inertial {
-            v.extend(r.params());
-        }
-        v.iter().map(|x| x.to_bits()).collect()
+    let shape = |law: &Option<FrameLaw>| {
+        law.map(|l| {
+            let statics = match l.statics {
+                Some(FrameStatic::Rft(r)) => (1, r.elements),
+                Some(FrameStatic::Poncelet(_)) => (2, 0),
+                None => (0, 0),
+            };
+            (statics, l.inertial.map(|r| r.elements))
+        })
     };
-    a.is_some() == b.is_some() && bits(a) == bits(b)
+    shape(a) == shape(b)
 }
 
 impl FrameLaw {
@@ -296,6 +369,7 @@ impl RodParams<f64> {
             smooth,
             eps,
             frame: frame.map(|(law, _)| law),
+            frame_numbers: FrameNumbers::of(frame.as_ref().map(|(law, _)| law)),
         })
     }
 }
@@ -326,15 +400,18 @@ impl RodParams<F64x4> {
             smooth: s(p.smooth),
             eps: s(p.eps),
             frame: p.frame,
+            frame_numbers: FrameNumbers::splat(&p.frame_numbers),
         }
     }
 
-    /// Lane `i` becomes `p`, whose [`FrameLaw`] must be the lanes' (one law's arithmetic).
+    /// Lane `i` becomes `p`, whose [`FrameLaw`] must share the lanes' terms and element
+    /// counts ([`same_law`]; its numbers are the lane's own).
     pub fn set(&mut self, i: usize, p: &RodParams<f64>) {
         debug_assert!(
             same_law(&self.frame, &p.frame),
             "the lanes run one frame law"
         );
+        self.frame_numbers.set(i, &p.frame_numbers);
         self.mass.0[i] = p.mass;
         self.g.0[i] = p.g;
         self.inv_m.0[i] = p.inv_m;
@@ -639,16 +716,19 @@ pub fn rod_eval_law<F: Real, const FRAME: bool>(
         // In the lanes the terms are inlined into their step (AVX2 where the CPU has it); a
         // lone run calls the general path's own copies (inlined into its AVX2 step, `rft`'s
         // group of eight elements was slower: measured).
-        let lanes = F::LANES > 1;
+        // The lanes read each lane's numbers; a lone run's are its law's own.
+        let (lanes, n) = (F::LANES > 1, &p.frame_numbers);
         let fs = match law.statics {
-            Some(FrameStatic::Rft(r)) if lanes => r.force_inline(&state),
+            Some(FrameStatic::Rft(r)) if lanes => r.force_with(&n.rft, &state),
             Some(FrameStatic::Rft(r)) => r.contact_force(&state, &p.medium),
-            Some(FrameStatic::Poncelet(t)) if lanes => t.force_inline(&state, &p.medium),
+            Some(FrameStatic::Poncelet(_)) if lanes => {
+                Poncelet::force_with(n.poncelet, &state, &p.medium)
+            }
             Some(FrameStatic::Poncelet(t)) => t.contact_force(&state, &p.medium),
             None => none,
         };
         let fi = match law.inertial {
-            Some(t) if lanes => t.force_inline(&state, &p.medium),
+            Some(t) if lanes => t.force_with(n.lam, &state, &p.medium),
             Some(t) => t.contact_force(&state, &p.medium),
             None => none,
         };
@@ -1019,7 +1099,8 @@ mod tests {
         /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
         /// the accelerations, the power and every finding of the contact (what the events
         /// and the observer read), in every mode the lanes cover, under every sign model and
-        /// with any of the thesis's terms, mixed across the lanes, or under one frame law.
+        /// with any of the thesis's terms, mixed across the lanes, or under one frame law's
+        /// terms and element count with each lane's own numbers.
         #[test]
         fn lanes_are_the_scalar_evaluation_bitwise(
             scenes in proptest::array::uniform4(scene()),
@@ -1034,7 +1115,9 @@ mod tests {
                 .iter()
                 .zip(terms)
                 .map(|(s, t)| match frame {
+                    // One law's terms and element count, each lane's own numbers.
                     Some((kind, a, n)) => {
+                        let a = a * (1.0 + s.2 / 40.0);
                         model_frame((s.0, s.1, s.6, s.7, s.8), &frame_law(kind, a, n))
                     }
                     None => model_signed(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7, s.8, t),
@@ -1300,6 +1383,28 @@ mod tests {
         pendulum.contacts.clear();
         assert!(RodLayout::of(&pendulum).is_none());
         assert!(RodParams::of(&pendulum).is_none());
+    }
+
+    /// Runs share the lanes when their frame laws list the same terms with the same element
+    /// counts, whatever their numbers (each lane has its own).
+    #[test]
+    fn frame_laws_share_the_lanes_by_their_terms_and_element_counts() {
+        let law = |kind: u8, a: f64, n: usize| {
+            let m = model_frame(
+                (0.184, 0.19, false, true, SignModel::Modes),
+                &frame_law(kind, a, n),
+            );
+            RodParams::of(&m).unwrap().frame
+        };
+        assert!(same_law(&law(0, 1e6, 8), &law(0, 3e5, 8)));
+        assert!(same_law(&law(1, 1e6, 8), &law(1, 2e5, 3)));
+        assert!(same_law(&law(3, 1e6, 8), &law(4, 5e5, 8)));
+        assert!(!same_law(&law(0, 1e6, 8), &law(0, 1e6, 7)));
+        assert!(!same_law(&law(0, 1e6, 8), &law(1, 1e6, 8)));
+        assert!(!same_law(&law(0, 1e6, 8), &law(3, 1e6, 8)));
+        assert!(!same_law(&law(2, 1e6, 8), &law(2, 1e6, 5)));
+        assert!(!same_law(&law(0, 1e6, 8), &None));
+        assert!(same_law(&None, &None));
     }
 
     /// The lanes cover the thesis's set under every sign model and the frame laws, and

@@ -131,25 +131,30 @@ impl Term for Poncelet {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        self.force_inline(c, m)
+        Self::force_with([F::splat(self.c), F::splat(self.k)], c, m)
     }
 }
 
 impl Poncelet {
-    /// [`Poncelet::contact_force`], inlined where it is called: the SIMD lanes
-    /// ([`crate::dynamics::rod_lanes`]) compile it into their AVX2 step.
+    /// [`Poncelet::contact_force`] with the coefficients `[c, k]` (this law's, or one per
+    /// lane), inlined where it is called: the SIMD lanes ([`crate::dynamics::rod_lanes`])
+    /// compile it into their AVX2 step.
     #[inline(always)]
-    pub fn force_inline<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+    pub fn force_with<F: Real>(
+        [c_d, k_d]: [F; 2],
+        c: &ContactState<F>,
+        m: &Medium<F>,
+    ) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
         };
-        let friction = F::splat(self.k) * c.depth;
+        let friction = k_d * c.depth;
         let one = F::splat(1.0);
         let v = b.v_centroid;
         let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
         let inv = speed.select_pos(speed.recip(), zero);
-        let drag = -(F::splat(self.c) * m.rho_g * Self::area_speed(b, v));
+        let drag = -(c_d * m.rho_g * Self::area_speed(b, v));
         let k = drag - friction * inv;
         // Along an axis held at zero the reaction stands in, up to k d.
         let [held_x, held_y] = b.held;

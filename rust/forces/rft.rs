@@ -131,6 +131,16 @@ fn cross<F: Real>(a: [F; 2], b: [F; 2]) -> F {
     a[0] * b[1] - a[1] * b[0]
 }
 
+/// `rft`'s numbers in `F` (one value per lane in the SIMD lanes, where the scenes' laws
+/// share only their element count): `zeta` and the nine coefficients.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RftCoefficients<F> {
+    /// zeta [N/m^3].
+    pub zeta: F,
+    /// The nine coefficients, in the order of [`GENERIC`].
+    pub k: [F; 9],
+}
+
 /// Planar resistive force theory on a contact's boundary.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rft {
@@ -147,8 +157,8 @@ pub struct Rft {
 /// so the force direction `(-alpha_x, alpha_z)` is `g0 + (v_x gx + v_y gy) / |v|`. Returns
 /// `(g0, gx, gy)` (the same nine-term series, gathered once per plate).
 #[inline(always)]
-fn alpha_affine<F: Real>(k: &[f64; 9], c2: F, s2: F) -> ([F; 2], [F; 2], [F; 2]) {
-    let p = |i: usize| F::splat(k[i]);
+fn alpha_affine<F: Real>(k: &[F; 9], c2: F, s2: F) -> ([F; 2], [F; 2], [F; 2]) {
+    let p = |i: usize| k[i];
     // alpha_z = z0 + zc cos g + zs sin g; alpha_x = x0 + xc cos g + xs sin g (expand the
     // sums of angles in [`alpha`]).
     let z0 = p(0) + p(1) * c2;
@@ -223,25 +233,35 @@ impl Rft {
     /// and the moment comes from sums over the plate: `sum r_k x df_k = r_0 x sum df_k +
     /// step x sum t_k df_k`, with `r_0` the immersed part's start from P.
     #[inline(always)]
-    fn integrate<F: Real>(&self, b: &Boundary<F>, dir: Option<[F; 2]>) -> ([F; 2], F) {
+    fn integrate<F: Real>(
+        &self,
+        co: &RftCoefficients<F>,
+        b: &Boundary<F>,
+        dir: Option<[F; 2]>,
+    ) -> ([F; 2], F) {
         if let Outline::Arc { .. } = b.outline {
-            return self.integrate_chords(b, dir);
+            return self.integrate_chords(co, b, dir);
         }
         // A rod's or a box's plates: the plain loop over their array.
         let (plates, n) = b.outline.fixed_plates(&b.frame);
         let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
         for p in &plates[..n] {
-            self.add_plate(p, b, dir, &mut sum);
+            self.add_plate(co, p, b, dir, &mut sum);
         }
         sum
     }
 
     /// [`Rft::integrate`] over an arc's chords, kept out of the rod's and the box's path.
     #[inline(never)]
-    fn integrate_chords<F: Real>(&self, b: &Boundary<F>, dir: Option<[F; 2]>) -> ([F; 2], F) {
+    fn integrate_chords<F: Real>(
+        &self,
+        co: &RftCoefficients<F>,
+        b: &Boundary<F>,
+        dir: Option<[F; 2]>,
+    ) -> ([F; 2], F) {
         let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
         b.outline
-            .for_each_plate(&b.frame, |p| self.add_plate(p, b, dir, &mut sum));
+            .for_each_plate(&b.frame, |p| self.add_plate(co, p, b, dir, &mut sum));
         sum
     }
 
@@ -249,16 +269,17 @@ impl Rft {
     #[inline(always)]
     fn add_plate<F: Real>(
         &self,
+        co: &RftCoefficients<F>,
         p: &Plate<F>,
         b: &Boundary<F>,
         dir: Option<[F; 2]>,
         sum: &mut ([F; 2], F),
     ) {
         let zero = F::splat(0.0);
-        let zeta = F::splat(self.zeta);
+        let zeta = co.zeta;
         let twelfth = F::splat(1.0 / 12.0);
         let (c2, s2) = line_angle(p);
-        let (g0, gx, gy) = alpha_affine(&self.coefficients, c2, s2);
+        let (g0, gx, gy) = alpha_affine(&co.k, c2, s2);
         let el = p.elements(self.elements);
         // Each element's load zeta w L |z_mid| (exact: the depth is linear along it).
         let load = zeta * el.width * el.length;
@@ -371,20 +392,34 @@ impl Term for Rft {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        self.force_inline(c)
+        self.force_with(&self.coefficients_in(), c)
     }
 }
 
 impl Rft {
-    /// [`Rft::contact_force`], inlined where it is called: the SIMD lanes
-    /// ([`crate::dynamics::rod_lanes`]) compile it into their AVX2 step.
+    /// Its numbers in `F` (every lane the same).
     #[inline(always)]
-    pub fn force_inline<F: Real>(&self, c: &ContactState<F>) -> TermForce<F> {
+    pub fn coefficients_in<F: Real>(&self) -> RftCoefficients<F> {
+        RftCoefficients {
+            zeta: F::splat(self.zeta),
+            k: self.coefficients.map(F::splat),
+        }
+    }
+
+    /// [`Rft::contact_force`] with the numbers `co` (this law's, or one per lane),
+    /// inlined where it is called: the SIMD lanes ([`crate::dynamics::rod_lanes`]) compile
+    /// it into their AVX2 step. Only the element count is `self`'s.
+    #[inline(always)]
+    pub fn force_with<F: Real>(
+        &self,
+        co: &RftCoefficients<F>,
+        c: &ContactState<F>,
+    ) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
         };
-        let (force, moment) = self.integrate(b, None);
+        let (force, moment) = self.integrate(co, b, None);
         let [held_x, held_y] = b.held;
         if (held_x + held_y).all_zero() {
             return TermForce {
@@ -393,7 +428,7 @@ impl Rft {
                 moment,
             };
         }
-        self.held(b, force, moment)
+        self.held(co, b, force, moment)
     }
 }
 
@@ -404,20 +439,26 @@ impl Rft {
     /// the moving elements' while one axis moves, and is zero at rest. Out of line: the
     /// moving contact's path stays one copy of [`Rft::integrate`].
     #[inline(never)]
-    fn held<F: Real>(&self, b: &Boundary<F>, force: [F; 2], moment: F) -> TermForce<F> {
+    fn held<F: Real>(
+        &self,
+        co: &RftCoefficients<F>,
+        b: &Boundary<F>,
+        force: [F; 2],
+        moment: F,
+    ) -> TermForce<F> {
         let zero = F::splat(0.0);
         let one = F::splat(1.0);
         let [held_x, held_y] = b.held;
         let (mut force, mut moment) = (force, moment);
         let mut bound = [zero; 2];
         if !held_y.all_zero() {
-            let (down, _) = self.integrate(b, Some([zero, -one]));
+            let (down, _) = self.integrate(co, b, Some([zero, -one]));
             bound[1] = held_y * down[1].max(zero);
             force[1] = (one - held_y) * force[1];
         }
         if !held_x.all_zero() {
-            let (right, _) = self.integrate(b, Some([one, zero]));
-            let (left, _) = self.integrate(b, Some([-one, zero]));
+            let (right, _) = self.integrate(co, b, Some([one, zero]));
+            let (left, _) = self.integrate(co, b, Some([-one, zero]));
             bound[0] = held_x * (-right[0]).max(zero).min(left[0].max(zero));
             force[0] = (one - held_x) * force[0];
         }
@@ -483,20 +524,21 @@ impl Term for RftInertial {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        self.force_inline(c, m)
+        self.force_with(F::splat(self.lam), c, m)
     }
 }
 
 impl RftInertial {
-    /// [`RftInertial::contact_force`], inlined where it is called: the SIMD lanes
-    /// ([`crate::dynamics::rod_lanes`]) compile it into their AVX2 step.
+    /// [`RftInertial::contact_force`] with the scale `lam` (this law's, or one per lane),
+    /// inlined where it is called: the SIMD lanes ([`crate::dynamics::rod_lanes`]) compile
+    /// it into their AVX2 step. Only the element count is `self`'s.
     #[inline(always)]
-    pub fn force_inline<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+    pub fn force_with<F: Real>(&self, lam: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
         };
-        let k = -(F::splat(self.lam) * m.rho_g);
+        let k = -(lam * m.rho_g);
         let mut f = [zero; 2];
         let mut moment = zero;
         b.outline.for_each_plate(&b.frame, |p| {
@@ -619,7 +661,7 @@ mod tests {
                     elements,
                     coefficients: GENERIC,
                 };
-                let (f, m) = t.integrate(&b, None);
+                let (f, m) = t.integrate(&t.coefficients_in(), &b, None);
                 let (fe, me) = element_sum(&t, &b);
                 let scale = fe[0].hypot(fe[1]);
                 assert!((f[0] - fe[0]).abs() < 1e-12 * scale, "{f:?} {fe:?}");

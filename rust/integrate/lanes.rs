@@ -1,7 +1,8 @@
 //! Several runs of the free link stepped at once, one per SIMD lane: the sweep's fast path.
 //! The lanes run one law's arithmetic at a time: the thesis's terms (any of them, with any
 //! coefficients per lane) or one law of terms that read the frame (`rft`, `poncelet`,
-//! `rft_inertial`: `dynamics::rod_lanes::FrameLaw`, its parameters shared by the four).
+//! `rft_inertial`: `dynamics::rod_lanes::FrameLaw`), its terms and element counts shared by
+//! the four, its numbers per lane.
 //!
 //! Layout (structure of arrays): each lane holds one scene; the state (q, q', work), the
 //! first stage, the step size, the held modes and the scene's parameters are each one
@@ -517,8 +518,9 @@ pub struct LaneCounts {
 /// cover ([`covered`]) runs alone, on the scalar path, as [`solve`] runs it.
 ///
 /// The lanes run one law's arithmetic at a time (the thesis's terms with any coefficients
-/// per lane, or one [`crate::dynamics::rod_lanes::FrameLaw`]). A scene under another law
-/// waits (up to [`WAITING`] of them; its lane stays empty) until the lanes have drained,
+/// per lane, or one [`crate::dynamics::rod_lanes::FrameLaw`]'s terms and element counts,
+/// with any numbers per lane: [`crate::dynamics::rod_lanes::same_law`]). A scene under
+/// another law waits (up to [`WAITING`] of them; its lane stays empty) until the lanes have drained,
 /// and then they take its law.
 ///
 /// A step that meets nothing (no event, every pivot clear) of a run that
@@ -776,6 +778,10 @@ fn copy_lane(p: &mut RodParams<F64x4>, i: usize, j: usize) {
     one(&mut p.eta_h);
     one(&mut p.eta_v);
     one(&mut p.lam);
+    one(&mut p.unheld);
+    one(&mut p.smooth);
+    one(&mut p.eps);
+    p.frame_numbers.each(one);
 }
 
 /// A run that failed leaves its lane with its error.
