@@ -9,11 +9,11 @@
 //! way: with AVX2's three-operand encodings it needs fewer register copies (a thesis-law
 //! impact about 8 % faster, bit for bit the same). One wheel thus runs on any x86-64 (SSE2,
 //! two lanes per instruction), uses 256-bit registers where the CPU has them, and builds
-//! unchanged for arm64 (NEON, two lanes per instruction). `sin_cos` and `powf` are libm's, lane by lane (libm has no vector
-//! versions). Vectorized ones were written and measured: a `sin_cos` (range reduction and a
-//! series, within 1 ulp of glibc) made the lanes 8 % faster but the scalar path, which must
-//! call the same function for the lanes to stay bit for bit, 22 % slower; a `pow` within 1
-//! ulp took 4x libm's time per call.
+//! unchanged for arm64 (NEON, two lanes per instruction). `sin_cos` and `powf` are libm's,
+//! lane by lane (libm has no vector versions). Vectorized ones were written and measured: a
+//! `sin_cos` (range reduction and a series, within 1 ulp of glibc) made the lanes 8 % faster
+//! but the scalar path, which must call the same function for the lanes to stay bit for
+//! bit, 22 % slower; a `pow` within 1 ulp took 4x libm's time per call.
 //!
 //! Why no crate: `wide` picks its instructions when the crate is compiled
 //! (`cfg(target_feature)`), so a baseline x86-64 wheel would never use AVX2; `pulp` does

@@ -52,6 +52,17 @@ def _assert_same(lanes: pd.DataFrame, scalar: pd.DataFrame) -> None:
     assert np.array_equal(a.view(np.uint64), b.view(np.uint64))
 
 
+def _lanes_equal_scalar(
+    scenes: granrs.Scene | list[granrs.Scene], threads: int = 1, **axes: list[float]
+) -> pd.DataFrame:
+    """Sweep ``scenes`` (a list, or a base scene with ``axes``) in the lanes and on the
+    scalar path, assert the rows are the same (:func:`_assert_same`), return the lanes'."""
+    lanes = granrs.sweep(scenes, threads=threads, progress=False, **axes)
+    scalar = granrs.sweep(scenes, threads=threads, progress=False, lanes=False, **axes)
+    _assert_same(lanes, scalar)
+    return lanes
+
+
 def _table_3_5() -> list[granrs.Scene]:
     t = granrs.data.load("table_3_5", as_="numpy")
     rows = zip(t["q_deg"], t["v0"], strict=True)
@@ -62,9 +73,7 @@ def _table_3_5() -> list[granrs.Scene]:
 def test_table_3_5_in_lanes_equals_the_scalar_path(sign_model: str) -> None:
     scenes = [s.replace(sign_model=sign_model) for s in _table_3_5()]
     assert len(scenes) == 31
-    lanes = granrs.sweep(scenes, threads=1, progress=False)
-    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    lanes = _lanes_equal_scalar(scenes)
     # The scenes end at different times: lanes refill at different steps.
     assert lanes["t_s"].nunique() > 20
     # And each row is simulate()'s (under `smooth` no sign reaches zero: no stop, t_s NaN).
@@ -93,9 +102,7 @@ def test_uncovered_scenes_mixed_in_run_alone_with_the_same_rows() -> None:
         base.replace(sign_model="smooth"),
         base.replace(end="time", t_end=0.02),
     ]
-    lanes = granrs.sweep(scenes, threads=2, progress=False)
-    scalar = granrs.sweep(scenes, threads=2, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    _lanes_equal_scalar(scenes, threads=2)
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -123,9 +130,7 @@ def test_random_sweeps_in_lanes_equal_the_scalar_path(
         mass=mass,
         forces=[gravity(), drag(eta_d=15.2), static_h(eta_h=6.5), static_v(eta_v=eta_v, lam=lam)],
     )
-    lanes = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False)
-    scalar = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    _lanes_equal_scalar(base, q_deg=qs, v0=vs)
 
 
 @pytest.mark.parametrize("keep", [("static_v",), ("drag", "static_v"), ("static_h", "static_v")])
@@ -134,9 +139,7 @@ def test_some_of_the_thesis_terms_in_lanes_equal_the_scalar_path(keep: tuple[str
     rows bit for bit as the scalar path and as simulate()."""
     law = select(thesis(), "gravity", *keep)
     scenes = [s.replace(forces=law) for s in _table_3_5()]
-    lanes = granrs.sweep(scenes, threads=1, progress=False)
-    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    lanes = _lanes_equal_scalar(scenes)
     for row, scene in zip(lanes.itertuples(index=False), scenes, strict=True):
         assert row.depth == granrs.simulate(scene).summary["depth"]
 
@@ -166,9 +169,7 @@ def test_frame_laws_in_lanes_equal_the_scalar_path(sign_model: str, law: str) ->
     Table 3.5 scenes give the scalar path's rows bit for bit, and simulate()'s."""
     terms = FRAME_LAWS[law]()
     scenes = [s.replace(forces=terms, sign_model=sign_model) for s in _table_3_5()]
-    lanes = granrs.sweep(scenes, threads=1, progress=False)
-    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    lanes = _lanes_equal_scalar(scenes)
     # The scenes end at different times (lanes refill at different steps), but under
     # `smooth` no sign reaches zero and `rft_inertial` alone never stops a rod: those run to
     # their end time.
@@ -201,9 +202,7 @@ def test_a_sweep_that_mixes_frame_laws_and_the_thesis_has_the_scalar_rows() -> N
             strict=True,
         )
     ]
-    lanes = granrs.sweep(scenes, threads=1, progress=False)
-    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    _lanes_equal_scalar(scenes)
 
 
 def test_a_sweep_over_a_frame_laws_numbers_runs_in_the_lanes() -> None:
@@ -219,9 +218,7 @@ def test_a_sweep_over_a_frame_laws_numbers_runs_in_the_lanes() -> None:
             base.replace(forces=[gravity(), rft(zeta=zeta), rft_inertial(lam=0.2 + 0.1 * k)])
         )
         scenes.append(base.replace(forces=[gravity(), poncelet(c=0.2 + 0.1 * k, k=50.0 + 10 * k)]))
-    lanes = granrs.sweep(scenes, threads=1, progress=False)
-    scalar = granrs.sweep(scenes, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    lanes = _lanes_equal_scalar(scenes)
     assert lanes["depth"].nunique() == len(scenes)
 
 
@@ -258,9 +255,7 @@ def test_random_frame_law_sweeps_in_lanes_equal_the_scalar_path(
     base = cases.free_link(q_deg=0.0, v0=1.0).replace(
         omega0=omega0, vx0=vx0, sign_model=sign_model, forces=terms
     )
-    lanes = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False)
-    scalar = granrs.sweep(base, q_deg=qs, v0=vs, threads=1, progress=False, lanes=False)
-    _assert_same(lanes, scalar)
+    _lanes_equal_scalar(base, q_deg=qs, v0=vs)
 
 
 def test_lanes_must_be_a_bool() -> None:

@@ -129,16 +129,6 @@ impl FrameNumbers<f64> {
         }
         n
     }
-
-    /// Its values in a fixed order ([`FrameNumbers::each`]'s).
-    fn values(&self) -> [f64; 13] {
-        let mut v = [0.0; 13];
-        v[0] = self.rft.zeta;
-        v[1..10].copy_from_slice(&self.rft.k);
-        v[10..12].copy_from_slice(&self.poncelet);
-        v[12] = self.lam;
-        v
-    }
 }
 
 impl FrameNumbers<F64x4> {
@@ -155,7 +145,7 @@ impl FrameNumbers<F64x4> {
         }
     }
 
-    /// Each value, in the order of [`FrameNumbers::values`].
+    /// Each value.
     pub fn each(&mut self, mut f: impl FnMut(&mut F64x4)) {
         f(&mut self.rft.zeta);
         self.rft.k.iter_mut().for_each(&mut f);
@@ -165,8 +155,14 @@ impl FrameNumbers<F64x4> {
 
     /// Lane `i` becomes `n`.
     fn set(&mut self, i: usize, n: &FrameNumbers<f64>) {
-        let mut v = n.values().into_iter();
-        self.each(|x| x.0[i] = v.next().unwrap_or(0.0));
+        self.rft.zeta.0[i] = n.rft.zeta;
+        for (x, v) in self.rft.k.iter_mut().zip(n.rft.k) {
+            x.0[i] = v;
+        }
+        for (x, v) in self.poncelet.iter_mut().zip(n.poncelet) {
+            x.0[i] = v;
+        }
+        self.lam.0[i] = n.lam;
     }
 }
 

@@ -520,8 +520,8 @@ pub struct LaneCounts {
 /// The lanes run one law's arithmetic at a time (the thesis's terms with any coefficients
 /// per lane, or one [`crate::dynamics::rod_lanes::FrameLaw`]'s terms and element counts,
 /// with any numbers per lane: [`crate::dynamics::rod_lanes::same_law`]). A scene under
-/// another law waits (up to [`WAITING`] of them; its lane stays empty) until the lanes have drained,
-/// and then they take its law.
+/// another law waits (up to [`WAITING`] of them; its lane stays empty) until the lanes have
+/// drained, and then they take its law.
 ///
 /// A step that meets nothing (no event, every pivot clear) of a run that
 /// [`Run::may_stay_in_lanes`] is accepted by the lanes ([`Run::accept_plain`]): the run's next
