@@ -116,26 +116,7 @@ impl<F: Real> Outline<F> {
         let mut out = [none; MAX_PLATES];
         match *self {
             Outline::Rod { diameter, immersed } => {
-                let t = frame.origin;
-                let e = frame.axis;
-                let half = F::splat(0.5) * diameter;
-                // The normal to the axis, (-e_y, e_x).
-                let n = [-e[1], e[0]];
-                // Directions and lengths from the frame: no square root, no division.
-                out[0] = Plate {
-                    a: t,
-                    b: [t[0] + immersed * e[0], t[1] + immersed * e[1]],
-                    u: e,
-                    length: immersed,
-                    width: diameter,
-                };
-                out[1] = Plate {
-                    a: [t[0] - half * n[0], t[1] - half * n[1]],
-                    b: [t[0] + half * n[0], t[1] + half * n[1]],
-                    u: n,
-                    length: diameter,
-                    width: diameter,
-                };
+                [out[0], out[1]] = rod_plates(diameter, immersed, frame);
                 (out, 2)
             }
             Outline::Box { corners, width } => {
@@ -148,6 +129,34 @@ impl<F: Real> Outline<F> {
             Outline::Arc { .. } => (out, 0),
         }
     }
+}
+
+/// A rod's two plates at the pose `frame`: its shaft from the tip T along the axis over the
+/// immersed length, and its tip end across the axis at T, both `diameter` wide.
+#[inline(always)]
+pub fn rod_plates<F: Real>(diameter: F, immersed: F, frame: &Frame<F>) -> [Plate<F>; 2] {
+    let t = frame.origin;
+    let e = frame.axis;
+    let half = F::splat(0.5) * diameter;
+    // The normal to the axis, (-e_y, e_x).
+    let n = [-e[1], e[0]];
+    // Directions and lengths from the frame: no square root, no division.
+    [
+        Plate {
+            a: t,
+            b: [t[0] + immersed * e[0], t[1] + immersed * e[1]],
+            u: e,
+            length: immersed,
+            width: diameter,
+        },
+        Plate {
+            a: [t[0] - half * n[0], t[1] - half * n[1]],
+            b: [t[0] + half * n[0], t[1] + half * n[1]],
+            u: n,
+            length: diameter,
+            width: diameter,
+        },
+    ]
 }
 
 impl<F: Real> Plate<F> {

@@ -47,7 +47,7 @@
 //! leading surfaces). `lam` = 1 is the momentum-flux value; the paper's own coefficient
 //! could not be checked here (see docs/laws.md). It is zero at rest, so it owns no switch.
 
-use super::outline::Plate;
+use super::outline::{rod_plates, Plate};
 use super::{
     Acts, Boundary, Class, ContactState, Medium, Outline, Param, Real, Switch, Term, TermForce,
     TermInfo,
@@ -246,8 +246,24 @@ impl Rft {
         let (plates, n) = b.outline.fixed_plates(&b.frame);
         let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
         for p in &plates[..n] {
-            self.add_plate(co, p, b, dir, &mut sum);
+            self.add_plate::<F, 0>(co, p, b, dir, &mut sum);
         }
+        sum
+    }
+
+    /// [`Rft::integrate`] over a rod's two plates at `N` elements each (`self.elements`), its
+    /// elements moving along their own velocities: the same arithmetic in the same order.
+    #[inline(always)]
+    fn integrate_rod<F: Real, const N: usize>(
+        &self,
+        co: &RftCoefficients<F>,
+        (diameter, immersed): (F, F),
+        b: &Boundary<F>,
+    ) -> ([F; 2], F) {
+        let plates = rod_plates(diameter, immersed, &b.frame);
+        let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
+        self.add_plate::<F, N>(co, &plates[0], b, None, &mut sum);
+        self.add_plate::<F, N>(co, &plates[1], b, None, &mut sum);
         sum
     }
 
@@ -260,14 +276,16 @@ impl Rft {
         dir: Option<[F; 2]>,
     ) -> ([F; 2], F) {
         let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
-        b.outline
-            .for_each_plate(&b.frame, |p| self.add_plate(co, p, b, dir, &mut sum));
+        b.outline.for_each_plate(&b.frame, |p| {
+            self.add_plate::<F, 0>(co, p, b, dir, &mut sum)
+        });
         sum
     }
 
-    /// Add plate `p`'s force and moment about P to `sum` ([`Rft::integrate`]).
+    /// Add plate `p`'s force and moment about P to `sum` ([`Rft::integrate`]), at `N`
+    /// elements (known when compiled), or `self.elements` where `N` is 0.
     #[inline(always)]
-    fn add_plate<F: Real>(
+    fn add_plate<F: Real, const N: usize>(
         &self,
         co: &RftCoefficients<F>,
         p: &Plate<F>,
@@ -280,7 +298,8 @@ impl Rft {
         let twelfth = F::splat(1.0 / 12.0);
         let (c2, s2) = line_angle(p);
         let (g0, gx, gy) = alpha_affine(&co.k, c2, s2);
-        let el = p.elements(self.elements);
+        let n = if N > 0 { N } else { self.elements };
+        let el = p.elements(n);
         // Each element's load zeta w L |z_mid| (exact: the depth is linear along it).
         let load = zeta * el.width * el.length;
         // Its moment about its middle, for the depth's slope along it: zeta w (u x f)
@@ -311,7 +330,6 @@ impl Rft {
         };
         // Elements in groups of 8 and 4 (independent square roots and divisions), the
         // rest one by one.
-        let n = self.elements;
         let mut c = 0;
         while c + 8 <= n {
             plate.add::<8>(c);
@@ -392,7 +410,69 @@ impl Term for Rft {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        self.force_with(&self.coefficients_in(), c)
+        let co = self.coefficients_in();
+        #[cfg(target_arch = "x86_64")]
+        if F::LANES == 1 && self.elements <= ROD_FAST_ELEMENTS && crate::simd::avx2() {
+            if let Some(b) = c.boundary {
+                if let Outline::Rod { diameter, immersed } = b.outline {
+                    if (b.held[0] + b.held[1]).all_zero() {
+                        // SAFETY: this CPU has AVX2 (checked).
+                        let (force, moment) =
+                            unsafe { self.rod_avx2(&co, (diameter, immersed), b) };
+                        return TermForce {
+                            force,
+                            bound: [F::splat(0.0); 2],
+                            moment,
+                        };
+                    }
+                }
+            }
+        }
+        self.force_base(&co, c)
+    }
+}
+
+/// Most elements per plate of a lone rod's fast path ([`Rft::rod_avx2`]).
+const ROD_FAST_ELEMENTS: usize = 8;
+
+impl Rft {
+    /// [`Rft::force_with`], out of line, with the numbers behind a reference (seen through,
+    /// they were ten more values held in registers in the AVX2 path: 13 % slower there).
+    #[inline(never)]
+    fn force_base<F: Real>(&self, co: &RftCoefficients<F>, c: &ContactState<F>) -> TermForce<F> {
+        self.force_with(co, c)
+    }
+
+    /// A lone rod's contact, held nowhere, at up to [`ROD_FAST_ELEMENTS`] elements per plate:
+    /// the count known when compiled (one instance per count) and the whole compiled with
+    /// AVX2 (its three-operand encodings; the same IEEE operations in the same order, so the
+    /// same bits as [`Rft::force_with`]). A quarter less time than the plain loop at eight
+    /// elements, half at two (docs/laws.md, "Cost"). Measured on the way: LLVM packs two
+    /// elements to a 128-bit register here; compiled one count per function it packed four
+    /// to a 256-bit one, and the shuffles of the x, y pairs made that a quarter slower. A
+    /// change here is to be measured (`benches/bench_laws.py`).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 ([`crate::simd::avx2`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    unsafe fn rod_avx2<F: Real>(
+        &self,
+        co: &RftCoefficients<F>,
+        rod: (F, F),
+        b: &Boundary<F>,
+    ) -> ([F; 2], F) {
+        match self.elements {
+            1 => self.integrate_rod::<F, 1>(co, rod, b),
+            2 => self.integrate_rod::<F, 2>(co, rod, b),
+            3 => self.integrate_rod::<F, 3>(co, rod, b),
+            4 => self.integrate_rod::<F, 4>(co, rod, b),
+            5 => self.integrate_rod::<F, 5>(co, rod, b),
+            6 => self.integrate_rod::<F, 6>(co, rod, b),
+            7 => self.integrate_rod::<F, 7>(co, rod, b),
+            _ => self.integrate_rod::<F, 8>(co, rod, b),
+        }
     }
 }
 
@@ -716,5 +796,81 @@ mod tests {
             );
             assert!(f.force[0].abs() < 1e-12 * expected && f.moment.abs() < 1e-12);
         }
+    }
+
+    /// A lone rod's fast path (`Rft::rod_avx2`, taken by `contact_force` where the CPU has
+    /// AVX2) gives the plain loop's bits at every element count it covers, on tilted,
+    /// spinning rods partly out of the sand, with an element at rest, and held or not.
+    #[test]
+    fn a_lone_rods_fast_path_is_the_plain_loop_bit_for_bit() {
+        use proptest::prelude::*;
+        let medium = crate::forces::Medium::default();
+        let case = |q: f64, v: [f64; 2], omega: f64, depth: f64, held: [f64; 2], n: usize| {
+            let (s, c) = q.sin_cos();
+            let axis = [-s, c];
+            let immersed = (depth / c.abs().max(1e-3)).min(0.19);
+            let b = Boundary {
+                frame: Frame {
+                    origin: [0.01, -depth],
+                    v,
+                    omega,
+                    axis,
+                },
+                outline: Outline::Rod {
+                    diameter: 0.0127,
+                    immersed,
+                },
+                apply: [
+                    0.01 + 0.3 * immersed * axis[0],
+                    -depth + 0.3 * immersed * axis[1],
+                ],
+                centroid: [0.0; 2],
+                v_centroid: v,
+                held,
+            };
+            let state = ContactState {
+                depth,
+                volume: 0.0,
+                width: 0.0127,
+                l_ref: 0.19,
+                v,
+                area_speed: 0.0,
+                sign: [0.0, -1.0],
+                boundary: Some(&b),
+            };
+            let t = Rft {
+                zeta: 1.3e6,
+                elements: n,
+                coefficients: GENERIC,
+            };
+            let fast = t.contact_force(&state, &medium);
+            let plain = t.force_with(&t.coefficients_in(), &state);
+            for (a, b) in [
+                (fast.force[0], plain.force[0]),
+                (fast.force[1], plain.force[1]),
+                (fast.bound[0], plain.bound[0]),
+                (fast.bound[1], plain.bound[1]),
+                (fast.moment, plain.moment),
+            ] {
+                prop_assert_eq!(a.to_bits(), b.to_bits(), "n {} held {:?}", n, held);
+            }
+            Ok(())
+        };
+        // An element at rest: the rod turning about its tip with the tip still.
+        for n in 1..=10 {
+            case(0.4, [0.0; 2], 5.0, 0.03, [0.0; 2], n).unwrap();
+        }
+        proptest!(ProptestConfig::with_cases(400), |(
+            q in -1.5f64..1.5,
+            vx in -2.0f64..2.0,
+            vy in -3.0f64..1.0,
+            omega in -40.0f64..40.0,
+            depth in 0.001f64..0.12,
+            hold in 0usize..4,
+            n in prop::sample::select(vec![1usize, 2, 3, 4, 5, 6, 7, 8, 9, 16]),
+        )| {
+            let held = [[0.0, 0.0], [0.0, 1.0], [1.0, 0.0], [1.0, 1.0]][hold];
+            case(q, [vx, vy], omega, depth, held, n)?;
+        });
     }
 }
