@@ -604,6 +604,21 @@ impl Term for RftInertial {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        #[cfg(target_arch = "x86_64")]
+        if F::LANES == 1 && self.elements <= ROD_FAST_ELEMENTS && crate::simd::avx2() {
+            if let Some(b) = c.boundary {
+                if let Outline::Rod { diameter, immersed } = b.outline {
+                    let k = -(F::splat(self.lam) * m.rho_g);
+                    // SAFETY: this CPU has AVX2 (checked).
+                    let (force, moment) = unsafe { self.rod_avx2(k, (diameter, immersed), b) };
+                    return TermForce {
+                        force,
+                        bound: [F::splat(0.0); 2],
+                        moment,
+                    };
+                }
+            }
+        }
         self.force_with(F::splat(self.lam), c, m)
     }
 }
@@ -619,37 +634,91 @@ impl RftInertial {
             return TermForce::force([zero; 2]);
         };
         let k = -(lam * m.rho_g);
-        let mut f = [zero; 2];
-        let mut moment = zero;
-        b.outline.for_each_plate(&b.frame, |p| {
-            // The plate's normal (-u_y, u_x); either face leads, by the sign of v_n.
-            let n = [-p.u[1], p.u[0]];
-            let el = p.elements(self.elements);
-            let area = el.length * el.width;
-            // v_n at t = k + 1/2 from the start is affine in t (a rigid link): vn0 + t dvn.
-            let v0 = b.frame.velocity_at(el.start);
-            let dv = [-b.frame.omega * el.step[1], b.frame.omega * el.step[0]];
-            let vn0 = v0[0] * n[0] + v0[1] * n[1];
-            let dvn = dv[0] * n[0] + dv[1] * n[1];
-            // Sums of w and t w; df = w n, so sum r_k x df_k = (r_0 sum w + step sum t w) x n.
-            let (mut sw, mut stw) = (zero, zero);
-            for e in 0..self.elements {
-                let t = F::splat(e as f64) + F::splat(0.5);
-                let vn = vn0 + t * dvn;
-                let w = vn.abs() * vn;
-                sw = sw + w;
-                stw = stw + t * w;
-            }
-            let (sw, stw) = (k * area * sw, k * area * stw);
-            f = [f[0] + sw * n[0], f[1] + sw * n[1]];
-            let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
-            let lever = [sw * r0[0] + stw * el.step[0], sw * r0[1] + stw * el.step[1]];
-            moment = moment + cross(lever, n);
-        });
+        let mut sum = ([zero; 2], zero);
+        b.outline
+            .for_each_plate(&b.frame, |p| self.add_plate::<F, 0>(k, p, b, &mut sum));
         TermForce {
-            force: f,
+            force: sum.0,
             bound: [zero; 2],
-            moment,
+            moment: sum.1,
+        }
+    }
+
+    /// Add plate `p`'s force and moment about P to `sum`, with `k = -lam rho_g`, at `N`
+    /// elements (known when compiled), or `self.elements` where `N` is 0.
+    #[inline(always)]
+    fn add_plate<F: Real, const N: usize>(
+        &self,
+        k: F,
+        p: &Plate<F>,
+        b: &Boundary<F>,
+        sum: &mut ([F; 2], F),
+    ) {
+        let zero = F::splat(0.0);
+        let n_el = if N > 0 { N } else { self.elements };
+        // The plate's normal (-u_y, u_x); either face leads, by the sign of v_n.
+        let n = [-p.u[1], p.u[0]];
+        let el = p.elements(n_el);
+        let area = el.length * el.width;
+        // v_n at t = k + 1/2 from the start is affine in t (a rigid link): vn0 + t dvn.
+        let v0 = b.frame.velocity_at(el.start);
+        let dv = [-b.frame.omega * el.step[1], b.frame.omega * el.step[0]];
+        let vn0 = v0[0] * n[0] + v0[1] * n[1];
+        let dvn = dv[0] * n[0] + dv[1] * n[1];
+        // Sums of w and t w; df = w n, so sum r_k x df_k = (r_0 sum w + step sum t w) x n.
+        let (mut sw, mut stw) = (zero, zero);
+        for e in 0..n_el {
+            let t = F::splat(e as f64) + F::splat(0.5);
+            let vn = vn0 + t * dvn;
+            let w = vn.abs() * vn;
+            sw = sw + w;
+            stw = stw + t * w;
+        }
+        let (sw, stw) = (k * area * sw, k * area * stw);
+        let (f, moment) = sum;
+        *f = [f[0] + sw * n[0], f[1] + sw * n[1]];
+        let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
+        let lever = [sw * r0[0] + stw * el.step[0], sw * r0[1] + stw * el.step[1]];
+        *moment = *moment + cross(lever, n);
+    }
+
+    /// [`RftInertial::force_with`] on a lone rod at up to [`ROD_FAST_ELEMENTS`] elements per
+    /// plate, the count known when compiled, compiled with AVX2 (the same operations in
+    /// the same order: the same bits), as [`Rft`]'s (docs/laws.md, "Cost").
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 ([`crate::simd::avx2`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    unsafe fn rod_avx2<F: Real>(
+        &self,
+        k: F,
+        (diameter, immersed): (F, F),
+        b: &Boundary<F>,
+    ) -> ([F; 2], F) {
+        #[inline(always)]
+        fn rod<F: Real, const N: usize>(
+            t: &RftInertial,
+            k: F,
+            plates: &[Plate<F>; 2],
+            b: &Boundary<F>,
+        ) -> ([F; 2], F) {
+            let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
+            t.add_plate::<F, N>(k, &plates[0], b, &mut sum);
+            t.add_plate::<F, N>(k, &plates[1], b, &mut sum);
+            sum
+        }
+        let plates = rod_plates(diameter, immersed, &b.frame);
+        match self.elements {
+            1 => rod::<F, 1>(self, k, &plates, b),
+            2 => rod::<F, 2>(self, k, &plates, b),
+            3 => rod::<F, 3>(self, k, &plates, b),
+            4 => rod::<F, 4>(self, k, &plates, b),
+            5 => rod::<F, 5>(self, k, &plates, b),
+            6 => rod::<F, 6>(self, k, &plates, b),
+            7 => rod::<F, 7>(self, k, &plates, b),
+            _ => rod::<F, 8>(self, k, &plates, b),
         }
     }
 }
@@ -798,9 +867,10 @@ mod tests {
         }
     }
 
-    /// A lone rod's fast path (`Rft::rod_avx2`, taken by `contact_force` where the CPU has
-    /// AVX2) gives the plain loop's bits at every element count it covers, on tilted,
-    /// spinning rods partly out of the sand, with an element at rest, and held or not.
+    /// A lone rod's fast paths (`Rft::rod_avx2`, `RftInertial::rod_avx2`, taken by
+    /// `contact_force` where the CPU has AVX2) give the plain loop's bits at every element
+    /// count they cover, on tilted, spinning rods partly out of the sand, with an element at
+    /// rest, and held or not.
     #[test]
     fn a_lone_rods_fast_path_is_the_plain_loop_bit_for_bit() {
         use proptest::prelude::*;
@@ -843,16 +913,30 @@ mod tests {
                 elements: n,
                 coefficients: GENERIC,
             };
-            let fast = t.contact_force(&state, &medium);
-            let plain = t.force_with(&t.coefficients_in(), &state);
-            for (a, b) in [
-                (fast.force[0], plain.force[0]),
-                (fast.force[1], plain.force[1]),
-                (fast.bound[0], plain.bound[0]),
-                (fast.bound[1], plain.bound[1]),
-                (fast.moment, plain.moment),
-            ] {
-                prop_assert_eq!(a.to_bits(), b.to_bits(), "n {} held {:?}", n, held);
+            let inertial = RftInertial {
+                lam: 1.7,
+                elements: n,
+            };
+            let pairs = [
+                (
+                    t.contact_force(&state, &medium),
+                    t.force_with(&t.coefficients_in(), &state),
+                ),
+                (
+                    inertial.contact_force(&state, &medium),
+                    inertial.force_with(1.7, &state, &medium),
+                ),
+            ];
+            for (fast, plain) in pairs {
+                for (a, b) in [
+                    (fast.force[0], plain.force[0]),
+                    (fast.force[1], plain.force[1]),
+                    (fast.bound[0], plain.bound[0]),
+                    (fast.bound[1], plain.bound[1]),
+                    (fast.moment, plain.moment),
+                ] {
+                    prop_assert_eq!(a.to_bits(), b.to_bits(), "n {} held {:?}", n, held);
+                }
             }
             Ok(())
         };
