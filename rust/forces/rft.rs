@@ -47,7 +47,9 @@
 //! leading surfaces). `lam` = 1 is the momentum-flux value; the paper's own coefficient
 //! could not be checked here (see docs/laws.md). It is zero at rest, so it owns no switch.
 
-use super::outline::{rod_plates, Plate};
+#[cfg(target_arch = "x86_64")]
+use super::outline::rod_plates;
+use super::outline::Plate;
 use super::{
     Acts, Boundary, Class, ContactState, Medium, Outline, Param, Real, Switch, Term, TermForce,
     TermInfo,
@@ -253,6 +255,7 @@ impl Rft {
 
     /// [`Rft::integrate`] over a rod's two plates at `N` elements each (`self.elements`), its
     /// elements moving along their own velocities: the same arithmetic in the same order.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn integrate_rod<F: Real, const N: usize>(
         &self,
@@ -412,7 +415,8 @@ impl Term for Rft {
     fn contact_force<F: Real>(&self, c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
         let co = self.coefficients_in();
         #[cfg(target_arch = "x86_64")]
-        if F::LANES == 1 && self.elements <= ROD_FAST_ELEMENTS && crate::simd::avx2() {
+        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::simd::avx2()
+        {
             if let Some(b) = c.boundary {
                 if let Outline::Rod { diameter, immersed } = b.outline {
                     if (b.held[0] + b.held[1]).all_zero() {
@@ -432,7 +436,9 @@ impl Term for Rft {
     }
 }
 
-/// Most elements per plate of a lone rod's fast path ([`Rft::rod_avx2`]).
+/// Most elements per plate of a lone rod's fast paths ([`Rft::rod_avx2`],
+/// [`RftInertial::rod_avx2`]); each count from 1 up has its own instance.
+#[cfg(target_arch = "x86_64")]
 const ROD_FAST_ELEMENTS: usize = 8;
 
 impl Rft {
@@ -605,7 +611,8 @@ impl Term for RftInertial {
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         #[cfg(target_arch = "x86_64")]
-        if F::LANES == 1 && self.elements <= ROD_FAST_ELEMENTS && crate::simd::avx2() {
+        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::simd::avx2()
+        {
             if let Some(b) = c.boundary {
                 if let Outline::Rod { diameter, immersed } = b.outline {
                     let k = -(F::splat(self.lam) * m.rho_g);

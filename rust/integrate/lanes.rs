@@ -470,6 +470,7 @@ impl LaneIsa {
             // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU (this method
             // is the crate's own, so no caller outside it picks the variant).
             LaneIsa::Avx2 if p.frame.is_some() => unsafe { lane_step_avx2::<F, true>(p, m, s) },
+            #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             LaneIsa::Avx2 => unsafe { lane_step_avx2::<F, false>(p, m, s) },
             _ if p.frame.is_some() => lane_step_base::<F, true>(p, m, s),
