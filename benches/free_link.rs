@@ -1,6 +1,9 @@
 //! Criterion benches of the free link, one group per layer (STYLE.md, "Benchmarks"):
 //!
-//! * `force/rod_force`: one evaluation of the resistance-force law;
+//! * `force/rod_force`: one evaluation of the resistance-force law; `force/rft/N`: `rft`'s
+//!   force on the same rod, tilted and spinning, at N elements per plate (a lone rod's fast
+//!   path up to 8, the plain loop beyond; docs/laws.md, "Cost": its speed hangs on how LLVM
+//!   packs the element groups, so compare 2 and 8 against 16 before and after a change);
 //! * `rhs/eval`: one right-hand-side evaluation of the free-link model at a mid-impact state
 //!   of the q = 45 row (both static terms sliding); `rhs/eval_vertical_stick` the same for
 //!   the vertical drop, whose horizontal term sticks (v_Ex = 0 held by a reaction);
@@ -24,7 +27,10 @@ use nalgebra::{SVector, Vector2};
 use _granrs::bodies::FreeLinkScene;
 use _granrs::dynamics::terms_on;
 use _granrs::dynamics::{ContactMode, Modes, SignModel, Slip, MAX_CONTACTS};
-use _granrs::forces::{Coefficients, ContactState, ForceSet, Medium};
+use _granrs::forces::rft::{Rft, GENERIC};
+use _granrs::forces::{
+    Boundary, Coefficients, ContactState, ForceSet, Frame, Medium, Outline, Term,
+};
 use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Record, SolveOptions, Status};
 
@@ -217,6 +223,38 @@ fn force(c: &mut Criterion) {
         let term = set.per_contact[0][k];
         g.bench_function(format!("term/{}", info.name), |b| {
             b.iter(|| black_box(&term).contact_force(black_box(&state), black_box(&medium)))
+        });
+    }
+    // `rft` on the rod's boundary: tip T at the depth, turning.
+    let tip = [0.0, -depth];
+    let boundary = Boundary {
+        frame: Frame {
+            origin: tip,
+            v: [v.x, v.y],
+            omega: 3.0,
+            axis: [axis.x, axis.y],
+        },
+        outline: Outline::Rod {
+            diameter: d_c,
+            immersed: l,
+        },
+        apply: tip,
+        centroid: [0.5 * l * axis.x, -depth + 0.5 * l * axis.y],
+        v_centroid: [v.x, v.y],
+        held: [0.0; 2],
+    };
+    let on_rod = ContactState {
+        boundary: Some(&boundary),
+        ..state
+    };
+    for n in [2, 8, 16] {
+        let rft = Rft {
+            zeta: 1e6,
+            elements: n,
+            coefficients: GENERIC,
+        };
+        g.bench_function(format!("rft/{n}"), |b| {
+            b.iter(|| black_box(&rft).contact_force(black_box(&on_rod), black_box(&medium)))
         });
     }
     g.bench_function("thesis_set", |b| {
