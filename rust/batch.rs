@@ -553,7 +553,6 @@ mod tests {
     /// under every sign model: every field of the outcome, summaries and counts.
     #[test]
     fn lean_steps_are_the_general_path_bitwise() {
-        use crate::integrate::solve::{solve, Run};
         let src = Source::Product {
             base: base(),
             axes: vec![
@@ -574,14 +573,7 @@ mod tests {
             let Ok(AnyScene::FreeLink(s)) = src.spec(i).build() else {
                 panic!("run {i} is not a free link");
             };
-            let (model, (q0, qd0)) = (s.model(), s.initial_state());
-            let lean = solve(&model, q0, qd0, &s.options).unwrap();
-            let mut run = Run::new(&model, q0, qd0, &s.options).general();
-            while let Some(h) = run.next_step(&model) {
-                run.step(&model, h).unwrap();
-            }
-            let general = run.finish(&model).unwrap();
-            assert_eq!(format!("{lean:?}"), format!("{general:?}"), "run {i}");
+            let lean = crate::dynamics::rod_lanes::lean_equals_general(&s, &format!("run {i}"));
             lean_steps += lean.stats.steps;
         }
         assert!(lean_steps > 100_000, "{lean_steps} steps");

@@ -945,6 +945,26 @@ impl RodEval<F64x4> {
     }
 }
 
+/// Run scene `s` as [`crate::integrate::solve`] runs it (the lean path where it covers the
+/// scene) and on the general path alone, assert the outcomes are the same bit for bit
+/// (every field; `what` names the case) and return it. For tests here and in `batch.rs`.
+#[cfg(test)]
+pub(crate) fn lean_equals_general(
+    s: &crate::bodies::FreeLinkScene,
+    what: &str,
+) -> crate::integrate::outcome::Outcome {
+    use crate::integrate::solve::{solve, Run};
+    let (model, (q0, qd0)) = (s.model(), s.initial_state());
+    let lean = solve(&model, q0, qd0, &s.options).unwrap();
+    let mut run = Run::new(&model, q0, qd0, &s.options).general();
+    while let Some(h) = run.next_step(&model) {
+        run.step(&model, h).unwrap();
+    }
+    let general = run.finish(&model).unwrap();
+    assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
+    lean
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1211,23 +1231,13 @@ mod tests {
         s
     }
 
-    /// Run scene `s` on the lean path ([`solve`]) and on the general path alone, assert the
-    /// outcomes are the same bit for bit (every field; `what` names the case) and return it.
+    /// [`lean_equals_general`] for a scene the lean path covers (asserted).
     fn lean_run_is_the_general_one(
         s: &FreeLinkScene,
         what: &str,
     ) -> crate::integrate::outcome::Outcome {
-        use crate::integrate::solve::{solve, Run};
-        let (model, (q0, qd0)) = (s.model(), s.initial_state());
-        assert!(RodParams::of(&model).is_some(), "{what}");
-        let lean = solve(&model, q0, qd0, &s.options).unwrap();
-        let mut run = Run::new(&model, q0, qd0, &s.options).general();
-        while let Some(h) = run.next_step(&model) {
-            run.step(&model, h).unwrap();
-        }
-        let general = run.finish(&model).unwrap();
-        assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
-        lean
+        assert!(RodParams::of(&s.model()).is_some(), "{what}");
+        lean_equals_general(s, what)
     }
 
     /// A free link with any of the thesis's terms runs its lean steps to the general path's
