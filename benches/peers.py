@@ -26,6 +26,12 @@ force applied at the tip T, dropped tip first at q with velocity (0, -v0). The p
   and decides stick or slip (Karnopp, a reaction solve); and the 85 deg rows stay at 3e-8 m
   against granrs's 4e-10 until the kink of l = min(d / cos q, L) is located and polished
   on the step map. With those, the loop is granrs's event engine written again.
+* ``libm_floor``: not a peer but a floor: ``numba_scalar``'s calls into the C library alone,
+  as many as its impact makes (one sin/cos pair and one pow per evaluation, four
+  evaluations per step), none waiting for another: their cost at full throughput, under any
+  loop that makes them. granrs makes the same calls (glibc's ``sincos`` and ``pow``) once
+  per evaluation. What an impact costs above this floor is each method's own work and its
+  waiting; the report sets the targets against it ("What the targets leave").
 * ``solve_ivp``: ``scipy.integrate.solve_ivp`` (RK45) on a plain-Python right-hand side
   (``math``, a list returned), with a terminal event on the tip's vertical velocity
   (direction +1); a run past ``IVP_MAX_NFEV`` evaluations is abandoned as failed (the
@@ -345,6 +351,20 @@ def impact_scalar(y0, p, dt, t_end):
     return np.nan, max(0.0, -h_prev), n_max
 
 
+@njit
+def libm_floor(n, q, depth, lam):
+    """``n`` evaluations' calls into the C library alone, as :func:`impact_scalar` makes them
+    (a sine and a cosine of an angle, the pow of a depth): the angle and depth step on by a
+    little each time, so that no call waits for another. Their cost at full throughput: a
+    floor under any loop that makes them, however well its own work hides behind them.
+    Returns a value that depends on every call (so that none is dropped)."""
+    acc = 0.0
+    for i in range(n):
+        s, c = math.sin(q + 1e-7 * i), math.cos(q + 1e-7 * i)
+        acc += math.pow(depth + 1e-9 * i, lam) + s * c
+    return acc
+
+
 @njit(inline="always")
 def _hermite(theta, dt, u0, du0, u1, du1):
     """The cubic Hermite interpolant of one step at ``theta`` in [0, 1]."""
@@ -519,6 +539,9 @@ class SceneRun:
     ivp_matched: bool = False
     ivp_failed: bool = False
     ivp_nfev: int = 0
+    #: Evaluations of one impact: ``numba_scalar``'s (four per step) and granrs's.
+    evals_scalar: int = 0
+    evals_granrs: int = 0
 
 
 def build(quick: bool) -> list[SceneRun]:
@@ -600,6 +623,10 @@ def methods(runs: list[SceneRun]) -> dict[str, Callable[[SceneRun], Any]]:
         "numba_user": lambda r: impact_user(r.y0, r.p, DT, T_END),
         "numba_scalar": lambda r: impact_scalar(r.y0, r.p, DT, T_END),
         "numba_located": lambda r: impact_located(r.y0, r.p, DT, T_END),
+        # The loop's library calls alone, at the scene's angle, half its depth and lambda.
+        "libm_floor": lambda r: libm_floor(
+            r.evals_scalar, math.radians(r.q_deg), 0.5 * r.depth["numba_scalar"], r.p[9]
+        ),
         # Timed without the evaluation budget (the matched rtol is known to run).
         "solve_ivp": lambda r: impact_ivp(r.y0, r.p, r.rtol, budget=False),
     }
@@ -853,6 +880,7 @@ def summarize(
         "numba_user": "numba RK4, user style (arrays)",
         "numba_scalar": "numba RK4, hand-tuned scalars",
         "numba_located": "numba RK4, hand-tuned scalars, stop located as granrs does",
+        "libm_floor": "floor: the hand-tuned loop's sin/cos and pow calls alone",
         "solve_ivp": "scipy solve_ivp RK45, matched rtol",
         "sweep_1": "granrs.sweep, SIMD lanes, 1 thread (per impact)",
         "sweep_2": "granrs.sweep, SIMD lanes, 2 threads (per impact)",
@@ -912,6 +940,7 @@ def summarize(
         f"{statistics.median(ivp_ratios):.3g} | min >= {TARGET_SOLVE_IVP:g} | "
         f"{'yes' if low >= TARGET_SOLVE_IVP else 'NO'} |"
     )
+    lines += targets_left(runs, us)
     unmatched = sum(not r.ivp_matched and not r.ivp_failed for r in runs)
     failed = sum(r.ivp_failed for r in runs)
     lines += [
@@ -939,6 +968,55 @@ def summarize(
             f"{s['granrs']:.0f} | {s['granrs_raw']:.0f} | {s['numba_user']:.0f} | "
             f"{s['numba_scalar']:.0f} | {s['numba_located']:.0f} | {s['solve_ivp']:.0f} |"
         )
+    return lines
+
+
+def targets_left(runs: list[SceneRun], us: dict[str, float]) -> list[str]:
+    """What the ``simulate`` and sweep targets leave granrs once the calls into the C library
+    are paid (``libm_floor``: the loop's sin/cos and pow calls at full throughput, the same
+    calls granrs makes once per evaluation): each side's own work and waiting per impact and
+    per evaluation, as lines of Markdown."""
+    if "libm_floor" not in us:
+        return []
+    n_loop = statistics.fmean(r.evals_scalar for r in runs)
+    n_granrs = statistics.fmean(r.evals_granrs for r in runs)
+    per_call = 1e3 * us["libm_floor"] / n_loop  # ns per evaluation's calls
+
+    def own(key: str, evals: float) -> float:
+        """``key``'s time per impact above its evaluations' calls [us]."""
+        return us[key] - per_call * evals / 1e3
+
+    loop_own, granrs_own = own("numba_scalar", n_loop), own("granrs", n_granrs)
+    sweep_budget = 1e3 * TARGET_SWEEP * us["numba_scalar"] / n_granrs
+    lines = [
+        "",
+        "What the targets leave: the calls into the C library (one sin/cos pair and one pow "
+        "per evaluation, at full throughput: the floor above) against each side's own work "
+        "and waiting.",
+        "",
+        "| | value |",
+        "|---|---:|",
+        f"| evaluations per impact: hand-tuned loop, granrs | {n_loop:.0f}, {n_granrs:.0f} |",
+        f"| the calls, ns per evaluation | {per_call:.1f} |",
+        f"| the loop's own, us per impact (ns per evaluation) | {loop_own:.1f} "
+        f"({1e3 * loop_own / n_loop:.1f}) |",
+        f"| granrs.simulate's own, us per impact (ns per evaluation) | {granrs_own:.1f} "
+        f"({1e3 * granrs_own / n_granrs:.1f}) |",
+        f"| simulate <= {TARGET_SCALAR:g} x the loop: granrs's own must shrink by | "
+        f"{granrs_own / loop_own:.2g}x |",
+    ]
+    if "granrs_raw" in us and "numba_located" in us:
+        raw_own, located_own = own("granrs_raw", n_granrs), own("numba_located", n_loop)
+        lines.append(
+            "| the same at the same accuracy: granrs raw's own / the located loop's own | "
+            f"{raw_own / located_own:.2g}x |"
+        )
+    lines += [
+        f"| sweep <= {TARGET_SWEEP:.2g} x the loop: ns per scene evaluation, all included | "
+        f"{sweep_budget:.1f} |",
+        "| of which the calls take, one lane at a time (the lanes' results are the scalar "
+        f"path's bit for bit) | {per_call:.1f} |",
+    ]
     return lines
 
 
@@ -996,7 +1074,10 @@ def main(argv: list[str] | None = None) -> int:
         r.depth["granrs"] = granrs_depth(r.scene)
         r.depth["granrs_raw"] = granrs_depth(r.scene.replace(sign_model="raw"))
         r.depth["numba_user"] = impact_user(r.y0, r.p, DT, T_END)[1]
-        r.depth["numba_scalar"] = impact_scalar(r.y0, r.p, DT, T_END)[1]
+        _, r.depth["numba_scalar"], steps = impact_scalar(r.y0, r.p, DT, T_END)
+        r.evals_scalar = 4 * int(steps)
+        summary = granrs.simulate(r.scene).summary
+        r.evals_granrs = int(summary["rhs_evals"]) + int(summary["root_evals"])
         r.depth["numba_located"] = impact_located(r.y0, r.p, DT, T_END)[1]
     agreement = check_agreement(runs)
     print("matching solve_ivp's tolerance to granrs's depth error ...", file=sys.stderr)

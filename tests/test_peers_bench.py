@@ -52,3 +52,41 @@ def test_peers_agree_with_granrs_raw_and_solve_ivp_converges():
     reference = peers.granrs_depth(r.scene.replace(dt=1e-6))
     _, depth, nfev = peers.impact_ivp(r.y0, r.p, 1e-10)
     assert abs(depth - reference) < 1e-8, (depth, reference, nfev)
+
+
+def test_the_floor_makes_the_loops_calls():
+    """``libm_floor`` makes n sin/cos/pow rounds at angles and depths that step on by a little:
+    its value is that sum's, as plain Python computes it (so jitting it dropped no call), and
+    it changes with n."""
+    import math
+
+    peers = _peers()
+    q, depth, lam, acc = 0.7, 0.012, 0.25, 0.0
+    for i in range(5):
+        s, c = math.sin(q + 1e-7 * i), math.cos(q + 1e-7 * i)
+        acc += math.pow(depth + 1e-9 * i, lam) + s * c
+    assert peers.libm_floor(5, 0.7, 0.012, 0.25) == pytest.approx(acc, rel=1e-14)
+    assert peers.libm_floor(4, 0.7, 0.012, 0.25) != peers.libm_floor(5, 0.7, 0.012, 0.25)
+
+
+def test_what_the_targets_leave_is_the_time_above_the_floor():
+    """The report's budget lines from made-up times: a loop of 800 evaluations taking 40 us
+        of which its calls take 32 (40 ns per evaluation), and granrs taking 80 us over 1000
+        evaluations: granrs's own work is 80 - 40 = 40 us against the loop's 8 (5x); the sweep
+        line leaves 40 / 3 us over 1000 evaluations, 13.3 ns each. A located loop of 42 us and granrs
+    raw of 80: 40 against 10 us (4x)."""
+    peers = _peers()
+    runs = peers.build(quick=True)[:2]
+    for r in runs:
+        r.evals_scalar, r.evals_granrs = 800, 1000
+    times = {"libm_floor": 32.0, "numba_scalar": 40.0, "granrs": 80.0}
+    times |= {"numba_located": 42.0, "granrs_raw": 80.0}
+    lines = "\n".join(peers.targets_left(runs, times))
+    assert "| evaluations per impact: hand-tuned loop, granrs | 800, 1000 |" in lines
+    assert "| the calls, ns per evaluation | 40.0 |" in lines
+    assert "| the loop's own, us per impact (ns per evaluation) | 8.0 (10.0) |" in lines
+    assert "| granrs.simulate's own, us per impact (ns per evaluation) | 40.0 (40.0) |" in lines
+    assert "granrs's own must shrink by | 5x |" in lines
+    assert "granrs raw's own / the located loop's own | 4x |" in lines
+    assert "all included | 13.3 |" in lines
+    assert peers.targets_left(runs, {"numba_scalar": 40.0, "granrs": 80.0}) == []
