@@ -71,10 +71,10 @@ def test_the_floor_makes_the_loops_calls():
 
 def test_what_the_targets_leave_is_the_time_above_the_floor():
     """The report's budget lines from made-up times: a loop of 800 evaluations taking 40 us
-        of which its calls take 32 (40 ns per evaluation), and granrs taking 80 us over 1000
-        evaluations: granrs's own work is 80 - 40 = 40 us against the loop's 8 (5x); the sweep
-        line leaves 40 / 3 us over 1000 evaluations, 13.3 ns each. A located loop of 42 us and granrs
-    raw of 80: 40 against 10 us (4x)."""
+    of which its calls take 32 (40 ns per evaluation), and granrs taking 80 us over 1000
+    evaluations: granrs's own work is 80 - 40 = 40 us against the loop's 8 (5x); the sweep
+    line leaves 40 / 3 us over 1000 evaluations, 13.3 ns each. A located loop of 42 us and
+    granrs raw of 80: 40 against 10 us (4x)."""
     peers = _peers()
     runs = peers.build(quick=True)[:2]
     for r in runs:
