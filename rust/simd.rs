@@ -10,7 +10,8 @@
 //! impact about 8 % faster, bit for bit the same). One wheel thus runs on any x86-64 (SSE2,
 //! two lanes per instruction), uses 256-bit registers where the CPU has them, and builds
 //! unchanged for arm64 (NEON, two lanes per instruction). `sin_cos` and `powf` are libm's,
-//! lane by lane (libm has no vector versions). Vectorized ones were written and measured: a
+//! lane by lane: glibc's vector versions (libmvec) do not give the scalar calls' bits
+//! (docs/sweeps.md, "What the speed targets leave"). Vectorized ones were written and measured: a
 //! `sin_cos` (range reduction and a series, within 1 ulp of glibc) made the lanes 8 % faster
 //! but the scalar path, which must call the same function for the lanes to stay bit for
 //! bit, 22 % slower; a `pow` within 1 ulp took 4x libm's time per call.
