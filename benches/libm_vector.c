@@ -3,8 +3,8 @@
  * against glibc's 4-lane AVX2 vector versions (libmvec: _ZGVdN4v_sin, _ZGVdN4v_cos,
  * _ZGVdN4vv_pow), which the SIMD lanes could call if their results were allowed to differ
  * from the scalar path's. Prints ns per evaluation's calls for both, and how far the vector
- * results are from the scalar ones (libmvec documents up to 4 ulp). benches/peers.py's
- * "What the targets leave" and docs/sweeps.md read these numbers.
+ * results are from the scalar ones (libmvec documents up to 4 ulp). docs/sweeps.md ("What
+ * the speed targets leave") quotes these numbers beside benches/peers.py's.
  *
  * x86-64 with AVX2 and glibc >= 2.22 only:
  *

@@ -556,11 +556,15 @@ def build(quick: bool) -> list[SceneRun]:
     return runs
 
 
-def granrs_depth(scene: granrs.Scene) -> float:
+def granrs_result(scene: granrs.Scene) -> granrs.Result:
     r = granrs.simulate(scene)
     if r.status != "stopped":
         raise RuntimeError(f"q = {scene.q_deg}, v0 = {scene.v0}: {r.status}")
-    return float(r.depth)
+    return r
+
+
+def granrs_depth(scene: granrs.Scene) -> float:
+    return float(granrs_result(scene).depth)
 
 
 def check_agreement(runs: list[SceneRun]) -> float:
@@ -1071,13 +1075,13 @@ def main(argv: list[str] | None = None) -> int:
 
     # Depths of every method (and the numba compile: the warm-up call).
     for r in runs:
-        r.depth["granrs"] = granrs_depth(r.scene)
+        result = granrs_result(r.scene)
+        r.depth["granrs"] = float(result.depth)
+        r.evals_granrs = int(result.summary["rhs_evals"]) + int(result.summary["root_evals"])
         r.depth["granrs_raw"] = granrs_depth(r.scene.replace(sign_model="raw"))
         r.depth["numba_user"] = impact_user(r.y0, r.p, DT, T_END)[1]
         _, r.depth["numba_scalar"], steps = impact_scalar(r.y0, r.p, DT, T_END)
         r.evals_scalar = 4 * int(steps)
-        summary = granrs.simulate(r.scene).summary
-        r.evals_granrs = int(summary["rhs_evals"]) + int(summary["root_evals"])
         r.depth["numba_located"] = impact_located(r.y0, r.p, DT, T_END)[1]
     agreement = check_agreement(runs)
     print("matching solve_ivp's tolerance to granrs's depth error ...", file=sys.stderr)
