@@ -24,6 +24,7 @@ from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
 from .compare import compare
 from .errors import (
+    CoefficientsWarning,
     CoefficientTableError,
     GranrsError,
     InvalidParameterError,
@@ -48,6 +49,7 @@ __all__ = [
     "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
+    "CoefficientsWarning",
     "ContactResult",
     "GranrsError",
     "ImpactAnimation",

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import itertools
 import math
 import uuid
 import warnings
@@ -34,7 +35,7 @@ from .errors import (
 )
 from .forces import Term
 from .result import JOINT_NAMES
-from .scene import Scene
+from .scene import Scene, axis_rows
 
 __all__ = ["STATUSES", "sweep"]
 
@@ -257,6 +258,23 @@ def _axis_columns(axes: dict[str, list[Any]], start: int, stop: int) -> dict[str
     return cols
 
 
+def _product_scenes(
+    base: dict[str, Any], axes: list[tuple[str, list[Any]]], field: str, terms: list[Any]
+) -> list[dict[str, Any]]:
+    """The runs of a product sweep as plain scenes (the last axis varying fastest), each with
+    the force terms of its ``field`` value (``terms``, one per value of that axis)."""
+    names = [name for name, _ in axes]
+    which = names.index(field)
+    out = []
+    for index in itertools.product(*(range(len(values)) for _, values in axes)):
+        plain = dict(base)
+        for name, (_, values), i in zip(names, axes, index, strict=True):
+            plain[name] = values[i]
+        plain["forces"] = list(terms[index[which]])
+        out.append(plain)
+    return out
+
+
 def _compiled(scenes: list[Scene]) -> list[Any]:
     """Each scene compiled by the core (``Scene._compiled()``, kept on the scene). A scene
     that does not compile gets its typed error from the sweep's own validation, which names
@@ -436,6 +454,12 @@ def sweep(
             "base": scene._plain(),
             "axes": [(k, [_plain(k, v) for v in vs]) for k, vs in plain_axes.items()],
         }
+        rows = axis_rows(scene, plain_axes)
+        if rows is not None:
+            # A thesis-row scene swept over the field that selects its row (the free link's
+            # q_deg): each run takes its value's row, as scene.replace does, so the runs
+            # are listed one by one.
+            kwargs = {"scenes": _product_scenes(kwargs["base"], kwargs["axes"], *rows)}
         n = math.prod(len(v) for v in plain_axes.values())
         keep_axes = plain_axes
     else:

@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -16,7 +17,7 @@ import numpy as np
 from . import data, forces, scenefile
 from .coefficients import Coefficients, resolve
 from .errors import InvalidParameterError, UnknownNameError
-from .scene import BODIES, Scene
+from .scene import _REPLACED, BODIES, Scene, leg_row, unknown_field_message
 
 __all__ = ["CHAIN", "FREE_LINK", "LEG", "chain", "chain_case", "free_link", "leg", "template"]
 
@@ -42,9 +43,23 @@ def _number(value: Any, field: str) -> float:
     return float(value)
 
 
+def _check_overrides(function: str, overrides: Mapping[str, Any], own: tuple[str, ...]) -> None:
+    """An unknown keyword of a case function raises UnknownNameError with the closest of its
+    parameters and the Scene's fields (Python's own TypeError says neither)."""
+    fields = [f.name for f in dataclasses.fields(Scene)]
+    for name in overrides:
+        if name not in fields and name not in _REPLACED:
+            raise UnknownNameError(
+                unknown_field_message(
+                    name, [*own, *fields], f"{function}() takes no parameter and Scene no field"
+                ),
+                field=name,
+            )
+
+
 def free_link(
-    q_deg: float,
-    v0: float,
+    q_deg: float | None = None,
+    v0: float | None = None,
     coefficients: str | Coefficients | Mapping[str, float] = "table_3_4",
     dt: float = 1e-4,
     apply_at: str = "tip",
@@ -58,8 +73,16 @@ def free_link(
     scene's ``coefficients_source`` says which), ``"table_3_2"`` (the closed forms at q and
     rho_g), or a :class:`~granrs.Coefficients` (or mapping). ``overrides`` set any other
     :class:`~granrs.Scene` field (e.g. ``mass=0.2``, ``record=("state", "forces")``).
-    Invalid input raises a :class:`~granrs.errors.InvalidSceneError` subclass naming the field.
+    Invalid input raises a :class:`~granrs.errors.InvalidSceneError` subclass naming the field
+    (``q_deg`` and ``v0`` are required; an unknown keyword names the closest field).
     """
+    _check_overrides("free_link", overrides, ("q_deg", "v0", "coefficients", "dt", "apply_at"))
+    for name, value in (("q_deg", q_deg), ("v0", v0)):
+        if value is None:
+            raise InvalidParameterError(
+                f"free_link() needs {name} (q_deg: deg from the vertical; v0: m/s downward)",
+                field=name,
+            )
     q = _number(q_deg, "q_deg")
     if not math.isfinite(q) or abs(q) >= 90.0:
         raise InvalidParameterError(
@@ -192,6 +215,9 @@ def chain(
     ``mass=0.017`` (or any) to change it, and ``pin_mass`` for the pin. ``overrides`` set any
     other :class:`~granrs.Scene` field.
     """
+    _check_overrides(
+        "chain", overrides, ("case", "q1_deg", "q2_deg", "coefficients", "dt", "apply_at")
+    )
     spec = chain_case(case)
     q1 = spec["q_deg"][0] if q1_deg is None else _number(q1_deg, "q1_deg")
     q2 = spec["q_deg"][1] if q2_deg is None else _number(q2_deg, "q2_deg")
@@ -243,12 +269,10 @@ def leg(
     :meth:`granrs.Scene.leg_segments`. ``overrides`` set any other :class:`~granrs.Scene`
     field (posture: ``knee_deg``, ``hip_deg``, ``trunk_deg``, ``foot_deg``).
     """
+    _check_overrides("leg", overrides, ("v0", "coefficients", "joints", "dt", "apply_at"))
     v = _number(v0, "v0")
     if coefficients is None:
-        table = data.load("human_coefficients", as_="numpy")
-        row = int(np.argmin(np.abs(table["v0"] - v)))
-        coef = _row_coefficients(table, row)
-        source = f"thesis sec. 5.3.2, row v0 = {float(table['v0'][row])} m/s"
+        coef, source = leg_row(v)
     else:
         coef = _coefficients_arg(coefficients, "coefficients")
         source = "user"

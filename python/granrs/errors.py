@@ -12,6 +12,7 @@ from __future__ import annotations
 
 __all__ = [
     "CoefficientTableError",
+    "CoefficientsWarning",
     "GranrsError",
     "InvalidParameterError",
     "InvalidSceneError",
@@ -60,3 +61,11 @@ class StepSizeWarning(UserWarning):
     its fastest rate (``Result.summary["h_lambda"]``) exceeded RK4's stability limit
     (:data:`granrs.RK4_STABILITY_LIMIT`). The run finished with finite numbers, but they are
     not the converged answer: rerun with a smaller ``dt`` or ``method="dopri5"``."""
+
+
+class CoefficientsWarning(UserWarning):
+    """A scene's angle (free link: ``q_deg``) or speed (leg: ``v0``) now selects another
+    row of the thesis's coefficient table than the one its ``coefficients_source`` names,
+    but its force parameters are no longer that row's (they were changed): they are kept
+    as given, and ``coefficients_source`` says so. A scene whose parameters are still the
+    named row's takes the new row instead, without a warning (:class:`granrs.Scene`)."""

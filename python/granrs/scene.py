@@ -16,6 +16,15 @@ the time series to record. :func:`granrs.simulate` runs it. Every field is check
 Rust core (one set of rules for Python, TOML and the CLI) before any work starts; an invalid
 field raises a :class:`~granrs.errors.InvalidSceneError` subclass whose ``field`` names it.
 
+A scene made from one of the thesis's coefficient rows follows its angle: when the
+free link's ``q_deg`` (or the leg's ``v0``) changes, by :meth:`Scene.replace`, a scene file's
+``--set``, or a sweep's axis, and ``coefficients_source`` names a row of Table 3.4 (or of
+sec. 5.3.2, for the leg) whose values the force terms still hold, the terms take the row of
+the new value (the nearest tabulated one; the thesis tuned each row by hand, so rows are not
+interpolated) and ``coefficients_source`` says which. Parameters changed from the named row
+are kept, with one :class:`~granrs.errors.CoefficientsWarning`; any other
+``coefficients_source`` (e.g. ``"user"``) keeps the terms as they are.
+
 Units are SI (m, kg, s, N, J), angles in degrees at this edge (``*_deg``).
 Defaults are those of the thesis's free link (section 3.2.1): L = 0.190 m, d_c = 0.0127 m,
 m = 0.184 kg, sand bulk density 1650 kg/m^3 (section 3.3.1), 10 kHz (section 3.3.2).
@@ -24,15 +33,23 @@ m = 0.184 kg, sand bulk density 1650 kg/m^3 (section 3.3.1), 10 kHz (section 3.3
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import math
+import os
+import re
+import sys
 import textwrap
-from collections.abc import Iterable, Mapping
+import warnings
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from . import _granrs
+import numpy as np
+
+from . import _granrs, data
 from .bodies import Linkage
-from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
+from .coefficients import Coefficients, resolve
+from .errors import CoefficientsWarning, InvalidParameterError, InvalidSceneError, UnknownNameError
 from .forces import Term, as_terms, thesis
 
 __all__ = [
@@ -117,6 +134,154 @@ def _joint(value: Any, field_name: str) -> str | dict[str, float]:
         f"{field_name} must be 'free', 'locked' or {{'k': .., 'c': ..}}; got {value!r}",
         field=field_name,
     )
+
+
+def unknown_field_message(name: str, known: Iterable[str], what: str = "Scene has no field") -> str:
+    """``what 'name'``, with the closest of ``known`` as a suggestion (or, with none close,
+    the list of them): the text of every unknown-field error of a scene."""
+    choices = sorted(set(known))
+    close = difflib.get_close_matches(name, choices, n=1, cutoff=0.5)
+    if close:
+        return f"{what} {name!r}; did you mean {close[0]!r}?"
+    return f"{what} {name!r}; fields: {', '.join(choices)}"
+
+
+@dataclass(frozen=True)
+class _RowRule:
+    """A thesis coefficient table whose row a scene field selects."""
+
+    #: The field that selects the row (the free link's angle, the leg's speed).
+    field: str
+    #: A ``coefficients_source`` naming a row; group 1 is the row's value of ``field``.
+    pattern: re.Pattern[str]
+    #: The coefficients of the row nearest a value of ``field``, and their source sentence.
+    row: Callable[[float], tuple[Coefficients, str]]
+    #: How to build the thesis's scene at another value (``{}``: the value; for the warning).
+    case: str
+
+
+def leg_row(v0: float) -> tuple[Coefficients, str]:
+    """The thesis's leg coefficients (sec. 5.3.2) at the nearest of its two speeds, 3.28 and
+    2.35 m/s, and their source sentence."""
+    table = data.load("human_coefficients", as_="numpy")
+    row = int(np.argmin(np.abs(table["v0"] - float(v0))))
+    coefficients = Coefficients(
+        eta_h=float(table["eta_h"][row]),
+        eta_d=float(table["eta_d"][row]),
+        eta_v=float(table["eta_v"][row]),
+        lam=float(table["lambda"][row]),
+    )
+    return coefficients, f"thesis sec. 5.3.2, row v0 = {float(table['v0'][row])} m/s"
+
+
+#: Per built-in body, the table whose row its coefficients follow (the chain's Table 4.4
+#: rows are per measured case, not per field: a chain keeps its coefficients).
+_ROW_RULES: dict[str, _RowRule] = {
+    "free_link": _RowRule(
+        "q_deg",
+        re.compile(r"Table 3\.4, row q = ([0-9.]+) deg(?: \([^()]*\))?"),
+        lambda q: resolve("table_3_4", q),
+        "granrs.cases.free_link(q_deg={}, v0=...)",
+    ),
+    "leg": _RowRule(
+        "v0",
+        re.compile(r"thesis sec\. 5\.3\.2, row v0 = ([0-9.]+) m/s"),
+        leg_row,
+        "granrs.cases.leg(v0={})",
+    ),
+}
+
+
+@dataclass(frozen=True)
+class _Kept:
+    """A row change refused: the forces were changed from the named row."""
+
+    message: str
+    source: str
+
+
+def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept | None:
+    """What the force terms of ``scene`` become when its row field (:data:`_ROW_RULES`) is
+    ``value``: None if nothing changes (another body, a source that names no row, a value
+    the core will refuse, the same row); ``(forces, source)`` to take the row of ``value``
+    (the terms still hold the named row's values); a :class:`_Kept` if they do not (the
+    warning, and the source that says they were kept). The one place where a scene follows
+    its row: :class:`Scene` (so ``replace``, the cases and scene files) and
+    :func:`granrs.sweep`'s axes call it."""
+    rule = _ROW_RULES.get(scene.body.name if isinstance(scene.body, Linkage) else scene.body)
+    source = scene.coefficients_source
+    named = rule.pattern.fullmatch(source) if rule and isinstance(source, str) else None
+    if rule is None or named is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return None
+    if not math.isfinite(value):
+        return None
+    try:
+        new, new_source = rule.row(float(value))
+        old = rule.row(float(named.group(1)))[0]
+    except InvalidSceneError:  # out of range: the core names the field
+        return None
+    if new_source == source:
+        return None
+    if scene.forces == thesis(old):
+        return thesis(new), new_source
+    if new == old:
+        return None
+    field, shown = rule.field, f"{float(value):g}"
+    values = ", ".join(f"{k} = {v:g}" for k, v in new.as_dict().items())
+    message = (
+        f"{field} = {shown} selects {new_source} ({values}), but the force parameters were "
+        f"changed from the row the scene names ({source}), so they are kept as given. For the "
+        f"new row, set those values (or start from {rule.case.format(shown)}); to keep yours "
+        "without this warning, set coefficients_source to say where they come from"
+    )
+    return _Kept(message, f"{source}, parameters changed (kept at {field} = {float(value):g})")
+
+
+def axis_rows(scene: Any, axes: Mapping[str, list[Any]]) -> tuple[str, list[Any]] | None:
+    """For a sweep of ``scene`` over ``axes``: the field that selects its coefficient row
+    and, per value of that axis, the force terms ``scene.replace(field=value)`` has (the
+    same :func:`_row_change`), or None where every run keeps the scene's terms (or the axes
+    give the terms themselves). Parameters changed from the named row are kept, with one
+    :class:`~granrs.errors.CoefficientsWarning` for the whole sweep."""
+    rule = _ROW_RULES.get(scene.kind)
+    if rule is None or rule.field not in axes or {"forces", "coefficients_source"} & set(axes):
+        return None
+    values = axes[rule.field]
+    terms: list[Any] = []
+    kept: list[_Kept] = []
+    for value in values:
+        change = _row_change(scene, value)
+        terms.append(change[0] if isinstance(change, tuple) else scene.forces)
+        if isinstance(change, _Kept):
+            kept.append(change)
+    if kept:
+        warnings.warn(
+            CoefficientsWarning(
+                f"{len(kept)} of the {len(values)} values of the sweep's {rule.field} axis: "
+                f"{kept[0].message}"
+            ),
+            stacklevel=3,
+        )
+    if all(t == scene.forces for t in terms):
+        return None
+    return rule.field, terms
+
+
+def _caller_stacklevel() -> int:
+    """The ``stacklevel`` of the first caller outside granrs and the dataclass machinery
+    (for a warning raised while a scene is built)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    frame = sys._getframe(1)
+    level = 1
+    while frame.f_back is not None and (
+        frame.f_code.co_filename.startswith(here)
+        or frame.f_code.co_filename in ("<string>", dataclasses.__file__)
+    ):
+        frame = frame.f_back
+        level += 1
+    return level
 
 
 #: The one table of a scene's fields (the core's, ``rust/spec/fields.rs``): name, part,
@@ -220,20 +385,28 @@ class Scene:
                 )
         object.__setattr__(self, "forces", as_terms(self.forces))
         object.__setattr__(self, "record", _names(self.record, "record", RECORDS))
+        rule = _ROW_RULES.get(kind)
+        change = _row_change(self, getattr(self, rule.field)) if rule else None
+        if isinstance(change, tuple):
+            object.__setattr__(self, "forces", change[0])
+            object.__setattr__(self, "coefficients_source", change[1])
+        elif isinstance(change, _Kept):
+            warnings.warn(CoefficientsWarning(change.message), stacklevel=_caller_stacklevel())
+            object.__setattr__(self, "coefficients_source", change.source)
 
     def replace(self, **changes: Any) -> Scene:
-        """A copy with some fields changed; an unknown field raises UnknownNameError."""
-        known = {f.name for f in dataclasses.fields(self)}
+        """A copy with some fields changed; an unknown field raises UnknownNameError (with
+        the closest field name). Changing the free link's ``q_deg`` (the leg's ``v0``) of
+        a scene made from a thesis coefficient row takes the new value's row (see the module
+        doc)."""
+        known = [f.name for f in dataclasses.fields(self)]
         for name in changes:
             if name in _REPLACED:
                 raise UnknownNameError(
                     f"Scene has no field {name!r} any more: {_REPLACED[name]}", field=name
                 )
             if name not in known:
-                raise UnknownNameError(
-                    f"Scene has no field {name!r}; fields: {', '.join(sorted(known))}",
-                    field=name,
-                )
+                raise UnknownNameError(unknown_field_message(name, known), field=name)
         return dataclasses.replace(self, **changes)
 
     @property
