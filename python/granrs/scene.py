@@ -21,9 +21,10 @@ free link's ``q_deg`` (or the leg's ``v0``) changes, by :meth:`Scene.replace`, a
 ``--set``, or a sweep's axis, and ``coefficients_source`` names a row of Table 3.4 (or of
 sec. 5.3.2, for the leg) whose values the force terms still hold, the terms take the row of
 the new value (the nearest tabulated one; the thesis tuned each row by hand, so rows are not
-interpolated) and ``coefficients_source`` says which. Parameters changed from the named row
-are kept, with one :class:`~granrs.errors.CoefficientsWarning`; any other
-``coefficients_source`` (e.g. ``"user"``) keeps the terms as they are.
+interpolated) and ``coefficients_source`` says which. The thesis's terms with parameters
+changed from the named row are kept, with one :class:`~granrs.errors.CoefficientsWarning`;
+another law, or any other ``coefficients_source`` (e.g. ``"user"``), keeps the terms as
+they are.
 
 Units are SI (m, kg, s, N, J), angles in degrees at this edge (``*_deg``).
 Defaults are those of the thesis's free link (section 3.2.1): L = 0.190 m, d_c = 0.0127 m,
@@ -50,7 +51,7 @@ from . import _granrs, data
 from .bodies import Linkage
 from .coefficients import Coefficients, resolve
 from .errors import CoefficientsWarning, InvalidParameterError, InvalidSceneError, UnknownNameError
-from .forces import Term, as_terms, thesis
+from .forces import Term, as_terms, thesis, thesis_row
 
 __all__ = [
     "BODIES",
@@ -204,8 +205,9 @@ def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept 
     """What the force terms of ``scene`` become when its row field (:data:`_ROW_RULES`) is
     ``value``: None if nothing changes (another body, a source that names no row, a value
     the core will refuse, the same row); ``(forces, source)`` to take the row of ``value``
-    (the terms still hold the named row's values); a :class:`_Kept` if they do not (the
-    warning, and the source that says they were kept). The one place where a scene follows
+    (the terms still hold the named row's values); a :class:`_Kept` if they are the thesis's
+    terms with other values (the warning, and the source that says they were kept); None
+    for another law. The one place where a scene follows
     its row: :class:`Scene` (so ``replace``, the cases and scene files) and
     :func:`granrs.sweep`'s axes call it."""
     rule = _ROW_RULES.get(scene.body.name if isinstance(scene.body, Linkage) else scene.body)
@@ -226,7 +228,8 @@ def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept 
         return None
     if scene.forces == thesis(old):
         return thesis(new), new_source
-    if new == old:
+    if new == old or thesis_row(scene.forces) is None:
+        # The same row, or another law than the thesis's: nothing to follow or warn about.
         return None
     field, shown = rule.field, f"{float(value):g}"
     values = ", ".join(f"{k} = {v:g}" for k, v in new.as_dict().items())
