@@ -129,11 +129,16 @@ def test_series_csv_turns_on_recording(
     assert code == 0
     assert "records nothing" in err
     frame = granrs.simulate(FREE_LINK.replace(record=SERIES_RECORD)).to_frame()
-    written = pd.read_csv(out_csv, index_col="t")
-    assert list(written.columns) == list(frame.columns)
+    written = pd.read_csv(out_csv, index_col="t [s]")
+    assert [_name(c) for c in written.columns] == list(frame.columns)
     assert len(written) == len(frame)
     assert written.index.to_numpy() == pytest.approx(frame.index.to_numpy(), rel=1e-12)
-    assert written["depth"].to_numpy() == pytest.approx(frame["depth"].to_numpy(), rel=1e-12)
+    assert written["depth [m]"].to_numpy() == pytest.approx(frame["depth"].to_numpy(), rel=1e-12)
+
+
+def _name(column: str) -> str:
+    """A --series column's series name (``"q [rad]"`` -> ``"q"``)."""
+    return column.rsplit(" [", 1)[0]
 
 
 def test_series_keeps_the_scene_record(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -145,7 +150,8 @@ def test_series_keeps_the_scene_record(capsys: pytest.CaptureFixture[str], tmp_p
     assert code == 0
     assert "records nothing" not in err
     frame = granrs.simulate(scene).to_frame()
-    assert list(pd.read_csv(out_csv, index_col="t").columns) == list(frame.columns)
+    written = pd.read_csv(out_csv, index_col="t [s]")
+    assert [_name(c) for c in written.columns] == list(frame.columns)
 
 
 def test_series_parquet_without_pyarrow_is_a_clear_error(

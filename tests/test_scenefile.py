@@ -218,10 +218,6 @@ def valid_scenes(draw: st.DrawFn) -> Scene:
     base, strategies = BASES[body]
     names = draw(st.lists(st.sampled_from(sorted(strategies)), unique=True))
     changes = {name: draw(strategies[name]) for name in names}
-    if "forces" in changes:
-        # Random terms are not the thesis row the base names: a scene says so (else a new
-        # q_deg or v0 warns CoefficientsWarning, the terms kept).
-        changes.setdefault("coefficients_source", "random terms")
     scene = base.replace(**changes)
     try:
         return scene.validate()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -600,19 +601,39 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         fps: Any = self.fps  # see write()
         return html if html is not None else str(self.to_jshtml(fps=fps))
 
-    def write(self, path: str | os.PathLike[str]) -> Path:
+    def write(self, path: str | os.PathLike[str], progress: bool | None = None) -> Path:
         """Write the animation to ``path``: ``.gif`` (Pillow), ``.mp4`` (ffmpeg) or ``.html``
         (a self-contained JavaScript player). The path is checked first, before any frame is drawn.
+        ``progress``: a tqdm bar of the frames on stderr (None: when stderr is a terminal).
         Returns the path."""
+        from ._progress import progress_bar
+
         out = check_output(path)
         suffix = out.suffix.lower()
         # matplotlib annotates fps as int, but only divides by it (1000 / fps, ffmpeg -r):
         # a derived frame rate such as speed / frame_dt = 12.5 is written as it is.
         fps: Any = self.fps
-        if suffix == ".html":
-            out.write_text(str(self.to_jshtml(fps=fps)), encoding="utf-8")
-        elif suffix == ".gif":
-            self.save(str(out), writer=mpl_animation.PillowWriter(fps=fps), dpi=self.dpi)
-        else:
-            self.save(str(out), writer=mpl_animation.FFMpegWriter(fps=fps), dpi=self.dpi)
+        bar = progress_bar(self.n_frames, progress, "granrs animate", "frame")
+        try:
+
+            def tick(_frame: int, _total: int) -> None:
+                bar.update(1)
+
+            if suffix == ".html":
+                # What to_jshtml() writes (its writer and mode), with the frames counted.
+                with tempfile.TemporaryDirectory() as tmp:
+                    temp = Path(tmp, "animation.html")
+                    writer = mpl_animation.HTMLWriter(
+                        fps=fps, embed_frames=True, default_mode="loop" if self._repeat else "once"
+                    )
+                    self.save(str(temp), writer=writer, progress_callback=tick)
+                    out.write_text(temp.read_text(encoding="utf-8"), encoding="utf-8")
+            elif suffix == ".gif":
+                writer = mpl_animation.PillowWriter(fps=fps)
+                self.save(str(out), writer=writer, dpi=self.dpi, progress_callback=tick)
+            else:
+                writer = mpl_animation.FFMpegWriter(fps=fps)
+                self.save(str(out), writer=writer, dpi=self.dpi, progress_callback=tick)
+        finally:
+            bar.close()
         return out

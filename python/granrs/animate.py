@@ -190,6 +190,7 @@ def animate(
     *,
     out: str | os.PathLike[str] | None = None,
     dpi: float = 100.0,
+    progress: bool | None = None,
 ) -> ImpactAnimation:
     """An animation of a recorded impact, from its series alone (no second simulation).
 
@@ -203,6 +204,8 @@ def animate(
         out: if given, also write the animation there (``.gif``, ``.mp4`` or ``.html``);
             checked before anything is drawn.
         dpi: resolution of written frames [dots per inch].
+        progress: while writing ``out``, a tqdm bar of the frames on stderr (None: when
+            stderr is a terminal; True: always; False: never).
 
     Returns:
         An :class:`ImpactAnimation` (a ``matplotlib.animation.FuncAnimation``) with
@@ -249,7 +252,7 @@ def animate(
     times = np.minimum(t[0] + frame_dt * np.arange(n), t[-1])
     anim = ImpactAnimation(result, times, frame_dt, speed, fps, dpi=dpi_value)
     if target is not None:
-        anim.write(target)
+        anim.write(target, progress=progress)
     return anim
 
 

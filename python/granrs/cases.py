@@ -17,7 +17,7 @@ import numpy as np
 from . import data, forces, scenefile
 from .coefficients import Coefficients, resolve
 from .errors import InvalidParameterError, UnknownNameError
-from .scene import _REPLACED, BODIES, Scene, leg_row, unknown_field_message
+from .scene import _REPLACED, BODIES, OWN_FORCES, Scene, leg_row, unknown_field_message
 
 __all__ = ["CHAIN", "FREE_LINK", "LEG", "chain", "chain_case", "free_link", "leg", "template"]
 
@@ -131,7 +131,7 @@ def _law(
     """The scene fields of a case's force law: the thesis's terms with its coefficient
     table's row(s) as their parameters, unless the caller gives ``forces=``."""
     if "forces" in overrides:
-        return {"coefficients_source": "the scene's forces"}
+        return {"coefficients_source": OWN_FORCES}
     rows = (c1,) if c2 is None else (c1, c2)
     return {"forces": forces.thesis(*rows), "coefficients_source": source}
 

@@ -34,6 +34,7 @@ import math
 import numbers
 import os
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -153,7 +154,7 @@ def _add_calibrate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         description=(
             "Fit parameters of the force law by weighted least squares to measured depths "
             "and stopping times (granrs.calibrate), print the fitted values with standard "
-            "errors and ~95%% intervals and each row's residuals in units of the measured sd; "
+            "errors and ~95% intervals and each row's residuals in units of the measured sd; "
             "optionally predict other rows out of sample."
         ),
     )
@@ -207,6 +208,9 @@ def _add_calibrate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
     parser.add_argument(
         "--out", metavar="FILE.csv", default=None, help="write the residuals per row to CSV"
     )
+    parser.add_argument(
+        "--quiet", action="store_true", help="no progress bar (shown on a terminal)"
+    )
     parser.set_defaults(handler=_cmd_calibrate)
 
 
@@ -244,7 +248,12 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     if args.starts < 1:
         raise InvalidParameterError(f"--starts must be >= 1; got {args.starts}", field="starts")
     params = [p.strip() for p in args.params.split(",") if p.strip()]
-    kwargs: dict[str, Any] = {"per_angle": args.per_angle, "starts": args.starts, "dt": args.dt}
+    kwargs: dict[str, Any] = {
+        "per_angle": args.per_angle,
+        "starts": args.starts,
+        "dt": args.dt,
+        "progress": False if args.quiet else None,
+    }
     if args.base:
         kwargs["base"] = args.base
     result = calibrate(cases, fit_rows, params, **kwargs)
@@ -416,6 +425,55 @@ SERIES_RECORD: tuple[str, ...] = ("state", "forces", "energy")
 SERIES_FORMATS: tuple[str, ...] = (".csv", ".parquet")
 
 
+#: Units of the recorded series the core names itself (per contact, per joint, energies);
+#: coordinates and rates take theirs from the body's names (``granrs.result``), a force
+#: term's columns are forces (its ``columns`` in ``granrs.forces``).
+_SERIES_UNITS: dict[str, str] = {
+    "t": "s",
+    "work_sand": "J",
+    "tip_x": "m",
+    "tip_y": "m",
+    "depth": "m",
+    "v_tip_x": "m/s",
+    "v_tip_y": "m/s",
+    "v_E_x": "m/s",
+    "v_E_y": "m/s",
+    "mode_x": "-",
+    "mode_y": "-",
+    "Fx": "N",
+    "Fy": "N",
+    "torque": "N m",
+    "KE": "J",
+    "PE": "J",
+    "E": "J",
+    "joint_loss": "J",
+}
+
+
+def series_units(result: Any) -> dict[str, str]:
+    """The unit of each recorded series of ``result`` (``Result.series``'s names): SI, angles
+    in rad (a name whose unit is not known here maps to ``""``)."""
+    from . import _granrs
+    from .result import _names
+
+    names = _names(result.scene)
+    units: dict[str, str] = {}
+    for coords, position, angle in (
+        (names["coords"], "m", "rad"),
+        (names["rates"], "m/s", "rad/s"),
+    ):
+        for i, name in enumerate(coords):
+            units[name] = position if i < 2 else angle
+    units.update({"clock": "s", "clock_rate": "-"})
+    for info in _granrs.term_infos():
+        units.update({column: "N" for column in info["columns"]})
+    out = {}
+    for name in result.series:
+        field = name.rsplit(".", 1)[-1] if "." in name else name
+        out[name] = units.get(name) or _SERIES_UNITS.get(field) or units.get(field, "")
+    return out
+
+
 def _add_scene_file(parser: argparse.ArgumentParser) -> None:
     """The arguments of a command that runs a scene file: the file and its ``--set``s."""
     parser.add_argument("scene", metavar="SCENE.toml", help="the scene file")
@@ -463,7 +521,8 @@ def _add_run(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         metavar="OUT",
         help=(
             "write the recorded time series to OUT.csv or OUT.parquet (parquet needs "
-            "pyarrow); a scene that records nothing records state, forces and energy"
+            "pyarrow), one column per series named with its SI unit ('q [rad]', "
+            "'depth [m]'); a scene that records nothing records state, forces and energy"
         ),
     )
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -562,8 +621,51 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
     return [line(header), line(["-" * w for w in widths]), *(line(row) for row in rows)]
 
 
+#: A joint's force (torque) below this fraction of the run's largest force (torque) is
+#: round-off of the solve, not a load: ``granrs run`` prints it as 0.
+ROUNDOFF_RTOL = 1e-9
+#: The contact quantities that are forces [N] (the scale of :data:`ROUNDOFF_RTOL`).
+_FORCE_KEYS: tuple[str, ...] = ("F_d_max", "F_s_end", "F_r_end")
+
+
+def _joint_rows(result: Any) -> tuple[list[list[str]], bool]:
+    """The joint table's rows, with forces and torques below :data:`ROUNDOFF_RTOL` of the
+    run's largest printed as 0, and whether any was."""
+    joints = result.joints
+
+    def largest(values: Any) -> float:
+        finite = [abs(float(v)) for v in values if math.isfinite(float(v))]
+        return max(finite, default=0.0)
+
+    force_scale = largest(
+        [j.get("F_max", math.nan) for j in joints.values()]
+        + [c.summary.get(k, math.nan) for c in result.contacts for k in _FORCE_KEYS]
+    )
+    torque_scale = largest([j.get("torque_max", math.nan) for j in joints.values()])
+    zeroed = False
+
+    def cell(value: float, scale: float) -> str:
+        nonlocal zeroed
+        if math.isfinite(value) and value != 0.0 and abs(value) < ROUNDOFF_RTOL * scale:
+            zeroed = True
+            return "0"
+        return _number(value)
+
+    rows = [
+        [
+            name,
+            cell(float(j.get("F_max", math.nan)), force_scale),
+            cell(float(j.get("torque_max", math.nan)), torque_scale),
+        ]
+        for name, j in joints.items()
+    ]
+    return rows, zeroed
+
+
 def summary_text(result: Any, source: str | None = None) -> str:
-    """The run's summary as a readable table (what ``granrs run`` prints)."""
+    """The run's summary as a readable table (what ``granrs run`` prints): the status, the
+    energies, where the coefficients come from, each contact's results (a scene without
+    contacts says so) and each joint's largest force and torque."""
     from .result import SUMMARY_UNITS
 
     s = result.summary
@@ -573,23 +675,31 @@ def summary_text(result: Any, source: str | None = None) -> str:
         f"({s['steps']} steps, {s['rhs_evals']} rhs evaluations, {s['events']} events)",
         f"energy: {_number(s['energy_start'])} J at the start, "
         f"{_number(s['energy_end'])} J at the end",
-        "",
     ]
-    names = _contact_names(result)
-    keys = [k for k in result.contacts[0].summary if k in SUMMARY_UNITS]
-    rows = [["stopped", "-", *(_number(c.stopped) for c in result.contacts)]]
-    rows += [
-        [key, SUMMARY_UNITS[key], *(_number(c.summary.get(key, math.nan)) for c in result.contacts)]
-        for key in keys
-    ]
-    lines += _table(["quantity", "unit", *names], rows)
+    if result.contacts:
+        lines += [f"coefficients: {result.scene.coefficients_source}", ""]
+        names = _contact_names(result)
+        keys = [k for k in result.contacts[0].summary if k in SUMMARY_UNITS]
+        rows = [["stopped", "-", *(_number(c.stopped) for c in result.contacts)]]
+        rows += [
+            [
+                key,
+                SUMMARY_UNITS[key],
+                *(_number(c.summary.get(key, math.nan)) for c in result.contacts),
+            ]
+            for key in keys
+        ]
+        lines += _table(["quantity", "unit", *names], rows)
+    else:
+        lines.append("no contacts: the sand never acts on this body")
     if result.joints:
         lines.append("")
-        joint_rows = [
-            [name, _number(j.get("F_max", math.nan)), _number(j.get("torque_max", math.nan))]
-            for name, j in result.joints.items()
-        ]
+        joint_rows, zeroed = _joint_rows(result)
         lines += _table(["joint", "F_max [N]", "torque_max [N m]"], joint_rows)
+        if zeroed:
+            lines.append(
+                f"(0: below {ROUNDOFF_RTOL:g} of the run's largest force or torque, round-off)"
+            )
     return "\n".join(lines)
 
 
@@ -610,6 +720,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     result = simulate(scene)
     if args.series:
         frame = result.to_frame()
+        units = series_units(result)
+        frame = frame.rename(columns=lambda name: f"{name} [{units[name]}]")
+        frame.index.name = f"t [{units['t']}]"
         if suffix == ".parquet":
             frame.to_parquet(args.series)
         else:
@@ -680,6 +793,9 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     parser.add_argument(
         "--dpi", type=float, default=100.0, metavar="DPI", help="resolution (default: 100)"
     )
+    parser.add_argument(
+        "--quiet", action="store_true", help="no progress bar (shown on a terminal)"
+    )
     parser.set_defaults(handler=_cmd_animate)
 
 
@@ -697,7 +813,7 @@ def _cmd_animate(args: argparse.Namespace) -> int:
     record = tuple(dict.fromkeys((*scene.record, *ANIMATE_RECORD)))
     result = simulate(scene.replace(record=record))
     anim = animate(result, frame_dt, speed, fps, dpi=args.dpi)
-    anim.write(out)
+    anim.write(out, progress=False if args.quiet else None)
     print(
         f"{PROG}: animation written to {out} ({anim.n_frames} frames, "
         f"{frame_dt * 1e3:.4g} ms per frame, {fps:.4g} fps, speed {speed:.4g})",
@@ -782,6 +898,18 @@ def _one_line(exc: BaseException) -> str:
     return message
 
 
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """A warning as one line on stderr (``granrs: warning: ...``), not Python's two."""
+    print(f"{PROG}: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``granrs`` command line with ``argv`` (default: ``sys.argv[1:]``).
 
@@ -794,7 +922,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # --help, --version, usage errors
         return exc.code if isinstance(exc.code, int) else EXIT_INVALID
     try:
-        return int(args.handler(args))
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return int(args.handler(args))
     except SimulationError as exc:
         print(f"{PROG}: simulation failed: {_one_line(exc)}", file=sys.stderr)
         return EXIT_SIMULATION

@@ -21,10 +21,12 @@ free link's ``q_deg`` (or the leg's ``v0``) changes, by :meth:`Scene.replace`, a
 ``--set``, or a sweep's axis, and ``coefficients_source`` names a row of Table 3.4 (or of
 sec. 5.3.2, for the leg) whose values the force terms still hold, the terms take the row of
 the new value (the nearest tabulated one; the thesis tuned each row by hand, so rows are not
-interpolated) and ``coefficients_source`` says which. The thesis's terms with parameters
-changed from the named row are kept, with one :class:`~granrs.errors.CoefficientsWarning`;
-another law, or any other ``coefficients_source`` (e.g. ``"user"``), keeps the terms as
-they are.
+interpolated) and ``coefficients_source`` says which. Terms given anew (``replace(forces=
+...)``) are the caller's: their source becomes ``"the scene's forces"`` and they are kept.
+The thesis's terms with parameters changed in place (a scene file's values, ``--set
+static_v.eta_v=...``) while the source still names a row are kept too, with one
+:class:`~granrs.errors.CoefficientsWarning`; another law, or any other
+``coefficients_source``, keeps the terms as they are.
 
 Units are SI (m, kg, s, N, J), angles in degrees at this edge (``*_deg``).
 Defaults are those of the thesis's free link (section 3.2.1): L = 0.190 m, d_c = 0.0127 m,
@@ -59,6 +61,7 @@ __all__ = [
     "FIELD_INFO",
     "JOINTS",
     "KINDS",
+    "OWN_FORCES",
     "RECORDS",
     "JointSpec",
     "Scene",
@@ -72,6 +75,9 @@ KINDS: tuple[str, ...] = (*BODIES, "linkage")
 JOINTS: tuple[str, ...] = ("free", "locked")
 #: A joint: ``"free"``, ``"locked"`` or ``{"k": stiffness, "c": damping}``.
 JointSpec = str | Mapping[str, float]
+
+#: The ``coefficients_source`` of a scene whose terms the caller gave (no table row).
+OWN_FORCES = "the scene's forces"
 
 #: Time series a scene may list in ``record``.
 RECORDS: tuple[str, ...] = ("state", "forces", "energy")
@@ -401,7 +407,8 @@ class Scene:
         """A copy with some fields changed; an unknown field raises UnknownNameError (with
         the closest field name). Changing the free link's ``q_deg`` (the leg's ``v0``) of
         a scene made from a thesis coefficient row takes the new value's row (see the module
-        doc)."""
+        doc); new ``forces`` (without a ``coefficients_source``) make the source
+        :data:`OWN_FORCES`."""
         known = [f.name for f in dataclasses.fields(self)]
         for name in changes:
             if name in _REPLACED:
@@ -410,6 +417,13 @@ class Scene:
                 )
             if name not in known:
                 raise UnknownNameError(unknown_field_message(name, known), field=name)
+        if (
+            "forces" in changes
+            and "coefficients_source" not in changes
+            and as_terms(changes["forces"]) != self.forces
+        ):
+            # Terms given by the caller are theirs: no table row is followed any more.
+            changes["coefficients_source"] = OWN_FORCES
         return dataclasses.replace(self, **changes)
 
     @property

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._progress import progress_bar
 from ..coefficients import Coefficients
 from ..errors import (
     InvalidParameterError,
@@ -471,6 +472,8 @@ class _Objective:
         self.means = {q: m.rows[f"{q}_mean"].to_numpy(dtype=float) for q in qs}
         self.counters = {"sims": 0, "failed": 0, "unresolved": 0}
         self.cache: dict[bytes, np.ndarray] = {}
+        #: The progress bar the runs advance (set by calibrate), or None.
+        self.bar: Any = None
 
     def weighted(self, depth: np.ndarray, t_s: np.ndarray) -> np.ndarray:
         """Residuals over sd_fit, one row per parameter vector; a failed run's are large."""
@@ -484,6 +487,8 @@ class _Objective:
         vectors = [self.model.to_natural(x) for x in xs]
         depth, t_s, ok = self.model.simulate(self.m.rows, vectors, self.threads)
         self.counters["sims"] += self.n_runs * len(xs)  # refused vectors count as attempted
+        if self.bar is not None:
+            self.bar.update(self.n_runs * len(xs))
         self.counters["failed"] += int(np.sum(~ok))
         self.counters["unresolved"] += int(np.sum(self.model.last_unresolved))
         return self.weighted(depth, t_s)
@@ -654,6 +659,7 @@ def calibrate(
     seed: int = 0,
     max_nfev: int = 200,
     threads: int | None = None,
+    progress: bool | None = False,
     **overrides: Any,
 ) -> CalibrationResult:
     """Fit ``params`` so that the simulated depth and stopping time match ``measurements``.
@@ -702,6 +708,9 @@ def calibrate(
             parameters) of the start; the best fit is kept.
         max_nfev: residual evaluations allowed per start.
         threads: the sweep's worker threads (default: every core).
+        progress: a tqdm bar counting the fit's runs on stderr: False (default: calibrate
+            is called inside compare and the report), True, or None (when stderr is a
+            terminal; ``granrs calibrate`` asks for that).
         **overrides: any other :class:`~granrs.Scene` field for every run (e.g.
             ``mass=0.017`` for the chain's links, ``apply_at="E"``).
 
@@ -747,7 +756,11 @@ def calibrate(
     x0 = np.clip(x0, lo_x, hi_x)
     n_runs = len(model.scenes(m.rows, x_start))
     objective = _Objective(model, m, qs, n_runs, rel_step, hi_x, threads)
-    best, nfev, njev = _fit_starts(objective, x0, lo_x, hi_x, starts, seed, max_nfev)
+    objective.bar = progress_bar(None, progress, "granrs calibrate", "run")
+    try:
+        best, nfev, njev = _fit_starts(objective, x0, lo_x, hi_x, starts, seed, max_nfev)
+    finally:
+        objective.bar.close()
 
     # Uncertainty from the Jacobian at the optimum.
     x = best.x
