@@ -15,7 +15,7 @@ def progress_bar(total: int | None, progress: bool | None, desc: str, unit: str)
 
     from .errors import InvalidParameterError
 
-    if progress not in (True, False, None) or not isinstance(progress, bool | None):
+    if not (progress is None or isinstance(progress, bool)):
         raise InvalidParameterError(
             f"progress must be True, False or None; got {progress!r}", field="progress"
         )
