@@ -40,7 +40,14 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
-from .errors import GranrsError, InvalidParameterError, InvalidSceneError, SimulationError
+from .errors import (
+    CoefficientsWarning,
+    GranrsError,
+    InvalidParameterError,
+    InvalidSceneError,
+    SimulationError,
+    StepSizeWarning,
+)
 
 __all__ = ["main"]
 
@@ -923,6 +930,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return exc.code if isinstance(exc.code, int) else EXIT_INVALID
     try:
         with warnings.catch_warnings():
+            # granrs's own warnings are part of the command's output: one line each.
+            for category in (CoefficientsWarning, StepSizeWarning):
+                warnings.simplefilter("default", category)
             warnings.showwarning = _show_warning
             return int(args.handler(args))
     except SimulationError as exc:

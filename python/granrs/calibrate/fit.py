@@ -759,19 +759,19 @@ def calibrate(
     objective.bar = progress_bar(None, progress, "granrs calibrate", "run")
     try:
         best, nfev, njev = _fit_starts(objective, x0, lo_x, hi_x, starts, seed, max_nfev)
+
+        # Uncertainty from the Jacobian at the optimum.
+        x = best.x
+        jmat = objective.jac(x)
+        r = objective.fun(x)
+        chi2, dof, scale, _cov, se_x, corr = _covariance(jmat, r, n_res, error_scale)
+        natural = model.to_natural(x)
+        values, se, intervals, at_bound = _natural_estimates(parsed, natural, x, se_x, lo_x, hi_x)
+
+        # Residual tables at the optimum and at the start (one sweep).
+        frame = _final_residuals(objective, natural, x0)
     finally:
         objective.bar.close()
-
-    # Uncertainty from the Jacobian at the optimum.
-    x = best.x
-    jmat = objective.jac(x)
-    r = objective.fun(x)
-    chi2, dof, scale, _cov, se_x, corr = _covariance(jmat, r, n_res, error_scale)
-    natural = model.to_natural(x)
-    values, se, intervals, at_bound = _natural_estimates(parsed, natural, x, se_x, lo_x, hi_x)
-
-    # Residual tables at the optimum and at the start (one sweep).
-    frame = _final_residuals(objective, natural, x0)
     counters = objective.counters
     return CalibrationResult(
         body=body,
