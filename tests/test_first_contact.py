@@ -139,10 +139,16 @@ def test_a_sweep_over_q_deg_takes_each_angles_row() -> None:
     row what cases.free_link at that angle gives (before: the q = 0 row at every angle,
     17.9 mm at 45 deg against 28.9 mm)."""
     base = cases.free_link(q_deg=0.0, v0=2.0)
-    frame = granrs.sweep(base, q_deg=[0.0, 45.0, -60.0], v0=[1.0, 2.0])
+    # The angle axis between two others: each run's row must land at its place.
+    frame = granrs.sweep(
+        base, v0=[1.0, 2.0], q_deg=[0.0, 45.0, -60.0, 10.0], apply_at=["tip", "centroid"]
+    )
+    assert len(frame) == 16
     for row in frame.itertuples(index=False):
-        expected = granrs.simulate(cases.free_link(q_deg=row.q_deg, v0=row.v0))
-        assert row.depth == expected.depth, (row.q_deg, row.v0)
+        case = cases.free_link(q_deg=row.q_deg, v0=row.v0, apply_at=row.apply_at)
+        expected = granrs.simulate(case)
+        assert (row.depth, row.steps) == (expected.depth, expected.summary["steps"]), row
+    frame = frame[frame.apply_at == "tip"]
     at_45 = frame[(frame.q_deg == 45.0) & (frame.v0 == 2.0)]["depth"].iloc[0]
     assert at_45 == pytest.approx(0.0289, abs=2e-4)
 

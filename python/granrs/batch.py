@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import difflib
 import functools
-import itertools
 import math
 import uuid
 import warnings
@@ -258,23 +257,6 @@ def _axis_columns(axes: dict[str, list[Any]], start: int, stop: int) -> dict[str
     return cols
 
 
-def _product_scenes(
-    base: dict[str, Any], axes: list[tuple[str, list[Any]]], field: str, terms: list[Any]
-) -> list[dict[str, Any]]:
-    """The runs of a product sweep as plain scenes (the last axis varying fastest), each with
-    the force terms of its ``field`` value (``terms``, one per value of that axis)."""
-    names = [name for name, _ in axes]
-    which = names.index(field)
-    out = []
-    for index in itertools.product(*(range(len(values)) for _, values in axes)):
-        plain = dict(base)
-        for name, (_, values), i in zip(names, axes, index, strict=True):
-            plain[name] = values[i]
-        plain["forces"] = list(terms[index[which]])
-        out.append(plain)
-    return out
-
-
 def _compiled(scenes: list[Scene]) -> list[Any]:
     """Each scene compiled by the core (``Scene._compiled()``, kept on the scene). A scene
     that does not compile gets its typed error from the sweep's own validation, which names
@@ -454,12 +436,9 @@ def sweep(
             "base": scene._plain(),
             "axes": [(k, [_plain(k, v) for v in vs]) for k, vs in plain_axes.items()],
         }
+        # A thesis-row scene swept over the field that selects its row (the free link's
+        # q_deg): each run takes its value's row, as scene.replace does.
         rows = axis_rows(scene, plain_axes)
-        if rows is not None:
-            # A thesis-row scene swept over the field that selects its row (the free link's
-            # q_deg): each run takes its value's row, as scene.replace does, so the runs
-            # are listed one by one.
-            kwargs = {"scenes": _product_scenes(kwargs["base"], kwargs["axes"], *rows)}
         n = math.prod(len(v) for v in plain_axes.values())
         keep_axes = plain_axes
     else:
@@ -482,30 +461,90 @@ def sweep(
         kwargs = {"scenes": _compiled(scenes) if client is None else [s._plain() for s in scenes]}
         n = len(scenes)
         keep_axes = {}
+        rows = None
     if not isinstance(lanes, bool):
         raise InvalidParameterError(f"lanes must be True or False; got {lanes!r}", field="lanes")
     kwargs["lanes"] = lanes
-    if client is not None:
-        if chunk_size is not None and (not isinstance(chunk_size, int) or chunk_size < 1):
+    if client is not None and chunk_size is not None:
+        if not isinstance(chunk_size, int) or chunk_size < 1:
             raise InvalidParameterError(
                 f"chunk_size must be a whole number >= 1; got {chunk_size!r}", field="chunk_size"
             )
-        if n == 0:
-            raw = run_chunk(kwargs, 0, 0, 1)
-        else:
+
+    def run(kw: dict[str, Any], count: int, validated: bool = False) -> dict[str, Any]:
+        if client is None:
+            return _run_local(kw, 0, count, n_threads, progress)
+        if count == 0:
+            return run_chunk(kw, 0, 0, 1)
+        if not validated:
             # Validate everything here, before any task is sent.
-            plain = {k: v for k, v in kwargs.items() if k != "lanes"}
-            _granrs.validate_sweep(**plain, threads=n_threads)
-            raw = _run_dask(client, kwargs, n, chunk_size, progress)
-        axis_columns = _axis_columns(keep_axes, 0, n) if keep_axes else None
+            _granrs.validate_sweep(
+                **{k: v for k, v in kw.items() if k != "lanes"}, threads=n_threads
+            )
+        return _run_dask(client, kw, count, chunk_size, progress)
+
+    axis_columns = _axis_columns(keep_axes, 0, n) if keep_axes else None
+    if rows is None:
+        raw = run(kwargs, n)
+        table = _table(raw)
+        failures, start = raw["failures"], raw["start"]
+        del raw
     else:
-        axis_columns = _axis_columns(keep_axes, 0, n) if keep_axes else None
-        raw = _run_local(kwargs, 0, n, n_threads, progress)
-    table = _table(raw)
+        # Every run validated first, so that an error names its index in the whole sweep.
+        _granrs.validate_sweep(
+            **{k: v for k, v in kwargs.items() if k != "lanes"}, threads=n_threads
+        )
+        table, failures = _run_by_row(kwargs, *rows, n, lambda kw, c: run(kw, c, True))
+        start = 0
     _warn_unresolved(table)
-    frame = table.frame(raw["failures"], raw["start"], axis_columns)
-    del raw, axis_columns, table
+    frame = table.frame(failures, start, axis_columns)
+    del axis_columns, table
     return frame
+
+
+def _run_by_row(
+    kwargs: dict[str, Any],
+    field: str,
+    terms: list[Any],
+    n: int,
+    run: Any,
+) -> tuple[_Table, list[tuple[int, str]]]:
+    """A product sweep whose ``field`` axis selects each run's force terms (``terms``, one
+    per value of that axis): one product per distinct set of terms, over the values that
+    select it, each row put at its place in the whole product (the last axis fastest)."""
+    axes = kwargs["axes"]
+    k = [name for name, _ in axes].index(field)
+    shape = [len(values) for _, values in axes]
+    groups: list[tuple[Any, list[int]]] = []
+    for i, t in enumerate(terms):
+        for group_terms, members in groups:
+            if group_terms == t:
+                members.append(i)
+                break
+        else:
+            groups.append((t, [i]))
+    index = np.arange(n).reshape(shape)
+    table: _Table | None = None
+    failures: list[tuple[int, str]] = []
+    for group_terms, members in groups:
+        sub_axes = list(axes)
+        sub_axes[k] = (field, [axes[k][1][i] for i in members])
+        sub = {**kwargs, "base": {**kwargs["base"], "forces": list(group_terms)}, "axes": sub_axes}
+        where = np.take(index, members, axis=k).ravel()
+        raw = run(sub, len(where))
+        part = _table(raw)
+        if table is None:
+            table = _Table(raw["columns"], raw["body"], n)
+        for kind, block in part.blocks.items():
+            if block.dtype != table.blocks[kind].dtype:
+                table.blocks[kind] = table.blocks[kind].astype(
+                    np.result_type(block, table.blocks[kind])
+                )
+            table.blocks[kind][:, where] = block
+        table.status[where] = part.status
+        failures += [(int(where[i - raw["start"]]), message) for i, message in raw["failures"]]
+    assert table is not None
+    return table, failures
 
 
 def _warn_unresolved(table: _Table) -> None:

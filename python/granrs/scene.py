@@ -25,8 +25,9 @@ interpolated) and ``coefficients_source`` says which. Terms given anew (``replac
 ...)``) are the caller's: their source becomes ``"the scene's forces"`` and they are kept.
 The thesis's terms with parameters changed in place (a scene file's values, ``--set
 static_v.eta_v=...``) while the source still names a row are kept too, with one
-:class:`~granrs.errors.CoefficientsWarning`; another law, or any other
-``coefficients_source``, keeps the terms as they are.
+:class:`~granrs.errors.CoefficientsWarning`. Another law, terms given with the default
+source (``Scene(forces=...)``: the default describes the default terms), or any other
+``coefficients_source`` keep the terms as they are, silently.
 
 Units are SI (m, kg, s, N, J), angles in degrees at this edge (``*_deg``).
 Defaults are those of the thesis's free link (section 3.2.1): L = 0.190 m, d_c = 0.0127 m,
@@ -234,8 +235,13 @@ def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept 
         return None
     if scene.forces == thesis(old):
         return thesis(new), new_source
-    if new == old or thesis_row(scene.forces) is None:
-        # The same row, or another law than the thesis's: nothing to follow or warn about.
+    if (
+        new == old
+        or thesis_row(scene.forces) is None
+        or source == _DEFAULTS["coefficients_source"]
+    ):
+        # The same row; another law than the thesis's; or the terms given without a source
+        # (the default source describes the default terms): nothing to follow or warn about.
         return None
     field, shown = rule.field, f"{float(value):g}"
     values = ", ".join(f"{k} = {v:g}" for k, v in new.as_dict().items())
