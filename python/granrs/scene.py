@@ -210,13 +210,14 @@ class _Kept:
 
 def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept | None:
     """What the force terms of ``scene`` become when its row field (:data:`_ROW_RULES`) is
-    ``value``: None if nothing changes (another body, a source that names no row, a value
-    the core will refuse, the same row); ``(forces, source)`` to take the row of ``value``
-    (the terms still hold the named row's values); a :class:`_Kept` if they are the thesis's
-    terms with other values (the warning, and the source that says they were kept); None
-    for another law. The one place where a scene follows
-    its row: :class:`Scene` (so ``replace``, the cases and scene files) and
-    :func:`granrs.sweep`'s axes call it."""
+    ``value``: ``(forces, source)`` to take the row of ``value`` (the terms still hold the
+    values of the row ``coefficients_source`` names); a :class:`_Kept` when they are the
+    thesis's terms with other values (the warning, and the source that says they were
+    kept); None when nothing changes (another body, a source naming no row, the same row, a
+    value the core will refuse, another law, terms given with the default source).
+
+    The one place where a scene follows its row: :class:`Scene` (so ``replace``, the cases
+    and scene files with their ``--set``) and :func:`axis_rows` (a sweep's axis) call it."""
     rule = _ROW_RULES.get(scene.body.name if isinstance(scene.body, Linkage) else scene.body)
     source = scene.coefficients_source
     named = rule.pattern.fullmatch(source) if rule and isinstance(source, str) else None
@@ -235,11 +236,7 @@ def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept 
         return None
     if scene.forces == thesis(old):
         return thesis(new), new_source
-    if (
-        new == old
-        or thesis_row(scene.forces) is None
-        or source == _DEFAULTS["coefficients_source"]
-    ):
+    if new == old or thesis_row(scene.forces) is None or source == _DEFAULTS["coefficients_source"]:
         # The same row; another law than the thesis's; or the terms given without a source
         # (the default source describes the default terms): nothing to follow or warn about.
         return None

@@ -165,7 +165,7 @@ class ReportContext:
         """A chapter's "Watch it" section: run ``scene`` recording its state and forces,
         keep its animation (:func:`granrs.animate`, one frame per ``frame_dt`` of simulated
         time) as the GIF ``figures/name``, and return the section: a heading, ``caption``
-        and the image (issue 20: one animation per chapter)."""
+        and the image (one animation per chapter)."""
         import tempfile
 
         from ..animate import animate
