@@ -130,6 +130,7 @@ def test_set_q_deg_on_a_scene_file_takes_that_angles_row(
     expected = granrs.simulate(cases.free_link(q_deg=0.0, v0=2.27))
     assert json.loads(out)["depth"] == expected.depth
     assert json.loads(out)["t_s"] == expected.t_s
+    assert json.loads(out)["coefficients_source"] == "Table 3.4, row q = 0 deg"
     code, out, _ = run(capsys, "run", str(Q45), "--set", "q_deg=0")
     assert "coefficients: Table 3.4, row q = 0 deg" in out
 

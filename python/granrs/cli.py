@@ -578,8 +578,9 @@ def _contact_names(result: Any) -> list[str]:
 
 def summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
     """The run's summary as plain data (what ``granrs run --json`` prints): the scene file,
-    body, status, the run's statistics, each contact's results by name, each joint's
-    largest force and torque, and the units. NaN (e.g. ``t_s`` without a stop) is None."""
+    body, where the coefficients come from, status, the run's statistics, each contact's
+    results by name, each joint's largest force and torque, and the units. NaN (e.g. ``t_s``
+    without a stop) is None."""
     from .result import SUMMARY_UNITS
 
     # The core's run-level entries of Result.summary (the rest are contact 0's).
@@ -594,6 +595,7 @@ def summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
         {
             "scene": source,
             "body": result.scene.kind,
+            "coefficients_source": result.scene.coefficients_source,
             "status": result.status,
             "t_s": result.t_s,
             "depth": result.depth,
