@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import functools
 import math
 import os
 import re
@@ -200,6 +201,12 @@ _ROW_RULES: dict[str, _RowRule] = {
 }
 
 
+@functools.lru_cache(maxsize=64)
+def _thesis_terms(row: Coefficients) -> tuple[Term, ...]:
+    """The thesis's terms with a table row's values (made once per row)."""
+    return thesis(row)
+
+
 @dataclass(frozen=True)
 class _Kept:
     """A row change refused: the forces were changed from the named row."""
@@ -234,8 +241,8 @@ def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept 
         return None
     if new_source == source:
         return None
-    if scene.forces == thesis(old):
-        return thesis(new), new_source
+    if scene.forces == _thesis_terms(old):
+        return _thesis_terms(new), new_source
     if new == old or thesis_row(scene.forces) is None or source == _DEFAULTS["coefficients_source"]:
         # The same row; another law than the thesis's; or the terms given without a source
         # (the default source describes the default terms): nothing to follow or warn about.
