@@ -334,6 +334,7 @@ _COMPARE_COLUMNS: tuple[str, ...] = (
     "depth_within_1sd",
     "ts_within_1sd",
     "ts_within_2sd",
+    "failed_out_of_sample",
     "n_rows",
 )
 
@@ -375,8 +376,16 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             rows.append([rec["dataset"], rec["law"], *["-"] * (len(_COMPARE_COLUMNS) - 2)])
             notes.append(f"{rec['dataset']} {rec['law']}: not run: {rec['reason']}")
             continue
-        rows.append([_number(_plain(rec[c])) for c in _COMPARE_COLUMNS])
-    print("\n".join(_table(list(_COMPARE_COLUMNS), rows)))
+        rows.append([_number(rec[c]) for c in _COMPARE_COLUMNS])
+        if rec["failed_in_sample"] or rec["failed_out_of_sample"]:
+            notes.append(
+                f"{rec['dataset']} {rec['law']}: runs failed on {rec['failed_in_sample']} of "
+                f"{rec['n_rows']} rows in sample and {rec['failed_out_of_sample']} out of "
+                "sample (no prediction: chi2, AIC and BIC undefined where a row failed); "
+                "ranked after the laws whose rows all ran; a smaller --dt may resolve them"
+            )
+    header = ["failed" if c == "failed_out_of_sample" else c for c in _COMPARE_COLUMNS]
+    print("\n".join(_table(header, rows)))
     if folds is None:
         print("(no cross-validation: every number in sample; rank by chi2)")
     else:
