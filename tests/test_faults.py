@@ -2,20 +2,34 @@
 
 * a sweep's check of its axes is linear in their length (it was quadratic: one axis of
   40,000 values took 37.1 s to validate against 2.8 s for a 400 x 100 product);
+* a file that a command fails to write leaves the previous one intact: every writer goes
+  through ``granrs._files.replacing`` (tested on a full disk: ``ulimit -f`` in a
+  subprocess, where the write fails with EFBIG since Python ignores SIGXFSZ), and
+  ``granrs reproduce`` installs its directory all or nothing;
 """
 
 from __future__ import annotations
 
+import os
+import re
+import shlex
+import stat
+import subprocess
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
 import granrs
-from granrs import batch, cases
-from granrs.errors import UnknownNameError
+from granrs import _files, batch, cases
+from granrs.errors import InvalidParameterError, UnknownNameError
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = ROOT / "python" / "granrs"
+SCENE = ROOT / "examples" / "scenes" / "free_link_q45.toml"
 
 # ------------------------------------------------------------------------------------------
 # The sweep's axis check
@@ -67,3 +81,233 @@ def test_axis_check_still_checks_each_distinct_value() -> None:
     with pytest.raises(UnknownNameError) as info:
         granrs.sweep(scene, apply_at=["tip"] * 5000 + ["nowhere"], progress=False)
     assert info.value.field == "apply_at"
+
+
+# ------------------------------------------------------------------------------------------
+# Files written whole
+
+
+def _granrs_with_file_limit(args: list[str], kib: int, cwd: Path) -> subprocess.CompletedProcess:
+    """``granrs ARGS`` in a shell whose files may not grow past ``kib`` KiB (a full disk)."""
+    command = " ".join(shlex.quote(a) for a in [sys.executable, "-m", "granrs.cli", *args])
+    env = {**os.environ, "PYTHONPATH": str(PACKAGE.parent), "PYTHONDONTWRITEBYTECODE": "1"}
+    return subprocess.run(
+        ["bash", "-c", f"ulimit -f {kib} && exec {command}"],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
+def _previous(path: Path, size: int) -> bytes:
+    """Write a previous file of ``size`` bytes at ``path``; return its content."""
+    content = (b"previous content, to be kept whole\n" * (size // 35 + 1))[:size]
+    path.write_bytes(content)
+    return content
+
+
+def _leftovers(directory: Path, keep: set[str]) -> list[str]:
+    return sorted(p.name for p in directory.iterdir() if p.name not in keep)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ulimit is POSIX")
+def test_series_on_a_full_disk_leaves_the_previous_file(tmp_path) -> None:
+    """Issue 34: ``granrs run --series good.csv`` wrote in place; on a full disk an existing
+    114 kB CSV became 8 kB. Now the series goes to a temporary file that replaces the old
+    one only once whole: the write fails (exit 1, one line naming the file) and the
+    previous file is byte for byte as it was, with no temporary file left."""
+    good = tmp_path / "good.csv"
+    before = _previous(good, 120_000)
+    proc = _granrs_with_file_limit(["run", str(SCENE), "--series", "good.csv"], 16, tmp_path)
+    assert proc.returncode == 1, proc.stderr
+    assert "good.csv" in proc.stderr.splitlines()[-1]
+    assert "Traceback" not in proc.stderr
+    assert good.read_bytes() == before
+    assert _leftovers(tmp_path, {"good.csv"}) == []
+    # Without the limit the same command writes the whole series (the test's own check).
+    proc = _granrs_with_file_limit(["run", str(SCENE), "--series", "good.csv"], 100_000, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert good.read_bytes() != before
+    assert good.read_text().startswith("t,")
+    assert _leftovers(tmp_path, {"good.csv"}) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ulimit is POSIX")
+def test_animation_on_a_full_disk_leaves_the_previous_file(tmp_path) -> None:
+    """Issue 34: ``granrs animate --out good.gif`` wrote in place. A GIF that does not fit
+    (about 100 kB against an 8 KiB limit) leaves the previous file as it was."""
+    good = tmp_path / "good.gif"
+    before = _previous(good, 50_000)
+    args = ["animate", str(SCENE), "--out", "good.gif", "--fps", "5", "--dpi", "50"]
+    proc = _granrs_with_file_limit(args, 8, tmp_path)
+    assert proc.returncode == 1, proc.stderr
+    assert "good.gif" in proc.stderr.splitlines()[-1]
+    assert good.read_bytes() == before
+    assert _leftovers(tmp_path, {"good.gif"}) == []
+
+
+def test_replacing_on_error_keeps_the_target_and_removes_the_temporary(tmp_path) -> None:
+    """An error while writing (here: raised by the writer) leaves the target as it was."""
+    target = tmp_path / "out.csv"
+    target.write_text("old\n")
+    with pytest.raises(RuntimeError), _files.replacing(target) as tmp:
+        tmp.write_text("half")
+        raise RuntimeError("the writer failed")
+    assert target.read_text() == "old\n"
+    assert _leftovers(tmp_path, {"out.csv"}) == []
+
+
+def test_replacing_keeps_permissions_and_writes_through_links(tmp_path) -> None:
+    """A replaced file keeps its permission bits; a new one gets those ``open`` gives (the
+    umask's); a symbolic link is written through, not replaced by a file."""
+    old = tmp_path / "old.txt"
+    old.write_text("x")
+    old.chmod(0o640)
+    _files.write_text(old, "y")
+    assert old.read_text() == "y"
+    assert stat.S_IMODE(old.stat().st_mode) == 0o640
+    plain = tmp_path / "plain.txt"
+    plain.write_text("by open")
+    new = tmp_path / "new.txt"
+    _files.write_text(new, "z")
+    assert stat.S_IMODE(new.stat().st_mode) == stat.S_IMODE(plain.stat().st_mode)
+    link = tmp_path / "link.txt"
+    link.symlink_to(old)
+    _files.write_text(link, "through")
+    assert link.is_symlink() and old.read_text() == "through"
+    assert _leftovers(tmp_path, {"old.txt", "plain.txt", "new.txt", "link.txt"}) == []
+
+
+#: Calls that write a file given by path or handle. Each must write the temporary file of
+#: ``granrs._files.replacing`` (named ``tmp``) or an in-memory buffer.
+_WRITES = re.compile(
+    r"\.write_text\(|\.write_bytes\(|\.to_csv\(|\.to_parquet\(|savefig\(|\.save\(|"
+    r"open\([^)]*[\"'][wax]b?\+?[\"']|json\.dump\("
+)
+
+
+def test_every_writer_of_the_package_writes_whole() -> None:
+    """One helper for every file granrs writes: a direct write of a path anywhere else in
+    the package (``Path.write_text``, ``DataFrame.to_csv``, ``savefig``, ...) would be a
+    writer that can leave a half-written file (issue 34)."""
+    direct = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.name == "_files.py":
+            continue
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            code = line.split("#", 1)[0]
+            if _WRITES.search(code) and not re.search(r"\btmp\b|\bbuf(fer)?\b", code):
+                direct.append(f"{path.relative_to(PACKAGE)}:{number}: {line.strip()}")
+    assert direct == []
+
+
+# ------------------------------------------------------------------------------------------
+# The report's directory, all or nothing
+
+
+def _toy_chapter(monkeypatch, built: list[str]) -> None:
+    """Replace the report's chapters by one that runs nothing and writes a figure and a
+    file (``toy.json``), so that the install is tested without the thesis's runs."""
+    from granrs.report import framework
+
+    def build(ctx: Any) -> str:
+        built.append("toy")
+        link = ctx.add_figure("new.png", b"\x89PNG new", "new")
+        ctx.add_file("toy.json", b"{}\n")
+        return f"text\n\n{link}\n"
+
+    chapters = {"toy": framework.Chapter("toy", "A toy chapter", build)}
+    monkeypatch.setattr(framework, "CHAPTERS", chapters)
+
+
+def _old_report(out: Path) -> dict[str, bytes]:
+    """An existing report directory with a user's own file; its files by relative path."""
+    (out / "figures").mkdir(parents=True)
+    (out / "figures" / "old.png").write_bytes(b"\x89PNG old")
+    (out / "notes.txt").write_text("mine")
+    return _tree(out)
+
+
+def _tree(out: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(out)): (p.read_bytes() if p.is_file() else b"<dir>")
+        for p in sorted(out.rglob("*"))
+    }
+
+
+def test_reproduce_refuses_a_readme_folder_before_any_run(tmp_path, monkeypatch) -> None:
+    """Issue 34: ``granrs reproduce --out DIR`` whose README.md is a directory deleted the
+    old figures, installed the new ones, then failed. Now it is refused before any run
+    (typed error, field ``out_dir``) and the directory is as it was."""
+    from granrs.report import reproduce
+
+    built: list[str] = []
+    _toy_chapter(monkeypatch, built)
+    out = tmp_path / "report"
+    _old_report(out)
+    (out / "README.md").mkdir()
+    before = _tree(out)
+    with pytest.raises(InvalidParameterError) as info:
+        reproduce(out, chapters=["toy"], progress=False)
+    assert info.value.field == "out_dir"
+    assert "README.md" in str(info.value)
+    assert built == []
+    assert _tree(out) == before
+    assert _leftovers(tmp_path, {"report"}) == []
+
+
+def test_reproduce_refuses_a_chapter_file_that_is_a_folder(tmp_path, monkeypatch) -> None:
+    """A chapter's file (``toy.json``) that exists as a folder is refused before anything
+    moves: the old figures stay (they were replaced before the failing move)."""
+    from granrs.report import reproduce
+
+    built: list[str] = []
+    _toy_chapter(monkeypatch, built)
+    out = tmp_path / "report"
+    _old_report(out)
+    (out / "toy.json").mkdir()
+    before = _tree(out)
+    with pytest.raises(InvalidParameterError) as info:
+        reproduce(out, chapters=["toy"], progress=False)
+    assert info.value.field == "out_dir"
+    assert _tree(out) == before
+    assert _leftovers(tmp_path, {"report"}) == []
+
+
+def test_reproduce_undoes_the_install_when_a_move_fails(tmp_path, monkeypatch) -> None:
+    """Whatever fails while the new report is moved in (here: the move of README.md, made
+    to fail), the moves already made are undone: the old figures, the old chapter file
+    and the old report are back, the user's own file untouched."""
+    from granrs.report import framework, reproduce
+
+    built: list[str] = []
+    _toy_chapter(monkeypatch, built)
+    out = tmp_path / "report"
+    _old_report(out)
+    (out / "README.md").write_text("old report")
+    (out / "toy.json").write_text("old file")
+    before = _tree(out)
+    real_replace = os.replace
+
+    def failing_replace(src: Any, dst: Any) -> None:
+        # The new report's move into place fails (not the moves that undo).
+        if Path(dst) == out.absolute() / "README.md" and Path(src).parent.name == "report":
+            raise OSError(28, "No space left on device", str(dst))
+        real_replace(src, dst)
+
+    monkeypatch.setattr(framework.os, "replace", failing_replace)
+    with pytest.raises(OSError):
+        reproduce(out, chapters=["toy"], progress=False)
+    monkeypatch.setattr(framework.os, "replace", real_replace)
+    assert built == ["toy"]
+    assert _tree(out) == before
+    assert _leftovers(tmp_path, {"report"}) == []
+    # And without the failure the new report is installed, the user's file kept.
+    reproduce(out, chapters=["toy"], progress=False)
+    after = _tree(out)
+    assert after["figures/new.png"] == b"\x89PNG new"
+    assert "figures/old.png" not in after
+    assert after["toy.json"] == b"{}\n"
+    assert after["notes.txt"] == b"mine"

@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 
+from ._files import replacing
 from .animate import TERM_COLOURS, check_output
 from .bodies import DEFAULT_CHORDS
 from .errors import InvalidParameterError
@@ -609,10 +610,12 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         # matplotlib annotates fps as int, but only divides by it (1000 / fps, ffmpeg -r):
         # a derived frame rate such as speed / frame_dt = 12.5 is written as it is.
         fps: Any = self.fps
-        if suffix == ".html":
-            out.write_text(str(self.to_jshtml(fps=fps)), encoding="utf-8")
-        elif suffix == ".gif":
-            self.save(str(out), writer=mpl_animation.PillowWriter(fps=fps), dpi=self.dpi)
-        else:
-            self.save(str(out), writer=mpl_animation.FFMpegWriter(fps=fps), dpi=self.dpi)
+        # Whole or not at all: an error leaves an existing file as it was.
+        with replacing(out) as tmp:
+            if suffix == ".html":
+                tmp.write_text(str(self.to_jshtml(fps=fps)), encoding="utf-8")
+            elif suffix == ".gif":
+                self.save(str(tmp), writer=mpl_animation.PillowWriter(fps=fps), dpi=self.dpi)
+            else:
+                self.save(str(tmp), writer=mpl_animation.FFMpegWriter(fps=fps), dpi=self.dpi)
         return out

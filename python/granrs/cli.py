@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
+from ._files import replacing, write_text
 from .errors import GranrsError, InvalidParameterError, InvalidSceneError, SimulationError
 
 __all__ = ["main"]
@@ -254,7 +255,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         predicted = result.predict(test_rows).assign(set="predicted")
         frame = _concat([frame, predicted])
     if args.out:
-        frame.to_csv(args.out, index=False)
+        with replacing(args.out) as tmp:
+            frame.to_csv(tmp, index=False)
     if args.json:
         out = result.to_dict()
         if predicted is not None:
@@ -366,7 +368,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     data = to_json(frame)
     text = json.dumps(data, indent=2, allow_nan=False)
     if args.out:
-        Path(args.out).write_text(text + "\n", encoding="utf-8")
+        write_text(args.out, text + "\n")
     if args.json:
         print(text)
         return 0
@@ -619,10 +621,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
     result = simulate(scene)
     if args.series:
         frame = result.to_frame()
-        if suffix == ".parquet":
-            frame.to_parquet(args.series)
-        else:
-            frame.to_csv(args.series)
+        with replacing(args.series) as tmp:
+            if suffix == ".parquet":
+                frame.to_parquet(tmp)
+            else:
+                frame.to_csv(tmp)
         print(
             f"{PROG}: series written to {args.series} ({len(frame)} rows, "
             f"{len(frame.columns) + 1} columns)",
@@ -752,7 +755,7 @@ def _cmd_scene(args: argparse.Namespace) -> int:
         return 0
     if os.path.exists(args.out) and not args.force:
         raise InvalidSceneError(f"{args.out} exists; pass --force to overwrite it", field="out")
-    Path(args.out).write_text(text, encoding="utf-8")
+    write_text(args.out, text)
     print(f"scene file written to {args.out}", file=sys.stderr)
     return 0
 

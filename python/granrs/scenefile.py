@@ -47,6 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from . import _granrs, forces
+from ._files import write_text
 from .bodies import ELEMENT_FIELDS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from .scene import BODY_FIELDS, FIELD_INFO, Scene
@@ -262,9 +263,10 @@ def _body_path(field: str, body: Any) -> tuple[str, ...]:
 
 
 def dump(scene: Scene, path: str | os.PathLike[str]) -> str:
-    """Write the scene to ``path`` (UTF-8) and return the text written."""
+    """Write the scene to ``path`` (UTF-8; whole or not at all: an error leaves an existing
+    file as it was) and return the text written."""
     text = dumps(scene)
-    Path(path).write_text(text, encoding="utf-8")
+    write_text(path, text)
     return text
 
 
