@@ -180,6 +180,42 @@ def test_replacing_keeps_permissions_and_writes_through_links(tmp_path) -> None:
     assert _leftovers(tmp_path, {"old.txt", "plain.txt", "new.txt", "link.txt"}) == []
 
 
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["run", str(SCENE), "--series", "{bad}/x.csv"],
+        [
+            "compare",
+            "--laws",
+            "thesis_published",
+            "--measurements",
+            "thesis:table_3_1",
+            "--quiet",
+            "--out",
+            "{bad}/x.json",
+        ],
+        ["calibrate", "--params", "eta_v", "--out", "{bad}/x.csv"],
+        ["scene", "new", "--force", "--out", "{bad}/x.toml"],
+    ],
+    ids=["run", "compare", "calibrate", "scene"],
+)
+def test_an_output_path_that_cannot_be_written_is_refused_first(command, tmp_path, capsys):
+    """An output file in a missing directory, or where a directory is, is the caller's
+    error, found before the work (exit 2, one line naming the option); it was an OSError
+    after the run (exit 1) or a traceback."""
+    from granrs.cli import main
+
+    (tmp_path / "dir.csv").mkdir()
+    for bad, args in (
+        ("missing", [a.replace("{bad}", str(tmp_path / "missing")) for a in command]),
+        ("a directory", [*command[:-1], str(tmp_path / "dir.csv")]),
+    ):
+        assert main(args) == 2, (bad, capsys.readouterr())
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("granrs: error: cannot write"), err
+        assert ("does not exist" if bad == "missing" else "is a directory") in err[0]
+
+
 #: Calls that write a file given by path or handle. Each must write the temporary file of
 #: ``granrs._files.replacing`` (named ``tmp``) or an in-memory buffer.
 _WRITES = re.compile(

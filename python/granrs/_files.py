@@ -17,7 +17,36 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["replacing", "write_bytes", "write_text"]
+from .errors import InvalidParameterError
+
+__all__ = ["check_target", "replacing", "write_bytes", "write_text"]
+
+
+def check_target(path: str | os.PathLike[str], field: str, what: str = "") -> Path:
+    """Check, before any work, that a file can be written at ``path``: its directory exists
+    and is writable, and an existing ``path`` is a writable file, not a directory. Returns
+    the path.
+
+    Raises:
+        InvalidParameterError: ``field`` names the option, the message the reason.
+    """
+    out = Path(path)
+    label = f"cannot write {what + ' ' if what else ''}{out}"
+    directory = out.parent
+    if not directory.is_dir():
+        raise InvalidParameterError(
+            f"{label}: the directory {directory} does not exist", field=field
+        )
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise InvalidParameterError(
+            f"{label}: the directory {directory} is not writable", field=field
+        )
+    if out.exists() and (out.is_dir() or not os.access(out, os.W_OK)):
+        raise InvalidParameterError(
+            f"{label}: it exists and is {'a directory' if out.is_dir() else 'not writable'}",
+            field=field,
+        )
+    return out
 
 
 def _temporary(target: Path) -> Path:

@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
-from ._files import replacing, write_text
+from ._files import check_target, replacing, write_text
 from .errors import GranrsError, InvalidParameterError, InvalidSceneError, SimulationError
 
 __all__ = ["main"]
@@ -232,6 +232,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     """Run ``granrs calibrate``."""
     from .calibrate import Measurements, calibrate
 
+    if args.out:
+        check_target(args.out, "out", "the residuals to")
     measurements = Measurements.load(args.measurements, args.cases)
     cases = args.cases or measurements.body
     fit_rows = measurements
@@ -346,6 +348,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from .calibrate import Measurements
     from .compare import compare, to_json
 
+    if args.out:
+        check_target(args.out, "out", "the comparison to")
     laws = None
     if args.laws is not None:
         laws = [name.strip() for name in args.laws.split(",") if name.strip()]
@@ -495,6 +499,7 @@ def _series_format(path: str) -> str:
             f"--series {path}: writing parquet needs pyarrow: pip install pyarrow (or write .csv)",
             field="series",
         )
+    check_target(path, "series", "the series to")
     return suffix
 
 
@@ -755,6 +760,7 @@ def _cmd_scene(args: argparse.Namespace) -> int:
         return 0
     if os.path.exists(args.out) and not args.force:
         raise InvalidSceneError(f"{args.out} exists; pass --force to overwrite it", field="out")
+    check_target(args.out, "out", "the scene file to")
     write_text(args.out, text)
     print(f"scene file written to {args.out}", file=sys.stderr)
     return 0
