@@ -6,6 +6,10 @@
   through ``granrs._files.replacing`` (tested on a full disk: ``ulimit -f`` in a
   subprocess, where the write fails with EFBIG since Python ignores SIGXFSZ), and
   ``granrs reproduce`` installs its directory all or nothing;
+* a scene file is read safely: nesting 500 deep (in the file or in ``--set``) is one line
+  and exit 2, not a 3,002-line RecursionError; ``/dev/zero``, a pipe or a file larger than
+  the limit is refused before it is read whole (it was a MemoryError or a hang); a UTF-8
+  byte-order mark is accepted (it was refused).
 """
 
 from __future__ import annotations
@@ -347,3 +351,139 @@ def test_reproduce_undoes_the_install_when_a_move_fails(tmp_path, monkeypatch) -
     assert "figures/old.png" not in after
     assert after["toy.json"] == b"{}\n"
     assert after["notes.txt"] == b"mine"
+
+
+# ------------------------------------------------------------------------------------------
+# Scene files read safely
+
+
+def _granrs_process(args: list[str], cwd: Path, prefix: str = "") -> subprocess.CompletedProcess:
+    """``granrs ARGS`` in a child process (``prefix``: shell commands first, e.g. a
+    ulimit), with a timeout: a hang is a failure, not a stuck suite."""
+    command = " ".join(shlex.quote(a) for a in [sys.executable, "-m", "granrs.cli", *args])
+    env = {**os.environ, "PYTHONPATH": str(PACKAGE.parent), "PYTHONDONTWRITEBYTECODE": "1"}
+    return subprocess.run(
+        ["bash", "-c", f"{prefix}exec {command}"],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+
+
+def _one_error_line(proc: subprocess.CompletedProcess) -> str:
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("granrs: error: "), lines[:5]
+    return lines[0]
+
+
+NESTED = {
+    "arrays": "[" * 500 + "]" * 500,
+    "inline tables": "{a = " * 500 + "1" + "}" * 500,
+    "arrays past the limit": "[" * 40 + "1.0" + "]" * 40,
+}
+
+
+@pytest.mark.parametrize("value", list(NESTED.values()), ids=list(NESTED))
+def test_deep_nesting_is_one_line_and_exit_2(value, tmp_path, capsys) -> None:
+    """Issue 34: a value nested 500 deep crashed ``granrs run`` with a 3,002-line
+    RecursionError (tomllib recurses per level). Now, in the file or in ``--set``, it is
+    one line naming the key, exit 2; 40 levels (which tomllib parses) are refused by the
+    same limit, ``granrs.scenefile.MAX_NESTING``."""
+    from granrs import scenefile
+    from granrs.cli import main
+    from granrs.errors import InvalidSceneError
+
+    path = tmp_path / "deep.toml"
+    path.write_text(f"q_deg = {value}\n")
+    assert main(["run", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nested more than 32" in err[0], err[:3]
+    assert main(["run", str(SCENE), "--set", f"q_deg={value}"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nested more than 32" in err[0] and "q_deg" in err[0], err[:3]
+    with pytest.raises(InvalidSceneError, match="nested more than 32"):
+        scenefile.loads(f"q_deg = {value}\n")
+
+
+def test_nesting_within_the_limit_reads_as_before() -> None:
+    """A linkage's tables (five deep) read, and a value nested to the limit reaches the
+    scene's own check (a wrong type), not the nesting limit."""
+    from granrs import scenefile
+    from granrs.errors import InvalidSceneError
+
+    linkage = (ROOT / "examples" / "scenes" / "three_link_pendulum.toml").read_text()
+    assert scenefile.loads(linkage).kind == "linkage"
+    value = "[" * 31 + "1.0" + "]" * 31  # 32 deep with the file's top level
+    with pytest.raises(InvalidSceneError) as info:
+        scenefile.loads(f"q_deg = {value}\n")
+    assert "nested more than" not in str(info.value)
+    assert info.value.field == "q_deg"
+
+
+def test_dev_zero_is_refused_before_it_is_read(tmp_path) -> None:
+    """Issue 34: ``granrs run /dev/zero`` read until memory ran out (MemoryError). Now a
+    file that is not a regular file is refused before any read; the child runs under a
+    1 GB address-space limit so that the old behaviour fails fast."""
+    if not Path("/dev/zero").exists():
+        pytest.skip("no /dev/zero")
+    proc = _granrs_process(["run", "/dev/zero"], tmp_path, prefix="ulimit -v 1000000 && ")
+    line = _one_error_line(proc)
+    assert "/dev/zero" in line and "not a regular file" in line
+
+
+def test_a_pipe_is_refused_without_waiting_for_it(tmp_path) -> None:
+    """A named pipe with no writer: reading it would wait forever (the old reader hung);
+    it is refused from its kind, without opening it."""
+    fifo = tmp_path / "scene.toml"
+    os.mkfifo(fifo)
+    line = _one_error_line(_granrs_process(["run", str(fifo)], tmp_path))
+    assert "not a regular file" in line
+
+
+def test_a_file_above_the_limit_is_refused_before_it_is_read(tmp_path) -> None:
+    """A scene file larger than ``MAX_FILE_BYTES`` (here a sparse file of 64 MiB, which the
+    old reader read whole, as it would any size) is refused from its size."""
+    from granrs import scenefile
+    from granrs.errors import InvalidSceneError
+
+    big = tmp_path / "big.toml"
+    with open(big, "wb") as handle:
+        handle.truncate(64 << 20)
+    with pytest.raises(InvalidSceneError) as info:
+        scenefile.load(big)
+    assert info.value.field == "scene"
+    assert str(scenefile.MAX_FILE_BYTES) in str(info.value)
+    line = _one_error_line(_granrs_process(["run", str(big)], tmp_path))
+    assert "larger than" in line
+
+
+def test_a_byte_order_mark_is_accepted(tmp_path) -> None:
+    """Issue 34: a UTF-8 scene file starting with a byte-order mark (as some Windows
+    editors write it) was refused as invalid TOML. It reads as the same file without it,
+    through every reader: the CLI, ``Scene.from_toml`` and ``scenefile.loads``."""
+    from granrs import Scene, scenefile
+    from granrs.cli import main
+
+    text = "q_deg = 30.0\nv0 = 1.5\n"
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    expected = Scene(q_deg=30.0, v0=1.5)
+    assert Scene.from_toml(path) == expected
+    assert scenefile.loads("\ufeff" + text) == expected
+    assert main(["run", str(path), "--json"]) == 0
+
+
+def test_a_file_that_is_not_utf8_is_a_typed_error(tmp_path) -> None:
+    """Bytes that are not UTF-8 raise the scene file's typed error from every reader (from
+    Python it was a UnicodeDecodeError)."""
+    from granrs import Scene
+    from granrs.errors import InvalidSceneError
+
+    path = tmp_path / "latin1.toml"
+    path.write_bytes('apply_at = "tip" # caf\xe9\n'.encode("latin-1"))
+    with pytest.raises(InvalidSceneError) as info:
+        Scene.from_toml(path)
+    assert info.value.field == "scene" and "UTF-8" in str(info.value)

@@ -454,11 +454,10 @@ def _read_scene(path: str, overrides: dict[str, Any]) -> Any:
     from . import scenefile
 
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        return scenefile.load(path, overrides)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
         raise InvalidSceneError(f"cannot read scene file {path}: {reason}") from None
-    return scenefile.loads(text, source=path, overrides=overrides)
 
 
 def _add_run(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
