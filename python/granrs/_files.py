@@ -81,16 +81,18 @@ def replacing(path: str | os.PathLike[str]) -> Iterator[Path]:
     target = Path(path)
     if target.is_symlink():
         target = target.resolve()
-    tmp = _temporary(target)
+    tmp: Path | None = None
     try:
+        tmp = _temporary(target)
         yield tmp
         _sync(tmp)
         with contextlib.suppress(FileNotFoundError):
             os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
         os.replace(tmp, target)
     except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
         if isinstance(exc, OSError) and exc.errno is not None:
             # Name the file the caller asked for (not the temporary one, nor none).
             raise OSError(exc.errno, exc.strerror, os.fspath(path)) from exc

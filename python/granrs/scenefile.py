@@ -65,6 +65,8 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 
 __all__ = [
     "FORMAT_VERSION",
+    "MAX_FILE_BYTES",
+    "MAX_NESTING",
     "dump",
     "dumps",
     "load",
