@@ -305,6 +305,18 @@ def test_bad_options_are_typed_errors_before_any_run(kwargs, field, monkeypatch)
     assert info.value.field == field
 
 
+def test_synthetic_refuses_a_bad_step_and_failed_runs() -> None:
+    """Issue 34: ``synthetic`` caught an invalid dt as failed runs and drew measurements
+    around NaN (dt = 0: all twelve means NaN; dt = 0.05: six). An invalid dt is the scene's
+    typed error; failed runs a SimulationError saying how many."""
+    with pytest.raises(InvalidParameterError) as info:
+        synthetic("thesis_published", {}, TABLE_3_1, dt=0.0)
+    assert info.value.field == "dt"
+    failed = _failing_rows(TABLE_3_1, 0.05)
+    with pytest.raises(SimulationError, match=f"{failed} of 12 rows failed"):
+        synthetic("thesis_published", {}, TABLE_3_1, dt=0.05)
+
+
 def test_bad_arguments() -> None:
     with pytest.raises(UnknownNameError) as info:
         compare(["thesis_publish"], TABLE_3_1)

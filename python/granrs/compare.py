@@ -65,7 +65,7 @@ from .batch import _threads as _check_threads
 from .calibrate import Measurements, calibrate, evaluate
 from .calibrate.fit import _residual_frame
 from .calibrate.model import _parse_param, base_coefficients
-from .errors import GranrsError, InvalidParameterError, UnknownNameError
+from .errors import GranrsError, InvalidParameterError, SimulationError, UnknownNameError
 from .scene import Scene
 
 __all__ = [
@@ -681,10 +681,9 @@ def compare(
     data = _datasets(measurements)
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
         raise InvalidParameterError(f"invalid starts: {starts!r}", field="starts")
-    # Before any run, by the rules every run uses: the step by a scene's (field "dt"), the
-    # threads by the sweep's (field "threads"). A bad one is the caller's error, not a
-    # failed run of each law.
-    Scene(dt=dt).validate()
+    # Before any run, by the rules every run uses: the step by a scene's, the threads by
+    # the sweep's. A bad one is the caller's error, not a failed run of each law.
+    _check_dt(dt)
     _check_threads(threads)
     groups = {name: _group_column(name, m, folds) for name, m in data.items()}
     plans: list[tuple[str, Law, Measurements, str | None, _Job | None, str]] = []
@@ -725,6 +724,11 @@ def compare(
     frame = pd.DataFrame.from_records(records)
     frame["rank"] = _rank(frame)
     return frame
+
+
+def _check_dt(dt: Any) -> None:
+    """Refuse an invalid step by the rule of every scene (``field="dt"``)."""
+    Scene(dt=dt).validate()
 
 
 def _rank(frame: pd.DataFrame) -> pd.Series:
@@ -858,13 +862,15 @@ def synthetic(
     the rows of ``like`` (its angles, speeds, cases), each mean drawn from a normal
     distribution around the simulated value with sd ``rel_sd`` times that value, which is
     also the row's sd. For checking that :func:`granrs.compare` picks the law that made the data
-    and recovers its parameters.
+    and recovers its parameters. A run that fails (no value to draw around) raises
+    :class:`~granrs.errors.SimulationError`; an invalid ``dt`` the scene's typed error.
 
     ``values`` gives every fitted parameter of the law on that body (its own and the
     body's unknowns, as :func:`granrs.compare` fits them; ``dataset`` names the settings of
     :data:`~granrs.compare.DATASETS` to use, default the body's name)."""
     (law_obj,) = _law_list([law])
     m = like if isinstance(like, Measurements) else Measurements.load(like)
+    _check_dt(dt)
     if not (isinstance(rel_sd, (int, float)) and 0.0 < rel_sd < 1.0):
         raise InvalidParameterError(f"rel_sd must be in (0, 1); got {rel_sd!r}", field="rel_sd")
     reason = _unavailable(law_obj, m.body)
@@ -880,6 +886,12 @@ def synthetic(
             field="values",
         )
     sim = _pinned(job, m, dt, [float(values[k]) for k in job.params])
+    failed = _failed(sim)
+    if failed:
+        raise SimulationError(
+            f"synthetic: the runs of {failed} of {len(m)} rows failed under {law_obj.name} "
+            f"at dt = {dt:g} s (no value to draw the measurements around); use a smaller dt"
+        )
     rng = np.random.default_rng(seed)
     rows = m.rows.copy()
     for q in ("depth", "t_s"):
