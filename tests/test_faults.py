@@ -20,12 +20,15 @@ import shlex
 import stat
 import subprocess
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import granrs
 from granrs import _files, batch, cases
@@ -487,3 +490,52 @@ def test_a_file_that_is_not_utf8_is_a_typed_error(tmp_path) -> None:
     with pytest.raises(InvalidSceneError) as info:
         Scene.from_toml(path)
     assert info.value.field == "scene" and "UTF-8" in str(info.value)
+
+
+#: Keys a random scene file sets (fields of each kind, and one unknown).
+_KEYS = st.sampled_from(
+    ["q_deg", "v0", "dt", "body", "record", "knee", "forces", "apply_at", "t_end", "nope"]
+)
+_VALUES = st.recursive(
+    st.one_of(st.integers(), st.floats(), st.text(max_size=5), st.booleans()),
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=3),
+        st.dictionaries(st.text("abck", min_size=1, max_size=2), inner, max_size=3),
+    ),
+    max_leaves=20,
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.dictionaries(_KEYS, _VALUES, max_size=4), st.booleans())
+def test_any_scene_file_is_a_scene_or_a_typed_error(data, bom) -> None:
+    """Whatever a scene file's keys hold (any TOML value, nested), reading it gives a
+    scene or a granrs error, never another exception; with a byte-order mark the same."""
+    from granrs import scenefile
+    from granrs.errors import GranrsError
+
+    text = "\n".join(f"{k} = {scenefile._format_value(v)}" for k, v in data.items())
+    outcomes = []
+    for t in (text, "\ufeff" + text) if bom else (text,):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", granrs.StepSizeWarning)
+                outcomes.append(scenefile.loads(t))
+        except GranrsError as exc:
+            outcomes.append(type(exc))
+    assert len(set(map(repr, outcomes))) == 1
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(max_size=200))
+def test_any_text_is_a_scene_or_a_typed_error(text) -> None:
+    """Arbitrary text as a scene file, or as a ``--set`` value: a scene (or a value), or a
+    granrs error; never another exception (a RecursionError, a UnicodeError, ...)."""
+    from granrs import scenefile
+    from granrs.errors import GranrsError
+
+    for parse in (scenefile.loads, lambda t: scenefile.parse_override(f"q_deg={t}")):
+        try:
+            parse(text)
+        except GranrsError:
+            pass
