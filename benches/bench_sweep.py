@@ -28,6 +28,11 @@ Parts:
   ``poncelet``, with the SIMD lanes (``lanes=True``) and on the scalar path
   (``lanes=False``), taken in turn. No target; the lanes' gain over the scalar path
   (``docs/sweeps.md``).
+* ``axis``: a sweep's validation before its first run (the Python-level checks of the
+  axes and the core's check of every run, as ``granrs.sweep`` does them), for one axis of
+  40,000 values against a 400 x 100 product of the same size. Target: under 1 s each; the
+  two within a factor of a few of each other (the check of one long axis was quadratic:
+  37.1 s against 2.8 s).
 
 Build in release first: ``maturin develop --release``.
 """
@@ -52,7 +57,7 @@ import granrs
 from granrs import _granrs, cases
 from granrs.forces import select, thesis
 
-PARTS = ("sweep", "overhead", "prune", "force", "fixed", "lanes")
+PARTS = ("sweep", "overhead", "prune", "force", "fixed", "lanes", "axis")
 
 
 def _median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -225,6 +230,38 @@ def part_fixed(repeat: int) -> list[str]:
     return [*lines, ""]
 
 
+# ---------------------------------------------------------------------------------- axis
+def part_axis(repeat: int, n: int = 40_000) -> list[str]:
+    """Validation of a sweep of ``n`` runs before it starts: one axis of ``n`` values, and
+    a product of two axes of the same size, each the median of ``repeat`` tries."""
+    from granrs.batch import _axis_sweep, _threads
+
+    scene = cases.free_link(q_deg=0.0, v0=2.0)
+    n_q = 100
+    shapes = {
+        f"one axis of {n:,} values": {"v0": list(np.linspace(0.5, 5.0, n))},
+        f"{n // n_q} x {n_q} product": {
+            "v0": list(np.linspace(0.5, 5.0, n // n_q)),
+            "q_deg": list(np.linspace(-85.0, 85.0, n_q)),
+        },
+    }
+
+    def validate(axes: dict[str, list[float]]) -> None:
+        kwargs, _ = _axis_sweep(scene, axes)
+        _granrs.validate_sweep(**kwargs, threads=_threads(None))
+
+    lines = [
+        f"### A sweep's validation before its first run ({n:,} runs, median of {repeat})",
+        "",
+        "| axes | validation [s] | target |",
+        "|---|---|---|",
+    ]
+    for label, axes in shapes.items():
+        seconds = _median_time(lambda a=axes: validate(a), repeat)
+        lines.append(f"| {label} | {seconds:.3f} | < 1 s: {'met' if seconds < 1 else 'MISSED'} |")
+    return [*lines, ""]
+
+
 # ---------------------------------------------------------------------------------- lanes
 def part_lanes(repeat: int) -> list[str]:
     """1000 free links on one thread under each sign model the lanes cover, and under
@@ -389,6 +426,8 @@ def main(argv: list[str] | None = None) -> int:
             lines += part_fixed(repeat)
         elif part == "lanes":
             lines += part_lanes(repeat)
+        elif part == "axis":
+            lines += part_axis(repeat)
         else:
             lines += part_force(repeat)
     print("\n".join(lines), flush=True)

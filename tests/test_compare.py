@@ -1,5 +1,5 @@
 """Tests of the law comparison (granrs.compare, ``granrs compare``) and of calibrating any
-term's parameter by name (issue 18).
+term's parameter by name (issue 18); failed runs counted, never a better fit (issue 34).
 
 Expected values come from independent granrs.simulate runs, from granrs.calibrate called
 directly on the same rows, from the shipped tables, and from the parameters that made
@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -19,7 +20,7 @@ from granrs import cases, forces
 from granrs.calibrate import Measurements, calibrate
 from granrs.cli import main
 from granrs.compare import LAWS, Law, compare, synthetic, to_json
-from granrs.errors import InvalidParameterError, UnknownNameError
+from granrs.errors import InvalidParameterError, SimulationError, StepSizeWarning, UnknownNameError
 
 TABLE_3_1 = Measurements.thesis("table_3_1")
 #: The keys the issue asks of each law's entry in laws.json.
@@ -216,6 +217,106 @@ def test_a_law_whose_term_is_missing_is_unavailable() -> None:
             assert not f["available"].iloc[0], name
 
 
+#: No sand force: every run falls to its end time (a finite t_s and depth, far off).
+FREE_FALL = Law("free_fall", "gravity alone, no sand force")
+
+
+def _failing_rows(m: Measurements, dt: float) -> int:
+    """The rows of ``m`` whose thesis run (granrs.simulate) fails at ``dt``: counted
+    independently of the comparison."""
+    failed = 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", StepSizeWarning)
+        for r in m.rows.to_dict("records"):
+            try:
+                granrs.simulate(cases.free_link(r["q_deg"], r["v0_mean"], dt=dt))
+            except SimulationError:
+                failed += 1
+    return failed
+
+
+def test_failed_runs_are_counted_and_never_a_better_fit() -> None:
+    """Issue 34: a failed run leaves NaN residuals that the sum skipped, so at dt = 0.05
+    (six of Table 3.1's twelve runs diverge under the thesis's law) the law got the chi2 of
+    the six that ran, and no count said so. Now each failed row is counted, the statistics
+    over it are undefined (None in JSON), and the law ranks after a law whose every run
+    ran, however far off that one is (free fall)."""
+    dt = 0.05
+    failed = _failing_rows(TABLE_3_1, dt)
+    assert 0 < failed < len(TABLE_3_1)
+    frame = compare([FREE_FALL, "thesis_published"], TABLE_3_1, dt=dt, progress=False)
+    entries = to_json(frame)["free_link"]
+    published = entries["thesis_published"]
+    assert published["failed_in_sample"] == failed
+    assert published["failed_out_of_sample"] == failed
+    assert sum(r["failed"] for r in published["rows"]) == failed
+    for r in published["rows"]:
+        assert r["failed"] == (r["depth_pred"] is None or r["t_s_pred"] is None)
+    for key in ("chi2", "chi2_dof", "aic", "bic", "oos_chi2"):
+        assert published[key] is None, key
+    fall = entries["free_fall"]
+    assert fall["failed_in_sample"] == fall["failed_out_of_sample"] == 0
+    assert all(math.isfinite(fall[k]) for k in ("chi2", "aic", "oos_chi2"))
+    assert (fall["rank"], published["rank"]) == (1, 2)
+
+
+def test_a_fitted_law_with_failed_runs_has_no_chi2() -> None:
+    """The fit's chi2 counts a failed run as a large residual (1e3 sd, so that the
+    optimizer steps back): it is not the law's chi2. At dt = 0.05 the rows at 45 deg
+    fail; the fit's and its fold's chi2 are undefined and the failures counted."""
+    m = TABLE_3_1.subset(q_deg=[0.0, 45.0])
+    failed = _failing_rows(m, 0.05)
+    assert failed > 0
+    frame = compare([THESIS_TWO], m, dt=0.05, folds=None, progress=False)
+    entry = to_json(frame)["free_link"]["thesis_two"]
+    assert entry["failed_in_sample"] >= 1
+    assert entry["chi2"] is None and entry["aic"] is None
+    (fold,) = entry["folds"]
+    assert fold["failed"] == entry["failed_in_sample"]
+    assert fold["chi2"] is None
+
+
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"dt": 0.0}, "dt"),
+        ({"dt": math.nan}, "dt"),
+        ({"dt": -1e-4}, "dt"),
+        ({"dt": "abc"}, "dt"),
+        ({"threads": -2}, "threads"),
+        ({"threads": 0}, "threads"),
+        ({"laws": []}, "laws"),
+    ],
+)
+def test_bad_options_are_typed_errors_before_any_run(kwargs, field, monkeypatch) -> None:
+    """Issue 34: an invalid dt was caught as a failed point of every run (dt = 0: every run
+    failed and the law got chi2 = 0, AIC 0); threads=-2 gave a 'law unavailable' row per
+    law, laws=[] a KeyError. Each is now the typed error naming the option, raised
+    before any run (the sweep is replaced by one that fails the test if called)."""
+    import granrs.batch
+
+    def no_run(*args, **kw):
+        raise AssertionError("a run started before the options were checked")
+
+    monkeypatch.setattr(granrs.batch, "sweep", no_run)
+    args = {"laws": ["thesis_published"], "measurements": TABLE_3_1, "progress": False}
+    with pytest.raises(InvalidParameterError) as info:
+        compare(**{**args, **kwargs})
+    assert info.value.field == field
+
+
+def test_synthetic_refuses_a_bad_step_and_failed_runs() -> None:
+    """Issue 34: ``synthetic`` caught an invalid dt as failed runs and drew measurements
+    around NaN (dt = 0: all twelve means NaN; dt = 0.05: six). An invalid dt is the scene's
+    typed error; failed runs a SimulationError saying how many."""
+    with pytest.raises(InvalidParameterError) as info:
+        synthetic("thesis_published", {}, TABLE_3_1, dt=0.0)
+    assert info.value.field == "dt"
+    failed = _failing_rows(TABLE_3_1, 0.05)
+    with pytest.raises(SimulationError, match=f"{failed} of 12 rows failed"):
+        synthetic("thesis_published", {}, TABLE_3_1, dt=0.05)
+
+
 def test_bad_arguments() -> None:
     with pytest.raises(UnknownNameError) as info:
         compare(["thesis_publish"], TABLE_3_1)
@@ -347,6 +448,35 @@ def test_cli_compare_table_and_errors(capsys) -> None:
     assert "leg" in text and "thesis_published" in text
     assert main(["compare", "--laws", "nope", "--quiet"]) == 2
     assert "unknown law" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "option, field",
+    [(["--dt", "nan"], "dt"), (["--dt", "0"], "dt"), (["--laws", ""], "laws")],
+)
+def test_cli_compare_bad_option_exits_2_with_one_line(option, field, capsys) -> None:
+    """Issue 34: ``granrs compare ... --dt nan`` exited 0 (every run failed, the law got
+    chi2 = 0); ``--laws ''`` raised a KeyError. Both now exit 2 with one line."""
+    args = ["compare", "--laws", "thesis_published", "--measurements", "thesis:table_3_1"]
+    assert main([*args, *option, "--quiet"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("granrs: error:")
+    assert field in lines[0].removeprefix("granrs: error:")
+
+
+def test_cli_compare_reports_failed_runs(capsys) -> None:
+    """The table has a ``failed`` column and a note names the failed rows (issue 34)."""
+    dt = 0.05
+    failed = _failing_rows(TABLE_3_1, dt)
+    args = ["compare", "--laws", "thesis_published", "--measurements", "thesis:table_3_1"]
+    assert main([*args, "--dt", str(dt), "--quiet"]) == 0
+    text = capsys.readouterr().out
+    header, _, row = text.splitlines()[:3]
+    assert header.split()[-2:] == ["failed", "n_rows"]
+    assert row.split()[-2:] == [str(failed), "12"]
+    assert f"runs failed on {failed} of 12 rows in sample and {failed} out of sample" in text
 
 
 def test_leg_published_is_locked_thesis() -> None:

@@ -20,6 +20,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 
+from ._files import replacing
+from ._progress import progress_bar
 from .animate import TERM_COLOURS, check_output
 from .bodies import DEFAULT_CHORDS
 from .errors import InvalidParameterError
@@ -606,7 +608,6 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         (a self-contained JavaScript player). The path is checked first, before any frame is drawn.
         ``progress``: a tqdm bar of the frames on stderr (None: when stderr is a terminal).
         Returns the path."""
-        from ._progress import progress_bar
 
         out = check_output(path)
         suffix = out.suffix.lower()
@@ -619,21 +620,25 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             def tick(_frame: int, _total: int) -> None:
                 bar.update(1)
 
-            if suffix == ".html":
-                # What to_jshtml() writes (its writer and mode), with the frames counted.
-                with tempfile.TemporaryDirectory() as tmp:
-                    temp = Path(tmp, "animation.html")
-                    writer = mpl_animation.HTMLWriter(
-                        fps=fps, embed_frames=True, default_mode="loop" if self._repeat else "once"
-                    )
-                    self.save(str(temp), writer=writer, progress_callback=tick)
-                    out.write_text(temp.read_text(encoding="utf-8"), encoding="utf-8")
-            elif suffix == ".gif":
-                writer = mpl_animation.PillowWriter(fps=fps)
-                self.save(str(out), writer=writer, dpi=self.dpi, progress_callback=tick)
-            else:
-                writer = mpl_animation.FFMpegWriter(fps=fps)
-                self.save(str(out), writer=writer, dpi=self.dpi, progress_callback=tick)
+            # Whole or not at all: an error leaves an existing file as it was.
+            with replacing(out) as tmp:
+                if suffix == ".html":
+                    # What to_jshtml() writes (its writer and mode), with the frames counted.
+                    with tempfile.TemporaryDirectory() as tmpdir:
+                        temp = Path(tmpdir, "animation.html")
+                        writer = mpl_animation.HTMLWriter(
+                            fps=fps,
+                            embed_frames=True,
+                            default_mode="loop" if self._repeat else "once",
+                        )
+                        self.save(str(temp), writer=writer, progress_callback=tick)
+                        tmp.write_text(temp.read_text(encoding="utf-8"), encoding="utf-8")
+                elif suffix == ".gif":
+                    writer = mpl_animation.PillowWriter(fps=fps)
+                    self.save(str(tmp), writer=writer, dpi=self.dpi, progress_callback=tick)
+                else:
+                    writer = mpl_animation.FFMpegWriter(fps=fps)
+                    self.save(str(tmp), writer=writer, dpi=self.dpi, progress_callback=tick)
         finally:
             bar.close()
         return out

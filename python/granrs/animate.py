@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._files import check_target
 from .errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -158,21 +159,7 @@ def check_output(path: str | os.PathLike[str]) -> Path:
             "write .gif or .html instead",
             field="out",
         )
-    directory = out.parent
-    if not directory.is_dir():
-        raise InvalidParameterError(
-            f"cannot write {out}: the directory {directory} does not exist", field="out"
-        )
-    if not os.access(directory, os.W_OK | os.X_OK):
-        raise InvalidParameterError(
-            f"cannot write {out}: the directory {directory} is not writable", field="out"
-        )
-    if out.exists() and (out.is_dir() or not os.access(out, os.W_OK)):
-        raise InvalidParameterError(
-            f"cannot write {out}: it exists and is "
-            f"{'a directory' if out.is_dir() else 'not writable'}",
-            field="out",
-        )
+    check_target(out, "out")
     return out
 
 

@@ -85,14 +85,31 @@ def _check_axes(scene: Scene, axes: dict[str, list[Any]]) -> None:
             hint = difflib.get_close_matches(name, known, n=1)
             more = f"; did you mean {hint[0]!r}?" if hint else ""
             raise UnknownNameError(f"Scene has no field {name!r}{more}", field=name)
-        seen: list[Any] = []
+        # Each distinct object once (by identity: the axis holds them, so their ids stay
+        # unique; a set, so that the check is linear in the axis's length).
+        seen: set[int] = set()
         for v in values:
-            if any(v is s for s in seen):
-                continue
-            seen.append(v)
             if isinstance(v, (int, float, np.number)) and not isinstance(v, bool):
                 continue  # ranges are checked in the core, for every run
+            if id(v) in seen:
+                continue
+            seen.add(id(v))
             scene.replace(**{name: v})
+
+
+def _axis_sweep(
+    scene: Scene, axes: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict[str, list[Any]]]:
+    """A sweep over ``axes`` of ``scene`` as the core takes it (``base`` and ``axes``), and
+    the axes' values, after the Python-level checks (:func:`_check_axes`); the core
+    validates every run (``_granrs.validate_sweep``)."""
+    plain_axes = {name: _axis_values(name, values) for name, values in axes.items()}
+    _check_axes(scene, plain_axes)
+    kwargs: dict[str, Any] = {
+        "base": scene._plain(),
+        "axes": [(k, [_plain(k, v) for v in vs]) for k, vs in plain_axes.items()],
+    }
+    return kwargs, plain_axes
 
 
 def _names(columns: Sequence[str], body: str) -> list[str]:
@@ -167,8 +184,8 @@ class _Table:
     columns`` floats) and then made a DataFrame without copying them: the floats are one
     ``columns x rows`` block (the frame's own), the counters and the flags one block each,
     ``status`` its own array. The counters are int32 (a run's stay far below 2^31; a block
-    that does not fit is widened to int64). So a sweep holds its result plus one chunk
-    (issue 22: a summary-only sweep of 1e6 runs under 300 MB)."""
+    that does not fit is widened to int64). So a sweep holds its result plus one chunk (a
+    summary-only sweep of 1e6 runs stays under 300 MB)."""
 
     def __init__(self, columns: Sequence[str], body: str, n: int) -> None:
         self.layout = _layout(tuple(columns), body)
@@ -430,12 +447,7 @@ def sweep(
     """
     n_threads = _threads(threads)
     if isinstance(scene, Scene):
-        plain_axes = {name: _axis_values(name, values) for name, values in axes.items()}
-        _check_axes(scene, plain_axes)
-        kwargs: dict[str, Any] = {
-            "base": scene._plain(),
-            "axes": [(k, [_plain(k, v) for v in vs]) for k, vs in plain_axes.items()],
-        }
+        kwargs, plain_axes = _axis_sweep(scene, axes)
         # A thesis-row scene swept over the field that selects its row (the free link's
         # q_deg): each run takes its value's row, as scene.replace does.
         rows = axis_rows(scene, plain_axes)

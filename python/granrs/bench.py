@@ -18,6 +18,7 @@ from typing import Any
 
 import pandas as pd
 
+from ._files import replacing, write_text
 from .api import simulate
 from .cases import free_link
 from .result import Result
@@ -189,8 +190,9 @@ def _failed_lines(df: pd.DataFrame) -> list[str]:
     return lines
 
 
-def _plot(df: pd.DataFrame, scenes: Sequence[BenchScene], path: Path) -> None:
-    """One log-log panel per scene: relative depth error against time per run."""
+def _plot(df: pd.DataFrame, scenes: Sequence[BenchScene], tmp: Path) -> None:
+    """One log-log panel per scene: relative depth error against time per run, saved to
+    ``tmp`` (the temporary file of :func:`granrs._files.replacing`)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -221,7 +223,7 @@ def _plot(df: pd.DataFrame, scenes: Sequence[BenchScene], path: Path) -> None:
         ax.set_ylabel("relative depth error")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
-    fig.savefig(path, dpi=110)
+    fig.savefig(tmp, dpi=110)
 
 
 def _fmt(value: Any, spec: str = ".2e") -> str:
@@ -322,9 +324,11 @@ def work_precision(
                     flush=True,
                 )
     df = pd.DataFrame(rows, columns=COLUMNS)
-    df.to_csv(out / "accuracy.csv", index=False)
-    _plot(df, SCENES, out / "accuracy.png")
-    (out / "accuracy.md").write_text(_markdown(df, SCENES, ref_dt, T_END), encoding="utf-8")
+    with replacing(out / "accuracy.csv") as tmp:
+        df.to_csv(tmp, index=False)
+    with replacing(out / "accuracy.png") as tmp:
+        _plot(df, SCENES, tmp)
+    write_text(out / "accuracy.md", _markdown(df, SCENES, ref_dt, T_END))
     if progress:
         print(f"[bench] wrote {out / 'accuracy.csv'}, accuracy.png, accuracy.md", flush=True)
     return df

@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from . import __version__
+from ._files import check_target, replacing, write_text
 from .errors import (
     CoefficientsWarning,
     GranrsError,
@@ -242,6 +243,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     """Run ``granrs calibrate``."""
     from .calibrate import Measurements, calibrate
 
+    if args.out:
+        check_target(args.out, "out", "the residuals to")
     measurements = Measurements.load(args.measurements, args.cases)
     cases = args.cases or measurements.body
     fit_rows = measurements
@@ -270,7 +273,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         predicted = result.predict(test_rows).assign(set="predicted")
         frame = _concat([frame, predicted])
     if args.out:
-        frame.to_csv(args.out, index=False)
+        with replacing(args.out) as tmp:
+            frame.to_csv(tmp, index=False)
     if args.json:
         out = result.to_dict()
         if predicted is not None:
@@ -350,6 +354,7 @@ _COMPARE_COLUMNS: tuple[str, ...] = (
     "depth_within_1sd",
     "ts_within_1sd",
     "ts_within_2sd",
+    "failed_out_of_sample",
     "n_rows",
 )
 
@@ -359,6 +364,8 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     from .calibrate import Measurements
     from .compare import compare, to_json
 
+    if args.out:
+        check_target(args.out, "out", "the comparison to")
     laws = None
     if args.laws is not None:
         laws = [name.strip() for name in args.laws.split(",") if name.strip()]
@@ -381,7 +388,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     data = to_json(frame)
     text = json.dumps(data, indent=2, allow_nan=False)
     if args.out:
-        Path(args.out).write_text(text + "\n", encoding="utf-8")
+        write_text(args.out, text + "\n")
     if args.json:
         print(text)
         return 0
@@ -391,8 +398,16 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             rows.append([rec["dataset"], rec["law"], *["-"] * (len(_COMPARE_COLUMNS) - 2)])
             notes.append(f"{rec['dataset']} {rec['law']}: not run: {rec['reason']}")
             continue
-        rows.append([_number(_plain(rec[c])) for c in _COMPARE_COLUMNS])
-    print("\n".join(_table(list(_COMPARE_COLUMNS), rows)))
+        rows.append([_number(rec[c]) for c in _COMPARE_COLUMNS])
+        if rec["failed_in_sample"] or rec["failed_out_of_sample"]:
+            notes.append(
+                f"{rec['dataset']} {rec['law']}: runs failed on {rec['failed_in_sample']} of "
+                f"{rec['n_rows']} rows in sample and {rec['failed_out_of_sample']} out of "
+                "sample (no prediction: chi2, AIC and BIC undefined where a row failed); "
+                "ranked after the laws whose rows all ran; a smaller --dt may resolve them"
+            )
+    header = ["failed" if c == "failed_out_of_sample" else c for c in _COMPARE_COLUMNS]
+    print("\n".join(_table(header, rows)))
     if folds is None:
         print("(no cross-validation: every number in sample; rank by chi2)")
     else:
@@ -504,11 +519,10 @@ def _read_scene(path: str, overrides: dict[str, Any]) -> Any:
     from . import scenefile
 
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        return scenefile.load(path, overrides)
+    except OSError as exc:
+        reason = exc.strerror or str(exc)
         raise InvalidSceneError(f"cannot read scene file {path}: {reason}") from None
-    return scenefile.loads(text, source=path, overrides=overrides)
 
 
 def _add_run(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -550,6 +564,7 @@ def _series_format(path: str) -> str:
             f"--series {path}: writing parquet needs pyarrow: pip install pyarrow (or write .csv)",
             field="series",
         )
+    check_target(path, "series", "the series to")
     return suffix
 
 
@@ -732,10 +747,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
         units = series_units(result)
         frame = frame.rename(columns=lambda name: f"{name} [{units[name]}]")
         frame.index.name = f"t [{units['t']}]"
-        if suffix == ".parquet":
-            frame.to_parquet(args.series)
-        else:
-            frame.to_csv(args.series)
+        with replacing(args.series) as tmp:
+            if suffix == ".parquet":
+                frame.to_parquet(tmp)
+            else:
+                frame.to_csv(tmp)
         print(
             f"{PROG}: series written to {args.series} ({len(frame)} rows, "
             f"{len(frame.columns) + 1} columns)",
@@ -868,7 +884,8 @@ def _cmd_scene(args: argparse.Namespace) -> int:
         return 0
     if os.path.exists(args.out) and not args.force:
         raise InvalidSceneError(f"{args.out} exists; pass --force to overwrite it", field="out")
-    Path(args.out).write_text(text, encoding="utf-8")
+    check_target(args.out, "out", "the scene file to")
+    write_text(args.out, text)
     print(f"scene file written to {args.out}", file=sys.stderr)
     return 0
 

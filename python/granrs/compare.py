@@ -1,4 +1,4 @@
-"""Which force law fits the experiments: a cross-validated comparison of laws (issue 18).
+"""Which force law fits the experiments: a cross-validated comparison of laws.
 
 :func:`granrs.compare` fits each law to each set of measurements (:func:`granrs.calibrate`), and
 checks every law out of sample by leave-one-group-out cross-validation: each group of rows
@@ -29,10 +29,18 @@ The numbers, per dataset and law (columns of the frame, and keys of
 * ``stop_order`` (chain): in how many cases the two links stop in the measured order, out
   of sample, and which link stops first per case, measured and predicted;
 * ``rows``: per row, the measured mean and sd and the out-of-sample prediction of depth and
-  t_s, with z = (prediction - mean) / sd, and the group it was held out with;
+  t_s, with z = (prediction - mean) / sd, the group it was held out with, and ``failed``
+  (its run failed: its prediction and z are NaN);
 * ``folds``: per fold (``"all"`` the in-sample fit, then each held-out group), the fitted
   values with their ~95 % intervals, chi2 and dof, the parameters that ended on a bound,
-  and the z of depth and t_s of the rows it was fitted to (in sample);
+  the z of depth and t_s of the rows it was fitted to (in sample) and how many of those
+  rows failed at the fitted values (``failed``);
+* ``failed_in_sample``, ``failed_out_of_sample``: the rows whose run failed (no
+  prediction: e.g. a step too coarse for the law), in the fit to every row and out of
+  sample. A failed row has no residual, so a statistic over it is undefined: ``chi2``,
+  ``chi2_dof``, ``aic`` and ``bic`` are NaN when a row failed in sample, ``oos_chi2`` when
+  one failed out of sample, and a law with a row failed out of sample is ranked after
+  every law whose rows all ran (by its number of failed rows), never as a better fit;
 * ``available``, ``reason``: whether the law could run, and why not;
 * ``simulations``, ``seconds``: what the comparison cost.
 
@@ -53,10 +61,12 @@ import numpy as np
 import pandas as pd
 
 from . import forces as _forces
+from .batch import _threads as _check_threads
 from .calibrate import Measurements, calibrate, evaluate
 from .calibrate.fit import _residual_frame
 from .calibrate.model import _parse_param, base_coefficients
-from .errors import GranrsError, InvalidParameterError, UnknownNameError
+from .errors import GranrsError, InvalidParameterError, SimulationError, UnknownNameError
+from .scene import Scene
 
 __all__ = [
     "BODY_UNKNOWNS",
@@ -306,6 +316,12 @@ def _law_list(laws: Any) -> list[Law]:
                 f"unknown law {item!r}{more} (laws: {', '.join(LAWS)}; or a granrs.compare.Law)",
                 field="laws",
             )
+    if not out:
+        raise InvalidParameterError(
+            f"no law to compare: laws is empty (give names of {', '.join(LAWS)}, or "
+            "granrs.compare.Law objects)",
+            field="laws",
+        )
     names = [law.name for law in out]
     for n in names:
         if names.count(n) > 1:
@@ -445,14 +461,17 @@ def _predict(
 
 def _fold_record(held_out: Any, fit: Any) -> dict[str, Any]:
     res = fit.residuals
+    failed = _failed(res)
     return {
         "held_out": held_out,
         "values": dict(fit.values),
         "intervals": {k: list(v) for k, v in fit.intervals.items()},
         "std_errors": dict(fit.std_errors),
-        "chi2": fit.chi2,
+        # The fit's chi2 counts a failed run as a large residual: no chi2 where one failed.
+        "chi2": fit.chi2 if failed == 0 else math.nan,
         "dof": fit.dof,
         "at_bound": list(fit.at_bound),
+        "failed": failed,
         # In sample: the z of the rows this fold was fitted to, in their order.
         "depth_z": [float(z) for z in res["depth_z"]],
         "t_s_z": [float(z) for z in res["t_s_z"]],
@@ -481,8 +500,28 @@ def _rows(m: Measurements, pred: pd.DataFrame, group: str | None) -> list[dict[s
             row[f"{q}_pred"] = float(p[f"{q}_sim"])
             row[f"{q}_z"] = float(p[f"{q}_z"])
             row[f"{q}_zfit"] = float(p[f"{q}_zfit"])
+        row["failed"] = not (math.isfinite(row["depth_pred"]) and math.isfinite(row["t_s_pred"]))
         out.append(row)
     return out
+
+
+def _failed(frame: pd.DataFrame) -> int:
+    """The rows of a residual frame whose run failed: no simulated depth or t_s (a failed
+    run's are NaN; a run that did not stop has its end time as t_s, a number)."""
+    ran = np.isfinite(frame["depth_sim"].to_numpy(dtype=float)) & np.isfinite(
+        frame["t_s_sim"].to_numpy(dtype=float)
+    )
+    return int(np.count_nonzero(~ran))
+
+
+def _chi2(frame: pd.DataFrame) -> float:
+    """The sum of the squared residuals over the fit's sd, NaN if a row failed (a failed
+    run has no residual: skipping it would make the law look better than it is)."""
+    depth = frame["depth_zfit"].to_numpy(dtype=float)
+    t_s = frame["t_s_zfit"].to_numpy(dtype=float)
+    if not (np.all(np.isfinite(depth)) and np.all(np.isfinite(t_s))):
+        return math.nan
+    return float(sum(d**2 + t**2 for d, t in zip(depth.tolist(), t_s.tolist(), strict=True)))
 
 
 def _count(rows: Sequence[Mapping[str, Any]], q: str, k: float) -> int:
@@ -526,13 +565,17 @@ def _entry(
     if k == 0:
         pred = _predict(job, m, dt, threads)
         sims += len(m)
-        chi2 = float(np.sum(pred["depth_zfit"] ** 2 + pred["t_s_zfit"] ** 2))
+        failed_in = _failed(pred)
+        chi2 = _chi2(pred)
         oos = pred
         tick(f"{name}: {job.law.name}")
     else:
         full = _fit(job, m, dt, threads, starts)
         sims += full.simulations
-        chi2 = full.chi2
+        failed_in = _failed(full.residuals)
+        # The fit's own chi2 (failed runs enter its steps as large residuals) where every
+        # row ran at the optimum; undefined otherwise.
+        chi2 = full.chi2 if failed_in == 0 else math.nan
         folds.append(_fold_record("all", full))
         tick(f"{name}: {job.law.name}, all rows")
         if group is None:
@@ -561,7 +604,7 @@ def _entry(
     rows = _rows(m, oos.reset_index(drop=True), group)
     stop_order = _stop_order(rows) if job.body == "chain" else None
     dof = n_res - k
-    oos_chi2 = float(sum(r["depth_zfit"] ** 2 + r["t_s_zfit"] ** 2 for r in rows))
+    oos_chi2 = _chi2(oos)
     return {
         "dataset": name,
         "law": job.law.name,
@@ -577,6 +620,8 @@ def _entry(
         "aic": chi2 + 2.0 * k,
         "bic": chi2 + k * math.log(n_res),
         "oos_chi2": oos_chi2,
+        "failed_in_sample": failed_in,
+        "failed_out_of_sample": sum(1 for r in rows if r["failed"]),
         "depth_within_1sd": _count(rows, "depth", 1.0),
         "ts_within_1sd": _count(rows, "t_s", 1.0),
         "ts_within_2sd": _count(rows, "t_s", 2.0),
@@ -621,18 +666,25 @@ def compare(
 
     Returns:
         A DataFrame with the columns of the module's notes, one row per (dataset, law), in
-        the order given; ``rank`` orders the available laws of a dataset by ``oos_chi2``.
-        A law whose term is not in this build, or that cannot run on a body, has
-        ``available`` False and its ``reason``; its numbers are NaN.
+        the order given; ``rank`` orders the available laws of a dataset by ``oos_chi2``,
+        those with failed runs last (``failed_out_of_sample``). A law whose term is not
+        in this build, or that cannot run on a body, has ``available`` False and its
+        ``reason``; its numbers are NaN.
 
     Raises:
         UnknownNameError: an unknown law or folds column (did-you-mean in the message).
-        InvalidParameterError: bad measurements, or a law given twice.
+        InvalidParameterError: bad measurements, no law or a law given twice
+            (``field="laws"``), an invalid ``dt`` (the scene's rule, ``field="dt"``),
+            ``threads`` (the sweep's rule) or ``starts``; all before any run.
     """
     law_list = _law_list(laws)
     data = _datasets(measurements)
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
         raise InvalidParameterError(f"invalid starts: {starts!r}", field="starts")
+    # Before any run, by the rules every run uses: the step by a scene's, the threads by
+    # the sweep's. A bad one is the caller's error, not a failed run of each law.
+    _check_dt(dt)
+    _check_threads(threads)
     groups = {name: _group_column(name, m, folds) for name, m in data.items()}
     plans: list[tuple[str, Law, Measurements, str | None, _Job | None, str]] = []
     total = 0
@@ -670,9 +722,29 @@ def compare(
     finally:
         bar.close()
     frame = pd.DataFrame.from_records(records)
-    score = frame["oos_chi2"].where(frame["available"])
-    frame["rank"] = score.groupby(frame["dataset"]).rank(method="min").astype("Int64")
+    frame["rank"] = _rank(frame)
     return frame
+
+
+def _check_dt(dt: Any) -> None:
+    """Refuse an invalid step by the rule of every scene (``field="dt"``)."""
+    Scene(dt=dt).validate()
+
+
+def _rank(frame: pd.DataFrame) -> pd.Series:
+    """Per dataset: the available laws whose rows all ran out of sample by ``oos_chi2``
+    (1 the best), then those with failed rows, by how many failed (ties share a rank);
+    NA for a law that did not run."""
+    rank = pd.array([pd.NA] * len(frame), dtype="Int64")
+    for _, sub in frame[frame["available"]].groupby("dataset", sort=False):
+        at = frame.index.get_indexer(sub.index)
+        failed = sub["failed_out_of_sample"].to_numpy(dtype=float)
+        clean = failed == 0
+        chi2 = pd.Series(sub["oos_chi2"].to_numpy(dtype=float)[clean])
+        rank[at[clean]] = chi2.rank(method="min").to_numpy(dtype=float)
+        after = pd.Series(failed[~clean]).rank(method="min").to_numpy(dtype=float)
+        rank[at[~clean]] = int(np.count_nonzero(clean)) + after
+    return pd.Series(rank, index=frame.index)
 
 
 def _missing(name: str, law: Law, m: Measurements, reason: str) -> dict[str, Any]:
@@ -692,6 +764,8 @@ def _missing(name: str, law: Law, m: Measurements, reason: str) -> dict[str, Any
         "aic": nan,
         "bic": nan,
         "oos_chi2": nan,
+        "failed_in_sample": nan,
+        "failed_out_of_sample": nan,
         "depth_within_1sd": nan,
         "ts_within_1sd": nan,
         "ts_within_2sd": nan,
@@ -718,6 +792,8 @@ JSON_KEYS: tuple[str, ...] = (
     "bic",
     "oos_chi2",
     "rank",
+    "failed_in_sample",
+    "failed_out_of_sample",
     "depth_within_1sd",
     "ts_within_1sd",
     "ts_within_2sd",
@@ -749,6 +825,8 @@ _COUNT_KEYS = (
     "n_rows",
     "dof",
     "rank",
+    "failed_in_sample",
+    "failed_out_of_sample",
     "depth_within_1sd",
     "ts_within_1sd",
     "ts_within_2sd",
@@ -784,13 +862,15 @@ def synthetic(
     the rows of ``like`` (its angles, speeds, cases), each mean drawn from a normal
     distribution around the simulated value with sd ``rel_sd`` times that value, which is
     also the row's sd. For checking that :func:`granrs.compare` picks the law that made the data
-    and recovers its parameters.
+    and recovers its parameters. A run that fails (no value to draw around) raises
+    :class:`~granrs.errors.SimulationError`; an invalid ``dt`` the scene's typed error.
 
     ``values`` gives every fitted parameter of the law on that body (its own and the
     body's unknowns, as :func:`granrs.compare` fits them; ``dataset`` names the settings of
     :data:`~granrs.compare.DATASETS` to use, default the body's name)."""
     (law_obj,) = _law_list([law])
     m = like if isinstance(like, Measurements) else Measurements.load(like)
+    _check_dt(dt)
     if not (isinstance(rel_sd, (int, float)) and 0.0 < rel_sd < 1.0):
         raise InvalidParameterError(f"rel_sd must be in (0, 1); got {rel_sd!r}", field="rel_sd")
     reason = _unavailable(law_obj, m.body)
@@ -806,6 +886,12 @@ def synthetic(
             field="values",
         )
     sim = _pinned(job, m, dt, [float(values[k]) for k in job.params])
+    failed = _failed(sim)
+    if failed:
+        raise SimulationError(
+            f"synthetic: the runs of {failed} of {len(m)} rows failed under {law_obj.name} "
+            f"at dt = {dt:g} s (no value to draw the measurements around); use a smaller dt"
+        )
     rng = np.random.default_rng(seed)
     rows = m.rows.copy()
     for q in ("depth", "t_s"):

@@ -31,6 +31,12 @@ offending key: a TOML syntax error raises :class:`~granrs.errors.InvalidSceneErr
 ``file:line:col``; an unknown key :class:`~granrs.errors.UnknownNameError` with its line and
 the closest field name; a wrong type or an out-of-range value the typed error of
 :class:`~granrs.Scene` (``field`` set) with ``file:line`` of that key prepended.
+
+A scene file is UTF-8 text (a byte-order mark at its start is allowed) in a regular file of
+at most :data:`MAX_FILE_BYTES`; its arrays and tables nest at most :data:`MAX_NESTING`
+deep (a scene needs five). Anything else (``/dev/zero``, a pipe, a folder, a file of
+gigabytes, a value nested 500 deep in the file or in an override) is refused with an
+:class:`~granrs.errors.InvalidSceneError` before it is parsed further.
 """
 
 from __future__ import annotations
@@ -41,12 +47,13 @@ import math
 import numbers
 import os
 import re
+import stat
 import sys
 from collections.abc import Callable, Mapping
-from pathlib import Path
 from typing import Any
 
 from . import _granrs, forces
+from ._files import write_text
 from .bodies import ELEMENT_FIELDS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from .scene import BODY_FIELDS, FIELD_INFO, Scene
@@ -58,6 +65,8 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 
 __all__ = [
     "FORMAT_VERSION",
+    "MAX_FILE_BYTES",
+    "MAX_NESTING",
     "dump",
     "dumps",
     "load",
@@ -69,6 +78,12 @@ __all__ = [
 FORMAT_VERSION = 1
 #: Versions :func:`loads` reads.
 SUPPORTED_FORMATS: tuple[int, ...] = (1,)
+#: The largest scene file :func:`load` reads [bytes] (1 MiB; a linkage of a hundred links
+#: takes about 20 kB).
+MAX_FILE_BYTES = 1 << 20
+#: How deep tables and arrays may nest in a scene file or an override, the file's top level
+#: being 1 (a scene's deepest, a linkage's ``body`` -> ``links`` -> a link -> a list, is 5).
+MAX_NESTING = 32
 
 _FIELDS: tuple[dataclasses.Field[Any], ...] = dataclasses.fields(Scene)
 _FIELD_NAMES: tuple[str, ...] = tuple(f.name for f in _FIELDS)
@@ -262,9 +277,10 @@ def _body_path(field: str, body: Any) -> tuple[str, ...]:
 
 
 def dump(scene: Scene, path: str | os.PathLike[str]) -> str:
-    """Write the scene to ``path`` (UTF-8) and return the text written."""
+    """Write the scene to ``path`` (UTF-8; whole or not at all: an error leaves an existing
+    file as it was) and return the text written."""
     text = dumps(scene)
-    Path(path).write_text(text, encoding="utf-8")
+    write_text(path, text)
     return text
 
 
@@ -466,6 +482,46 @@ def _build(
     return scene
 
 
+def _nesting(value: Any) -> tuple[int, str | None]:
+    """How deep tables and arrays nest in ``value`` (a table or array counts 1), and the
+    top-level key of the deepest (without recursion: any depth is measured)."""
+    deepest, key = 0, None
+    stack: list[tuple[Any, int, str | None]] = [(value, 1, None)]
+    while stack:
+        item, depth, top = stack.pop()
+        if isinstance(item, dict):
+            children = [(v, str(k) if top is None else top) for k, v in item.items()]
+        elif isinstance(item, list):
+            children = [(v, top) for v in item]
+        else:
+            continue
+        if depth > deepest:
+            deepest, key = depth, top
+        stack.extend((v, depth + 1, k) for v, k in children)
+    return deepest, key
+
+
+def _parse_toml(text: str, where: str, field: str | None = None) -> dict[str, Any]:
+    """TOML text as data (a byte-order mark at its start is skipped), nested at most
+    :data:`MAX_NESTING` deep, else :class:`~granrs.errors.InvalidSceneError` naming
+    ``where`` and the key (or ``field``). A syntax error is ``tomllib``'s."""
+    text = text.removeprefix("\ufeff")
+    try:
+        data = tomllib.loads(text)
+        depth, key = _nesting(data)
+    except RecursionError:
+        # The parser recurses at least once per level: far past the limit.
+        depth, key = MAX_NESTING + 1, None
+    if depth > MAX_NESTING:
+        key = field or key
+        raise InvalidSceneError(
+            f"{where}: {key + ': ' if key else ''}nested more than {MAX_NESTING} tables or "
+            "arrays deep (a scene needs five)",
+            field=key,
+        )
+    return data
+
+
 def parse_override(text: str) -> tuple[str, Any]:
     """``"field=value"`` (a ``--set`` argument) as ``(field, value)``: the value is a TOML
     value (``30``, ``1e-5``, ``"tip"``, ``["state"]``, ``{ k = 300.0, c = 5.0 }``); a bare
@@ -480,7 +536,7 @@ def parse_override(text: str) -> tuple[str, Any]:
         )
     value = value.strip()
     try:
-        parsed = tomllib.loads(f"v = {value}")["v"]
+        parsed = _parse_toml(f"v = {value}", "--set", field=key)["v"]
     except tomllib.TOMLDecodeError:
         if not re.fullmatch(r"[A-Za-z0-9_.+-]+", value):
             raise InvalidSceneError(
@@ -546,8 +602,9 @@ def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | No
     ``overrides`` (``{"q_deg": 30.0, "static_v.eta_v": 300.0}``) replace values of the
     file before validation; an error in one points at ``--set field=value``.
     """
+    text = text.removeprefix("\ufeff")
     try:
-        data = tomllib.loads(text)
+        data = _parse_toml(text, source)
     except tomllib.TOMLDecodeError as exc:
         raise _syntax_error(exc, text, source) from None
     origins = _apply_overrides(data, overrides)
@@ -567,6 +624,41 @@ def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | No
 def load(path: str | os.PathLike[str], overrides: Mapping[str, Any] | None = None) -> Scene:
     """A validated :class:`~granrs.Scene` from the TOML file at ``path`` (see :func:`loads`).
 
-    A file that cannot be read raises the ``OSError`` of the operating system."""
-    text = Path(path).read_text(encoding="utf-8")
-    return loads(text, source=os.fspath(path), overrides=overrides)
+    A file that is not a regular file, is larger than :data:`MAX_FILE_BYTES` or is not
+    UTF-8 raises :class:`~granrs.errors.InvalidSceneError` (``field="scene"``) before it is
+    read whole; one that cannot be opened raises the ``OSError`` of the operating system."""
+    return loads(_read(path), source=os.fspath(path), overrides=overrides)
+
+
+def _read(path: str | os.PathLike[str]) -> str:
+    """The text of the scene file at ``path``, checked before it is read whole: a regular
+    file (not a folder, a device such as ``/dev/zero`` or a pipe) of at most
+    :data:`MAX_FILE_BYTES`, UTF-8 (a byte-order mark is dropped). Else
+    :class:`~granrs.errors.InvalidSceneError` with ``field="scene"``; an ``OSError`` if it
+    cannot be opened."""
+    name = os.fspath(path)
+    info = os.stat(path)
+    if not stat.S_ISREG(info.st_mode):
+        kind = "a directory" if stat.S_ISDIR(info.st_mode) else "not a regular file"
+        raise InvalidSceneError(
+            f"cannot read scene file {name}: it is {kind}; a scene file is read from a "
+            "regular file",
+            field="scene",
+        )
+    too_large = (
+        f"cannot read scene file {name}: larger than {MAX_FILE_BYTES} bytes, the limit of a "
+        "scene file"
+    )
+    if info.st_size > MAX_FILE_BYTES:
+        raise InvalidSceneError(too_large, field="scene")
+    with open(path, "rb") as handle:
+        data = handle.read(MAX_FILE_BYTES + 1)  # it may have grown since
+    if len(data) > MAX_FILE_BYTES:
+        raise InvalidSceneError(too_large, field="scene")
+    try:
+        return data.decode("utf-8").removeprefix("\ufeff")
+    except UnicodeDecodeError as exc:
+        raise InvalidSceneError(
+            f"cannot read scene file {name}: not UTF-8 text (byte {exc.start}: {exc.reason})",
+            field="scene",
+        ) from None

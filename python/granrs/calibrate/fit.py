@@ -831,6 +831,9 @@ def evaluate(
         base = "table_3_4" if cases == "free_link" else "thesis"
     fixed = _check_joints(joints, cases)
     model = _Model(cases, (), base, float(dt), dict(overrides), fixed, _check_law(forces))
+    # Build every scene up front: a bad dt or override raises here (naming the field), not
+    # as a failed run of every row.
+    model.scenes(m.rows, [])
     depth, t_s, _ = model.simulate(m.rows, [[]], threads)
     frame = _residual_frame(m, depth[0], t_s[0])
     frame["unresolved"] = model.last_unresolved[0]

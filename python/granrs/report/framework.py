@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__, cases
+from .._files import write_bytes
 from ..api import simulate
 from ..errors import InvalidParameterError, UnknownNameError
 from ..result import Result
@@ -245,13 +246,26 @@ or, from Python, `granrs.report.reproduce("DIR", chapters={chapter_keys}, dt={dt
 """
 
 
-def _validate_out_dir(out_dir: Path) -> None:
-    """Reject an output path that exists and is not a directory (field ``out_dir``)."""
+def _validate_out_dir(out_dir: Path, files: Sequence[str] = ()) -> None:
+    """Reject an output path that exists and is not a directory, or in which the report,
+    the ``figures`` folder or one of ``files`` exists as the wrong kind (a folder where the
+    report goes, a file where the figures go): field ``out_dir``, nothing touched."""
     if out_dir.exists() and not out_dir.is_dir():
         raise InvalidParameterError(
             f"the output directory {str(out_dir)!r} exists and is not a directory",
             field="out_dir",
         )
+    if not out_dir.is_dir():
+        return
+    for name in (FIGURES_DIR, REPORT_NAME, *files):
+        path = out_dir / name
+        want_dir = name == FIGURES_DIR
+        if path.exists() and path.is_dir() != want_dir:
+            raise InvalidParameterError(
+                f"cannot write the report to {str(out_dir)!r}: {name} there is "
+                f"{'not a directory' if want_dir else 'a directory'}; move it away",
+                field="out_dir",
+            )
 
 
 def _write(
@@ -260,13 +274,18 @@ def _write(
     figures: Mapping[str, bytes],
     files: Mapping[str, bytes] | None = None,
 ) -> Path:
-    """Write the report and figures to a temporary directory, then move them into place.
+    """Write the report and figures to a temporary directory, then move them into place,
+    all or nothing.
 
     A new ``out_dir`` is created by one rename. In an existing ``out_dir`` the report file,
     the chapters' other ``files`` and the ``figures`` folder are replaced (the old folder is
-    removed); other files are left alone.
+    removed); other files are left alone. Every target is checked first
+    (:func:`_validate_out_dir`); the old ones are moved aside, the new ones in, and if a
+    move fails those done are undone, so that an error leaves ``out_dir`` as it was.
     """
     out_dir = out_dir.absolute()
+    files = dict(files or {})
+    _validate_out_dir(out_dir, tuple(files))
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
     try:
@@ -274,24 +293,37 @@ def _write(
         new = staging / "report"
         (new / FIGURES_DIR).mkdir(parents=True)
         for name, png in figures.items():
-            (new / FIGURES_DIR / name).write_bytes(png)
-        (new / REPORT_NAME).write_text(report, encoding="utf-8")
-        for name, content in (files or {}).items():
-            (new / name).write_bytes(content)
+            write_bytes(new / FIGURES_DIR / name, png)
+        write_bytes(new / REPORT_NAME, report.encode("utf-8"))
+        for name, content in files.items():
+            write_bytes(new / name, content)
         if not out_dir.exists():
             os.replace(new, out_dir)
             return out_dir / REPORT_NAME
-        _validate_out_dir(out_dir)
-        old_figures = out_dir / FIGURES_DIR
-        if old_figures.exists():
-            os.replace(old_figures, staging / "old-figures")
-        os.replace(new / FIGURES_DIR, old_figures)
-        for name in files or {}:
-            os.replace(new / name, out_dir / name)
-        os.replace(new / REPORT_NAME, out_dir / REPORT_NAME)
+        old = staging / "old"
+        old.mkdir()
+        _swap(out_dir, new, old, (FIGURES_DIR, *files, REPORT_NAME))
         return out_dir / REPORT_NAME
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def _swap(out_dir: Path, new: Path, old: Path, names: Sequence[str]) -> None:
+    """Move each of ``names`` from ``new`` into ``out_dir``, the one it replaces into
+    ``old`` first; on an error undo every move made, in reverse order, and re-raise."""
+    done: list[tuple[Path, Path]] = []
+    try:
+        for name in names:
+            target = out_dir / name
+            if target.exists() or target.is_symlink():
+                os.replace(target, old / name)
+                done.append((target, old / name))
+            os.replace(new / name, target)
+            done.append((new / name, target))
+    except BaseException:
+        for source, moved_to in reversed(done):
+            os.replace(moved_to, source)
+        raise
 
 
 def reproduce(
@@ -305,9 +337,9 @@ def reproduce(
 
     Writes ``out_dir/README.md`` (Markdown) and its PNG figures in ``out_dir/figures/``.
     Everything is computed in memory before anything is written, and the files are moved
-    into place at the end, so an error leaves ``out_dir`` as it was (a new ``out_dir`` is
-    not created). In an existing ``out_dir`` the report and the ``figures`` folder are
-    replaced.
+    into place at the end, all or nothing, so an error leaves ``out_dir`` as it was (a new
+    ``out_dir`` is not created). In an existing ``out_dir`` the report and the ``figures``
+    folder are replaced.
 
     Args:
         out_dir: the output directory (created if missing).
@@ -323,8 +355,9 @@ def reproduce(
 
     Raises:
         UnknownNameError: an unknown chapter (``field="chapters"``).
-        InvalidParameterError: an invalid ``dt`` (``field="dt"``) or an ``out_dir`` that is
-            a file (``field="out_dir"``).
+        InvalidParameterError: an invalid ``dt`` (``field="dt"``), or an ``out_dir`` that is
+            a file or holds a folder named ``README.md`` or a file named ``figures``
+            (``field="out_dir"``), before any run.
     """
     out_path = Path(out_dir)
     if chapters is None:
