@@ -137,7 +137,7 @@ def test_series_on_a_full_disk_leaves_the_previous_file(tmp_path) -> None:
     proc = _granrs_with_file_limit(["run", str(SCENE), "--series", "good.csv"], 100_000, tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert good.read_bytes() != before
-    assert good.read_text().startswith("t,")
+    assert good.read_text().startswith("t [s],")
     assert _leftovers(tmp_path, {"good.csv"}) == []
 
 

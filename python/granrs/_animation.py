@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -624,15 +623,12 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             with replacing(out) as tmp:
                 if suffix == ".html":
                     # What to_jshtml() writes (its writer and mode), with the frames counted.
-                    with tempfile.TemporaryDirectory() as tmpdir:
-                        temp = Path(tmpdir, "animation.html")
-                        writer = mpl_animation.HTMLWriter(
-                            fps=fps,
-                            embed_frames=True,
-                            default_mode="loop" if self._repeat else "once",
-                        )
-                        self.save(str(temp), writer=writer, progress_callback=tick)
-                        tmp.write_text(temp.read_text(encoding="utf-8"), encoding="utf-8")
+                    writer = mpl_animation.HTMLWriter(
+                        fps=fps,
+                        embed_frames=True,
+                        default_mode="loop" if self._repeat else "once",
+                    )
+                    self.save(str(tmp), writer=writer, progress_callback=tick)
                 elif suffix == ".gif":
                     writer = mpl_animation.PillowWriter(fps=fps)
                     self.save(str(tmp), writer=writer, dpi=self.dpi, progress_callback=tick)
