@@ -168,7 +168,7 @@ class _Table:
     ``columns x rows`` block (the frame's own), the counters and the flags one block each,
     ``status`` its own array. The counters are int32 (a run's stay far below 2^31; a block
     that does not fit is widened to int64). So a sweep holds its result plus one chunk
-    (issue 22: a summary-only sweep of 1e6 runs under 300 MB)."""
+    (a summary-only sweep of 1e6 runs stays under 300 MB)."""
 
     def __init__(self, columns: Sequence[str], body: str, n: int) -> None:
         self.layout = _layout(tuple(columns), body)

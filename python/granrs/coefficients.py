@@ -72,7 +72,8 @@ def _is_real(value: object) -> TypeGuard[numbers.Real]:
 
 @dataclass(frozen=True)
 class Coefficients:
-    """The four dimensionless coefficients of the resistance force (thesis eqs. 3.1-3.3).
+    """The four dimensionless coefficients of the resistance force, as in the thesis's
+    equations 3.1-3.3: eta_h, eta_d, eta_v and lambda.
 
     Attributes:
         eta_h: scaling constant of the horizontal static force F_sh, dimensionless, >= 0.

@@ -1,4 +1,4 @@
-"""Which force law fits the experiments: a cross-validated comparison of laws (issue 18).
+"""Which force law fits the experiments: a cross-validated comparison of laws.
 
 :func:`granrs.compare` fits each law to each set of measurements (:func:`granrs.calibrate`), and
 checks every law out of sample by leave-one-group-out cross-validation: each group of rows

@@ -1,4 +1,4 @@
-"""Scenes as files: one TOML file is one reproducible run (issue 5).
+"""Scenes as files: one TOML file is one reproducible run.
 
 The format (``format = 1``)::
 
