@@ -92,3 +92,20 @@ def test_readme_granrs_commands_run(command: str, tmp_path: Path) -> None:
     done = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr
+
+
+def test_readme_links_and_paths_exist_in_a_clone() -> None:
+    """Every relative link of the README, and every repository path it names in backticks,
+    is in the repository: no pointer to a file a clone does not have (it once sent readers
+    to ``../shared/MODEL.md``)."""
+    text = README.read_text()
+    root = README.parent
+    links = re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", text)
+    local = [link for link in links if not re.match(r"[a-z]+://", link)]
+    assert local, "the README links no page of the docs"
+    missing = [link for link in local if not (root / link).exists()]
+    named = re.findall(r"`((?:docs|examples|benches|tests|python|rust|\.ci)/[^`\s]*)`", text)
+    # (docs/_build/ is what the docs command writes, not a file of the clone.)
+    missing += [p for p in named if not p.startswith("docs/_build/") and not (root / p).exists()]
+    assert not missing, missing
+    assert "shared/" not in text and "MODEL.md" not in text
