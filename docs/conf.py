@@ -119,6 +119,9 @@ sphinx_gallery_conf = {
     "abort_on_example_error": True,
     "show_memory": False,
     "min_reported_time": 1,
+    # No "computation times" pages: their sortable tables load jQuery and DataTables from
+    # CDNs, and the site loads nothing from another host (tests/test_docs_api.py).
+    "write_computation_times": False,
     "reference_url": {"granrs": None},
 }
 

@@ -166,15 +166,17 @@ def test_built_site_has_every_term_and_gallery_page() -> None:
 
 
 def test_built_site_serves_its_math_locally() -> None:
-    """The site renders its math offline: no page loads a script from another host (the
-    default MathJax comes from a CDN, so an offline reader saw raw ``\\(x\\)``), and the
-    MathJax that the pages with math load is in the site itself."""
+    """The site renders its math offline: no page loads a script or a stylesheet from
+    another host (the default MathJax comes from a CDN, so an offline reader saw raw
+    ``\\(x\\)``; sphinx-gallery's computation-times pages load DataTables from CDNs), and
+    the MathJax that the pages with math load is in the site itself."""
     html = _built_site()
     remote = {
         (str(page.relative_to(html)), src)
         for page in html.rglob("*.html")
         for src in re.findall(
-            r'<script[^>]*\ssrc="((?:https?:)?//[^"]*)"', page.read_text(encoding="utf-8")
+            r'<(?:script[^>]*\ssrc|link[^>]*\shref)="((?:https?:)?//[^"]*)"',
+            page.read_text(encoding="utf-8"),
         )
     }
     assert not remote, sorted(remote)[:5]
