@@ -39,6 +39,10 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax served from the site itself, not a CDN, so that the math renders offline: the
+    # package (a ``docs`` extra) ships MathJax 3 and copies it into _static/mathjax when the
+    # build finishes; it points mathjax_path there.
+    "sphinx-mathjax-offline",
     "sphinx.ext.viewcode",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
@@ -58,6 +62,10 @@ exclude_patterns = [
 
 # A broken cross-reference fails the build (CI passes -n too).
 nitpicky = True
+
+# The script the pages load for their math: the copy above, never a URL
+# (tests/test_docs_api.py checks the built pages).
+mathjax_path = "mathjax/tex-chtml.js"
 
 # -- Markdown (MyST) --------------------------------------------------------------------------
 
@@ -111,6 +119,9 @@ sphinx_gallery_conf = {
     "abort_on_example_error": True,
     "show_memory": False,
     "min_reported_time": 1,
+    # No "computation times" pages: their sortable tables load jQuery and DataTables from
+    # CDNs, and the site loads nothing from another host (tests/test_docs_api.py).
+    "write_computation_times": False,
     "reference_url": {"granrs": None},
 }
 

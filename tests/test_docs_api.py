@@ -163,3 +163,26 @@ def test_built_site_has_every_term_and_gallery_page() -> None:
     for script in scripts:
         page = (html / "auto_examples" / f"{script.stem}.html").read_text(encoding="utf-8")
         assert f"sphx_glr_{script.stem}_001.png" in page, f"{script.name} drew no figure"
+
+
+def test_built_site_serves_its_math_locally() -> None:
+    """The site renders its math offline: no page loads a script or a stylesheet from
+    another host (the default MathJax comes from a CDN, so an offline reader saw raw
+    ``\\(x\\)``; sphinx-gallery's computation-times pages load DataTables from CDNs), and
+    the MathJax that the pages with math load is in the site itself."""
+    html = _built_site()
+    remote = {
+        (str(page.relative_to(html)), src)
+        for page in html.rglob("*.html")
+        for src in re.findall(
+            r'<(?:script[^>]*\ssrc|link[^>]*\shref)="((?:https?:)?//[^"]*)"',
+            page.read_text(encoding="utf-8"),
+        )
+    }
+    assert not remote, sorted(remote)[:5]
+    model = (html / "model.html").read_text(encoding="utf-8")
+    assert 'class="math' in model, "docs/model.md has no math any more: pick another page"
+    scripts = re.findall(r'<script[^>]*\ssrc="([^"]*mathjax[^"]*)"', model, flags=re.I)
+    assert scripts, "model.html loads no MathJax"
+    for src in scripts:
+        assert (html / src.split("?")[0]).is_file(), f"{src} is not in the built site"

@@ -216,8 +216,8 @@ class Contact:
       the thesis's eqs. 3.4-3.15);
     * ``"box"``: a box (a sole, a plate) with its corner ``at`` on the sole, ``length``
       along ``+s``, ``height`` towards ``-n`` and ``width`` out of the plane; its immersed
-      part is the box clipped by the surface (MODEL.md, "Foot"). ``l_ref``: the depth
-      factor's reference length (default: ``length``);
+      part is the box clipped by the surface (``docs/model.md``, "What is immersed").
+      ``l_ref``: the depth factor's reference length (default: ``length``);
     * ``"arc"``: a thin circular arc (a C-shaped leg) with its centre ``at``, ``radius``,
       from the angle ``start_deg`` to ``end_deg`` and ``width`` out of the plane, cut into
       ``chords`` chords (default :data:`DEFAULT_CHORDS`, at most :data:`MAX_CHORDS`). The

@@ -2,7 +2,7 @@
 
 Source: the thesis "Bipedal impact with granular matter", section 3.3 (the force model, eqs.
 3.1-3.3 and 3.16-3.20, with the coefficients of section 3.3.1) and section 3.4. The force on
-one contact is (see the project's MODEL.md)::
+one contact is (the model's page of the docs, ``docs/model.md``)::
 
     F_d  = - eta_d * rho_g * A_r * |v_E| * v_E                      (dynamic)
     F_sh = - sgn(v_Ex) * eta_h * g * rho_g * w * d^2                (static, horizontal)
@@ -72,7 +72,8 @@ def _is_real(value: object) -> TypeGuard[numbers.Real]:
 
 @dataclass(frozen=True)
 class Coefficients:
-    """The four dimensionless coefficients of the resistance force (thesis eqs. 3.1-3.3).
+    """The four dimensionless coefficients of the resistance force, as in the thesis's
+    equations 3.1-3.3: eta_h, eta_d, eta_v and lambda.
 
     Attributes:
         eta_h: scaling constant of the horizontal static force F_sh, dimensionless, >= 0.
@@ -197,7 +198,7 @@ class _Band:
 
 #: Table 3.2 of the thesis (section 3.3.1): the closed forms of eta_h, eta_d, eta_v and lambda,
 #: in alpha = pi/2 - |q| and q = |q| (radians) and the sand density rho_g (kg/m^3), grouped by
-#: the tabulated alphas (degrees) that share them. As in MODEL.md: the alpha = 35 row is
+#: the tabulated alphas (degrees) that share them. The alpha = 35 row is
 #: shifted by one cell in the extracted source; it is restored to the alpha = 25 forms, which
 #: match Table 3.4's alpha = 35 row.
 _TABLE_3_2: tuple[_Band, ...] = (
@@ -271,7 +272,7 @@ def table_3_2(q_deg: float, rho_g: float = DEFAULT_RHO_G) -> Coefficients:
     |q|) are used, as in :func:`table_3_4`. Beyond the table (alpha > 90 cannot happen;
     alpha < 5) the nearest row's forms are extrapolated.
 
-    Check (MODEL.md): at q = 0, rho_g = 1650 this gives eta_h, eta_d, eta_v, lambda of about
+    Check: at q = 0, rho_g = 1650 this gives eta_h, eta_d, eta_v, lambda of about
     6.69, 15.8, 259, 0.105, against Table 3.4's 6.5, 15.2, 248, 0.106.
 
     Raises :class:`~granrs.errors.InvalidParameterError` with ``field="q_deg"`` unless

@@ -4,7 +4,7 @@ For users who couple granrs's granular resistance force to their own simulator (
 multibody code, a robot model, a controller): give the kinematics of a rod's contact and get
 the force components, evaluated in the Rust core with the GIL released.
 
-The model (MODEL.md; thesis eqs. 2.1-2.4, 3.1-3.3 and 3.13-3.15), for a rod whose tip T is
+The model (``docs/model.md``; thesis eqs. 2.1-2.4, 3.1-3.3 and 3.13-3.15), for a rod whose tip T is
 at depth ``d`` with angle ``q`` from the vertical, tip velocity ``(vx, vy)`` and angular
 velocity ``omega = dq/dt``:
 

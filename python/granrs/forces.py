@@ -93,7 +93,7 @@ class TermInfo:
     Attributes:
         name: the name a scene lists (``term = "name"`` in TOML).
         summary: one line: what the term is.
-        equation: the term in granrs's frame (``shared/MODEL.md``), as plain text.
+        equation: the term in granrs's frame (``docs/model.md``), as plain text.
         source: paper, thesis section and equation numbers.
         params: its parameters.
         acts: ``"contact"`` (on each contact in the sand) or ``"body"`` (through the

@@ -77,7 +77,7 @@ mod tests {
     use crate::forces::{ForceSet, TermSpec};
     use crate::integrate::{EndCondition, Record};
 
-    /// Issue 16: a new term takes one file and one registry line, and then runs. A vertical
+    /// A new term takes one file and one registry line, and then runs. A vertical
     /// rod already in the sand, pushed up by a constant 2 m g at its tip against gravity,
     /// decelerates at exactly g: it stops at t = v0 / g, v0^2 / (2 g) deeper.
     #[test]

@@ -7,9 +7,9 @@
 //! with `A_r |v_E| = d_c * l * |e x v_E|` for a rod (the reference area of eqs. 3.13-3.14
 //! written without the atan of eq. 3.14, which breaks at v_Ey = 0: smooth at v_E = 0, no
 //! division), and for a sole box the immersed part's area projected normal to v_E, times
-//! |v_E| (`shared/MODEL.md`, "Contact geometry").
+//! |v_E| (`docs/model.md`, "What is immersed").
 //!
-//! - **Source:** "Bipedal impact with granular matter" (the thesis in `shared/thesis/`),
+//! - **Source:** "Bipedal impact with granular matter" (the thesis),
 //!   eqs. 2.1 and 3.1, with the geometry of eqs. 3.13-3.14.
 //! - **Parameters:** `eta_d` [-], the dynamic scaling constant; default 15.2, thesis Table 3.4
 //!   at q = 0 (the vertical rod).
@@ -33,7 +33,7 @@ impl Term for Drag {
         name: "drag",
         summary: "dynamic drag, quadratic in the speed of the immersed centroid E",
         equation: "F_d = -eta_d rho_g A_r |v_E| v_E,  A_r |v_E| = d_c l |e x v_E| (rod)",
-        source: "thesis eqs. 2.1, 3.1, 3.13-3.14 (shared/MODEL.md)",
+        source: "thesis eqs. 2.1, 3.1, 3.13-3.14 (docs/model.md)",
         params: &[Param {
             name: "eta_d",
             unit: "-",

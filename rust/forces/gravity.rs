@@ -4,7 +4,7 @@
 //! F_i = m_i g (0, -1)   at each link's centre of mass
 //! ```
 //!
-//! - **Source:** `shared/MODEL.md`, "Frame and notation" (g = 9.81 m/s^2, as in the thesis).
+//! - **Source:** granrs's model, `docs/model.md`, "Frame, units and the impact" (g = 9.81 m/s^2, as in the thesis).
 //! - **Parameters:** none; g is the medium's (`Scene.g`), which also scales the static
 //!   terms whether or not this term acts.
 //! - **Reads:** each link's mass and centre of mass.
@@ -23,7 +23,7 @@ impl Term for Gravity {
         name: "gravity",
         summary: "the weight of every link, at its centre of mass",
         equation: "F_i = -m_i g y_hat  (each link i)",
-        source: "shared/MODEL.md, frame and notation",
+        source: "granrs's model, docs/model.md (frame, units and the impact)",
         params: &[],
         acts: Acts::Body,
         class: Class::Static,

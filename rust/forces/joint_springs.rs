@@ -8,8 +8,8 @@
 //! [N m/rad] and damping `c` [N m s/rad] are the joints' own (`knee = {k = 300.0, c = 5.0}`),
 //! not this term's: listing it switches them on. Without it a spring-damper joint is free.
 //!
-//! - **Source:** granrs (the thesis's CAD model does not say what its joints were; README,
-//!   "The chain and the leg").
+//! - **Source:** granrs (the thesis's CAD model does not say what its joints were;
+//!   `docs/bodies/leg.md`).
 //! - **Parameters:** none.
 //! - **Reads:** each spring-damper joint's angle and rate.
 //! - **Switches:** none.
@@ -26,7 +26,7 @@ impl Term for JointSprings {
         name: "joint_springs",
         summary: "the joints' rotational spring-dampers (k, c on each joint)",
         equation: "tau = -k (theta - theta_rest) - c dtheta/dt  (each spring-damper joint)",
-        source: "granrs (README, the chain and the leg)",
+        source: "granrs (docs/bodies/leg.md, docs/bodies/linkage.md)",
         params: &[],
         acts: Acts::Body,
         class: Class::Static,

@@ -3,7 +3,7 @@
 //! A scene lists the terms that act on its body ([`ForceSet`]); a term that is not listed is
 //! neither evaluated nor stored, and its sign switches are not watched. Each term is one file
 //! here, opening (as a REBOUNDx effect does) with its equation in granrs's frame
-//! (`shared/MODEL.md`: x right, y up, sand surface at y = 0), its source, its parameters with
+//! (`docs/model.md`: x right, y up, sand surface at y = 0), its source, its parameters with
 //! units and defaults, and the switches it owns. Its [`TermInfo`] is the one description of
 //! it: validation, the TOML tables, the Python constructors (`granrs.forces`), the docs and
 //! the error messages all read it.
@@ -152,7 +152,7 @@ impl Default for Medium {
 }
 
 /// What a contact term reads: one contact's geometry and kinematics below the surface
-/// (`shared/MODEL.md`, "Contact geometry"). The engine fills it once per contact and
+/// (`docs/model.md`, "What is immersed"). The engine fills it once per contact and
 /// evaluation, and evaluates the contact terms where `depth > 0`, or from the moment of
 /// entry when a listed term reads the frame ([`TermInfo::reads_frame`]: `rft`, `poncelet`,
 /// `rft_inertial` are finite at depth 0).

@@ -14,7 +14,7 @@
 //!
 //! - **Source:** Li, Zhang & Goldman, "A terradynamics of legged locomotion on granular
 //!   media", Science 339 (2013) 1408, eq. 1 and the generic coefficients (supplementary
-//!   material, Table S2; `shared/LAWS.md`). Checked against the identities, not a code:
+//!   material, Table S2; `docs/laws.md`). Checked against the identities, not a code:
 //!   alpha(0, pi/2) = (0, 1); alpha(-beta, pi - gamma) = (-alpha_x, alpha_z); pi-periodic
 //!   in beta; F . v <= 0 for every (beta, gamma) (the tests).
 //! - **Parameters:** `zeta` [N/m^3], required (the paper's values are 1e6 order, e.g.
@@ -60,7 +60,7 @@ use super::{
 pub const DEFAULT_ELEMENTS: usize = 8;
 
 /// The paper's generic coefficients, in the order A00 A10 B11 B01 B-11 C11 C01 C-11 D10
-/// (Li, Zhang & Goldman 2013, supplementary Table S2; `shared/LAWS.md`).
+/// (Li, Zhang & Goldman 2013, supplementary Table S2; `docs/laws.md`).
 pub const GENERIC: [f64; 9] = [
     0.206, 0.169, 0.212, 0.358, 0.055, -0.124, 0.253, 0.007, 0.088,
 ];

@@ -7,7 +7,7 @@
 //! with `w` the contact's width (d_c for a rod, the sole length f_s for a foot, as in
 //! eq. 5.3) and `d` its depth.
 //!
-//! - **Source:** the thesis, eqs. 2.2 and 3.2 (`shared/MODEL.md`, "Resistance force").
+//! - **Source:** the thesis, eqs. 2.2 and 3.2 (`docs/model.md`, "The resistance force").
 //! - **Parameters:** `eta_h` [-], the horizontal static scaling constant; default 6.5, thesis
 //!   Table 3.4 at q = 0.
 //! - **Reads:** the medium's g and rho_g, the contact's width and depth, the sign of v_Ex.
@@ -31,7 +31,7 @@ impl Term for StaticH {
         name: "static_h",
         summary: "static horizontal resistance, Coulomb-like in the sign of v_Ex",
         equation: "F_sh = -sgn(v_Ex) eta_h g rho_g w d^2  (along x)",
-        source: "thesis eqs. 2.2, 3.2 (shared/MODEL.md)",
+        source: "thesis eqs. 2.2, 3.2 (docs/model.md)",
         params: &[Param {
             name: "eta_h",
             unit: "-",

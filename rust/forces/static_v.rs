@@ -8,7 +8,7 @@
 //! with `V` the immersed volume (pi d_c^2 / 4 l for a rod, eq. 3.15), `d` the depth and
 //! `L_ref` the body length (the rod's L; the tibia l_l for the leg).
 //!
-//! - **Source:** the thesis, eqs. 2.3-2.4, 3.3 and 3.15 (`shared/MODEL.md`).
+//! - **Source:** the thesis, eqs. 2.3-2.4, 3.3 and 3.15 (`docs/model.md`).
 //! - **Parameters:** `eta_v` [-], the vertical static scaling constant, default 248.0; `lam`
 //!   [-], the depth exponent lambda, default 0.106; both thesis Table 3.4 at q = 0.
 //! - **Reads:** the medium's g and rho_g, the contact's depth, L_ref, V and the sign of v_Ey.
@@ -33,7 +33,7 @@ impl Term for StaticV {
         name: "static_v",
         summary: "static vertical resistance, Coulomb-like in the sign of v_Ey",
         equation: "F_sv = -sgn(v_Ey) eta_v (d / L_ref)^lam g rho_g V  (along y)",
-        source: "thesis eqs. 2.3-2.4, 3.3, 3.15 (shared/MODEL.md)",
+        source: "thesis eqs. 2.3-2.4, 3.3, 3.15 (docs/model.md)",
         params: &[
             Param {
                 name: "eta_v",

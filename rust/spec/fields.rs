@@ -134,7 +134,7 @@ scene_fields! {
     "sole_height": "body", LEG, "m", "> 0; left out: the tibia length",
         "height of the contact box above the sole; None: the tibia length (the sole's footprint carried up the leg, so V keeps growing as f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count";
     "sole_model": "body", LEG, "", "box or thesis",
-        "the sole's contact: \"box\" (the geometric box of MODEL.md) or \"thesis\" (eqs. 5.5-5.7 with the shank's angle; finite only for 1 <= shank angle <= 89 deg)";
+        "the sole's contact: \"box\" (the geometric box of docs/model.md) or \"thesis\" (eqs. 5.5-5.7 with the shank's angle; finite only for 1 <= shank angle <= 89 deg)";
     "t_end": "solver", ALL, "s", "> 0",
         "latest end time";
     "tibia_length": "body", LEG, "m", "> 0",
