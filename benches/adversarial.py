@@ -333,7 +333,7 @@ def outcome(case: Case) -> str:
             return f"typed:{type(e).__name__}"
         text = f"{e} {getattr(e, 'field', '') or ''}"
         names = (case.field.split(".")[-1], case.field, *case.names)
-        if case.loose and getattr(e, "field", None) or any(n in text for n in names):
+        if (case.loose and getattr(e, "field", None)) or any(n in text for n in names):
             return f"typed:{type(e).__name__}"
         return f"FAIL: {type(e).__name__} does not name {case.field}: {e}"
     except BaseException as e:  # a PanicException derives from BaseException

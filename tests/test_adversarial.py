@@ -23,7 +23,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import granrs
 from granrs import Scene, cases, forces, scenefile
 from granrs.bodies import Contact, Joint, Link, Linkage, Root
 from granrs.errors import GranrsError, InvalidParameterError, InvalidSceneError
@@ -114,14 +113,6 @@ def test_numpy_bool_is_refused_where_bool_is(call: Any, field: str) -> None:
     with pytest.raises(InvalidSceneError) as info:
         call()
     assert field in f"{info.value.field} {info.value}"
-
-
-def test_numpy_bool_is_refused_on_a_sweep_axis() -> None:
-    """The same through a sweep axis (the sweep converts its values with the same rule)."""
-    base = cases.free_link(q_deg=10.0, v0=1.5, t_end=0.01)
-    with pytest.raises(InvalidSceneError) as info:
-        granrs.sweep(base, threads=1, progress=False, mass=[0.2, np.True_])
-    assert "mass" in f"{info.value.field} {info.value}"
 
 
 # --------------------------------------------------------------------------------------
