@@ -12,9 +12,9 @@ use nalgebra::SVector;
 use crate::body::Joint;
 use crate::dynamics::{Model, SignModel};
 use crate::error::{check_finite, check_range, fmt_num, GranrsError, Result};
-use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
 use crate::forces::Medium;
 use crate::integrate::{Method, Outcome, SolveOptions};
+use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
 
 pub mod chain;
 pub mod free_link;

@@ -213,9 +213,7 @@ impl TermSpec {
                 });
             }
             for &v in &values {
-                if !(v.is_finite() && v >= p.min && v <= p.max)
-                    || (p.integer && v.fract() != 0.0)
-                {
+                if !(v.is_finite() && v >= p.min && v <= p.max) || (p.integer && v.fract() != 0.0) {
                     let kind = if p.integer { "an integer" } else { "finite" };
                     let min = if p.min == f64::NEG_INFINITY {
                         String::new()

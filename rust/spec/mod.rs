@@ -590,7 +590,10 @@ impl<'a> Element<'a> {
 const SHAPE_KEYS: &[(&str, &[&str])] = &[
     ("rod", &["length", "diameter"]),
     ("box", &["length", "height", "width", "l_ref"]),
-    ("arc", &["radius", "start_deg", "end_deg", "width", "chords"]),
+    (
+        "arc",
+        &["radius", "start_deg", "end_deg", "width", "chords"],
+    ),
 ];
 
 /// The keys each joint kind reads beyond `name`, `parent`, `child`, `at` and `kind`.
@@ -775,9 +778,17 @@ impl SceneSpec {
             let at = e.point_or("at", Vector2::zeros())?;
             let shape_name = e.str("shape")?;
             if !SHAPE_KEYS.iter().any(|(k, _)| *k == shape_name) {
-                return Err(unknown(&e.field("shape"), shape_name, &["rod", "box", "arc"]));
+                return Err(unknown(
+                    &e.field("shape"),
+                    shape_name,
+                    &["rod", "box", "arc"],
+                ));
             }
-            e.only_for(&format!("a contact of shape {shape_name:?}"), SHAPE_KEYS, shape_name)?;
+            e.only_for(
+                &format!("a contact of shape {shape_name:?}"),
+                SHAPE_KEYS,
+                shape_name,
+            )?;
             let length = if shape_name == "arc" {
                 0.0
             } else {

@@ -189,7 +189,10 @@ fn a_series_listed_twice_is_refused() {
     let mut s = free_link_spec();
     s.set("record", Value::Names(vec!["state".into(), "state".into()]));
     assert_eq!(refused_field(&s).as_deref(), Some("record"));
-    s.set("record", Value::Names(vec!["state".into(), "energy".into()]));
+    s.set(
+        "record",
+        Value::Names(vec!["state".into(), "energy".into()]),
+    );
     assert_eq!(refused_field(&s), None);
 }
 
@@ -263,4 +266,14 @@ fn numbers_in_messages_are_short() {
     assert_eq!(fmt_num(1.0000000000000001e304), "1e304");
     assert_eq!(fmt_num(1.23456789e-300), "1.23e-300");
     assert_eq!(fmt_num(f64::NAN), "NaN");
+}
+
+#[test]
+fn the_notes_state_the_work_bounds() {
+    // The field table's notes (TOML comments, docs, errors) say the bounds the checks use.
+    use crate::spec::fields::{info, MAX_SAMPLES, MAX_STEPS};
+    let steps = format!("t_end / dt <= {MAX_STEPS:e} steps");
+    assert!(info("t_end").unwrap().note.contains(&steps));
+    let samples = format!("t_end / dt / record_stride <= {MAX_SAMPLES:e} samples");
+    assert!(info("record_stride").unwrap().note.contains(&samples));
 }
