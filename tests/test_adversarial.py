@@ -262,7 +262,7 @@ def test_recorded_series_have_a_stated_bound() -> None:
 
 @pytest.mark.parametrize("target", list(adversarial.GENERATORS))
 @settings(
-    max_examples=60,
+    max_examples=150,
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
 )
