@@ -1,7 +1,7 @@
 """Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6), and
 beside them (``--table-share``, 2 % by default) two-link linkages whose knee is driven along a
 random table (issue 19), and (``--arc-share``, 2 %) random arc contacts, C-legs (issue 19,
-:func:`random_arc`), each kind swept separately.
+:func:`random_arc`; half of them with a box contact too), each kind swept separately.
 
 Checks that a long batch never returns NaN or infinity in a run that did not fail, never
 hangs and keeps its memory flat. Scenes are drawn from the valid domain of
@@ -183,7 +183,9 @@ def random_arc(rng: np.random.Generator, dt_range: bool, max_steps: int) -> Scen
     """A random valid arc contact (issue 19): radius 1 cm .. 20 cm, span 1 .. 360 deg,
     1 .. MAX_CHORDS chords, on a link of 10 g .. 10 kg hung 0 .. 2 radii above the sand; the
     root pinned (its angle driven at -30 .. 30 rad/s, or free), moving (down at 0 .. 3 m/s)
-    or free; rft with zeta 0 .. 1e7 N/m^3, and rft_inertial in half of them."""
+    or free; in half of them a box (a plate one radius long, a fifth of it high) on the
+    same link as well, so that boxes soak too; rft with zeta 0 .. 1e7 N/m^3, and
+    rft_inertial in half of them."""
     from granrs.bodies import MAX_CHORDS, Contact, Link, Linkage, Root
 
     dt = float(10.0 ** rng.uniform(-6.0, -3.0)) if dt_range else 1e-4
@@ -215,7 +217,12 @@ def random_arc(rng: np.random.Generator, dt_range: bool, max_steps: int) -> Scen
                 width=float(rng.uniform(0.001, 0.05)),
                 at=(radius, 0.0),
                 chords=int(rng.integers(1, MAX_CHORDS + 1)),
-            )
+            ),
+            *(
+                [Contact.box("leg", radius, 0.2 * radius, float(rng.uniform(0.001, 0.05)))]
+                if rng.random() < 0.5
+                else []
+            ),
         ],
         root=Root(
             kind,

@@ -10,7 +10,7 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum GranrsError {
     /// A numeric field is out of its allowed range (negative mass, NaN speed, ...).
-    #[error("invalid value for `{field}`: {value} (allowed: {allowed})")]
+    #[error("invalid value for `{field}`: {} (allowed: {allowed})", fmt_num(*value))]
     InvalidParameter {
         field: String,
         value: f64,
@@ -47,6 +47,28 @@ pub enum GranrsError {
 }
 
 pub type Result<T> = std::result::Result<T, GranrsError>;
+
+/// A number for a message: as written when that is short (`0.184`, `1e-5`, `250`), else
+/// in `%.3g`'s spirit (`1e300`, `1.23e-300`), never a line of digits.
+pub fn fmt_num(x: f64) -> String {
+    let plain = format!("{x}");
+    if plain.len() <= 12 {
+        return plain;
+    }
+    let short = format!("{x:e}");
+    if short.len() <= 12 {
+        return short;
+    }
+    // Three significant digits, trailing zeros dropped: 1.000e304 -> 1e304.
+    let three = format!("{x:.2e}");
+    match three.split_once('e') {
+        Some((mantissa, exp)) if mantissa.contains('.') => {
+            let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+            format!("{mantissa}e{exp}")
+        }
+        _ => three,
+    }
+}
 
 /// Check that `value` is finite and at least `min` (or strictly above it).
 pub fn check_range(field: &str, value: f64, min: f64, strict: bool) -> Result<f64> {

@@ -90,7 +90,7 @@ BAD_FIELDS: list[tuple[Scene, str, Any, type[GranrsError], str]] = [
     (FREE, "method", "RK4", UnknownNameError, "method"),
     (FREE, "end", "stop", UnknownNameError, "end"),
     (FREE, "sign_model", "Modes", UnknownNameError, "sign_model"),
-    (FREE, "t_end", 1e30, InvalidParameterError, "dt"),  # 1e34 steps: refused by count
+    (FREE, "t_end", 1e30, InvalidParameterError, "t_end"),  # 1e34 steps: refused by count
     (FREE, "record_stride", 10**30, InvalidParameterError, "record_stride"),
     (FREE, "vx0", -INF, InvalidParameterError, "vx0"),
     *[(CHAIN, "pin_mass", v, InvalidParameterError, "pin_mass") for v in (-1.0, NAN, INF)],

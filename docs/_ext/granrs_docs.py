@@ -271,6 +271,7 @@ def term_rst(name: str) -> str:
             "     - unit",
             "     - default",
             "     - smallest value",
+            "     - largest value",
             "     - what it is",
             "     - source of the default",
         ]
@@ -280,6 +281,7 @@ def term_rst(name: str) -> str:
                 f"     - {'dimensionless' if p.unit == '-' else rst_escape(p.unit)}",
                 f"     - {'required' if p.required else _number(p.default)}",
                 f"     - {_number(p.min)}",
+                f"     - {'none' if p.max == float('inf') else _number(p.max)}",
                 f"     - {rst_escape(p.description)}",
                 f"     - {rst_escape(p.source)}",
             ]

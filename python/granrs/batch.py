@@ -53,7 +53,7 @@ def _plain(name: str, value: Any) -> Any:
         return value.item()
     if name == "record" and isinstance(value, tuple):
         return list(value)
-    if name == "forces":
+    if name == "forces" and isinstance(value, list | tuple):
         return [t.to_dict() if isinstance(t, Term) else t for t in value]
     return value
 
@@ -89,7 +89,9 @@ def _check_axes(scene: Scene, axes: dict[str, list[Any]]) -> None:
         # unique; a set, so that the check is linear in the axis's length).
         seen: set[int] = set()
         for v in values:
-            if isinstance(v, (int, float, np.number)) and not isinstance(v, bool):
+            if isinstance(v, float | np.floating) or (
+                isinstance(v, int | np.integer) and not isinstance(v, bool) and abs(v) < 2**53
+            ):
                 continue  # ranges are checked in the core, for every run
             if id(v) in seen:
                 continue

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, fields
+from dataclasses import MISSING, asdict, dataclass, fields
 from typing import Any
 
 from . import _granrs
@@ -73,11 +73,25 @@ for _f in _granrs.element_fields():
 Point = tuple[float, float]
 
 
+def _not_none(element: Any, prefix: str) -> None:
+    """Refuse ``None`` for each field of ``element`` whose default is a value (or that has
+    no default): ``None`` means "left out" only where the field says so."""
+    for f in fields(element):
+        if f.default is not None and getattr(element, f.name) is None:
+            raise InvalidParameterError(
+                f"{prefix}{f.name} must be a value, not None"
+                + ("" if f.default is MISSING else f" (its default: {f.default!r})"),
+                field=f"{prefix}{f.name}",
+            )
+
+
 def _point(value: Any, field: str) -> Point:
     try:
         x, y = value
+        if any(type(c).__name__ in ("bool", "bool_") for c in (x, y)):
+            raise TypeError("a truth value is not a coordinate")
         return (float(x), float(y))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidParameterError(
             f"{field} must be a pair of numbers (s, n) or (x, y); got {value!r}", field=field
         ) from None
@@ -98,6 +112,7 @@ class Link:
     omega0: float = 0.0
 
     def __post_init__(self) -> None:
+        _not_none(self, f"links.{self.name}.")
         object.__setattr__(self, "com", _point(self.com, f"links.{self.name}.com"))
 
     @classmethod
@@ -179,6 +194,7 @@ class Joint:
     table: tuple[tuple[float, float], ...] | None = None
 
     def __post_init__(self) -> None:
+        _not_none(self, f"joints.{self.name}.")
         object.__setattr__(self, "at", _point(self.at, f"joints.{self.name}.at"))
         object.__setattr__(self, "table", _table(self.table))
 
@@ -242,7 +258,9 @@ class Contact:
     chords: int | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "at", _point(self.at, f"contacts.{self.name or self.link}.at"))
+        label = self.name if isinstance(self.name, str) and self.name else self.link
+        _not_none(self, f"contacts.{label}.")
+        object.__setattr__(self, "at", _point(self.at, f"contacts.{label}.at"))
 
     @classmethod
     def rod(
@@ -314,6 +332,7 @@ class Root:
     rate: float | None = None
 
     def __post_init__(self) -> None:
+        _not_none(self, "root.")
         object.__setattr__(self, "position", _point(self.position, "root.position"))
         object.__setattr__(self, "velocity", _point(self.velocity, "root.velocity"))
 

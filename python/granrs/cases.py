@@ -40,7 +40,10 @@ def _number(value: Any, field: str) -> float:
         except ImportError:  # pragma: no cover
             pass
         raise InvalidParameterError(f"{field} must be a number, got {value!r}", field=field)
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond the floats (10**400): not finite, refused by name
+        return math.inf
 
 
 def _check_overrides(function: str, overrides: Mapping[str, Any], own: tuple[str, ...]) -> None:
@@ -140,7 +143,7 @@ def _coefficients_arg(value: Any, field: str) -> Coefficients:
     if isinstance(value, Coefficients):
         return value
     if isinstance(value, Mapping):
-        return Coefficients(**dict(value))
+        return resolve(value, 0.0)[0]  # its keys and values checked, typed errors
     raise InvalidParameterError(
         f"{field} must be a granrs.Coefficients or a mapping of eta_h, eta_d, eta_v, lam; "
         f"got {value!r}",
@@ -166,7 +169,11 @@ def chain_case(case: int) -> dict[str, Any]:
     Returns a dict with ``q_deg`` (two angles), ``v0_links``, ``v0``, ``coefficients`` (two
     :class:`~granrs.Coefficients`) and ``sources`` (two strings).
     """
-    if isinstance(case, bool) or case not in (1, 2, 3):
+    if (
+        isinstance(case, bool | np.bool_)
+        or not isinstance(case, int | float | np.number)
+        or case not in (1, 2, 3)
+    ):
         raise InvalidParameterError(f"case must be 1, 2 or 3; got {case!r}", field="case")
     exp = data.load("chain_experiments", as_="numpy")
     coef = data.load("chain_coefficients", as_="numpy")

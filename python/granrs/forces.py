@@ -28,6 +28,7 @@ parameter (``static_v.eta_v``), and suggest the near miss of a mistyped name.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -74,6 +75,8 @@ class Param:
         description: what it is.
         integer: whether it is a count (an integer >= ``min``).
         required: whether a scene must give it (no default; ``default`` is NaN).
+        max: largest allowed value (inclusive; ``inf``: no bound). A count that sizes the
+            work of every force evaluation (``elements``) has one.
     """
 
     name: str
@@ -84,6 +87,7 @@ class Param:
     description: str
     integer: bool = False
     required: bool = False
+    max: float = math.inf
 
 
 @dataclass(frozen=True)
@@ -303,9 +307,22 @@ def rft(
             those left out keep the generic values (``granrs.forces.RFT_GENERIC``).
     """
     params: dict[str, ParamValue] = {"zeta": zeta, "elements": elements}
-    for k, v in (coefficients or {}).items():
+    for k, v in _coefficients(coefficients).items():
         params[str(k).replace("-1", "m1")] = v
     return Term("rft", params)
+
+
+def _coefficients(value: Any) -> Mapping[Any, Any]:
+    """RFT coefficients by name (``None``: none), or a typed error naming the argument."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise InvalidParameterError(
+            f"rft coefficients must be a mapping of name to value (names: "
+            f"{', '.join(RFT_COEFFICIENTS)}); got {value!r}",
+            field="rft.coefficients",
+        )
+    return value
 
 
 def rft_inertial(lam: ParamValue = 1.0, elements: int = 8) -> Term:
@@ -354,7 +371,7 @@ def rft_alpha(beta: Any, gamma: Any, coefficients: Mapping[str, float] | None = 
     import numpy as np
 
     k = dict(RFT_GENERIC)
-    for name, v in (coefficients or {}).items():
+    for name, v in _coefficients(coefficients).items():
         key = str(name).replace("-1", "m1")
         if key not in k:
             raise InvalidParameterError(
@@ -402,8 +419,13 @@ def select(terms: Iterable[Term], *names: str) -> tuple[Term, ...]:
     ``effects=`` names of earlier versions did): ``select(scene.forces, "gravity",
     "static_v")``. An unknown name raises, with a near miss."""
     for n in names:
+        if not isinstance(n, str):
+            raise InvalidParameterError(
+                f"select takes term names (strings), got {n!r}", field="names"
+            )
         info(n)
-    return tuple(t for t in terms if t.name in names)
+    items = as_terms(terms, "terms")
+    return tuple(t for t in items if t.name in names)
 
 
 def thesis_row(terms: Iterable[Term], contact: int = 0) -> Any:
@@ -442,13 +464,18 @@ def _row(c: Any, i: int) -> dict[str, float]:
 
 def as_terms(value: Any, field_name: str = "forces") -> tuple[Term, ...]:
     """``value`` (a sequence of :class:`Term`) as a tuple, or a typed error naming the item."""
-    if isinstance(value, (str, Term)) or not isinstance(value, Iterable):
+    items: Sequence[Any] | None = None
+    if not isinstance(value, (str, Term)) and isinstance(value, Iterable):
+        try:
+            items = tuple(value)
+        except TypeError:  # iterable by type only (a 0-d numpy array)
+            items = None
+    if items is None:
         raise InvalidParameterError(
             f"{field_name} must be a list of granrs.forces terms (e.g. "
             f"[granrs.forces.gravity(), granrs.forces.drag()]); got {value!r}",
             field=field_name,
         )
-    items: Sequence[Any] = tuple(value)
     for i, t in enumerate(items):
         if not isinstance(t, Term):
             raise InvalidParameterError(

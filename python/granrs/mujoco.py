@@ -81,11 +81,11 @@ _PLANE_TOL = 1e-9
 
 
 def _number(value: Any, name: str) -> float:
-    if isinstance(value, bool):
+    if isinstance(value, bool | np.bool_):
         raise InvalidParameterError(f"`{name}` must be a number, got {value!r}", field=name)
     try:
         x = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InvalidParameterError(
             f"`{name}` must be a number, got {value!r}", field=name
         ) from None
@@ -163,6 +163,10 @@ class Sand:
                 f"unknown statics `{statics}` (allowed: {', '.join(STATICS)})", field="statics"
             )
         self.statics = statics
+        # Checked whichever sign model is chosen (as a Scene's smooth_eps).
+        eps = _number(smooth_eps, "smooth_eps")
+        if eps <= 0.0:
+            raise InvalidParameterError(f"`smooth_eps` must be > 0, got {eps}", field="smooth_eps")
         try:
             lo, hi = (float(x) for x in patch)
         except (TypeError, ValueError):
@@ -223,7 +227,7 @@ class Sand:
             self.g,
             apply_at,
             sign_model,
-            float(smooth_eps),
+            eps,
         )
         self.apply_at = apply_at
         dofs = []

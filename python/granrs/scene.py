@@ -13,8 +13,9 @@ with every default set.
 A scene is plain data: the body and its size, the sand, the force terms that act (each with
 its parameters: :mod:`granrs.forces`), the initial state, the step, the end condition and
 the time series to record. :func:`granrs.simulate` runs it. Every field is checked by the
-Rust core (one set of rules for Python, TOML and the CLI) before any work starts; an invalid
-field raises a :class:`~granrs.errors.InvalidSceneError` subclass whose ``field`` names it.
+Rust core (one set of rules for Python, TOML, the CLI and sweeps) when the scene is built,
+whether or not its model or method reads it; an invalid field raises a
+:class:`~granrs.errors.InvalidSceneError` subclass whose ``field`` names it.
 
 A scene made from one of the thesis's coefficient rows follows its angle: when the
 free link's ``q_deg`` (or the leg's ``v0``) changes, by :meth:`Scene.replace`, a scene file's
@@ -105,12 +106,17 @@ _REPLACED: dict[str, str] = {
 
 
 def _names(value: Any, field_name: str, allowed: tuple[str, ...]) -> tuple[str, ...]:
-    if isinstance(value, str) or not isinstance(value, Iterable):
+    names: tuple[Any, ...] | None = None
+    if not isinstance(value, str) and isinstance(value, Iterable):
+        try:
+            names = tuple(value)
+        except TypeError:  # iterable by type only (a 0-d numpy array)
+            names = None
+    if names is None:
         raise InvalidParameterError(
             f"{field_name} must be a list of names from {', '.join(allowed)}; got {value!r}",
             field=field_name,
         )
-    names = tuple(value)
     for name in names:
         if name not in allowed:
             raise UnknownNameError(
@@ -118,6 +124,17 @@ def _names(value: Any, field_name: str, allowed: tuple[str, ...]) -> tuple[str, 
                 field=field_name,
             )
     return names
+
+
+def _differs(value: Any, default: Any) -> bool:
+    """Whether a field's value is not its default; a value that does not compare as one
+    truth value (an array) differs."""
+    if value is default:
+        return False
+    try:
+        return bool(value != default)
+    except (TypeError, ValueError):
+        return True
 
 
 def _joint(value: Any, field_name: str) -> str | dict[str, float]:
@@ -391,7 +408,7 @@ class Scene:
 
         defaults = _DEFAULTS
         for name, bodies in BODY_FIELDS.items():
-            if kind not in bodies and getattr(self, name) != defaults[name]:
+            if kind not in bodies and _differs(getattr(self, name), defaults[name]):
                 raise InvalidSceneError(
                     f"{name} applies to body {' or '.join(repr(b) for b in bodies)} only, "
                     f"not {kind!r}"
@@ -412,6 +429,10 @@ class Scene:
         elif isinstance(change, _Kept):
             warnings.warn(CoefficientsWarning(change.message), stacklevel=_caller_stacklevel())
             object.__setattr__(self, "coefficients_source", change.source)
+        # Every field checked by the core now, whoever built the scene (Python, TOML, the
+        # CLI, cases): a bad field is a typed error naming it at construction, not when a
+        # run, a model or a method first reads it. The compiled scene is kept for the run.
+        self._compiled()
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with some fields changed; an unknown field raises UnknownNameError (with
@@ -483,8 +504,9 @@ class Scene:
         return _granrs.compiled_scene(self.__dict__, _CORE_FIELDS)
 
     def validate(self) -> Scene:
-        """Check every field in the Rust core; raise the typed error naming the first bad one."""
-        _granrs.validate(self.to_dict())
+        """This scene, checked in full by the Rust core (which a Scene is on construction:
+        a bad field raises the typed error naming it then)."""
+        self._compiled()
         return self
 
     def leg_segments(self) -> list[dict[str, Any]]:

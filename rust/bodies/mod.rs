@@ -11,9 +11,10 @@ use nalgebra::SVector;
 
 use crate::body::Joint;
 use crate::dynamics::{Model, SignModel};
-use crate::error::{check_finite, check_range, GranrsError, Result};
+use crate::error::{check_finite, check_range, fmt_num, GranrsError, Result};
 use crate::forces::Medium;
 use crate::integrate::{Method, Outcome, SolveOptions};
+use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
 
 pub mod chain;
 pub mod free_link;
@@ -39,11 +40,32 @@ pub fn validate_medium(m: &Medium) -> Result<()> {
 pub fn validate_options(o: &SolveOptions, sign_model: &SignModel) -> Result<()> {
     check_range("dt", o.dt, 0.0, true)?;
     check_range("t_end", o.t_end, 0.0, true)?;
-    if o.t_end / o.dt > 1e9 {
+    // The work a run may ask for is bounded (the field table's MAX_STEPS, MAX_SAMPLES).
+    let steps = o.t_end / o.dt;
+    if steps > MAX_STEPS {
         return Err(GranrsError::InvalidParameter {
-            field: "dt".into(),
-            value: o.dt,
-            allowed: format!("at most 1e9 steps to t_end = {} s", o.t_end),
+            field: "t_end".into(),
+            value: o.t_end,
+            allowed: format!(
+                "t_end / dt <= {MAX_STEPS:e} steps, so t_end <= {} s at dt = {} s (it asks \
+                 for {} steps); shorten t_end or lengthen dt",
+                fmt_num(MAX_STEPS * o.dt),
+                fmt_num(o.dt),
+                fmt_num(steps)
+            ),
+        });
+    }
+    let stride = o.record.stride.max(1) as f64;
+    if o.record.any() && steps / stride > MAX_SAMPLES {
+        return Err(GranrsError::InvalidParameter {
+            field: "record_stride".into(),
+            value: stride,
+            allowed: format!(
+                "t_end / dt / record_stride <= {MAX_SAMPLES:e} recorded samples, so \
+                 record_stride >= {} for t_end / dt = {} steps",
+                (steps / MAX_SAMPLES).ceil(),
+                fmt_num(steps)
+            ),
         });
     }
     if let SignModel::Smooth { eps } = sign_model {

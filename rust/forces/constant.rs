@@ -36,6 +36,7 @@ impl Term for Constant {
                 min: f64::NEG_INFINITY,
                 description: "x component",
                 integer: false,
+                max: f64::INFINITY,
             },
             Param {
                 name: "fy",
@@ -45,6 +46,7 @@ impl Term for Constant {
                 min: f64::NEG_INFINITY,
                 description: "y component",
                 integer: false,
+                max: f64::INFINITY,
             },
         ],
         acts: Acts::Contact,

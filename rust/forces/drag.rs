@@ -42,6 +42,7 @@ impl Term for Drag {
             min: 0.0,
             description: "dynamic scaling constant",
             integer: false,
+            max: f64::INFINITY,
         }],
         acts: Acts::Contact,
         class: Class::Dynamic,

@@ -348,6 +348,10 @@ pub struct Param {
     pub description: &'static str,
     /// Whether it is a count (an integer >= `min`).
     pub integer: bool,
+    /// Largest allowed value (inclusive; `f64::INFINITY`: no bound). A parameter that sizes
+    /// the work of every force evaluation (an element count) has a finite one, so that no
+    /// scene asks for unbounded work.
+    pub max: f64,
 }
 
 impl Param {

@@ -95,6 +95,7 @@ impl Term for Poncelet {
                 min: 0.0,
                 description: "inertial drag coefficient",
                 integer: false,
+                max: f64::INFINITY,
             },
             Param {
                 name: "k",
@@ -104,6 +105,7 @@ impl Term for Poncelet {
                 min: 0.0,
                 description: "depth-friction coefficient",
                 integer: false,
+                max: f64::INFINITY,
             },
         ],
         acts: Acts::Contact,

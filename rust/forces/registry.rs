@@ -213,17 +213,22 @@ impl TermSpec {
                 });
             }
             for &v in &values {
-                if !(v.is_finite() && v >= p.min) || (p.integer && v.fract() != 0.0) {
+                if !(v.is_finite() && v >= p.min && v <= p.max) || (p.integer && v.fract() != 0.0) {
                     let kind = if p.integer { "an integer" } else { "finite" };
                     let min = if p.min == f64::NEG_INFINITY {
                         String::new()
                     } else {
                         format!(", >= {}", p.min)
                     };
+                    let max = if p.max == f64::INFINITY {
+                        String::new()
+                    } else {
+                        format!(", <= {}", p.max)
+                    };
                     return Err(GranrsError::InvalidParameter {
                         field: field(),
                         value: v,
-                        allowed: format!("{kind}{min} ({} [{}])", p.description, p.unit),
+                        allowed: format!("{kind}{min}{max} ({} [{}])", p.description, p.unit),
                     });
                 }
             }

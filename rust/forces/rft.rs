@@ -59,6 +59,12 @@ use super::{
 /// second order in the element count on an oblique drop).
 pub const DEFAULT_ELEMENTS: usize = 8;
 
+/// The most elements per plate a scene may ask for (the `elements` parameter's bound):
+/// twice the 512 of the docs' convergence reference. The work of every force evaluation
+/// grows with it (a whole impact takes about 4 us per element and plate), so an unbounded
+/// count would be unbounded work.
+pub const MAX_ELEMENTS: usize = 1024;
+
 /// The paper's generic coefficients, in the order A00 A10 B11 B01 B-11 C11 C01 C-11 D10
 /// (Li, Zhang & Goldman 2013, supplementary Table S2; `docs/laws.md`).
 pub const GENERIC: [f64; 9] = [
@@ -82,6 +88,7 @@ macro_rules! coefficient {
             min: f64::NEG_INFINITY,
             description: $what,
             integer: false,
+            max: f64::INFINITY,
         }
     };
 }
@@ -95,6 +102,7 @@ const ELEMENTS: Param = Param {
     min: 1.0,
     description: "elements per boundary plate",
     integer: true,
+    max: MAX_ELEMENTS as f64,
 };
 
 /// alpha = (alpha_x, alpha_z) for the line angle's `(cos 2 beta, sin 2 beta)` and the
@@ -371,6 +379,7 @@ impl Term for Rft {
                 min: 0.0,
                 description: "alpha_z of a horizontal plate pushed straight down, per unit depth",
                 integer: false,
+                max: f64::INFINITY,
             },
             ELEMENTS,
             coefficient!(0, "Fourier coefficient A00 of alpha_z"),
@@ -584,6 +593,7 @@ impl Term for RftInertial {
                 min: 0.0,
                 description: "scale of the momentum flux rho_g v_n^2",
                 integer: false,
+                max: f64::INFINITY,
             },
             ELEMENTS,
         ],

@@ -40,6 +40,7 @@ impl Term for StaticH {
             min: 0.0,
             description: "horizontal static scaling constant",
             integer: false,
+            max: f64::INFINITY,
         }],
         acts: Acts::Contact,
         class: Class::Static,

@@ -43,6 +43,7 @@ impl Term for StaticV {
                 min: 0.0,
                 description: "vertical static scaling constant",
                 integer: false,
+                max: f64::INFINITY,
             },
             Param {
                 name: "lam",
@@ -52,6 +53,7 @@ impl Term for StaticV {
                 min: 0.0,
                 description: "depth exponent lambda",
                 integer: false,
+                max: f64::INFINITY,
             },
         ],
         acts: Acts::Contact,

@@ -11,7 +11,8 @@ use super::errors::to_pyerr;
 
 /// Every registered term's description, in the registry's order: name, summary, equation,
 /// source, acts (`"contact"` or `"body"`), class, velocity_dependent, reads, switches,
-/// columns and params (each: name, unit, default, source, min, description).
+/// columns and params (each: name, unit, default, source, min, max, description, integer,
+/// required).
 #[pyfunction]
 pub fn term_infos(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     let out = PyList::empty(py);
@@ -49,6 +50,7 @@ pub fn term_infos(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
             pd.set_item("default", p.default)?;
             pd.set_item("source", p.source)?;
             pd.set_item("min", p.min)?;
+            pd.set_item("max", p.max)?;
             pd.set_item("description", p.description)?;
             pd.set_item("integer", p.integer)?;
             pd.set_item("required", p.required())?;
@@ -97,7 +99,7 @@ fn params_from_py<'py>(
     params: impl Iterator<Item = (Bound<'py, PyAny>, Bound<'py, PyAny>)>,
 ) -> Vec<(String, Vec<f64>)> {
     let one = |v: &Bound<'_, PyAny>| -> f64 {
-        if v.is_instance_of::<pyo3::types::PyBool>() {
+        if v.is_instance_of::<pyo3::types::PyBool>() || super::convert::is_numpy_bool(v) {
             return f64::NAN;
         }
         v.extract::<f64>().unwrap_or(f64::NAN)

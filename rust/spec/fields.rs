@@ -8,6 +8,15 @@
 //! Defaults live with their values: the `granrs.Scene` dataclass, whose fields a test holds
 //! to this table. Sorted by name.
 
+/// The most steps a run may take, `t_end / dt` (the bound of the `t_end` field): a run of
+/// the free link takes about 1 us a step, so this is about a quarter of an hour.
+pub const MAX_STEPS: f64 = 1e9;
+
+/// The most samples a recorded series may hold, `t_end / dt / record_stride` (the bound of
+/// the `record_stride` field with `record`): each sample takes a few dozen floats, so this is
+/// a few GB at most.
+pub const MAX_SAMPLES: f64 = 1e7;
+
 /// One field of a scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FieldInfo {
@@ -119,7 +128,7 @@ scene_fields! {
         "initial angle of the rod (chain: link 1) from the vertical";
     "record": "outputs", ALL, "", "from state, forces, energy",
         "time series to record, from RECORDS (none by default)";
-    "record_stride": "outputs", ALL, "-", "a whole number >= 1",
+    "record_stride": "outputs", ALL, "-", "a whole number >= 1; with record, t_end / dt / record_stride <= 1e7 samples",
         "record every n-th step (events are always recorded)";
     "rho_g": "medium", ALL, "kg/m^3", "> 0",
         "bulk density of the sand, packing included (thesis sec. 3.3.1: 1650; the leg's sand, sec. 5.3.2: 1600)";
@@ -135,7 +144,7 @@ scene_fields! {
         "height of the contact box above the sole; None: the tibia length (the sole's footprint carried up the leg, so V keeps growing as f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count";
     "sole_model": "body", LEG, "", "box or thesis",
         "the sole's contact: \"box\" (the geometric box of docs/model.md) or \"thesis\" (eqs. 5.5-5.7 with the shank's angle; finite only for 1 <= shank angle <= 89 deg)";
-    "t_end": "solver", ALL, "s", "> 0",
+    "t_end": "solver", ALL, "s", "> 0; t_end / dt <= 1e9 steps",
         "latest end time";
     "tibia_length": "body", LEG, "m", "> 0",
         "tibia l_l (thesis sec. 5.3.2: 0.432): the shank and L_ref of eq. 5.4";

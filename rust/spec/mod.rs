@@ -17,7 +17,7 @@ use crate::bodies::{
 use crate::body::rod::ApplyAt;
 use crate::body::{DriveTable, Joint, SoleModel};
 use crate::dynamics::SignModel;
-use crate::error::{GranrsError, Result};
+use crate::error::{check_range, GranrsError, Result};
 use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
 use crate::integrate::{EndCondition, Method, Record, SolveOptions};
 
@@ -269,11 +269,17 @@ impl SceneSpec {
     fn record(&self) -> Result<Record> {
         let mut r = Record::default();
         for n in self.names("record")?.unwrap_or_default() {
-            match n.as_ref() {
-                "state" => r.state = true,
-                "forces" => r.forces = true,
-                "energy" => r.energy = true,
+            let seen = match n.as_ref() {
+                "state" => std::mem::replace(&mut r.state, true),
+                "forces" => std::mem::replace(&mut r.forces, true),
+                "energy" => std::mem::replace(&mut r.energy, true),
                 other => return Err(unknown("record", other, &RECORDS)),
+            };
+            if seen {
+                return Err(GranrsError::InvalidScene {
+                    field: "record".into(),
+                    message: format!("lists {n:?} twice (each series once)"),
+                });
             }
         }
         let stride = self.f64_or("record_stride", 1.0)?;
@@ -291,6 +297,13 @@ impl SceneSpec {
     /// The fields every body shares but the initial motion (a linkage's is in its
     /// elements).
     fn common_numerics(&self) -> Result<Common> {
+        // The fields that one sign model or one method reads are checked whichever is
+        // chosen: a scene holding a bad one is refused, not kept until it is switched on.
+        for name in ["smooth_eps", "rtol", "atol"] {
+            if let Some(x) = self.opt_f64(name)? {
+                check_range(name, x, 0.0, true)?;
+            }
+        }
         let apply_at = match self.str("apply_at")? {
             "tip" => ApplyAt::Tip,
             "centroid" => ApplyAt::Centroid,
@@ -502,6 +515,34 @@ impl<'a> Element<'a> {
         Ok((Element { path, entries }, name))
     }
 
+    /// Refuse a key that the element's kind (`kind`, a key of `keys`) does not read, where
+    /// `keys` lists the keys only some kinds read (the other keys every kind reads): a rod
+    /// contact given a `radius` is an error, not a value silently left unused. An unknown
+    /// kind passes (its own check names it).
+    fn only_for(&self, what: &str, keys: &[(&str, &[&str])], kind: &str) -> Result<()> {
+        let Some((_, own)) = keys.iter().find(|(k, _)| *k == kind) else {
+            return Ok(());
+        };
+        for (k, v) in self.entries {
+            let k = k.as_ref();
+            let some_kind_reads = keys.iter().any(|(_, ks)| ks.contains(&k));
+            if some_kind_reads && !own.contains(&k) && !matches!(v, Value::None) {
+                return Err(GranrsError::InvalidScene {
+                    field: self.field(k),
+                    message: format!(
+                        "{what} takes no {k} (it reads {}); leave it out",
+                        if own.is_empty() {
+                            "none of its kind's parameters".to_string()
+                        } else {
+                            own.join(", ")
+                        }
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
     fn field(&self, k: &str) -> String {
         format!("{}.{k}", self.path)
     }
@@ -544,6 +585,27 @@ impl<'a> Element<'a> {
         }
     }
 }
+
+/// The keys each contact shape reads beyond `name`, `shape`, `link` and `at`.
+const SHAPE_KEYS: &[(&str, &[&str])] = &[
+    ("rod", &["length", "diameter"]),
+    ("box", &["length", "height", "width", "l_ref"]),
+    (
+        "arc",
+        &["radius", "start_deg", "end_deg", "width", "chords"],
+    ),
+];
+
+/// The keys each joint kind reads beyond `name`, `parent`, `child`, `at` and `kind`.
+const JOINT_KEYS: &[(&str, &[&str])] = &[
+    ("free", &[]),
+    ("locked", &[]),
+    ("spring", &["k", "c", "rest_deg"]),
+    (
+        "driven",
+        &["rate", "amplitude_deg", "frequency", "phase_deg", "table"],
+    ),
+];
 
 /// A driven joint's table, `[(time [s], angle [deg]), ...]`, with its angles in radians
 /// (its values are checked by the linkage).
@@ -634,6 +696,7 @@ impl SceneSpec {
                 None => "free",
                 Some(_) => e.str("kind")?,
             };
+            e.only_for(&format!("a joint of kind {kind:?}"), JOINT_KEYS, kind)?;
             let parent = e.str("parent")?.to_string();
             let child = e.str("child")?.to_string();
             let table = match e.get("table") {
@@ -714,6 +777,18 @@ impl SceneSpec {
             let (e, name) = Element::new("contact", "contacts", i, v)?;
             let at = e.point_or("at", Vector2::zeros())?;
             let shape_name = e.str("shape")?;
+            if !SHAPE_KEYS.iter().any(|(k, _)| *k == shape_name) {
+                return Err(unknown(
+                    &e.field("shape"),
+                    shape_name,
+                    &["rod", "box", "arc"],
+                ));
+            }
+            e.only_for(
+                &format!("a contact of shape {shape_name:?}"),
+                SHAPE_KEYS,
+                shape_name,
+            )?;
             let length = if shape_name == "arc" {
                 0.0
             } else {

@@ -151,3 +151,129 @@ fn springs_are_free_without_the_effect() {
     assert!(!without.forces.joint_springs);
     assert_eq!(without.forces.names, vec!["gravity", "static_v"]);
 }
+
+/// The field a spec's build refuses (or `None` when it builds).
+fn refused_field(s: &SceneSpec) -> Option<String> {
+    match s.build() {
+        Ok(_) => None,
+        Err(
+            GranrsError::InvalidParameter { field, .. }
+            | GranrsError::WrongType { field, .. }
+            | GranrsError::UnknownName { field, .. }
+            | GranrsError::InvalidScene { field, .. },
+        ) => Some(field),
+        Err(other) => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn fields_a_model_or_method_reads_are_checked_whatever_is_chosen() {
+    // rk4 and the "modes" sign read none of them; a bad one was kept until switched on.
+    for (field, v) in [
+        ("smooth_eps", Value::Num(f64::NAN)),
+        ("smooth_eps", Value::Num(-1.0)),
+        ("rtol", Value::Str("abc".into())),
+        ("atol", Value::Num(-1.0)),
+        ("rtol", Value::Num(0.0)),
+    ] {
+        let mut s = free_link_spec();
+        s.set(field, v);
+        assert_eq!(refused_field(&s).as_deref(), Some(field));
+    }
+    // Left out (a TOML file may leave them out): nothing to check.
+    assert_eq!(refused_field(&free_link_spec()), None);
+}
+
+#[test]
+fn a_series_listed_twice_is_refused() {
+    let mut s = free_link_spec();
+    s.set("record", Value::Names(vec!["state".into(), "state".into()]));
+    assert_eq!(refused_field(&s).as_deref(), Some("record"));
+    s.set(
+        "record",
+        Value::Names(vec!["state".into(), "energy".into()]),
+    );
+    assert_eq!(refused_field(&s), None);
+}
+
+#[test]
+fn the_work_of_a_run_is_bounded_naming_the_field() {
+    use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
+    // Too many steps: t_end is blamed (it was dt), with the limit in short numbers.
+    let mut s = free_link_spec();
+    s.set("t_end", Value::Num(1e300));
+    let e = s.build().unwrap_err();
+    assert!(matches!(&e, GranrsError::InvalidParameter { field, .. } if field == "t_end"));
+    let text = e.to_string();
+    assert!(text.contains("1e9 steps") && text.len() < 250, "{text}");
+    // At the bound it builds.
+    s.set("t_end", Value::Num(MAX_STEPS * 1e-4));
+    assert_eq!(refused_field(&s), None);
+    // Recorded samples: bounded too, naming the stride that fits.
+    s.set("t_end", Value::Num(MAX_SAMPLES * 1e-4 * 10.0));
+    s.set("record", Value::Names(vec!["state".into()]));
+    assert_eq!(refused_field(&s).as_deref(), Some("record_stride"));
+    s.set("record_stride", Value::Num(10.0));
+    assert_eq!(refused_field(&s), None);
+}
+
+#[test]
+fn parameters_a_contact_shape_or_joint_kind_does_not_read_are_refused() {
+    let link = Value::Map(vec![
+        ("name".into(), Value::Str("a".into())),
+        ("mass".into(), Value::Num(1.0)),
+        ("inertia".into(), Value::Num(0.01)),
+        ("length".into(), Value::Num(0.3)),
+    ]);
+    let rod = |extra: Option<(&'static str, f64)>| {
+        let mut c = vec![
+            ("name".into(), Value::Str("r".into())),
+            ("shape".into(), Value::Str("rod".into())),
+            ("link".into(), Value::Str("a".into())),
+            ("length".into(), Value::Num(0.2)),
+            ("diameter".into(), Value::Num(0.01)),
+        ];
+        if let Some((k, v)) = extra {
+            c.push((k.into(), Value::Num(v)));
+        }
+        Value::Map(c)
+    };
+    let mut s = free_link_spec();
+    s.set("forces", Value::Names(vec![]));
+    for (extra, want) in [
+        (None, None),
+        (Some(("radius", 0.05)), Some("contacts.r.radius")),
+        (Some(("chords", 4.0)), Some("contacts.r.chords")),
+    ] {
+        s.set(
+            "body",
+            Value::Map(vec![
+                ("links".into(), Value::List(vec![link.clone()])),
+                ("contacts".into(), Value::List(vec![rod(extra)])),
+            ]),
+        );
+        assert_eq!(refused_field(&s).as_deref(), want);
+    }
+}
+
+#[test]
+fn numbers_in_messages_are_short() {
+    use crate::error::fmt_num;
+    assert_eq!(fmt_num(0.184), "0.184");
+    assert_eq!(fmt_num(1e-4), "0.0001");
+    assert_eq!(fmt_num(1e300), "1e300");
+    assert_eq!(fmt_num(1e-300), "1e-300");
+    assert_eq!(fmt_num(1.0000000000000001e304), "1e304");
+    assert_eq!(fmt_num(1.23456789e-300), "1.23e-300");
+    assert_eq!(fmt_num(f64::NAN), "NaN");
+}
+
+#[test]
+fn the_notes_state_the_work_bounds() {
+    // The field table's notes (TOML comments, docs, errors) say the bounds the checks use.
+    use crate::spec::fields::{info, MAX_SAMPLES, MAX_STEPS};
+    let steps = format!("t_end / dt <= {MAX_STEPS:e} steps");
+    assert!(info("t_end").unwrap().note.contains(&steps));
+    let samples = format!("t_end / dt / record_stride <= {MAX_SAMPLES:e} samples");
+    assert!(info("record_stride").unwrap().note.contains(&samples));
+}
