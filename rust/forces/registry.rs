@@ -10,11 +10,22 @@ use super::{
 };
 use crate::error::{suggest, GranrsError, Result};
 
-/// Most contact terms a scene may list: the thesis's three and one more. The per-term forces
-/// of an evaluation are a fixed-size array (an evaluation allocates nothing), copied with
-/// every contact's findings: at 6 the free link's vertical drop measured 5 % slower than at
-/// 3 (criterion `impact/vertical_2.214`), so the array is kept as small as the laws need.
-pub const MAX_TERMS: usize = 4;
+/// Most contact terms a scene may list: every contact term of the registry (each at most
+/// once). The per-term forces of an evaluation are a fixed-size array of this length (an
+/// evaluation allocates nothing).
+pub const MAX_TERMS: usize = contact_terms(ALL_TERMS);
+
+/// How many of `terms` act at a contact.
+const fn contact_terms(terms: &[&TermInfo]) -> usize {
+    let (mut n, mut i) = (0, 0);
+    while i < terms.len() {
+        if matches!(terms[i].acts, Acts::Contact) {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+}
 
 macro_rules! registry {
     ($($(#[$m:meta])* $variant:ident($ty:ty),)*) => {
@@ -25,7 +36,10 @@ macro_rules! registry {
         }
 
         /// Every registered term's description.
-        pub static TERMS: &[&TermInfo] = &[$($(#[$m])* &<$ty as Term>::INFO,)*];
+        pub static TERMS: &[&TermInfo] = ALL_TERMS;
+
+        /// [`TERMS`] as a constant (for [`MAX_TERMS`]).
+        const ALL_TERMS: &[&TermInfo] = &[$($(#[$m])* &<$ty as Term>::INFO,)*];
 
         impl AnyTerm {
             /// The term's description.
