@@ -29,6 +29,7 @@ __all__ = [
     "compiled_scene",
     "element_fields",
     "leg_segments",
+    "max_threads",
     "resistance_force",
     "rft_alpha",
     "run",

@@ -495,6 +495,36 @@ mod tests {
         }
     }
 
+    /// A scene may list every registered term at once: [`MAX_TERMS`] is the count of the
+    /// contact terms (it was a fixed 4 while six existed, and a scene listing more failed).
+    #[test]
+    fn every_term_may_be_listed_at_once() {
+        let contact = TERMS.iter().filter(|t| t.acts == Acts::Contact).count();
+        assert!(contact >= 6, "{contact}");
+        assert_eq!(MAX_TERMS, contact);
+        let specs: Vec<TermSpec> = TERMS
+            .iter()
+            .map(|t| TermSpec {
+                name: t.name.into(),
+                params: t
+                    .params
+                    .iter()
+                    .map(|p| {
+                        let value = if p.required() {
+                            p.min.max(0.0) + 1.0
+                        } else {
+                            p.default
+                        };
+                        (p.name.to_string(), vec![value])
+                    })
+                    .collect(),
+            })
+            .collect();
+        let set = ForceSet::build(&specs, 2).unwrap();
+        assert_eq!(set.contact_info.len(), contact);
+        assert_eq!(set.names.len(), TERMS.len());
+    }
+
     #[test]
     fn unknown_terms_and_parameters_are_named_with_a_near_miss() {
         let err = ForceSet::build(&[TermSpec::new("stati_v", &[])], 1).unwrap_err();

@@ -613,7 +613,7 @@ impl<const N: usize> Run<N> {
     pub fn finish(self, model: &Model<N>) -> Result<Outcome> {
         debug_assert!(!self.in_lanes, "resume the run first");
         if self.cancelled {
-            return Err(GranrsError::Cancelled { t: self.t });
+            return Err(GranrsError::Cancelled);
         }
         let status = self.status.unwrap_or(Status::NotStopped);
         self.obs.finish(

@@ -20,7 +20,7 @@ pub(crate) fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
         GranrsError::NonFinite { .. } => ("SimulationError", None),
         // A run stopped from outside: the binding raises what stopped it (Ctrl-C's
         // KeyboardInterrupt); this is the fallback.
-        GranrsError::Cancelled { .. } => return PyKeyboardInterrupt::new_err(err.to_string()),
+        GranrsError::Cancelled => return PyKeyboardInterrupt::new_err(err.to_string()),
     };
     let message = err.to_string();
     let make = || -> PyResult<PyErr> {
