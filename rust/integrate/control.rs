@@ -109,7 +109,8 @@ impl Control {
     /// find the next one too short (a step size underflow).
     #[inline]
     pub(super) fn would_underflow(&self, h: f64, err: f64) -> bool {
-        self.adaptive && !(err <= 1.0) && !(h * Self::factor(err).min(0.9) > self.floor())
+        let next = h * Self::factor(err).min(0.9);
+        self.adaptive && (err.is_nan() || err > 1.0) && (next.is_nan() || next <= self.floor())
     }
 
     /// Judge a step of size `h` from `t` with error norm `err`: accept it (true; the next
