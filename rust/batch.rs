@@ -1,22 +1,22 @@
 //! Many runs at once: a Cartesian product of field values over a base scene, or a list of
-//! scenes, run on a rayon pool and summarized into one table (one row per run, in input
-//! order).
+//! scenes, run on the process's one rayon pool ([`pool`], one thread per core) and
+//! summarized into one table (one row per run, in input order).
 //!
 //! Every scene of the batch is built and validated before the first run starts, so a bad
 //! value stops the batch with an error naming the run and the field, and nothing has run. A
 //! run that fails (a non-finite state) does not stop the batch: its row has status
 //! [`STATUS_FAILED`] and its message is kept. Progress is an atomic counter and
 //! cancellation an atomic flag, so a caller (Python's Ctrl-C) can watch and stop the
-//! batch from another thread; a cancelled batch stops after the runs in flight.
+//! batch, its validation included, from another thread: the runs in flight stop within a
+//! few milliseconds ([`crate::integrate::cancel`]).
 
 use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-use rayon::prelude::*;
-
 use crate::bodies::AnyScene;
 use crate::error::{GranrsError, Result};
+use crate::integrate::cancel::Watch;
 use crate::integrate::lanes::{run_lanes, LaneIsa, LaneScene};
 use crate::integrate::{Outcome, Status, OUTCOME_FIELDS};
 use crate::spec::{SceneSpec, Value};
@@ -230,48 +230,97 @@ pub fn in_run(i: usize, e: GranrsError) -> GranrsError {
     }
 }
 
-/// The rayon pool of `threads` threads (0: one per core), started on first use and kept
-/// for the process, one per thread count: a sweep neither starts nor stops threads.
+/// The machine's cores (what the process may run on: its CPU affinity and cgroup quota):
+/// the size of the one pool ([`pool`]), so the most threads a batch runs on.
+pub fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The one rayon pool of the process, of [`cores`] threads, started on first use and kept:
+/// every batch runs on it, whatever its thread count ([`workers`]), so a process never holds
+/// more of granrs' threads than cores, and a sweep neither starts nor stops threads.
 ///
-/// Each pool carries the id of the process that started it. A forked child (multiprocessing's
-/// fork, a forking Dask worker) inherits the list but not the pools' threads, so it starts
-/// its own and forgets the parent's: never drops them, as dropping would wake threads that
-/// do not exist in the child.
-pub fn pool(threads: usize) -> Result<Arc<rayon::ThreadPool>> {
-    type Kept = Vec<(usize, u32, Arc<rayon::ThreadPool>)>;
-    static POOLS: Mutex<Kept> = Mutex::new(Vec::new());
+/// The pool carries the id of the process that started it. A forked child (multiprocessing's
+/// fork, a forking Dask worker) inherits it but not its threads, so it starts its own and
+/// forgets the parent's: never drops it, as dropping would wake threads that do not exist in
+/// the child.
+pub fn pool() -> Result<Arc<rayon::ThreadPool>> {
+    static POOL: Mutex<Option<(u32, Arc<rayon::ThreadPool>)>> = Mutex::new(None);
     let pid = std::process::id();
-    let mut pools = POOLS.lock().unwrap_or_else(|p| p.into_inner());
-    // The list is the parent's whole or this process's whole: the first call in a child
-    // forgets it.
-    if pools.first().is_some_and(|(_, owner, _)| *owner != pid) {
-        pools
-            .drain(..)
-            .for_each(|(_, _, inherited)| std::mem::forget(inherited));
-    }
-    if let Some((_, _, kept)) = pools.iter().find(|(n, _, _)| *n == threads) {
-        return Ok(Arc::clone(kept));
+    let mut kept = POOL.lock().unwrap_or_else(|p| p.into_inner());
+    match kept.take() {
+        Some((owner, pool)) if owner == pid => {
+            *kept = Some((owner, Arc::clone(&pool)));
+            return Ok(pool);
+        }
+        Some((_, inherited)) => std::mem::forget(inherited),
+        None => {}
     }
     let started = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
+        .num_threads(cores())
+        .thread_name(|i| format!("granrs-{i}"))
         .build()
         .map_err(|e| GranrsError::InvalidScene {
             field: "threads".into(),
             message: format!("cannot start a thread pool: {e}"),
         })?;
     let started = Arc::new(started);
-    pools.push((threads, pid, Arc::clone(&started)));
+    *kept = Some((pid, Arc::clone(&started)));
     Ok(started)
 }
 
-/// Build and validate every run in `range` (in parallel); the error of the first bad run,
-/// in input order, names it.
-pub fn validate(src: &Source, range: std::ops::Range<usize>) -> Result<()> {
-    let first = range
-        .into_par_iter()
-        .filter_map(|i| src.scene(i).err().map(|e| (i, e)))
-        .min_by_key(|(i, _)| *i);
-    match first {
+/// The threads of `pool` a batch asked for `threads` runs on: all of them for 0, at most
+/// all of them (a larger count is capped; the Python layer says so).
+pub fn workers(pool: &rayon::ThreadPool, threads: usize) -> usize {
+    let all = pool.current_num_threads();
+    if threads == 0 {
+        all
+    } else {
+        threads.min(all)
+    }
+}
+
+/// Run `work` on the first `workers` threads of the current rayon pool (call inside
+/// `pool.install` or a job of the pool), each with a [`Watch`] on `cancel` over its runs;
+/// the rest of the pool's threads stay idle.
+fn on_workers(workers: usize, cancel: &AtomicBool, work: impl Fn() + Sync) {
+    rayon::broadcast(|ctx| {
+        if ctx.index() < workers {
+            Watch::new(cancel).over(&work);
+        }
+    });
+}
+
+/// Build and validate every run in `range` on `workers` threads (the current pool's, see
+/// [`on_workers`]); the error of the first bad run, in input order, names it. Setting
+/// `cancel` stops the validation ([`GranrsError::Cancelled`]).
+pub fn validate(
+    src: &Source,
+    range: std::ops::Range<usize>,
+    workers: usize,
+    cancel: &AtomicBool,
+) -> Result<()> {
+    // Runs are handed out in input order, so once run `i` is found bad every earlier run
+    // has been handed out: no later one needs building.
+    let next = AtomicUsize::new(range.start);
+    let first_bad = AtomicUsize::new(usize::MAX);
+    let bad = Mutex::new(Vec::new());
+    on_workers(workers, cancel, || loop {
+        let i = next.fetch_add(1, Ordering::Relaxed);
+        if i >= range.end || i > first_bad.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed)
+        {
+            return;
+        }
+        if let Err(e) = src.scene(i) {
+            first_bad.fetch_min(i, Ordering::Relaxed);
+            bad.lock().unwrap_or_else(|p| p.into_inner()).push((i, e));
+        }
+    });
+    if cancel.load(Ordering::Relaxed) {
+        return Err(GranrsError::Cancelled);
+    }
+    let bad = bad.into_inner().unwrap_or_else(|p| p.into_inner());
+    match bad.into_iter().min_by_key(|(i, _)| *i) {
         None => Ok(()),
         Some((i, e)) => Err(in_run(i, e)),
     }
@@ -334,14 +383,17 @@ impl Rows {
     }
 }
 
-/// Run every scene in `range` on the current rayon pool (call inside `pool.install`).
-/// `done` counts finished runs; setting `cancel` stops the batch after the runs in flight
-/// (the rest get status [`STATUS_CANCELLED`]). Validate first: a run whose scene does not
-/// build is recorded as failed. `path` chooses the lanes or the scalar path.
+/// Run every scene in `range` on `workers` threads of the current rayon pool (call inside
+/// `pool.install` or a job of the pool; see [`on_workers`]). `done` counts finished runs;
+/// setting `cancel` stops the batch: the runs in flight stop within a few milliseconds
+/// ([`crate::integrate::cancel`]) and every run not finished gets status
+/// [`STATUS_CANCELLED`]. Validate first: a run whose scene does not build is recorded as
+/// failed. `path` chooses the lanes or the scalar path.
 pub fn run(
     src: &Source,
     range: std::ops::Range<usize>,
     body: &str,
+    workers: usize,
     done: &AtomicUsize,
     cancel: &AtomicBool,
     path: Path,
@@ -352,21 +404,26 @@ pub fn run(
     let mut data = vec![f64::NAN; range.len() * width];
     let failures = Mutex::new(Vec::new());
     let fail = |i: usize, row: &mut [f64], e: GranrsError| {
+        if let GranrsError::Cancelled = e {
+            row.fill(f64::NAN);
+            row[0] = STATUS_CANCELLED;
+            return;
+        }
         row[0] = STATUS_FAILED;
         failures
             .lock()
             .unwrap_or_else(|p| p.into_inner())
             .push((i, e.to_string()));
     };
+    let n = range.len();
+    let rows = Rows::new(&mut data, width);
     if path == Path::Lanes && body == "free_link" {
         let isa = LaneIsa::detect();
-        let n = range.len();
         // Every thread runs its own four lanes and takes the batch's next scene whenever a
         // lane frees: no thread waits on another's tail, and no lane idles until the batch
         // runs out (with fixed chunks, each chunk's last steps ran with idle lanes).
         let next_scene = AtomicUsize::new(0);
-        let rows = Rows::new(&mut data, width);
-        rayon::broadcast(|_| {
+        on_workers(workers, cancel, || {
             let next = || -> Option<LaneScene<usize>> {
                 loop {
                     let j = next_scene.fetch_add(1, Ordering::Relaxed);
@@ -407,15 +464,21 @@ pub fn run(
             run_lanes(isa, next, finished);
         });
     } else {
-        data.par_chunks_mut(width).enumerate().for_each(|(k, row)| {
-            let i = start + k;
-            if cancel.load(Ordering::Relaxed) {
-                row[0] = STATUS_CANCELLED;
+        let next_run = AtomicUsize::new(0);
+        on_workers(workers, cancel, || loop {
+            let j = next_run.fetch_add(1, Ordering::Relaxed);
+            if j >= n {
                 return;
             }
-            match src.scene(i).and_then(|s| s.run()) {
+            // SAFETY: `next_run` hands each row to one thread once.
+            let row = unsafe { rows.row(j) };
+            if cancel.load(Ordering::Relaxed) {
+                row[0] = STATUS_CANCELLED;
+                continue;
+            }
+            match src.scene(start + j).and_then(|s| s.run()) {
                 Ok(out) => summarize(&out, row),
-                Err(e) => fail(i, row, e),
+                Err(e) => fail(start + j, row, e),
             }
             done.fetch_add(1, Ordering::Relaxed);
         });
@@ -481,9 +544,17 @@ mod tests {
         let src = product();
         let done = AtomicUsize::new(0);
         let cancel = AtomicBool::new(false);
-        let out = pool(2)
-            .unwrap()
-            .install(|| run(&src, 0..src.len(), "free_link", &done, &cancel, Path::Lanes));
+        let out = pool().unwrap().install(|| {
+            run(
+                &src,
+                0..src.len(),
+                "free_link",
+                2,
+                &done,
+                &cancel,
+                Path::Lanes,
+            )
+        });
         assert_eq!(done.load(Ordering::Relaxed), 6);
         let width = out.columns.len();
         let depth = out.columns.iter().position(|c| c == "c0.depth").unwrap();
@@ -507,9 +578,9 @@ mod tests {
     fn rows_bits(src: &Source, path: Path) -> Vec<u64> {
         let done = AtomicUsize::new(0);
         let cancel = AtomicBool::new(false);
-        let out = pool(2)
+        let out = pool()
             .unwrap()
-            .install(|| run(src, 0..src.len(), "free_link", &done, &cancel, path));
+            .install(|| run(src, 0..src.len(), "free_link", 2, &done, &cancel, path));
         assert_eq!(done.load(Ordering::Relaxed), src.len());
         assert!(out.failures.is_empty(), "{:?}", out.failures);
         out.data.iter().map(|x| x.to_bits()).collect()
@@ -588,7 +659,7 @@ mod tests {
                 vec![Value::Num(1.0), Value::Num(-1.0), Value::Num(f64::NAN)],
             )],
         };
-        match validate(&src, 0..3) {
+        match validate(&src, 0..3, 2, &AtomicBool::new(false)) {
             Err(GranrsError::InvalidParameter { field, allowed, .. }) => {
                 assert_eq!(field, "mass");
                 assert!(allowed.ends_with("in run 1"), "{allowed}");
@@ -597,12 +668,79 @@ mod tests {
         }
     }
 
+    /// A batch of runs that each take minutes, cancelled from another thread: every run,
+    /// in flight or not, stops within milliseconds with status cancelled (no failure), on
+    /// both paths. Before, a cancelled batch waited for its runs in flight.
+    #[test]
+    fn cancelling_a_batch_stops_the_runs_in_flight() {
+        for path in [Path::Lanes, Path::Scalar] {
+            let mut long = base();
+            long.set("end", Value::Str(std::borrow::Cow::Borrowed("time")));
+            long.set("t_end", Value::Num(1e3));
+            long.set("dt", Value::Num(1e-5));
+            let src = Source::Product {
+                base: long,
+                axes: vec![("v0".into(), num(&[1.0, 2.0, 3.0, 4.0, 5.0]))],
+            };
+            let done = AtomicUsize::new(0);
+            let cancel = AtomicBool::new(false);
+            let t0 = std::time::Instant::now();
+            let out = std::thread::scope(|s| {
+                s.spawn(|| {
+                    std::thread::sleep(std::time::Duration::from_millis(100));
+                    cancel.store(true, Ordering::Relaxed);
+                });
+                pool()
+                    .unwrap()
+                    .install(|| run(&src, 0..src.len(), "free_link", 2, &done, &cancel, path))
+            });
+            let took = t0.elapsed();
+            assert!(took.as_secs_f64() < 2.0, "{path:?}: stopped after {took:?}");
+            assert!(out.cancelled);
+            assert!(out.failures.is_empty(), "{:?}", out.failures);
+            assert!(out
+                .data
+                .chunks(out.columns.len())
+                .all(|r| r[0] == STATUS_CANCELLED));
+        }
+    }
+
+    /// Validation stops when cancelled, with [`GranrsError::Cancelled`].
+    #[test]
+    fn a_cancelled_validation_stops() {
+        let src = product();
+        let cancel = AtomicBool::new(true);
+        let out = pool()
+            .unwrap()
+            .install(|| validate(&src, 0..src.len(), 2, &cancel));
+        assert!(matches!(out, Err(GranrsError::Cancelled)), "{out:?}");
+    }
+
+    /// The one pool has a thread per core; a batch asks for at most that many.
+    #[test]
+    fn the_pool_is_one_thread_per_core_and_shared() {
+        let pool = pool().unwrap();
+        assert_eq!(pool.current_num_threads(), cores());
+        assert!(Arc::ptr_eq(&pool, &super::pool().unwrap()));
+        assert_eq!(workers(&pool, 0), cores());
+        assert_eq!(workers(&pool, 1), 1);
+        assert_eq!(workers(&pool, 1000), cores());
+    }
+
     #[test]
     fn a_cancelled_batch_marks_what_it_did_not_run() {
         let src = product();
         let done = AtomicUsize::new(0);
         let cancel = AtomicBool::new(true);
-        let out = run(&src, 0..src.len(), "free_link", &done, &cancel, Path::Lanes);
+        let out = run(
+            &src,
+            0..src.len(),
+            "free_link",
+            2,
+            &done,
+            &cancel,
+            Path::Lanes,
+        );
         assert!(out.cancelled);
         assert_eq!(done.load(Ordering::Relaxed), 0);
         assert!(out

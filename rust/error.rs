@@ -44,6 +44,10 @@ pub enum GranrsError {
     /// unless the physics itself blows up; the message says when and where.
     #[error("integration failed at t = {t} s: {message}")]
     NonFinite { t: f64, message: String },
+    /// A run or a batch's validation was stopped from outside (Ctrl-C, a cancelled sweep):
+    /// not a failure (see `integrate::cancel`).
+    #[error("interrupted")]
+    Cancelled,
 }
 
 pub type Result<T> = std::result::Result<T, GranrsError>;

@@ -29,6 +29,7 @@ __all__ = [
     "compiled_scene",
     "element_fields",
     "leg_segments",
+    "max_threads",
     "resistance_force",
     "rft_alpha",
     "run",
@@ -101,8 +102,8 @@ def sweep(
     lanes: bool = True,
 ) -> dict[str, Any]:
     """Run runs start..stop of a batch (the product of axes over base, or a list of scene
-    dicts or compiled scenes) on `threads` threads (0: every core); return columns, data
-    (rows x columns), failures [(run, message)] and body."""
+    dicts or compiled scenes) on `threads` threads (0, or more than the cores: every core);
+    return columns, data (rows x columns), failures [(run, message)] and body."""
 
 def validate_sweep(
     base: dict[str, Any] | None = None,
@@ -111,6 +112,9 @@ def validate_sweep(
     threads: int = 0,
 ) -> int:
     """Validate every run of a batch without running it; return the number of runs."""
+
+def max_threads() -> int:
+    """The most threads a sweep runs on: the machine's cores (the shared pool's size)."""
 
 FORCE_INPUTS: list[str]
 FORCE_OUTPUTS: list[str]

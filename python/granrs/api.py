@@ -44,8 +44,9 @@ def simulate(scene: Scene) -> Result:
 
     The scene is validated in full before the run starts (an invalid field raises a
     :class:`~granrs.errors.InvalidSceneError` subclass naming it). The run itself releases
-    the GIL. A body that has not stopped by ``scene.t_end`` is not an error: the result's
-    ``status`` says ``"not_stopped"``.
+    the GIL; on the main thread, Ctrl-C stops it within a fraction of a second and raises
+    ``KeyboardInterrupt``. A body that has not stopped by ``scene.t_end`` is not an error:
+    the result's ``status`` says ``"not_stopped"``.
 
     Example:
         >>> import granrs

@@ -4,7 +4,8 @@
 scenes) in the Rust core, on a rayon pool with the GIL released, and returns a pandas
 DataFrame of summaries in input order. Every run is validated before the first starts; a
 bad value raises the typed error naming the field and the run. A progress bar (tqdm) shows
-on long sweeps; Ctrl-C cancels after the runs in flight and raises ``KeyboardInterrupt``.
+on long sweeps; Ctrl-C cancels the sweep (its validation and the runs in flight included)
+within a fraction of a second and raises ``KeyboardInterrupt``.
 Given a ``dask.distributed`` client, the same sweep is cut into chunks that each run the
 Rust batch on a worker (``pip install 'granrs[dask]'``).
 """
@@ -288,6 +289,9 @@ def _compiled(scenes: list[Scene]) -> list[Any]:
 
 
 def _threads(threads: int | None) -> int:
+    """The core's thread count of a sweep's ``threads`` (0: every core). A count above the
+    machine's cores runs on every core, with a :class:`RuntimeWarning` saying so: every sweep
+    shares one pool of one thread per core."""
     if threads is None:
         return 0
     if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
@@ -295,6 +299,15 @@ def _threads(threads: int | None) -> int:
             f"threads must be a whole number >= 1 (or None for every core); got {threads!r}",
             field="threads",
         )
+    cores = _granrs.max_threads()
+    if threads > cores:
+        warnings.warn(
+            f"threads={threads} is more than this machine's {cores} cores: the sweep runs on "
+            f"{cores} threads",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+        return cores
     return threads
 
 
@@ -408,7 +421,9 @@ def sweep(
     Args:
         scene: the base scene, whose fields the ``axes`` vary; or a list of scenes (then no
             axes), all of one body.
-        threads: worker threads (default: one per core). Results do not depend on it.
+        threads: worker threads (default: one per core). Results do not depend on it. Every
+            sweep shares one pool of one thread per core: a larger count runs on every core,
+            with a ``RuntimeWarning``.
         progress: show a tqdm progress bar: None (default) shows it on a terminal for
             sweeps of at least 2000 runs; True always; False never.
         client: a ``dask.distributed.Client``: cut the sweep into chunks of ``chunk_size``
@@ -438,7 +453,8 @@ def sweep(
     Raises:
         InvalidSceneError: (or a subclass) before anything runs, naming the field, with
             the index of the first bad run.
-        KeyboardInterrupt: on Ctrl-C, after the runs in flight.
+        KeyboardInterrupt: on Ctrl-C, within a fraction of a second (the runs in flight
+            stop too).
 
     Example:
         >>> import granrs

@@ -13,7 +13,7 @@ use crate::body::Joint;
 use crate::dynamics::{Model, SignModel};
 use crate::error::{check_finite, check_range, fmt_num, GranrsError, Result};
 use crate::forces::Medium;
-use crate::integrate::{Method, Outcome, SolveOptions};
+use crate::integrate::{Method, Outcome, SolveOptions, RTOL_MIN};
 use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
 
 pub mod chain;
@@ -73,6 +73,16 @@ pub fn validate_options(o: &SolveOptions, sign_model: &SignModel) -> Result<()> 
     }
     if let Method::Dopri5 { rtol, atol } = o.method {
         check_range("rtol", rtol, 0.0, true)?;
+        if rtol < RTOL_MIN {
+            return Err(GranrsError::InvalidParameter {
+                field: "rtol".into(),
+                value: rtol,
+                allowed: format!(
+                    ">= {RTOL_MIN:.1e} (100 x f64's epsilon: a smaller relative tolerance is \
+                     below what the arithmetic resolves)"
+                ),
+            });
+        }
         check_range("atol", atol, 0.0, true)?;
     }
     Ok(())

@@ -10,11 +10,22 @@ use super::{
 };
 use crate::error::{suggest, GranrsError, Result};
 
-/// Most contact terms a scene may list: the thesis's three and one more. The per-term forces
-/// of an evaluation are a fixed-size array (an evaluation allocates nothing), copied with
-/// every contact's findings: at 6 the free link's vertical drop measured 5 % slower than at
-/// 3 (criterion `impact/vertical_2.214`), so the array is kept as small as the laws need.
-pub const MAX_TERMS: usize = 4;
+/// Most contact terms a scene may list: every contact term of the registry (each at most
+/// once). The per-term forces of an evaluation are a fixed-size array of this length (an
+/// evaluation allocates nothing).
+pub const MAX_TERMS: usize = contact_terms(ALL_TERMS);
+
+/// How many of `terms` act at a contact.
+const fn contact_terms(terms: &[&TermInfo]) -> usize {
+    let (mut n, mut i) = (0, 0);
+    while i < terms.len() {
+        if matches!(terms[i].acts, Acts::Contact) {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+}
 
 macro_rules! registry {
     ($($(#[$m:meta])* $variant:ident($ty:ty),)*) => {
@@ -25,7 +36,10 @@ macro_rules! registry {
         }
 
         /// Every registered term's description.
-        pub static TERMS: &[&TermInfo] = &[$($(#[$m])* &<$ty as Term>::INFO,)*];
+        pub static TERMS: &[&TermInfo] = ALL_TERMS;
+
+        /// [`TERMS`] as a constant (for [`MAX_TERMS`]).
+        const ALL_TERMS: &[&TermInfo] = &[$($(#[$m])* &<$ty as Term>::INFO,)*];
 
         impl AnyTerm {
             /// The term's description.
@@ -484,6 +498,36 @@ mod tests {
             );
             assert_eq!(term.map(|x| x.info().name), Some(t.name));
         }
+    }
+
+    /// A scene may list every registered term at once: [`MAX_TERMS`] is the count of the
+    /// contact terms (it was a fixed 4 while six existed, and a scene listing more failed).
+    #[test]
+    fn every_term_may_be_listed_at_once() {
+        let contact = TERMS.iter().filter(|t| t.acts == Acts::Contact).count();
+        assert!(contact >= 6, "{contact}");
+        assert_eq!(MAX_TERMS, contact);
+        let specs: Vec<TermSpec> = TERMS
+            .iter()
+            .map(|t| TermSpec {
+                name: t.name.into(),
+                params: t
+                    .params
+                    .iter()
+                    .map(|p| {
+                        let value = if p.required() {
+                            p.min.max(0.0) + 1.0
+                        } else {
+                            p.default
+                        };
+                        (p.name.to_string(), vec![value])
+                    })
+                    .collect(),
+            })
+            .collect();
+        let set = ForceSet::build(&specs, 2).unwrap();
+        assert_eq!(set.contact_info.len(), contact);
+        assert_eq!(set.names.len(), TERMS.len());
     }
 
     #[test]

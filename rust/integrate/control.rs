@@ -39,6 +39,18 @@ impl Control {
         }
     }
 
+    /// Whether the step adapts (Dopri5), else the grid (RK4).
+    #[inline]
+    pub(super) fn adaptive(&self) -> bool {
+        self.adaptive
+    }
+
+    /// Make the next adaptive step of size `h`.
+    #[inline]
+    pub(super) fn retry(&mut self, h: f64) {
+        self.h = h;
+    }
+
     /// Whether the run has reached `t_end` at `t`.
     #[inline]
     pub(super) fn finished(&self, t: f64) -> bool {
@@ -77,6 +89,30 @@ impl Control {
         }
     }
 
+    /// The factor of the next adaptive step's size after one of error norm `err`.
+    #[inline]
+    fn factor(err: f64) -> f64 {
+        if err == 0.0 {
+            5.0
+        } else {
+            (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+        }
+    }
+
+    /// The shortest adaptive step [s].
+    #[inline]
+    fn floor(&self) -> f64 {
+        1e-14 * self.t_end.max(1.0)
+    }
+
+    /// Whether [`Control::judge`] would reject a step of size `h` with error norm `err` and
+    /// find the next one too short (a step size underflow).
+    #[inline]
+    pub(super) fn would_underflow(&self, h: f64, err: f64) -> bool {
+        let next = h * Self::factor(err).min(0.9);
+        self.adaptive && (err.is_nan() || err > 1.0) && (next.is_nan() || next <= self.floor())
+    }
+
     /// Judge a step of size `h` from `t` with error norm `err`: accept it (true; the next
     /// adaptive step's size is set) or reject it (false; to be tried again, shorter). The
     /// grid accepts every step. An adaptive step that shrinks to nothing is an error.
@@ -85,15 +121,11 @@ impl Control {
         if !self.adaptive {
             return Ok(true);
         }
-        let factor = if err == 0.0 {
-            5.0
-        } else {
-            (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
-        };
+        let factor = Self::factor(err);
         if err.is_nan() || err > 1.0 {
             stats.rejected += 1;
             self.h = h * factor.min(0.9);
-            if self.h.is_nan() || self.h <= 1e-14 * self.t_end.max(1.0) {
+            if self.h.is_nan() || self.h <= self.floor() {
                 return Err(GranrsError::NonFinite {
                     t,
                     message: format!("step size underflow at t = {t} s (error norm {err})"),

@@ -2,8 +2,10 @@
 //! ([`solve`](mod@solve): step, detect, handle, observe), the step ([`stepper`]: RK4 and
 //! Dopri5, dense output), where the steps end ([`control`]), the events ([`events`]), what
 //! the run keeps of itself ([`observe`]) and what it returns ([`outcome`], with the one
-//! table of output fields [`OUTCOME_FIELDS`]).
+//! table of output fields [`OUTCOME_FIELDS`]), and how a run is stopped from outside
+//! ([`cancel`]).
 
+pub mod cancel;
 pub mod control;
 pub mod drives;
 pub mod events;
@@ -20,4 +22,4 @@ pub use outcome::{
     Stats, Status, OUTCOME_FIELDS,
 };
 pub use solve::{solve, solve_driven, EndCondition, Run, SolveOptions};
-pub use stepper::Method;
+pub use stepper::{Method, RTOL_MIN};

@@ -10,6 +10,7 @@
 
 use nalgebra::SVector;
 
+use super::cancel;
 use super::control::Control;
 use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
@@ -138,6 +139,11 @@ pub struct Run<const N: usize> {
     /// Whether the lanes accepted this run's last step ([`Run::accept_plain`]) and keep its
     /// end's evaluation: the run must [`Run::resume`] it before it steps itself.
     in_lanes: bool,
+    /// Steps until the run next looks at its thread's watch ([`cancel::look`]).
+    look_in: u32,
+    /// Whether the watch stopped the run ([`Run::finish`] then gives
+    /// [`GranrsError::Cancelled`]).
+    cancelled: bool,
 }
 
 impl<const N: usize> Run<N> {
@@ -186,6 +192,8 @@ impl<const N: usize> Run<N> {
             layout: RodLayout::of(model).unwrap_or_default(),
             isa: LaneIsa::detect(),
             in_lanes: false,
+            look_in: cancel::FIRST_LOOK,
+            cancelled: false,
         }
     }
 
@@ -206,6 +214,12 @@ impl<const N: usize> Run<N> {
     #[inline(always)]
     pub fn next_step(&mut self, model: &Model<N>) -> Option<f64> {
         if self.status.is_some() {
+            return None;
+        }
+        // Now and then, whether whoever started the run wants it stopped: one decrement a
+        // step.
+        self.look_in -= 1;
+        if self.look_in == 0 && self.look() {
             return None;
         }
         loop {
@@ -239,6 +253,20 @@ impl<const N: usize> Run<N> {
             self.clamped = clamped;
             return Some(h);
         }
+    }
+
+    /// Look at the thread's watch ([`cancel::look`]): whether the run is to stop (then it
+    /// has ended, cancelled), and when to look next.
+    #[cold]
+    #[inline(never)]
+    fn look(&mut self) -> bool {
+        let (stop, next) = cancel::look();
+        self.look_in = next.max(1);
+        if stop {
+            self.cancelled = true;
+            self.status = Some(Status::NotStopped);
+        }
+        stop
     }
 
     /// At a time of the drive tables: the rates take the impulse onto the new segments.
@@ -364,20 +392,9 @@ impl<const N: usize> Run<N> {
         let control = &mut self.control;
         let (y, t, cur) = (&mut self.y, &mut self.t, &mut self.cur);
         let (t_next, clamped) = (self.t_next, self.clamped);
-        if !control.judge(h, err, *t, stats)? {
-            return Ok(());
-        }
         let (e0, e1) = start_and_end(&mut self.evals, *cur);
         let e1: &Eval<N> = e1;
-        if !y1.is_finite() || !e1.qdd.iter().all(|v| v.is_finite()) {
-            let t = *t;
-            return Err(GranrsError::NonFinite {
-                t,
-                message: format!("state became non-finite in the step from t = {t} s (h = {h} s)"),
-            });
-        }
-
-        // Detect.
+        let finite = y1.is_finite() && e1.qdd.iter().all(|v| v.is_finite());
         let span = Span {
             y0: y,
             k1,
@@ -386,7 +403,46 @@ impl<const N: usize> Run<N> {
             e1,
             h,
         };
-        let mut earliest = events.detect(model, modes, &span, stats);
+        // An adaptive step that fails its error test however short it gets, across an event:
+        // the force law may jump there (a sole's drag at the surface), which no step across it
+        // resolves. Rather than give up, step to the event, located on this step of the
+        // shortest size the control allows, and handle it there.
+        let mut to_event = None;
+        if control.adaptive() && finite && control.would_underflow(h, err) {
+            let earliest = events.detect(model, modes, &span, stats);
+            if !events.none() && earliest < 1.0 {
+                stats.rejected += 1;
+                let h_star = earliest * h;
+                let y_star = if h_star > 0.0 {
+                    let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
+                    partial_step(model, options.method, modes, y, k1, h_star, stats, sample).0
+                } else {
+                    *y
+                };
+                // The next step starts at the shortest size again.
+                control.retry(h);
+                to_event = Some((earliest, y_star));
+            }
+        }
+        let (mut earliest, y_to_event) = match to_event {
+            Some((earliest, y_star)) => (earliest, Some(y_star)),
+            None => {
+                if !control.judge(h, err, *t, stats)? {
+                    return Ok(());
+                }
+                if !finite {
+                    let t = *t;
+                    return Err(GranrsError::NonFinite {
+                        t,
+                        message: format!(
+                            "state became non-finite in the step from t = {t} s (h = {h} s)"
+                        ),
+                    });
+                }
+                // Detect.
+                (events.detect(model, modes, &span, stats), None)
+            }
+        };
         if events.none() {
             // Accept the whole step.
             *y = y1;
@@ -416,11 +472,13 @@ impl<const N: usize> Run<N> {
             earliest = events.polish(model, modes, &span, earliest, stats);
         }
         let h_star = earliest * h;
-        let y_star = if earliest >= 1.0 {
+        let y_star = if let Some(y_star) = y_to_event {
+            y_star
+        } else if earliest >= 1.0 {
             y1
         } else if h_star > 0.0 {
             let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
-            partial_step(model, options.method, modes, y, k1, h_star, stats, sample)
+            partial_step(model, options.method, modes, y, k1, h_star, stats, sample).0
         } else {
             *y
         };
@@ -550,9 +608,13 @@ impl<const N: usize> Run<N> {
         self.in_lanes
     }
 
-    /// The outcome of a run that has ended ([`Run::next_step`] gave `None`).
+    /// The outcome of a run that has ended ([`Run::next_step`] gave `None`), or
+    /// [`GranrsError::Cancelled`] for a run its watch stopped.
     pub fn finish(self, model: &Model<N>) -> Result<Outcome> {
         debug_assert!(!self.in_lanes, "resume the run first");
+        if self.cancelled {
+            return Err(GranrsError::Cancelled);
+        }
         let status = self.status.unwrap_or(Status::NotStopped);
         self.obs.finish(
             model,

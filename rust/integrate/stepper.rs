@@ -13,6 +13,11 @@ use nalgebra::SVector;
 use super::outcome::Stats;
 use crate::dynamics::{DragStiffness, Eval, Model, Modes};
 
+/// The smallest relative tolerance of Dopri5: 100 times f64's epsilon (2.2e-14), the floor
+/// of MATLAB's ode45 and SciPy's RK45. Below it a step's own round-off is a fair part of
+/// what the tolerance allows, and the step-size control chases it down to nothing.
+pub const RTOL_MIN: f64 = 100.0 * f64::EPSILON;
+
 /// The time stepper.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
@@ -20,7 +25,7 @@ pub enum Method {
     Rk4,
     /// Adaptive Dormand-Prince 5(4): tolerances instead of a step; `dt` is the first step.
     Dopri5 {
-        /// Relative tolerance.
+        /// Relative tolerance (at least [`RTOL_MIN`]).
         rtol: f64,
         /// Absolute tolerance [SI units of each coordinate].
         atol: f64,
@@ -281,7 +286,8 @@ pub fn full_step<const N: usize>(
 }
 
 /// A step of `method` of size `h` from `y` to a located event, without the evaluation at
-/// its end (RK4: three evaluations; Dopri5 spends its six). RK4 shows `sample` its stages.
+/// its end (RK4: three evaluations; Dopri5 spends its six), and its error estimate's
+/// weighted RMS norm (0 for RK4). RK4 shows `sample` its stages.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn partial_step<const N: usize>(
@@ -293,15 +299,16 @@ pub fn partial_step<const N: usize>(
     h: f64,
     stats: &mut Stats,
     sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
-) -> State<N> {
+) -> (State<N>, f64) {
     match method {
         Method::Rk4 => {
             stats.rhs_evals += 3;
-            step_sampling(model, modes, y, k1, h, sample)
+            (step_sampling(model, modes, y, k1, h, sample), 0.0)
         }
         Method::Dopri5 { rtol, atol } => {
             stats.rhs_evals += 6;
-            dopri5_step(model, modes, y, k1, h, rtol, atol).0
+            let (y1, _, err) = dopri5_step(model, modes, y, k1, h, rtol, atol);
+            (y1, err)
         }
     }
 }

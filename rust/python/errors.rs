@@ -2,7 +2,7 @@
 //! `granrs.errors`, so that the Python and Rust layers share one exception tree (rooted at
 //! `granrs.GranrsError`; the classes for bad input subclass `ValueError`).
 
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 
 use crate::error::GranrsError;
@@ -18,6 +18,9 @@ pub(crate) fn to_pyerr(py: Python<'_>, err: GranrsError) -> PyErr {
         GranrsError::UnknownParameter { field, .. } => ("UnknownNameError", Some(field.clone())),
         GranrsError::InvalidScene { field, .. } => ("InvalidSceneError", Some(field.clone())),
         GranrsError::NonFinite { .. } => ("SimulationError", None),
+        // A run stopped from outside: the binding raises what stopped it (Ctrl-C's
+        // KeyboardInterrupt); this is the fallback.
+        GranrsError::Cancelled => return PyKeyboardInterrupt::new_err(err.to_string()),
     };
     let message = err.to_string();
     let make = || -> PyResult<PyErr> {

@@ -105,9 +105,15 @@ pub(super) fn resistance_force<'py>(
         sign,
     };
     let width = OUTPUTS.len();
+    const CHUNK: usize = 4096;
+    // Large calls run on the process's one pool (`batch::pool`), as sweeps do.
+    let pool = if n > 4 * CHUNK {
+        Some(crate::batch::pool().map_err(err)?)
+    } else {
+        None
+    };
     let out = py.detach(|| {
         use rayon::prelude::*;
-        const CHUNK: usize = 4096;
         let mut out = vec![0.0; n * width];
         let run = |c: usize, rows: &mut [f64]| {
             for (j, row) in rows.chunks_exact_mut(width).enumerate() {
@@ -123,15 +129,17 @@ pub(super) fn resistance_force<'py>(
                 evaluate(&setup, input, row);
             }
         };
-        if n <= 4 * CHUNK {
+        match pool {
             // Small calls (a simulator's contacts at one step): no thread hand-off.
-            out.chunks_mut(CHUNK * width)
+            None => out
+                .chunks_mut(CHUNK * width)
                 .enumerate()
-                .for_each(|(c, rows)| run(c, rows));
-        } else {
-            out.par_chunks_mut(CHUNK * width)
-                .enumerate()
-                .for_each(|(c, rows)| run(c, rows));
+                .for_each(|(c, rows)| run(c, rows)),
+            Some(pool) => pool.install(|| {
+                out.par_chunks_mut(CHUNK * width)
+                    .enumerate()
+                    .for_each(|(c, rows)| run(c, rows))
+            }),
         }
         out
     });

@@ -3,6 +3,7 @@
 //! stays in Rust ([`RunOutcome`]) until Python asks for its dict, whose summaries are read
 //! from the one table of output fields.
 
+use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Mutex};
 
 use numpy::IntoPyArray;
@@ -14,6 +15,7 @@ use super::convert::{scene_from_dict, spec_from_dict, spec_from_fields, value_fr
 use super::errors::to_pyerr;
 use crate::bodies::AnyScene;
 use crate::error::GranrsError;
+use crate::integrate::cancel::Watch;
 use crate::integrate::{FieldValue, Outcome, OUTCOME_FIELDS};
 use crate::spec::SceneSpec;
 
@@ -224,15 +226,57 @@ impl RunOutcome {
     }
 }
 
-/// Run a compiled scene; its outcome stays in Rust until asked for.
+/// Whether this thread is Python's main thread, the one that runs its signal handlers
+/// (asked of `threading` once per thread).
+fn on_main_thread(py: Python<'_>) -> bool {
+    thread_local! {
+        static MAIN: std::cell::Cell<Option<bool>> = const { std::cell::Cell::new(None) };
+    }
+    MAIN.with(|main| match main.get() {
+        Some(answer) => answer,
+        None => {
+            let ask = || -> PyResult<bool> {
+                let threading = py.import("threading")?;
+                let current = threading.call_method0("current_thread")?;
+                Ok(current.is(&threading.call_method0("main_thread")?))
+            };
+            let answer = ask().unwrap_or(false);
+            main.set(Some(answer));
+            answer
+        }
+    })
+}
+
+/// Run a compiled scene with the GIL released; its outcome stays in Rust until asked for.
+///
+/// On Python's main thread the run polls the signals about every 20 ms
+/// ([`crate::integrate::cancel`]: the GIL is taken back for the poll only), so that Ctrl-C
+/// stops it and raises `KeyboardInterrupt` (or what a signal handler raised).
 #[pyfunction]
 pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
     let scene = &compiled.get().scene;
-    let (out, seconds) = py.detach(|| {
+    let main = on_main_thread(py);
+    let (out, seconds, raised) = py.detach(|| {
         let t0 = std::time::Instant::now();
-        let out = scene.run();
-        (out, t0.elapsed().as_secs_f64())
+        let raised: std::cell::RefCell<Option<PyErr>> = std::cell::RefCell::new(None);
+        let cancel = AtomicBool::new(false);
+        let out = if main {
+            let poll = || match Python::attach(|py| py.check_signals()) {
+                Ok(()) => false,
+                Err(e) => {
+                    *raised.borrow_mut() = Some(e);
+                    true
+                }
+            };
+            Watch::polling(&cancel, &poll).over(|| scene.run())
+        } else {
+            scene.run()
+        };
+        (out, t0.elapsed().as_secs_f64(), raised.into_inner())
     });
+    if let Some(e) = raised {
+        return Err(e);
+    }
     let out = out.map_err(|e| to_pyerr(py, e))?;
     let first = out.contacts.first();
     Ok(RunOutcome {

@@ -1,5 +1,5 @@
-//! Batches from Python: `sweep` (run on a rayon pool with the GIL released, with progress
-//! and Ctrl-C) and `validate_sweep`.
+//! Batches from Python: `sweep` (run on the shared rayon pool with the GIL released, with
+//! progress and Ctrl-C) and `validate_sweep` (Ctrl-C too).
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -62,8 +62,105 @@ fn source_from_py(
     }
 }
 
-/// Validate every run of a batch (as `sweep` describes it) without running any; raises the
-/// typed error of the first bad run, naming the field and the run.
+/// How often the calling thread of a sweep polls Python's signals (Ctrl-C): the batch's runs
+/// see the cancellation within a few milliseconds more.
+const SIGNALS_EVERY: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// How often a sweep reports its progress.
+const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Run `job` (given the flag that cancels it) on the shared pool while this thread waits
+/// with the GIL released, polls Python's signals every [`SIGNALS_EVERY`] and reports
+/// `progress(done)` about every [`PROGRESS_EVERY`]. Ctrl-C (or an exception in `progress`)
+/// sets the flag, which the job's runs and validation watch, and is raised once the job has
+/// stopped.
+fn on_pool<R: Send>(
+    py: Python<'_>,
+    pool: &rayon::ThreadPool,
+    done: &AtomicUsize,
+    progress: Option<&Bound<'_, PyAny>>,
+    job: impl FnOnce(&AtomicBool) -> R + Send,
+) -> PyResult<R> {
+    let cancel = AtomicBool::new(false);
+    let finished = AtomicBool::new(false);
+    let caller = std::thread::current();
+    let mut out = None;
+    let interrupted = pool.in_place_scope(|scope| {
+        scope.spawn(|_| {
+            // A panic is caught here, so that `finished` is always set.
+            out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job(&cancel))).ok();
+            finished.store(true, Ordering::Release);
+            caller.unpark();
+        });
+        let mut interrupted: Option<PyErr> = None;
+        let mut reported = usize::MAX;
+        // A small sweep is over within a fraction of a millisecond: wait for it yielding the
+        // core rather than asleep, whose wake-up added its latency to every small sweep.
+        py.detach(|| {
+            let t0 = std::time::Instant::now();
+            while !finished.load(Ordering::Acquire) && t0.elapsed() < YIELD_WAIT {
+                std::thread::yield_now();
+            }
+        });
+        let mut last_report: Option<std::time::Instant> = None;
+        loop {
+            py.detach(|| {
+                if !finished.load(Ordering::Acquire) {
+                    std::thread::park_timeout(SIGNALS_EVERY);
+                }
+            });
+            let now = done.load(Ordering::Relaxed);
+            if let Some(cb) = progress {
+                let due = last_report.is_none_or(|t| t.elapsed() >= PROGRESS_EVERY);
+                if now != reported && (due || finished.load(Ordering::Acquire)) {
+                    reported = now;
+                    last_report = Some(std::time::Instant::now());
+                    if let Err(e) = cb.call1((now,)) {
+                        interrupted.get_or_insert(e);
+                    }
+                }
+            }
+            if let Err(e) = py.check_signals() {
+                interrupted.get_or_insert(e);
+            }
+            if interrupted.is_some() {
+                cancel.store(true, Ordering::Relaxed);
+            }
+            if finished.load(Ordering::Acquire) || interrupted.is_some() {
+                break;
+            }
+        }
+        // A cancelled job stops within milliseconds: wait for it without the GIL.
+        py.detach(|| {
+            while !finished.load(Ordering::Acquire) {
+                std::thread::park_timeout(std::time::Duration::from_millis(5));
+            }
+        });
+        interrupted
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    out.ok_or_else(|| PyRuntimeError::new_err("a sweep worker panicked"))
+}
+
+/// The shared pool and the threads of it a sweep asked for (0: all; more than the pool
+/// has: all, see [`batch::workers`]).
+fn pool_for(py: Python<'_>, threads: usize) -> PyResult<(Arc<rayon::ThreadPool>, usize)> {
+    let pool = batch::pool().map_err(|e| to_pyerr(py, e))?;
+    let workers = batch::workers(&pool, threads);
+    Ok((pool, workers))
+}
+
+/// The most threads a sweep runs on: the machine's cores (the shared pool's size).
+#[pyfunction]
+pub(super) fn max_threads(py: Python<'_>) -> PyResult<usize> {
+    Ok(pool_for(py, 0)?.1)
+}
+
+/// Validate every run of a batch (as `sweep` describes it) without running any, on
+/// `threads` threads (as `sweep`); raises the typed error of the first bad run, naming the
+/// field and the run. Ctrl-C stops it (within milliseconds) and raises.
 #[pyfunction]
 #[pyo3(signature = (base=None, axes=None, scenes=None, threads=0))]
 pub(super) fn validate_sweep<'py>(
@@ -77,20 +174,25 @@ pub(super) fn validate_sweep<'py>(
     let src = source_from_py(base, axes, scenes)?;
     src.body().map_err(err)?;
     let n = src.len();
-    let pool = batch::pool(threads).map_err(err)?;
-    py.detach(|| pool.install(|| batch::validate(&src, 0..n)))
-        .map_err(err)?;
+    let (pool, workers) = pool_for(py, threads)?;
+    let done = AtomicUsize::new(0);
+    on_pool(py, &pool, &done, None, |cancel| {
+        batch::validate(&src, 0..n, workers, cancel)
+    })?
+    .map_err(err)?;
     Ok(n)
 }
 
 /// Run a batch: the Cartesian product of `axes` (a list of `(field, values)`) over the scene
 /// dict `base`, or a list of scene dicts `scenes`; runs `start..stop` of it (default: all)
-/// on `threads` threads (0: one per core) with the GIL released.
+/// on `threads` threads of the shared pool (0, or more than the machine's cores: one per
+/// core) with the GIL released.
 ///
 /// Every run is validated before any starts. `progress(done)` is called about ten times a
-/// second from the calling thread; Ctrl-C (or an exception in `progress`) cancels the batch
-/// after the runs in flight and raises. Returns a dict: `columns` (names), `data` (a
-/// rows x columns float array, input order), `failures` (list of (run, message)), `body`.
+/// second from the calling thread; Ctrl-C (or an exception in `progress`) cancels the batch,
+/// the runs in flight and the validation included, within milliseconds, and raises. Returns
+/// a dict: `columns` (names), `data` (a rows x columns float array, input order),
+/// `failures` (list of (run, message)), `body`.
 ///
 /// `lanes` (default true) runs the free-link scenes under the thesis's terms or a frame law
 /// (`rft`, `poncelet`, `rft_inertial`) four at a time in SIMD lanes (`batch::Path::Lanes`;
@@ -120,74 +222,14 @@ pub(super) fn sweep<'py>(
     let stop = stop.unwrap_or(n).min(n);
     let range = start.min(stop)..stop;
     let body = src.body().map_err(err)?;
-    let pool = batch::pool(threads).map_err(err)?;
+    let (pool, workers) = pool_for(py, threads)?;
     let done = AtomicUsize::new(0);
-    let cancel = AtomicBool::new(false);
-    let finished = AtomicBool::new(false);
-    let caller = std::thread::current();
-    let mut out = None;
-    // One job on the kept pool validates every run, then runs them; this thread meanwhile
-    // reports progress and watches for Ctrl-C, and waits with the GIL released.
-    let interrupted = pool.in_place_scope(|scope| {
-        scope.spawn(|_| {
-            // A panic is caught here, so that `finished` is always set.
-            out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                batch::validate(&src, range.clone())
-                    .map(|()| batch::run(&src, range.clone(), &body, &done, &cancel, path))
-            }))
-            .ok();
-            finished.store(true, Ordering::Release);
-            caller.unpark();
-        });
-        let mut interrupted: Option<PyErr> = None;
-        let mut reported = usize::MAX;
-        // A small sweep is over within a fraction of a millisecond: wait for it yielding the
-        // core rather than asleep, whose wake-up added its latency to every small sweep.
-        py.detach(|| {
-            let t0 = std::time::Instant::now();
-            while !finished.load(Ordering::Acquire) && t0.elapsed() < YIELD_WAIT {
-                std::thread::yield_now();
-            }
-        });
-        loop {
-            py.detach(|| {
-                if !finished.load(Ordering::Acquire) {
-                    std::thread::park_timeout(std::time::Duration::from_millis(100));
-                }
-            });
-            let now = done.load(Ordering::Relaxed);
-            if let Some(cb) = &progress {
-                if now != reported {
-                    reported = now;
-                    if let Err(e) = cb.call1((now,)) {
-                        interrupted.get_or_insert(e);
-                    }
-                }
-            }
-            if let Err(e) = py.check_signals() {
-                interrupted.get_or_insert(e);
-            }
-            if interrupted.is_some() {
-                cancel.store(true, Ordering::Relaxed);
-            }
-            if finished.load(Ordering::Acquire) || interrupted.is_some() {
-                break;
-            }
-        }
-        // A cancelled batch ends after the runs in flight: wait for them without the GIL.
-        py.detach(|| {
-            while !finished.load(Ordering::Acquire) {
-                std::thread::park_timeout(std::time::Duration::from_millis(10));
-            }
-        });
-        interrupted
-    });
-    if let Some(e) = interrupted {
-        return Err(e);
-    }
-    let out = out
-        .ok_or_else(|| PyRuntimeError::new_err("a sweep worker panicked"))?
-        .map_err(err)?;
+    // One job on the shared pool validates every run, then runs them.
+    let out = on_pool(py, &pool, &done, progress.as_ref(), |cancel| {
+        batch::validate(&src, range.clone(), workers, cancel)
+            .map(|()| batch::run(&src, range.clone(), &body, workers, &done, cancel, path))
+    })?
+    .map_err(err)?;
     let rows = range.len();
     let width = out.columns.len();
     let d = PyDict::new(py);

@@ -132,7 +132,7 @@ scene_fields! {
         "record every n-th step (events are always recorded)";
     "rho_g": "medium", ALL, "kg/m^3", "> 0",
         "bulk density of the sand, packing included (thesis sec. 3.3.1: 1650; the leg's sand, sec. 5.3.2: 1600)";
-    "rtol": "solver", ALL, "-", "> 0",
+    "rtol": "solver", ALL, "-", ">= 2.2e-14 (100 x f64's epsilon)",
         "relative tolerance of \"dopri5\"";
     "shoe_width": "body", LEG, "m", "> 0",
         "shoe width w_s (thesis sec. 5.3.2: 0.086)";
