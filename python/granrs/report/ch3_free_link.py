@@ -520,7 +520,7 @@ def chapter_3(ctx: ReportContext) -> str:
 
 
 def _watch(ctx: ReportContext) -> str:
-    """The Table 3.1 drop at q = 45 deg, v0 = 2.27 m/s as an animation (issue 20)."""
+    """The Table 3.1 drop at q = 45 deg, v0 = 2.27 m/s as an animation."""
     return ctx.watch(
         "ch3_free_link_q45.gif",
         cases.free_link(q_deg=45.0, v0=2.27, dt=ctx.dt),
