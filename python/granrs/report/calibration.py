@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate import CalibrationResult, Measurements, calibrate, evaluate, within
-from .format import _fmt, md_table
+from .format import _fmt, md_table, table_3_1_drop, watch_caption
 from .framework import ReportContext, register_chapter
 
 __all__ = ["FREE_LINK_VARIANTS", "chapter_calibration", "vertical_drop"]
@@ -641,10 +641,11 @@ def _watch(ctx: ReportContext) -> str:
     """The vertical drop the fits cannot match, as an animation."""
     from .. import cases
 
+    scene = cases.free_link(*table_3_1_drop(0.0), dt=ctx.dt)
     return ctx.watch(
         "calibration_vertical.gif",
-        cases.free_link(q_deg=0.0, v0=2.24, dt=ctx.dt),
-        "The vertical drop (Table 3.1, q = 0, thesis coefficients), whose stopping time no "
-        "coefficients match: only static_v acts on it.",
+        scene,
+        watch_caption(scene, "The fastest vertical drop of Table 3.1 (thesis coefficients)")
+        + ", whose stopping time no coefficients match: only static_v acts on it.",
         frame_dt=1e-3,
     )
