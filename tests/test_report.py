@@ -733,7 +733,7 @@ def test_leg_target_is_not_claimed_out_of_sample_on_folds_with_no_dof() -> None:
     text = laws._acceptance(ctx, weak)
     assert "met** by rft (in sample only)" in text
     assert "(out of sample)" not in text
-    assert "no test" in text and "not identifiable" in text
+    assert "no test" in text and "no degree of freedom left" in text
     verdict, headlines = laws._verdict(ctx, weak)
     assert "no test" in verdict
     assert "predicts best out of sample" not in headlines[0]
@@ -854,7 +854,7 @@ def test_depth_time_figure_says_how_each_law_predicts() -> None:
     fig = laws.depth_time_figure(ctx, frame)
     titles = [ax.get_title() for ax in fig.axes]
     assert not any("held out" in t for t in titles), titles
-    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "thesis_published (nothing fitted)" in labels
     assert "rft (fitted without the angle shown)" in labels
     assert not any(ax.yaxis_inverted() for ax in fig.axes)

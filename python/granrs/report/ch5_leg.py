@@ -524,10 +524,11 @@ def chapter_5(ctx: ReportContext) -> str:
 
 def _watch(ctx: ReportContext) -> str:
     """The leg at 3.28 m/s, joints locked, as an animation."""
+    scene = cases.leg(v0=3.28, dt=ctx.dt)
     return ctx.watch(
         "ch5_leg_3_28.gif",
-        cases.leg(v0=3.28, dt=ctx.dt),
-        "The 3.28 m/s landing, joints locked, one frame per 2 ms (the second panel zooms on "
-        "the foot).",
+        scene,
+        f"The {scene.v0:g} m/s landing, joints locked, one frame per 2 ms (the second panel "
+        "zooms on the foot).",
         frame_dt=2e-3,
     )

@@ -66,10 +66,10 @@ def _z(v: Any) -> str:
 
 
 def _identified(fold: Mapping[str, Any]) -> bool:
-    """Whether a fold's fit pins its parameters down: more residuals than parameters
-    (dof > 0) and every ~95 % interval bounded. A fold with dof = 0 fits as many parameters
-    as residuals: it matches its rows whatever the law, its intervals are unbounded, and its
-    prediction of the rows held out is no test of the law."""
+    """Whether a fold's fit can pin its parameters down: more residuals than parameters
+    (dof > 0) and every ~95 % interval bounded. A fold with dof = 0 has as many parameters
+    as residuals: no residual is left to test the fit or to estimate the parameters'
+    uncertainty, so its prediction of the rows held out is no test of the law."""
     if fold["dof"] <= 0:
         return False
     return all(math.isfinite(lo) and math.isfinite(hi) for lo, hi in fold["intervals"].values())
@@ -88,12 +88,22 @@ def _evidence(law: Mapping[str, Any]) -> str:
     if not weak:
         return ""
     held = sum(f["held_out"] != "all" for f in law["folds"])
-    dofs = ", ".join(str(int(f["dof"])) for f in weak)
+    k = law["n_params"]
+    which = f"each of its {held} folds" if len(weak) == held else f"{len(weak)} of its {held} folds"
+    reasons = []
+    no_dof = [f for f in weak if f["dof"] <= 0]
+    if no_dof:
+        residuals = sorted({k + int(f["dof"]) for f in no_dof})
+        reasons.append(
+            f"fits {k} parameters to {' or '.join(map(str, residuals))} residuals (no degree "
+            "of freedom left): nothing is left to test its fit or to estimate the "
+            "parameters' uncertainty"
+        )
+    if len(no_dof) < len(weak):
+        reasons.append("leaves a parameter's ~95 % interval unbounded")
     return (
-        f"its out-of-sample numbers are no test: {len(weak)} of its {held} folds fit "
-        f"{law['n_params']} parameters with {dofs} degrees of freedom left, so a fold "
-        "matches its own rows whatever the law, and its parameters have no uncertainty "
-        "(~95 % intervals unbounded): they are not identifiable from the rows it sees"
+        f"its out-of-sample numbers are no test: {which} {' or '.join(reasons)}, so the "
+        "parameters it carries to the held-out rows are not identified by the rows it saw"
     )
 
 
@@ -352,8 +362,10 @@ def depth_time_figure(ctx: ReportContext, frame: pd.DataFrame) -> Any:
         ax.set_xlabel("t [ms]")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("depth [mm]")
-    axes[0].legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
+    # Below the panels, clear of the curves and the measured stops.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8)
+    fig.tight_layout(rect=(0.0, 0.08, 1.0, 1.0))
     return fig
 
 
@@ -425,8 +437,10 @@ def _verdict(ctx: ReportContext, frame: pd.DataFrame) -> tuple[str, list[str]]:
             continue
         win = laws[0]
         n = win["n_rows"]
+        evidence = _evidence(win)
+        lead = "ranks first by the held-out χ²" if evidence else "predicts best out of sample"
         text = (
-            f"- **{_TITLES.get(d, d)}**: **{win['law']}** predicts best out of sample (χ² = "
+            f"- **{_TITLES.get(d, d)}**: **{win['law']}** {lead} (χ² = "
             f"{win['oos_chi2']:.1f} over {2 * n} values; depth within 1 sd on "
             f"{win['depth_within_1sd']}/{n} rows, t_s within 1 sd on {win['ts_within_1sd']}/{n} "
             f"and within 2 sd on {win['ts_within_2sd']}/{n})"
@@ -439,7 +453,6 @@ def _verdict(ctx: ReportContext, frame: pd.DataFrame) -> tuple[str, list[str]]:
                 f"({second['oos_chi2']:.1f}); in sample, AIC {win['aic']:.1f} against "
                 f"{second['aic']:.1f} ({win['n_params']} and {second['n_params']} parameters)"
             )
-        evidence = _evidence(win)
         if evidence:
             text += f". For {win['law']}, {evidence}"
         text += ". Where each law fails (out of sample): " + "; ".join(
@@ -457,8 +470,8 @@ def _verdict(ctx: ReportContext, frame: pd.DataFrame) -> tuple[str, list[str]]:
             f"{win['ts_within_2sd']}/{n}."
             if not evidence
             else f"**Which law fits ({_TITLES.get(d, d)}).** {win['law']} ranks first by "
-            "its held-out χ², which is no out-of-sample test for it: its folds fit "
-            f"{win['n_params']} parameters with no degree of freedom left (not identifiable)."
+            "its held-out χ², which is no out-of-sample test for it: the parameters of its "
+            "folds are not identified by the rows each fold sees (see the chapter)."
         )
     return "\n".join(lines), headlines
 
