@@ -550,8 +550,11 @@ def test_chapter_verdict_names_the_winner_of_laws_json(chapter) -> None:
     for dataset, laws in data.items():
         ran = {k: v for k, v in laws.items() if v["available"]}
         best = min(ran, key=lambda k: ran[k]["oos_chi2"])
-        assert f"**{best}** predicts best out of sample" in text, dataset
-    assert "### Acceptance targets of issue 18" in text
+        # Where the folds cannot test a law (no dof left) the winner only "ranks first".
+        assert f"**{best}** predicts best out of sample" in text or (
+            f"**{best}** ranks first by the held-out χ²" in text
+        ), dataset
+    assert "### Targets" in text
 
 
 def test_chain_mass_and_force_scale_are_one_direction() -> None:

@@ -651,3 +651,223 @@ def test_joint_study_closest_settings(built: tuple[Path, str]) -> None:
             assert _float(row[i]) == pytest.approx(rms, rel=0.02, abs=0.3)
     assert "Closest to the thesis's simulation" in _section(text, "### The joints")
     assert "Leg (chapter 5)" in _section(text, "## Summary")
+
+
+# --------------------------------------------------------------------------------------
+# What the report claims, and how its figures read (first contact with the report)
+# --------------------------------------------------------------------------------------
+
+
+def test_report_output_has_no_internal_issue_numbers(built: tuple[Path, str]) -> None:
+    """Nothing a user reads in the report's output directory mentions internal bookkeeping
+    ("Target of issue 7", "Acceptance targets of issue 18" were in the text): the same
+    check as ``grep -rin "issue [0-9]"`` over the directory."""
+    path, _ = built
+    files = [p for p in path.parent.rglob("*") if p.is_file()]
+    assert any(p.name == "laws.json" for p in files)
+    for p in files:
+        hits = re.findall(rb"(?i)issue [0-9]+", p.read_bytes())
+        assert not hits, (p.name, hits)
+
+
+def _leg_frame(dof: int, interval: tuple[float, float]) -> object:
+    """A made-up comparison frame: one law on the leg, every count within 1 sd, its two
+    leave-one-height-out folds fitted with ``dof`` degrees of freedom left and ``interval``
+    on each parameter; the fit to every row has 2 dof and bounded intervals."""
+    import pandas as pd
+
+    def fold(held_out: str, dof: int, interval: tuple[float, float]) -> dict[str, object]:
+        return {
+            "held_out": held_out,
+            "values": {"rft.zeta": 2.4e6, "joints.k": 180.0},
+            "intervals": {"rft.zeta": list(interval), "joints.k": list(interval)},
+            "std_errors": {},
+            "chi2": 0.1,
+            "dof": dof,
+            "at_bound": [],
+            "depth_z": [0.1] * (2 if held_out == "all" else 1),
+            "t_s_z": [-0.2] * (2 if held_out == "all" else 1),
+        }
+
+    rows = [
+        {"dataset": "leg", "law": "rft", "height_case": "h1", "v0_mean": 2.6},
+        {"dataset": "leg", "law": "rft", "height_case": "h2", "v0_mean": 3.3},
+    ]
+    record = {
+        "dataset": "leg",
+        "law": "rft",
+        "available": True,
+        "reason": "",
+        "rank": 1,
+        "n_params": 2,
+        "n_rows": 2,
+        "dof": 2,
+        "chi2_dof": 0.1,
+        "aic": 4.2,
+        "bic": 3.0,
+        "oos_chi2": 0.4,
+        "depth_within_1sd": 2,
+        "ts_within_1sd": 2,
+        "ts_within_2sd": 2,
+        "simulations": 10,
+        "stop_order": None,
+        "rows": [dict(r, depth_z=0.3, t_s_z=-0.4) for r in rows],
+        "folds": [
+            fold("all", 2, (1e6, 5e6)),
+            fold("h1", dof, interval),
+            fold("h2", dof, interval),
+        ],
+    }
+    return pd.DataFrame([record])
+
+
+def test_leg_target_is_not_claimed_out_of_sample_on_folds_with_no_dof() -> None:
+    """The leg's folds fit 2 parameters to the 2 residuals of one height (0 dof, intervals
+    unbounded): their predictions are no out-of-sample test. The report said "met by rft
+    (out of sample)" and "rft predicts best out of sample"; it must say in sample only, and
+    why. With a degree of freedom left and bounded intervals, out of sample stands."""
+    from granrs.report import laws
+
+    ctx = report.ReportContext(dt=1e-3, progress=False)
+    weak = _leg_frame(0, (0.0, math.inf))
+    text = laws._acceptance(ctx, weak)
+    assert "met** by rft (in sample only)" in text
+    assert "(out of sample)" not in text
+    assert "no test" in text and "no degree of freedom left" in text
+    verdict, headlines = laws._verdict(ctx, weak)
+    assert "no test" in verdict
+    assert "predicts best out of sample" not in headlines[0]
+    assert "not identifiable" in laws._params_table(weak, "leg")
+
+    sound = _leg_frame(1, (1e6, 5e6))
+    text = laws._acceptance(ctx, sound)
+    assert "met** by rft (out of sample)" in text
+    assert "no test" not in text
+    _, headlines = laws._verdict(ctx, sound)
+    assert "predicts best out of sample" in headlines[0]
+
+
+def test_chain_stop_order_is_explained(built: tuple[Path, str]) -> None:
+    """The chain's links stop in the reverse of the measured order: the report states why,
+    with numbers. Its claim is checked here on fresh runs: exchanging the two links'
+    Table 4.4 rows exchanges the order in every case (at the solid-steel mass)."""
+    _, text = built
+    start = text.index("**Why granrs's links stop in the reverse order.**")
+    why = text[start : text.index("###", start)]
+    assert "Exchanging the two links' rows in the chain exchanges the order" in why
+    assert "The pin lengthens the gap" in why
+    for case in (1, 2, 3):
+        c1, c2 = granrs.cases.chain_case(case)["coefficients"]
+        gaps = []
+        for coefficients in ((c1, c2), (c2, c1)):
+            r = granrs.simulate(
+                granrs.cases.chain(case, coefficients=coefficients, end="all_stops")
+            )
+            gaps.append(_chain_link(r, 2)[0] - _chain_link(r, 1)[0])
+        assert gaps[0] < 0 < gaps[1], (case, gaps)
+
+
+def test_animations_are_readable(built: tuple[Path, str]) -> None:
+    """The report's GIFs were 243-560 px wide with ~7 px text (dpi 60): each is now at
+    least 640 px wide, at a resolution where 8 pt text is at least 10 px."""
+    from PIL import Image
+
+    from granrs.report.framework import WATCH_DPI
+
+    path, text = built
+    gifs = re.findall(r"!\[[^\]]*\]\(([^)]+\.gif)\)", text)
+    assert len(gifs) == 4
+    for gif in gifs:
+        with Image.open(path.parent / gif) as image:
+            assert image.size[0] >= 640, (gif, image.size)
+    assert 8.0 * WATCH_DPI / 72.0 >= 10.0
+
+
+def test_animation_captions_give_the_table_3_1_speed(built: tuple[Path, str]) -> None:
+    """A free-link animation's caption gives q and v0 from its scene, as the animation's
+    title does, and they are a Table 3.1 drop (the vertical one said "Table 3.1" while it
+    ran at 2.24 m/s; Table 3.1's fastest vertical drop is 2.211 m/s)."""
+    _, text = built
+    measured = {
+        (float(r["q_deg"]), float(r["v0_mean"])) for r in _csv("table_3_1_free_link_experiments")
+    }
+    # Each caption is in the text and in the image's alt text.
+    drops = set(re.findall(r"Table 3\.1[^:\n]*: q = ([\d.]+)°, v0 = ([\d.]+) m/s", text))
+    assert len(drops) == 2, drops
+    for q, v0 in drops:
+        assert (float(q), float(v0)) in measured
+    assert ("0", "2.211") in drops
+
+
+def test_animation_title_clears_the_legend() -> None:
+    """A tall, thin scene (the vertical drop) made a figure 4.1 in wide whose title ran into
+    the legend's column; the title now ends left of the legend."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    scene = granrs.cases.free_link(0.0, 2.211, dt=1e-3, record=("state", "forces"))
+    anim = granrs.animate(granrs.simulate(scene), frame_dt=5e-3)
+    fig = anim.figure
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    title = fig.axes[0].title.get_window_extent(renderer)
+    legend = fig.legends[0].get_window_extent(renderer)
+    assert title.x1 < legend.x0
+
+
+def test_depth_axes_point_the_same_way() -> None:
+    """The force-laws figure drew depth growing downwards (inverted axis), unlike every
+    other depth-against-time figure of the report; now all grow upwards."""
+    from granrs.report import force_laws
+
+    ctx = report.ReportContext(dt=1e-3, progress=False)
+    fig = force_laws.depth_figure(ctx)
+    assert not fig.axes[0].yaxis_inverted()
+
+
+def test_depth_time_figure_says_how_each_law_predicts() -> None:
+    """laws_depth_time titled every angle "held out of the fit", also for a law that fits
+    nothing; each law's legend entry now says whether it was fitted without the angle."""
+    import pandas as pd
+
+    from granrs.report import laws
+
+    angles = (0.0, 45.0, 60.0, 75.0)
+    common = {
+        "dataset": "free_link",
+        "available": True,
+        "depth_within_1sd": 0,
+        "ts_within_1sd": 0,
+        "ts_within_2sd": 0,
+        "dof": 20,
+    }
+    frame = pd.DataFrame(
+        [
+            {**common, "law": "thesis_published", "rank": 1, "folds": []},
+            {
+                **common,
+                "law": "rft",
+                "rank": 2,
+                "folds": [{"held_out": q, "values": {"rft.zeta": 2e6}} for q in angles],
+            },
+        ]
+    )
+    ctx = report.ReportContext(dt=1e-3, progress=False)
+    fig = laws.depth_time_figure(ctx, frame)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert not any("held out" in t for t in titles), titles
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "thesis_published (nothing fitted)" in labels
+    assert "rft (fitted without the angle shown)" in labels
+    assert not any(ax.yaxis_inverted() for ax in fig.axes)
+
+
+def test_run_summary_reads_the_status(capsys: pytest.CaptureFixture[str]) -> None:
+    """The C-leg run (status end_time, driven at a constant rate) printed "stopped yes"
+    with no word that its stop is only the tip's lowest point; the summary now says so
+    whenever a contact stopped but the run did not end at a stop."""
+    scenes = Path(__file__).resolve().parents[1] / "examples" / "scenes"
+    assert main(["run", str(scenes / "c_leg_rft.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "status end_time" in out
+    assert "the body need not be at rest" in out
+    assert main(["run", str(scenes / "free_link_q45.toml")]) == 0
+    assert "need not be at rest" not in capsys.readouterr().out

@@ -35,6 +35,9 @@ __all__ = ["ANKLE_HEIGHT_FRACTION", "ImpactAnimation"]
 ANKLE_HEIGHT_FRACTION = 0.039
 #: Longest force arrow, as a fraction of the body's reference length (rod length, tibia).
 _ARROW_FRACTION = 0.6
+#: The narrowest figure [in]: a tall, thin scene (a vertical rod) still leaves its axes'
+#: cell room for the title, clear of the legend's column.
+_MIN_WIDTH = 7.2
 _MM = 1e3
 
 
@@ -522,7 +525,8 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         widths = [(hi[0] - lo[0]) / (hi[1] - lo[1]) for _, (lo, hi) in views]
         height = 6.0
         side = 2.4  # the legend's column [in]
-        fig = Figure(figsize=(height * 0.82 * sum(widths) + side + 0.9 * len(views), height))
+        width = max(height * 0.82 * sum(widths) + side + 0.9 * len(views), _MIN_WIDTH)
+        fig = Figure(figsize=(width, height))
         fig.set_dpi(self.dpi)
         FigureCanvasAgg(fig)
         plot_right = 1.0 - side / fig.get_figwidth()

@@ -714,6 +714,13 @@ def summary_text(result: Any, source: str | None = None) -> str:
             for key in keys
         ]
         lines += _table(["quantity", "unit", *names], rows)
+        if result.status != "stopped" and any(c.stopped for c in result.contacts):
+            # A contact's stop is its tip's vertical velocity reaching zero from below; the
+            # run went on (a driven body, a run to t_end), so say what "stopped" means here.
+            lines += [
+                'note: "stopped" = the tip\'s downward velocity reached zero at t_s; the run went',
+                f"on (status {result.status}), so the body need not be at rest there.",
+            ]
     else:
         lines.append("no contacts: the sand never acts on this body")
     if result.joints:

@@ -1,4 +1,4 @@
-"""The calibration chapter of the reproduction report (issue 7).
+"""The calibration chapter of the reproduction report.
 
 Registered after chapter 5 (``granrs reproduce --chapter calibration``). It runs
 :func:`granrs.calibrate` on the thesis's measurements and shows, in units of the
@@ -15,7 +15,7 @@ experiment's sd:
 4. the chain: fitted on two speeds, predicting the third;
 5. the leg: coefficients and joint settings best matching Table 5.1's averages.
 
-Every number is computed at run time; the target of the issue (depth within 1 sd for at
+Every number is computed at run time; the target (depth within 1 sd for at
 least 10 of 12 rows, t_s within 2 sd for at least 9, the 60 degree rows out of sample) is
 stated and checked, not assumed.
 """
@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate import CalibrationResult, Measurements, calibrate, evaluate, within
-from .format import _fmt, md_table
+from .format import _fmt, md_table, table_3_1_drop, watch_caption
 from .framework import ReportContext, register_chapter
 
 __all__ = ["FREE_LINK_VARIANTS", "chapter_calibration", "vertical_drop"]
@@ -62,7 +62,7 @@ FREE_LINK_VARIANTS: dict[str, dict[str, Any]] = {
 _FIT_ANGLES = (0.0, 45.0, 75.0)
 _TEST_ANGLE = 60.0
 _STARTS = 3
-#: The issue's target: depth within 1 sd for >= 10 rows, t_s within 2 sd for >= 9.
+#: The calibration's target: depth within 1 sd for >= 10 rows, t_s within 2 sd for >= 9.
 _TARGET = {"depth": (1.0, 10), "t_s": (2.0, 9)}
 
 
@@ -94,7 +94,7 @@ def vertical_drop(
     """Stopping time [s] and depth [m] of the free link dropped vertically (q = 0), by an
     independent one-dimensional integration (scipy's solve_ivp, rtol 1e-10).
 
-    At q = 0 with the force at the tip only the static vertical term acts (MODEL.md):
+    At q = 0 with the force at the tip only the static vertical term acts (docs/model.md):
     m d'' = m g - eta_v g rho_g (pi d_c^2 / 4) d (d / L)^lambda while the rod moves down;
     the stop is d' = 0. Unlike granrs's Coefficients, ``lam`` may be negative here (down
     to -1), and ``axial_drag`` [kg/m] adds a quadratic drag along the axis, -c v|v|, which
@@ -389,7 +389,7 @@ Table 3.2 closed forms at 60 deg. Each fit: scipy's least_squares from {_STARTS}
 Jacobian in one parallel sweep. The fit "chosen" is the one with the lowest reduced χ² on
 the fit rows: chosen before looking at the 60 deg rows.
 
-**Target of issue 7**: depth within 1 sd for at least {_TARGET["depth"][1]} of the 12 rows and
+**Target**: depth within 1 sd for at least {_TARGET["depth"][1]} of the 12 rows and
 t_s within 2 sd for at least {_TARGET["t_s"][1]}, the 60 deg rows out of sample.
 
 {md_table(header, body, "l")}
@@ -426,7 +426,7 @@ vertical drops stay at t_s z = {z0_t} and depth z = {z0_d}, with lambda at
 target (9 of 12) leaves no room for a single miss elsewhere.
 
 **Which term: at q = 0 only the static vertical force acts.** A vertical rod meets only F_sv =
-eta_v g rho_g V (d/L)^lambda with V ∝ d (MODEL.md), a spring force ∝ d^n, n = 1 +
+eta_v g rho_g V (d/L)^lambda with V ∝ d (docs/model.md), a spring force ∝ d^n, n = 1 +
 lambda, and nothing else: the drag F_d needs a velocity component across the rod (A_r ∝
 |e x v_E|), which a vertical drop has not. The measured drops stop late for their depth (0
 deg, 2.211 m/s: 51 mm after 40 ms, a mean speed of 0.58 v0 down to the stop). Without
@@ -620,7 +620,7 @@ large (the subjects differ by up to a factor 2 in depth): within 1 sd is a weak 
 
 @register_chapter("calibration", "Calibration: fitting the coefficients to the experiments")
 def chapter_calibration(ctx: ReportContext) -> str:
-    """The calibration chapter (issue 7): Table 3.1, the chain and the leg, fitted."""
+    """The calibration chapter: Table 3.1, the chain and the leg, fitted."""
     parts = [
         "The thesis tuned its coefficients by hand, one angle at a time (sec. 3.3.1), and "
         "concludes that its stopping times disagree with the experiments where its depths "
@@ -638,13 +638,14 @@ def chapter_calibration(ctx: ReportContext) -> str:
 
 
 def _watch(ctx: ReportContext) -> str:
-    """The vertical drop the fits cannot match, as an animation (issue 20)."""
+    """The vertical drop the fits cannot match, as an animation."""
     from .. import cases
 
+    scene = cases.free_link(*table_3_1_drop(0.0), dt=ctx.dt)
     return ctx.watch(
         "calibration_vertical.gif",
-        cases.free_link(q_deg=0.0, v0=2.24, dt=ctx.dt),
-        "The vertical drop (Table 3.1, q = 0, thesis coefficients), whose stopping time no "
-        "coefficients match: only static_v acts on it.",
+        scene,
+        watch_caption(scene, "The fastest vertical drop of Table 3.1 (thesis coefficients)")
+        + ", whose stopping time no coefficients match: only static_v acts on it.",
         frame_dt=1e-3,
     )

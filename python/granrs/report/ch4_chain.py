@@ -500,6 +500,103 @@ one granrs gets from the measured angles (the lower tip starts at the surface).
 """
 
 
+def _span(values: Sequence[float], fmt: str, scale: float = 1.0) -> str:
+    """``low-high`` of ``values`` (one value if they round the same), for the text."""
+    low, high = _fmt(min(values), fmt, scale), _fmt(max(values), fmt, scale)
+    return low if low == high else f"{low} to {high}"
+
+
+def _later(result: Result) -> float:
+    """Link 2's stop minus link 1's, each from its own entry [s]."""
+    return _link_stop(result, 2)[0] - _link_stop(result, 1)[0]
+
+
+def _ch4_stop_order_why(ctx: ReportContext, mass: float, runs: ChainRuns) -> str:
+    """Why granrs's links stop in the reverse of the measured order: the numbers that show
+    it, computed at link mass ``mass`` from ``runs`` (recorded with forces) and from runs
+    with the links' coefficients exchanged or made equal, and with each link alone."""
+    coef = {_link_case(row): row for row in _rows("chain_coefficients")}
+    swapped, same1, same2, alone = [], [], [], []
+    static_before, static_after, pin_before, pin_after, creep = [], [], [], [], []
+    with ctx.step(f"chapter 4: why the links stop in this order ({_grams(mass)})"):
+        for case in _CHAIN_CASES:
+            spec = cases.chain_case(case)
+            c1, c2 = spec["coefficients"]
+            swapped.append(_later(ctx.chain(case, mass=mass, coefficients=(c2, c1))))
+            same1.append(_later(ctx.chain(case, mass=mass, coefficients=c1)))
+            same2.append(_later(ctx.chain(case, mass=mass, coefficients=c2)))
+            t_alone = []
+            for link in (0, 1):
+                rod = cases.free_link(
+                    q_deg=spec["q_deg"][link],
+                    v0=spec["v0"],
+                    coefficients=spec["coefficients"][link],
+                    dt=ctx.dt,
+                    **{k: cases.CHAIN[k] for k in ("length", "diameter")},
+                    mass=mass,
+                )
+                t_alone.append(ctx.run(rod).t_s)
+            alone.append(t_alone[1] - t_alone[0])
+            # The forces on either side of link 2's stop, from the recorded run.
+            r = runs[case]
+            s = r.series
+            assert s is not None
+            time = np.asarray(s["t"])
+            t1, t2 = r.contacts[0].t_s, r.contacts[1].t_s
+            before = max(int(np.searchsorted(time, t2)) - 1, 0)
+            after = int(np.searchsorted(time, 0.5 * (t1 + t2)))
+            static_before.append((float(s["c0.F_sv"][before]), float(s["c1.F_sv"][before])))
+            static_after.append((float(s["c0.F_sv"][after]), float(s["c1.F_sv"][after])))
+            pin_before.append(float(s["pin.Fy"][before]))
+            pin_after.append(float(s["pin.Fy"][after]))
+            creep.append(t1 - t2)
+    eta_v1 = [coef[(1, c)]["eta_v"] for c in _CHAIN_CASES]
+    eta_v2 = [coef[(2, c)]["eta_v"] for c in _CHAIN_CASES]
+    lam1 = [coef[(1, c)]["lambda"] for c in _CHAIN_CASES]
+    lam2 = [coef[(2, c)]["lambda"] for c in _CHAIN_CASES]
+    eta_d1 = [coef[(1, c)]["eta_d"] for c in _CHAIN_CASES]
+    eta_d2 = [coef[(2, c)]["eta_d"] for c in _CHAIN_CASES]
+    weight = mass * 9.81
+    published = [_later(runs[c]) for c in _CHAIN_CASES]
+    ctx.add_headline(
+        f"Chain stop order: granrs's reversed order follows Table 4.4's per-link coefficients "
+        f"(link 1's eta_v {_span(eta_v1, '.0f')} against link 2's {_span(eta_v2, '.0f')}): "
+        f"exchanging the two links' rows exchanges it (link 2 - link 1 "
+        f"{_span(published, '+.1f', 1e3)} ms becomes {_span(swapped, '+.1f', 1e3)} ms at "
+        f"{_grams(mass)}), and the pin lengthens the gap."
+    )
+    return f"""**Why granrs's links stop in the reverse order.** Checked at {_grams(mass)} per
+link in every case; "link 2 - link 1" is the difference of the stops, each from its link's
+own entry.
+
+- **The coefficients set the order.** Table 4.4 gives link 1 a static vertical coefficient
+  eta_v = {_span(eta_v1, ".0f")} against link 2's {_span(eta_v2, ".0f")} (lambda
+  {_span(lam1, ".3f")} against {_span(lam2, ".3f")}) and more drag (eta_d
+  {_span(eta_d1, ".0f")} against {_span(eta_d2, ".1f")}): link 1 is braked mostly by drag,
+  link 2 by the static term, the term that brings a tip to rest. Just before link 2 stops,
+  the static vertical force is {_span([a for a, _ in static_before], ".2f")} N on link 1
+  against {_span([b for _, b in static_before], ".2f")} N on link 2. Each link alone (a free
+  rod of the chain's size and mass at its measured angle and the chain's speed, with its own
+  Table 4.4 row): link 2 - link 1 = {_span(alone, "+.1f", 1e3)} ms, already the reverse
+  order. Exchanging the two links' rows in the chain exchanges the order:
+  {_span(swapped, "+.1f", 1e3)} ms, against {_span(published, "+.1f", 1e3)} ms with the
+  rows as published. With one row for both links the gap shrinks: link 1's row
+  {_span(same1, "+.1f", 1e3)} ms, link 2's row {_span(same2, "+.1f", 1e3)} ms.
+- **The pin lengthens the gap.** At link 2's stop its tip turns back and its static force
+  drops to a small sticking reaction ({_span([b for _, b in static_after], "+.3f")} N,
+  halfway to link 1's stop); the pin's vertical force on link 2 turns from
+  {_span(pin_before, "+.2f")} N (link 1 pushing it down) to {_span(pin_after, "+.2f")} N
+  (link 1 holding it up; link 2 weighs {weight:.2f} N). Link 1, with a static force of
+  {_span([a for a, _ in static_after], ".2f")} N, then carries the chain and keeps sinking
+  slowly while the chain turns about link 2's tip, for another {_span(creep, ".0f", 1e3)} ms.
+
+So the order is that of Table 4.4's per-link coefficients, lengthened by the pin. The
+thesis's own simulation (Table 4.5) reports the measured order with the same rows; what its
+model did differently (its link mass, how it coupled the links) is not stated, so that
+difference is not explained here.
+"""
+
+
 def _ch4_quoted(
     experiments: Sequence[Mapping[str, Any]], runs_by_mass: Mapping[float, ChainRuns]
 ) -> str:
@@ -863,6 +960,7 @@ def chapter_4(ctx: ReportContext) -> str:
         }
     compared: dict[float, ChainRuns] = {**runs_by_mass, best: best_runs}
     stops = _ch4_stop_times(ctx, experiments, compared)
+    stops += "\n" + _ch4_stop_order_why(ctx, best, best_runs)
     quoted = _ch4_quoted(experiments, compared)
     figures = _ch4_figures(ctx, experiments, best, best_runs, runs_by_mass[cases.CHAIN["mass"]])
     return "\n".join(
@@ -887,7 +985,7 @@ def chapter_4(ctx: ReportContext) -> str:
 
 
 def _watch(ctx: ReportContext) -> str:
-    """Chain case 1 as an animation (issue 20)."""
+    """Chain case 1 as an animation."""
     return ctx.watch(
         "ch4_chain_case1.gif",
         cases.chain(case=1, dt=ctx.dt, end="all_stops"),

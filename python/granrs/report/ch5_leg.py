@@ -509,7 +509,7 @@ def chapter_5(ctx: ReportContext) -> str:
             "(half the body), segment data from Dempster as tabulated by Winter, scaled to "
             "75.35 kg and 1.78 m; posture at touchdown: knee and hip flexed 20°, trunk 10° "
             "forward, flat foot (granrs assumptions; the thesis gives none). The sole is a "
-            "box of the foot's length and the shoe's width (MODEL.md), the coefficients the "
+            "box of the foot's length and the shoe's width (docs/model.md), the coefficients the "
             "thesis's for each speed (sec. 5.3.2), the force at the tip (the sole). The "
             "thesis's human model (SolidWorks, GrabCAD parts) is not published, so this "
             "chapter compares end results only.",
@@ -523,11 +523,12 @@ def chapter_5(ctx: ReportContext) -> str:
 
 
 def _watch(ctx: ReportContext) -> str:
-    """The leg at 3.28 m/s, joints locked, as an animation (issue 20)."""
+    """The leg at 3.28 m/s, joints locked, as an animation."""
+    scene = cases.leg(v0=3.28, dt=ctx.dt)
     return ctx.watch(
         "ch5_leg_3_28.gif",
-        cases.leg(v0=3.28, dt=ctx.dt),
-        "The 3.28 m/s landing, joints locked, one frame per 2 ms (the second panel zooms on "
-        "the foot).",
+        scene,
+        f"The {scene.v0:g} m/s landing, joints locked, one frame per 2 ms (the second panel "
+        "zooms on the foot).",
         frame_dt=2e-3,
     )

@@ -1,4 +1,4 @@
-"""The report's chapter "Force laws" (issue 17): the thesis's three bodies under each of
+"""The report's chapter "Force laws": the thesis's three bodies under each of
 granrs's force laws, side by side with the thesis's law.
 
 The laws' parameters here are the illustrative ones of ``docs/laws.md`` (``rft``: zeta =
@@ -9,8 +9,8 @@ with fitted parameters and cross-validation, is the comparison of :mod:`granrs.c
 
 from __future__ import annotations
 
-import io
 from collections.abc import Callable
+from typing import Any
 
 from .. import forces as f
 from ..forces import Term
@@ -105,30 +105,35 @@ def chapter_force_laws(ctx: ReportContext) -> str:
     return "\n".join(parts)
 
 
-def _figure(ctx: ReportContext) -> str:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def depth_figure(ctx: ReportContext) -> Any:
+    """Tip depth against time of :data:`FIGURE_DROP` under each law (a matplotlib Figure)."""
+    from matplotlib.figure import Figure
 
     from ..cases import free_link
 
     q, v0 = FIGURE_DROP
-    fig, ax = plt.subplots(figsize=(6.0, 3.6), dpi=110)
+    fig = Figure(figsize=(6.0, 3.6))
+    ax = fig.subplots()
     for name, make in LAWS.items():
         scene = free_link(q, v0, dt=ctx.dt)
         r = ctx.run(scene.replace(forces=make(scene.forces), record=("state", "forces")))
         depth = [max(0.0, -y) for y in r.series["tip_y"]]
         ax.plot([1e3 * x for x in r.series["t"]], [1e3 * d for d in depth], label=name)
     ax.set_xlabel("t [ms]")
+    # Depth grows upwards, as in every other depth-against-time figure of the report.
     ax.set_ylabel("tip depth [mm]")
-    ax.invert_yaxis()
     ax.set_title(f"The free link at q = {q:g} deg, v0 = {v0:g} m/s, under each law")
+    ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
+    return fig
+
+
+def _figure(ctx: ReportContext) -> str:
+    from .. import plots
+
     return ctx.add_figure(
-        "force_laws_depth.png", buf.getvalue(), "tip depth against time under each law"
+        "force_laws_depth.png",
+        plots.png_bytes(depth_figure(ctx)),
+        "tip depth against time under each law",
     )

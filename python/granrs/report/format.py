@@ -13,6 +13,7 @@ import numpy as np
 
 from .. import data
 from ..result import Result
+from ..scene import Scene
 
 __all__ = ["md_table", "relative_error"]
 
@@ -90,6 +91,21 @@ def _rows(name: str) -> list[dict[str, Any]]:
         {c: v.item() if isinstance(v, np.generic) else v for c in columns for v in [frame[c][i]]}
         for i in range(n)
     ]
+
+
+def table_3_1_drop(q_deg: float) -> tuple[float, float]:
+    """The fastest Table 3.1 drop at ``q_deg``: (q [deg], v0 [m/s], the measured mean)."""
+    rows = [r for r in _rows("table_3_1") if r["q_deg"] == q_deg]
+    if not rows:
+        raise ValueError(f"Table 3.1 has no drop at q = {q_deg:g} deg")
+    fastest = max(rows, key=lambda r: r["v0_mean"])
+    return float(fastest["q_deg"]), float(fastest["v0_mean"])
+
+
+def watch_caption(scene: Scene, what: str) -> str:
+    """The caption of a free-link animation: ``what`` and the drop's q and v0, read from
+    ``scene`` (as the animation's title reads them)."""
+    return f"{what}: q = {scene.q_deg:g}°, v0 = {scene.v0:g} m/s"
 
 
 def _status_note(result: Result) -> str:

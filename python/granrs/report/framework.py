@@ -47,6 +47,10 @@ REPORT_NAME = "README.md"
 FIGURES_DIR = "figures"
 
 ChapterBuilder = Callable[["ReportContext"], str]
+#: The resolution of the report's animations [dots per inch]: their smallest text (8 pt)
+#: is 10 px high, and the narrowest is 648 px wide (granrs.animate's figures are at least
+#: 7.2 in wide).
+WATCH_DPI = 90.0
 
 
 @dataclass(frozen=True)
@@ -175,7 +179,7 @@ class ReportContext:
             result = self.run(scene.replace(record=("state", "forces")))
             with tempfile.TemporaryDirectory() as tmp:
                 path = Path(tmp) / name
-                animate(result, frame_dt=frame_dt, fps=10.0, dpi=60.0, out=path)
+                animate(result, frame_dt=frame_dt, fps=10.0, dpi=WATCH_DPI, out=path)
                 gif = path.read_bytes()
         link = self.add_figure(name, gif, caption)
         return f"### Watch it\n\n{caption}\n\n{link}\n"

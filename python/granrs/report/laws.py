@@ -1,4 +1,4 @@
-"""The chapter "Which law fits the experiments" (issue 18).
+"""The chapter "Which law fits the experiments".
 
 Registered after the calibration chapter (``granrs reproduce --chapter laws``). It runs
 :func:`granrs.compare.compare` on the thesis's three datasets (Table 3.1, the chain, the
@@ -13,7 +13,7 @@ as ``laws.json`` next to the report (``{dataset: {law: {...}}}``, see
 4. depth against time of the two best laws on each Table 3.1 angle, each predicted by the
    fit that did not see that angle, against the measured (t_s, depth);
 5. a paragraph written from these numbers: which law wins, by how much, where every law
-   fails, and the issue's acceptance targets, met or not, with the rows that miss.
+   fails, and the targets, met or not, with the rows that miss.
 """
 
 from __future__ import annotations
@@ -38,13 +38,13 @@ LAWS_JSON = "laws.json"
 #: Starts of each fit: the law's own start and one seeded random one (with one start, the
 #: RFT fits of the leg and the chain stop in a local minimum near their start).
 _STARTS = 2
-#: The issue's targets. Free link, out of sample: depth within 1 sd on >= 10 of 12 rows
+#: The targets. Free link, out of sample: depth within 1 sd on >= 10 of 12 rows
 #: and t_s within 2 sd on >= 10 of 12.
 _FREE_LINK_TARGET = {"depth_within_1sd": 10, "ts_within_2sd": 10}
 #: Leg: no coefficient scaled by more than this factor from the thesis's.
 _LEG_MAX_SCALE = 3.0
 #: The order of zeta Li, Zhang & Goldman (2013) measured for their media [N/m^3] (1 N/cm^3;
-#: ``shared/LAWS.md``, the rft term's registry entry): the leg's scale check compares with it.
+#: ``docs/laws.md``, the rft law): the leg's scale check compares with it.
 _RFT_ZETA_REF = 1e6
 #: One colour per law, in the order of LAWS.
 _COLOURS = dict(
@@ -63,6 +63,48 @@ def _colour(law: str) -> str:
 
 def _z(v: Any) -> str:
     return _fmt(float(v), "+.1f") if v is not None else "n/a"
+
+
+def _identified(fold: Mapping[str, Any]) -> bool:
+    """Whether a fold's fit can pin its parameters down: more residuals than parameters
+    (dof > 0) and every ~95 % interval bounded. A fold with dof = 0 has as many parameters
+    as residuals: no residual is left to test the fit or to estimate the parameters'
+    uncertainty, so its prediction of the rows held out is no test of the law."""
+    if fold["dof"] <= 0:
+        return False
+    return all(math.isfinite(lo) and math.isfinite(hi) for lo, hi in fold["intervals"].values())
+
+
+def _unidentified_folds(law: Mapping[str, Any]) -> list[Mapping[str, Any]]:
+    """The cross-validation folds of ``law`` (not the fit to every row) whose fit is not
+    identified (:func:`_identified`)."""
+    return [f for f in law["folds"] if f["held_out"] != "all" and not _identified(f)]
+
+
+def _evidence(law: Mapping[str, Any]) -> str:
+    """What the law's "out of sample" numbers rest on: empty when every fold's fit is
+    identified (or nothing is fitted), else a clause saying they are not a test."""
+    weak = _unidentified_folds(law)
+    if not weak:
+        return ""
+    held = sum(f["held_out"] != "all" for f in law["folds"])
+    k = law["n_params"]
+    which = f"each of its {held} folds" if len(weak) == held else f"{len(weak)} of its {held} folds"
+    reasons = []
+    no_dof = [f for f in weak if f["dof"] <= 0]
+    if no_dof:
+        residuals = sorted({k + int(f["dof"]) for f in no_dof})
+        reasons.append(
+            f"fits {k} parameters to {' or '.join(map(str, residuals))} residuals (no degree "
+            "of freedom left): nothing is left to test its fit or to estimate the "
+            "parameters' uncertainty"
+        )
+    if len(no_dof) < len(weak):
+        reasons.append("leaves a parameter's ~95 % interval unbounded")
+    return (
+        f"its out-of-sample numbers are no test: {which} {' or '.join(reasons)}, so the "
+        "parameters it carries to the held-out rows are not identified by the rows it saw"
+    )
 
 
 def _row_label(body: str, r: Mapping[str, Any]) -> str:
@@ -84,10 +126,13 @@ def _table(frame: pd.DataFrame, dataset: str) -> str:
         if not r["available"]:
             body.append([r["law"], "not run", *["-"] * 9, r["reason"]])
             continue
-        order = ""
+        notes = []
         if r.get("stop_order"):
             so = r["stop_order"]
-            order = f"stop order {so['in_order']}/{so['cases']}"
+            notes.append(f"stop order {so['in_order']}/{so['cases']}")
+        if _unidentified_folds(r):
+            notes.append("folds not identifiable (no dof left): no test out of sample")
+        order = "; ".join(notes)
         body.append(
             [
                 r["law"],
@@ -135,7 +180,10 @@ def _params_table(frame: pd.DataFrame, dataset: str) -> str:
                 lo, hi = f["intervals"][p]
                 flag = " (bound)" if p in f["at_bound"] else ""
                 cells.append(f"{p} = {v:.3g} [{lo:.3g}, {hi:.3g}]{flag}")
-            body.append([r["law"], held, "; ".join(cells), f"{f['chi2']:.1f} / {f['dof']}"])
+            fit = f"{f['chi2']:.1f} / {f['dof']}"
+            if not _identified(f):
+                fit += " (not identifiable)"
+            body.append([r["law"], held, "; ".join(cells), fit])
     if not body:
         return "(no law fitted)"
     return md_table(
@@ -266,18 +314,24 @@ def _fold_values(law: Mapping[str, Any], held_out: Any) -> dict[str, float]:
     return {}
 
 
-def _figure_depth_time(ctx: ReportContext, frame: pd.DataFrame) -> str:
-    """Depth against time of the two best laws on each Table 3.1 angle."""
-    from matplotlib.figure import Figure
+def _how_predicted(law: Mapping[str, Any]) -> str:
+    """How ``law`` predicts a Table 3.1 angle in the depth-time figure: from its fit without
+    that angle, or, a law with nothing to fit, as it is."""
+    return "fitted without the angle shown" if law["folds"] else "nothing fitted"
 
-    from .. import plots
+
+def depth_time_figure(ctx: ReportContext, frame: pd.DataFrame) -> Any:
+    """Depth against time of the two best laws on each Table 3.1 angle (a matplotlib
+    Figure, or None if no law ran on the free link). Each law's legend entry says how it
+    predicts the angle: by its fit without that angle, or with nothing fitted."""
+    from matplotlib.figure import Figure
 
     best = _available(frame, "free_link")[:2]
     if not best:
-        return ""
+        return None
     m = Measurements.thesis(DATASETS["free_link"].measurements)
     angles = sorted(pd.unique(m.rows["q_deg"]))
-    fig = Figure(figsize=(13.0, 3.4))
+    fig = Figure(figsize=(13.0, 3.8))
     axes = fig.subplots(1, len(angles), squeeze=False)[0]
     for ax, q in zip(axes, angles, strict=True):
         sub = m.subset(q_deg=q)
@@ -291,7 +345,7 @@ def _figure_depth_time(ctx: ReportContext, frame: pd.DataFrame) -> str:
                     np.asarray(s["depth"]) * 1e3,
                     color=_colour(law["law"]),
                     lw=1.2,
-                    label=law["law"] if n == 0 else None,
+                    label=f"{law['law']} ({_how_predicted(law)})" if n == 0 else None,
                 )
         r = sub.rows
         ax.errorbar(
@@ -304,17 +358,31 @@ def _figure_depth_time(ctx: ReportContext, frame: pd.DataFrame) -> str:
             capsize=3,
             label="experiment (t_s, depth)",
         )
-        ax.set_title(f"q = {q:g}°, held out of the fit", fontsize=9)
+        ax.set_title(f"q = {q:g}°", fontsize=9)
         ax.set_xlabel("t [ms]")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("depth [mm]")
-    axes[0].legend(fontsize=6, loc="lower right")
-    fig.tight_layout()
+    # Below the panels, clear of the curves and the measured stops.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8)
+    fig.tight_layout(rect=(0.0, 0.08, 1.0, 1.0))
+    return fig
+
+
+def _figure_depth_time(ctx: ReportContext, frame: pd.DataFrame) -> str:
+    """The depth-time figure (:func:`depth_time_figure`) kept in the report."""
+    from .. import plots
+
+    fig = depth_time_figure(ctx, frame)
+    if fig is None:
+        return ""
+    how = "; ".join(
+        f"{law['law']}: {_how_predicted(law)}" for law in _available(frame, "free_link")[:2]
+    )
     return ctx.add_figure(
         "laws_depth_time.png",
         plots.png_bytes(fig),
-        "Depth against time of the two best laws (each angle predicted by the fit without "
-        "it) and the measured stops",
+        f"Depth against time of the two best laws ({how}) and the measured stops",
     )
 
 
@@ -369,8 +437,10 @@ def _verdict(ctx: ReportContext, frame: pd.DataFrame) -> tuple[str, list[str]]:
             continue
         win = laws[0]
         n = win["n_rows"]
+        evidence = _evidence(win)
+        lead = "ranks first by the held-out χ²" if evidence else "predicts best out of sample"
         text = (
-            f"- **{_TITLES.get(d, d)}**: **{win['law']}** predicts best out of sample (χ² = "
+            f"- **{_TITLES.get(d, d)}**: **{win['law']}** {lead} (χ² = "
             f"{win['oos_chi2']:.1f} over {2 * n} values; depth within 1 sd on "
             f"{win['depth_within_1sd']}/{n} rows, t_s within 1 sd on {win['ts_within_1sd']}/{n} "
             f"and within 2 sd on {win['ts_within_2sd']}/{n})"
@@ -383,6 +453,8 @@ def _verdict(ctx: ReportContext, frame: pd.DataFrame) -> tuple[str, list[str]]:
                 f"({second['oos_chi2']:.1f}); in sample, AIC {win['aic']:.1f} against "
                 f"{second['aic']:.1f} ({win['n_params']} and {second['n_params']} parameters)"
             )
+        if evidence:
+            text += f". For {win['law']}, {evidence}"
         text += ". Where each law fails (out of sample): " + "; ".join(
             f"{law['law']}: {_misses(law, body)}" for law in laws
         )
@@ -396,6 +468,10 @@ def _verdict(ctx: ReportContext, frame: pd.DataFrame) -> tuple[str, list[str]]:
             f"**Which law fits ({_TITLES.get(d, d)}).** {win['law']} predicts best out of "
             f"sample: depth within 1 sd {win['depth_within_1sd']}/{n}, t_s within 2 sd "
             f"{win['ts_within_2sd']}/{n}."
+            if not evidence
+            else f"**Which law fits ({_TITLES.get(d, d)}).** {win['law']} ranks first by "
+            "its held-out χ², which is no out-of-sample test for it: the parameters of its "
+            "folds are not identified by the rows each fold sees (see the chapter)."
         )
     return "\n".join(lines), headlines
 
@@ -540,9 +616,13 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
         lo, hi = BODY_UNKNOWNS["leg"]["joints.k"][1:]
         good, notes = [], []
         for law in laws:
-            oos = law["depth_within_1sd"] == law["n_rows"] and law["ts_within_1sd"] == law["n_rows"]
+            n = law["n_rows"]
+            within = law["depth_within_1sd"] == n and law["ts_within_1sd"] == n
             folds = law["folds"]
             full = next((f for f in folds if f["held_out"] == "all"), None)
+            # Out of sample counts only where every fold's fit is identified.
+            evidence = _evidence(law)
+            oos = within and not evidence
             if full is None:  # nothing fitted: in sample is out of sample
                 insample = oos
             else:
@@ -557,7 +637,10 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
                 "joints.k" not in f["at_bound"] for f in folds if "joints.k" in f["values"]
             )
             if (oos or insample) and worst_scale <= _LEG_MAX_SCALE and k_free:
-                good.append(law["law"] + (" (out of sample)" if oos else " (in sample only)"))
+                if full is None:
+                    good.append(law["law"] + " (nothing fitted)")
+                else:
+                    good.append(law["law"] + (" (out of sample)" if oos else " (in sample only)"))
             fits = "; ".join(
                 ("all rows" if f["held_out"] == "all" else f"without {f['held_out']}")
                 + ": "
@@ -577,15 +660,16 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
                     else f"{law['law']}: "
                 )
                 + f"out of sample depth {law['depth_within_1sd']}/{law['n_rows']}, "
-                f"t_s {law['ts_within_1sd']}/{law['n_rows']} within 1 sd; in sample "
-                f"{'all' if insample else 'not all'} within 1 sd"
+                f"t_s {law['ts_within_1sd']}/{law['n_rows']} within 1 sd"
+                + (f" ({evidence})" if evidence else "")
+                + f"; in sample {'all' if insample else 'not all'} within 1 sd"
                 + (f"; largest scale factor {worst_scale:.2g}" if scales else "")
                 + (f" ({fits})" if fits else "")
             )
         out.append(
             "- **Leg** (Table 5.1's averages within 1 sd, joints in a physiological range, no "
             f"coefficient scaled by more than {_LEG_MAX_SCALE:g}x; out of sample, leave one "
-            "height out, or at least in sample): "
+            "height out, where the folds can test it, or at least in sample): "
             + (f"**met** by {', '.join(good)}" if good else "**not met** by any law run")
             + f". Joint stiffness k [N m/rad] fitted within {lo:g}-{hi:g} N m/rad (a joint "
             "setting on a bound is outside the range the law would choose), c = 5 N m s/rad. "
@@ -597,7 +681,7 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
 
 @register_chapter("laws", "Which law fits the experiments")
 def chapter_laws(ctx: ReportContext) -> str:
-    """The comparison of force laws (issue 18): table, figures, verdict, ``laws.json``."""
+    """The comparison of force laws: table, figures, verdict, ``laws.json``."""
     with ctx.step("laws: fit and cross-validate every law on every dataset"):
         frame = compare(dt=ctx.dt, starts=_STARTS, progress=ctx.progress)
         ctx.runs += int(frame["simulations"].sum())
@@ -642,7 +726,7 @@ The laws:
 
 {verdict}
 
-### Acceptance targets of issue 18
+### Targets
 
 {acceptance}
 
