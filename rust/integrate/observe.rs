@@ -51,6 +51,31 @@ fn drag_rate(w: &nalgebra::Matrix2<f64>, k: f64, dir: Vector2<f64>) -> f64 {
     0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
 }
 
+/// The fastest rate [1/s] of the listed terms' stiffness at `y`, over the contacts in the
+/// sand and not stopped: with `w` the largest eigenvalue of E's inverse effective mass
+/// (`Model::centroid_inverse_mass`), `w damping` (a decay) or `sqrt(w spring)` (an
+/// oscillation), whichever is faster.
+fn term_rate<const N: usize>(model: &Model<N>, y: &State<N>, modes: &Modes) -> f64 {
+    (0..model.contacts.len())
+        .filter(|&ci| !modes[ci].stopped && modes[ci].in_contact)
+        .map(|ci| {
+            let r = model.contact_rates(&y.q, &y.qd, modes, ci);
+            if r.damping <= 0.0 && r.spring <= 0.0 {
+                return 0.0;
+            }
+            let w = largest_eigenvalue(&model.centroid_inverse_mass(&y.q, ci));
+            (w * r.damping).max((w * r.spring).sqrt())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The largest eigenvalue of a symmetric positive semi-definite 2 x 2 matrix (an inverse
+/// effective mass [1/kg]); NaN in, NaN out.
+fn largest_eigenvalue(w: &nalgebra::Matrix2<f64>) -> f64 {
+    let (tr, det) = (w.trace(), w.determinant());
+    0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
+}
+
 /// The drag's stiffest moment of a run so far, and the coordinates where it was.
 struct Stiffest<const N: usize> {
     best: DragStiffness,
@@ -79,6 +104,13 @@ pub(super) struct Observer<const N: usize> {
     /// contact, the stages meet a stiffness the ends do not). Squared norms: a square root
     /// only when a maximum is beaten.
     stiffest: Stiffest<N>,
+    /// Whether the terms' own stiffness is sampled ([`Observer::sample_rates`]): a listed
+    /// term reads the contact's boundary (`rft`, `rft_inertial`, `poncelet`), whose rates the
+    /// drag's |F_d| / |v_E| does not see. The thesis's terms keep the drag's estimate alone.
+    rates_on: bool,
+    /// The fastest rate [1/s] of the terms' stiffness at the start, the step ends and the
+    /// events so far.
+    term_rate: f64,
     recorder: Recorder,
     /// Record every `stride`-th grid step.
     stride: u64,
@@ -132,6 +164,12 @@ impl<const N: usize> Observer<N> {
                 best: DragStiffness::default(),
                 q: y.q,
             },
+            rates_on: model.forces.reads_frame,
+            term_rate: if model.forces.reads_frame {
+                term_rate(model, y, modes)
+            } else {
+                0.0
+            },
             recorder: Recorder::new(record, &model.forces, N, nc, n_links, joint_loads(model)),
             stride: record.stride.max(1) as u64,
             q0: y.q,
@@ -157,7 +195,14 @@ impl<const N: usize> Observer<N> {
     /// reports no joint loads.
     #[inline]
     pub(super) fn drag_only(&self, model: &Model<N>) -> bool {
-        !self.recorder.on.any() && !joint_loads(model)
+        !self.recorder.on.any() && !joint_loads(model) && !self.rates_on
+    }
+
+    /// The terms' stiffness at a step's end or an event `y` ([`Observer::rates_on`]).
+    pub(super) fn sample_rates(&mut self, model: &Model<N>, y: &State<N>, modes: &Modes) {
+        if self.rates_on {
+            self.term_rate = self.term_rate.max(term_rate(model, y, modes));
+        }
     }
 
     /// Show the drag's stiffness `s` at an RK4 stage with coordinates `q()` (read only when
@@ -323,11 +368,14 @@ impl<const N: usize> Observer<N> {
         let best = &self.stiffest.best;
         let h_lambda = if options.method != Method::Rk4 {
             f64::NAN
-        } else if best.k2() > 0.0 {
-            let inverse_mass = model.centroid_inverse_mass(&self.stiffest.q, best.contact);
-            options.dt * drag_rate(&inverse_mass, best.k2().sqrt(), best.v.normalize())
         } else {
-            0.0
+            let drag = if best.k2() > 0.0 {
+                let inverse_mass = model.centroid_inverse_mass(&self.stiffest.q, best.contact);
+                drag_rate(&inverse_mass, best.k2().sqrt(), best.v.normalize())
+            } else {
+                0.0
+            };
+            options.dt * drag.max(self.term_rate)
         };
         let out = Outcome {
             h_lambda,
