@@ -39,6 +39,13 @@ impl Record {
 /// `h lambda` beyond which the classical RK4 is unstable for a real, negative rate.
 pub const RK4_STABILITY_LIMIT: f64 = 2.785;
 
+/// The largest error of a located stop time, as a fraction of t_s, that counts as resolved
+/// (`Stats::unresolved_stops`): 1 %, the change that `benches/step_warning.py` counts as a
+/// result that moves with the step. The error is estimated at the located stop from its
+/// switching function, the tip's vertical velocity (zero there when the step resolves the
+/// stop): that velocity over the tip's vertical acceleration.
+pub const STOP_TIME_ERROR: f64 = 0.01;
+
 /// The fastest rate [1/s] of a quadratic drag `F = -c |v| v` on a point of inverse effective
 /// mass `w`, with `k = |F| / |v|` and `dir` the unit velocity: the largest eigenvalue of
 /// `w K`, `K = dF/dv = -k (I + dir dir^T)` (twice as stiff along the motion as across).
@@ -108,6 +115,9 @@ pub(super) struct Observer<const N: usize> {
     /// term reads the contact's boundary (`rft`, `rft_inertial`, `poncelet`), whose rates the
     /// drag's |F_d| / |v_E| does not see. The thesis's terms keep the drag's estimate alone.
     rates_on: bool,
+    /// Stops whose estimated time error was past [`STOP_TIME_ERROR`]
+    /// (`Stats::unresolved_stops`).
+    unresolved_stops: usize,
     /// The fastest rate [1/s] of the terms' stiffness at the start, the step ends and the
     /// events so far.
     term_rate: f64,
@@ -165,6 +175,7 @@ impl<const N: usize> Observer<N> {
                 q: y.q,
             },
             rates_on: model.forces.reads_frame,
+            unresolved_stops: 0,
             term_rate: if model.forces.reads_frame {
                 term_rate(model, y, modes)
             } else {
@@ -308,6 +319,18 @@ impl<const N: usize> Observer<N> {
         e: &Eval<N>,
     ) {
         let energies = model.energies(&y.q, &y.qd);
+        // The stop's switching function there (zero where the step resolves the stop) over
+        // its rate, the tip's vertical acceleration: the stop time's error.
+        let contact = &model.contacts[ci];
+        let (link, tip) = (contact.link(), contact.reference_point());
+        let pose = model.mechanism.pose(&y.q);
+        let accel = model.mechanism.point_velocity(&pose, link, tip, &e.qdd)
+            + model
+                .mechanism
+                .point_bias_acceleration(&pose, link, tip, &y.qd);
+        if e.contacts[ci].v_tip.y.abs() > STOP_TIME_ERROR * t * accel.y.abs() {
+            self.unresolved_stops += 1;
+        }
         let s = &mut self.summaries[ci];
         s.stopped = true;
         s.t_s = t;
@@ -377,6 +400,8 @@ impl<const N: usize> Observer<N> {
             };
             options.dt * drag.max(self.term_rate)
         };
+        let mut stats = stats;
+        stats.unresolved_stops = self.unresolved_stops;
         let out = Outcome {
             h_lambda,
             status,
