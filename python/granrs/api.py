@@ -18,9 +18,7 @@ RK4_STABILITY_LIMIT = 2.785
 ENERGY_ROSE_RTOL = 1e-9
 
 
-def step_advice(
-    dt: float, h_lambda: float, unresolved: int = 0, unresolved_stops: int = 0
-) -> str:
+def step_advice(dt: float, h_lambda: float, unresolved: int = 0, unresolved_stops: int = 0) -> str:
     """What to tell a user whose run did not resolve its contact: ``h_lambda`` above
     :data:`RK4_STABILITY_LIMIT`, ``unresolved_stops`` stops the step missed, or
     ``unresolved`` steps the sign modes chattered through."""

@@ -77,7 +77,11 @@ impl Term for Drag {
         let speed = c.v[0].hypot(c.v[1]);
         Rates {
             damping: 2.0 * k,
-            spring: if c.depth > 0.0 { k * speed / c.depth } else { 0.0 },
+            spring: if c.depth > 0.0 {
+                k * speed / c.depth
+            } else {
+                0.0
+            },
         }
     }
 }

@@ -454,8 +454,8 @@ impl Term for Rft {
             let turn = (gx[0] * gx[0] + gx[1] * gx[1] + gy[0] * gy[0] + gy[1] * gy[1]).sqrt();
             let el = p.elements(self.elements);
             // Every element of the immersed part: zeta dA |alpha| each.
-            rates.spring += co.zeta * el.width * el.length * self.elements as f64
-                * (g0[0].hypot(g0[1]) + turn);
+            rates.spring +=
+                co.zeta * el.width * el.length * self.elements as f64 * (g0[0].hypot(g0[1]) + turn);
         });
         rates
     }

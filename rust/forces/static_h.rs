@@ -17,7 +17,9 @@
 //!   the term's magnitude (Karnopp).
 //! - **Series:** `F_sh` (and `mode_x`, the held sign).
 
-use super::{Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo};
+use super::{
+    Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo,
+};
 
 /// The static horizontal term F_sh.
 #[derive(Debug, Clone, Copy, PartialEq)]

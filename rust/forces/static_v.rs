@@ -17,7 +17,9 @@
 //!   of the engine, polished on the RK4 map).
 //! - **Series:** `F_sv` (and `mode_y`, the held sign).
 
-use super::{Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo};
+use super::{
+    Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo,
+};
 
 /// The static vertical term F_sv.
 #[derive(Debug, Clone, Copy, PartialEq)]
