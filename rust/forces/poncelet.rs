@@ -138,8 +138,8 @@ impl Term for Poncelet {
     /// friction's `k`. The friction's direction also turns with v (`k d / |v|` across the
     /// motion), which is not counted: as E comes to rest it grows as 1 / |v|, so that at
     /// the step ends before any stop it reads about 1 / dt whether or not the step resolves
-    /// the motion (measured on an `rft` rod, whose elements turn alike: `h_lambda` 26 at
-    /// dt = 1e-4 and 160 at 1e-6, where the run is converged). Along an axis held at zero
+    /// the motion (measured on an `rft` rod, whose elements turn alike: `h_lambda` 28 at
+    /// dt = 1e-4 and 25 to 161 at 1e-6, where the run is converged). Along an axis held at zero
     /// nothing moves and no term acts.
     fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates {
         let Some(b) = c.boundary else {

@@ -58,22 +58,49 @@ fn drag_rate(w: &nalgebra::Matrix2<f64>, k: f64, dir: Vector2<f64>) -> f64 {
     0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
 }
 
-/// The fastest rate [1/s] of the listed terms' stiffness at `y`, over the contacts in the
-/// sand and not stopped: with `w` the largest eigenvalue of E's inverse effective mass
-/// (`Model::centroid_inverse_mass`), `w damping` (a decay) or `sqrt(w spring)` (an
-/// oscillation), whichever is faster.
-fn term_rate<const N: usize>(model: &Model<N>, y: &State<N>, modes: &Modes) -> f64 {
-    (0..model.contacts.len())
-        .filter(|&ci| !modes[ci].stopped && modes[ci].in_contact)
-        .map(|ci| {
-            let r = model.contact_rates(&y.q, &y.qd, modes, ci);
-            if r.damping <= 0.0 && r.spring <= 0.0 {
-                return 0.0;
+/// The listed terms' stiffest moments so far: the largest damping D [N s/m] and the
+/// largest spring K [N/m] met, each with the coordinates and the contact where it was (the
+/// inverse effective mass there is taken once, at the end, as for the drag).
+#[derive(Debug, Clone, Copy)]
+struct TermStiffest<const N: usize> {
+    damping: (f64, SVector<f64, N>, usize),
+    spring: (f64, SVector<f64, N>, usize),
+}
+
+impl<const N: usize> TermStiffest<N> {
+    /// The terms' rates at `y`, over the contacts in the sand and not stopped.
+    fn offer(&mut self, model: &Model<N>, y: &State<N>, modes: &Modes) {
+        for ci in 0..model.contacts.len() {
+            if modes[ci].stopped || !modes[ci].in_contact {
+                continue;
             }
-            let w = largest_eigenvalue(&model.centroid_inverse_mass(&y.q, ci));
-            (w * r.damping).max((w * r.spring).sqrt())
-        })
-        .fold(0.0, f64::max)
+            let r = model.contact_rates(&y.q, &y.qd, modes, ci);
+            if r.damping > self.damping.0 {
+                self.damping = (r.damping, y.q, ci);
+            }
+            if r.spring > self.spring.0 {
+                self.spring = (r.spring, y.q, ci);
+            }
+        }
+    }
+
+    /// The fastest rate [1/s]: with `w` the largest eigenvalue of E's inverse effective
+    /// mass (`Model::centroid_inverse_mass`) where each was met, `w D` (a decay) or
+    /// `sqrt(w K)` (an oscillation), whichever is faster.
+    fn rate(&self, model: &Model<N>) -> f64 {
+        let w = |q: &SVector<f64, N>, ci: usize| {
+            largest_eigenvalue(&model.centroid_inverse_mass(q, ci))
+        };
+        let (d, qd, cd) = self.damping;
+        let (k, qk, ck) = self.spring;
+        let decay = if d > 0.0 { w(&qd, cd) * d } else { 0.0 };
+        let oscillation = if k > 0.0 {
+            (w(&qk, ck) * k).sqrt()
+        } else {
+            0.0
+        };
+        decay.max(oscillation)
+    }
 }
 
 /// The largest eigenvalue of a symmetric positive semi-definite 2 x 2 matrix (an inverse
@@ -118,9 +145,8 @@ pub(super) struct Observer<const N: usize> {
     /// Stops whose estimated time error was past [`STOP_TIME_ERROR`]
     /// (`Stats::unresolved_stops`).
     unresolved_stops: usize,
-    /// The fastest rate [1/s] of the terms' stiffness at the start, the step ends and the
-    /// events so far.
-    term_rate: f64,
+    /// The terms' stiffest moments at the start, the step ends and the events so far.
+    terms: TermStiffest<N>,
     recorder: Recorder,
     /// Record every `stride`-th grid step.
     stride: u64,
@@ -176,10 +202,15 @@ impl<const N: usize> Observer<N> {
             },
             rates_on: model.forces.reads_frame,
             unresolved_stops: 0,
-            term_rate: if model.forces.reads_frame {
-                term_rate(model, y, modes)
-            } else {
-                0.0
+            terms: {
+                let mut terms = TermStiffest {
+                    damping: (0.0, y.q, 0),
+                    spring: (0.0, y.q, 0),
+                };
+                if model.forces.reads_frame {
+                    terms.offer(model, y, modes);
+                }
+                terms
             },
             recorder: Recorder::new(record, &model.forces, N, nc, n_links, joint_loads(model)),
             stride: record.stride.max(1) as u64,
@@ -212,7 +243,7 @@ impl<const N: usize> Observer<N> {
     /// The terms' stiffness at a step's end or an event `y` ([`Observer::rates_on`]).
     pub(super) fn sample_rates(&mut self, model: &Model<N>, y: &State<N>, modes: &Modes) {
         if self.rates_on {
-            self.term_rate = self.term_rate.max(term_rate(model, y, modes));
+            self.terms.offer(model, y, modes);
         }
     }
 
@@ -398,7 +429,7 @@ impl<const N: usize> Observer<N> {
             } else {
                 0.0
             };
-            options.dt * drag.max(self.term_rate)
+            options.dt * drag.max(self.terms.rate(model))
         };
         let mut stats = stats;
         stats.unresolved_stops = self.unresolved_stops;
