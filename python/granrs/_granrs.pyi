@@ -74,6 +74,7 @@ class RunOutcome:
     run_seconds: float
     h_lambda: float
     unresolved: int
+    unresolved_stops: int
     def to_dict(self) -> dict[str, Any]:
         """Everything, as a dict; once (the outcome moves out). ``impulses``: the
         table-driven joints' impulses, ``(link, t, impulse, energy)`` tuples in time order

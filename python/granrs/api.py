@@ -18,15 +18,23 @@ RK4_STABILITY_LIMIT = 2.785
 ENERGY_ROSE_RTOL = 1e-9
 
 
-def step_advice(dt: float, h_lambda: float, unresolved: int = 0) -> str:
+def step_advice(dt: float, h_lambda: float, unresolved: int = 0, unresolved_stops: int = 0) -> str:
     """What to tell a user whose run did not resolve its contact: ``h_lambda`` above
-    :data:`RK4_STABILITY_LIMIT`, or ``unresolved`` steps the sign modes chattered through."""
+    :data:`RK4_STABILITY_LIMIT`, ``unresolved_stops`` stops the step missed, or
+    ``unresolved`` steps the sign modes chattered through."""
     if h_lambda > RK4_STABILITY_LIMIT:
         why = (
-            f"dt times the drag's fastest rate reached {h_lambda:.3g} (RK4 is stable below "
+            f"dt times the contact's fastest rate reached {h_lambda:.3g} (RK4 is stable below "
             f"{RK4_STABILITY_LIMIT})"
         )
         advice = f"use dt <= {dt * 0.5 / h_lambda:.2g} s (dt * rate <= 0.5)"
+    elif unresolved_stops:
+        why = (
+            f"{unresolved_stops} stop{'s' if unresolved_stops != 1 else ''} fell between "
+            "the steps (the tip's vertical velocity was not zero where the stop was located: "
+            "the impact is over in too few steps)"
+        )
+        advice = f"use dt <= {dt / 10:.2g} s (dt / 10)"
     else:
         why = (
             f"in {unresolved} step{'s' if unresolved != 1 else ''} the force's signs switched "
@@ -61,14 +69,18 @@ def simulate(scene: Scene) -> Result:
     # scene._compiled() and _granrs.run in one call of the core.
     outcome = _granrs.run_scene(scene.__dict__, _CORE_FIELDS)
     result = Result(scene, outcome)
-    if outcome.h_lambda > RK4_STABILITY_LIMIT or (
-        outcome.unresolved
-        and energy_rose(result.summary["energy_start"], result.summary["energy_end"])
-    ):
-        warnings.warn(
-            StepSizeWarning(step_advice(scene.dt, outcome.h_lambda, outcome.unresolved)),
-            stacklevel=2,
+    if (
+        outcome.h_lambda > RK4_STABILITY_LIMIT
+        or outcome.unresolved_stops
+        or (
+            outcome.unresolved
+            and energy_rose(result.summary["energy_start"], result.summary["energy_end"])
         )
+    ):
+        advice = step_advice(
+            scene.dt, outcome.h_lambda, outcome.unresolved, outcome.unresolved_stops
+        )
+        warnings.warn(StepSizeWarning(advice), stacklevel=2)
     return result
 
 

@@ -43,7 +43,15 @@ __all__ = ["STATUSES", "sweep"]
 STATUSES: tuple[str, ...] = ("stopped", "end_time", "not_stopped", "failed", "cancelled")
 #: Sweeps with at least this many runs show a progress bar by default (on a terminal).
 PROGRESS_MIN_RUNS = 2000
-_INT_COLUMNS = ("steps", "rhs_evals", "root_evals", "events", "rejected", "unresolved")
+_INT_COLUMNS = (
+    "steps",
+    "rhs_evals",
+    "root_evals",
+    "events",
+    "rejected",
+    "unresolved",
+    "unresolved_stops",
+)
 
 
 def _plain(name: str, value: Any) -> Any:
@@ -591,15 +599,18 @@ def _warn_unresolved(table: _Table) -> None:
     end = table.column("energy_end")[maybe]
     with np.errstate(invalid="ignore"):
         rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
-    flagged = np.flatnonzero(h_lambda > RK4_STABILITY_LIMIT)
+    flagged = np.flatnonzero(
+        (h_lambda > RK4_STABILITY_LIMIT) | (table.column("unresolved_stops") > 0)
+    )
     bad = np.union1d(flagged, maybe[rose])
     if bad.size:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
         warnings.warn(
             StepSizeWarning(
                 f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
-                f"(h_lambda above {RK4_STABILITY_LIMIT}, or 'unresolved' steps where the sign "
-                f"modes chattered and the energy rose); the largest h_lambda is "
+                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or "
+                "'unresolved' steps where the sign modes chattered and the energy rose); the "
+                "largest h_lambda is "
                 f"{np.nanmax(h_lambda[bad]):.3g}. "
                 "Use a smaller dt (dt * rate <= 0.5) for those runs"
             ),

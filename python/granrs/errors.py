@@ -57,10 +57,13 @@ class SimulationError(GranrsError, RuntimeError):
 
 
 class StepSizeWarning(UserWarning):
-    """The fixed step did not resolve the run: at the drag's stiffest moment, ``dt`` times
-    its fastest rate (``Result.summary["h_lambda"]``) exceeded RK4's stability limit
-    (:data:`granrs.RK4_STABILITY_LIMIT`). The run finished with finite numbers, but they are
-    not the converged answer: rerun with a smaller ``dt`` or ``method="dopri5"``."""
+    """The fixed step did not resolve the run: at the contact's stiffest moment, ``dt`` times
+    its fastest rate (``Result.summary["h_lambda"]``: the drag's, and each listed force term's
+    own stiffness in velocity and depth) exceeded RK4's stability limit
+    (:data:`granrs.RK4_STABILITY_LIMIT`), or steps where the force's signs chattered gained
+    energy. The run finished with finite numbers, but they are not the converged answer: the
+    message gives the ``dt`` used and a ``dt`` that resolves it; rerun with that ``dt`` or
+    ``method="dopri5"``."""
 
 
 class CoefficientsWarning(UserWarning):

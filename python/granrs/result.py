@@ -42,6 +42,7 @@ SUMMARY_UNITS: dict[str, str] = {
     "events": "-",
     "rejected": "-",
     "unresolved": "-",
+    "unresolved_stops": "-",
     "h_lambda": "-",
 }
 

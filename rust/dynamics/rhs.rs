@@ -16,7 +16,7 @@ use super::{
 use crate::body::mechanism::Pose;
 use crate::body::rod::ApplyAt;
 use crate::body::SoleModel;
-use crate::forces::{Boundary, ContactState, Frame, Outline, Switch};
+use crate::forces::{Boundary, ContactState, Frame, Outline, Rates, Switch};
 
 /// The immersed geometry of one contact, as the force law needs it.
 #[derive(Debug, Clone, Copy)]
@@ -307,6 +307,88 @@ impl<const N: usize> Model<N> {
         );
     }
 
+    /// What the terms read of a contact in the sand beyond its geometry `geom` and E's
+    /// velocity `v_e`: A_r |v_E| (for a rod |e x v_E| times d_c l: in `Modes` the sign is
+    /// held, the kink at 0 is a located event), the point of application P, the signs of
+    /// v_E, and the boundary (only when a listed term reads it).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn immersed_state(
+        &self,
+        c: &Contact,
+        pose: &Pose<N>,
+        qd: &SVector<f64, N>,
+        mode: &ContactMode,
+        geom: &Geometry,
+        v_e: Vector2<f64>,
+        cross_signed: f64,
+    ) -> (f64, Vector2<f64>, [f64; 2], Option<Boundary<f64>>) {
+        let area_speed = match (&geom.sole, &c.shape) {
+            _ if !self.forces.reads_area_speed => 0.0,
+            (Some(sg), Shape::Sole(sole)) => sole.drag_area_speed(sg, v_e),
+            _ => geom.factor * self.held_cross(mode, cross_signed),
+        };
+        let p = self.application_point(c, geom.centroid);
+        let sign = self.signs(mode, v_e);
+        let boundary = if self.forces.reads_frame {
+            let mut b = self.boundary(c, pose, qd, geom, p);
+            let shift = held_shift(
+                sign,
+                v_e,
+                [
+                    self.forces.owns(Switch::SlipX),
+                    self.forces.owns(Switch::SlipY),
+                ],
+            );
+            b.frame.v = [b.frame.v[0] + shift.x, b.frame.v[1] + shift.y];
+            b.v_centroid = [v_e.x + shift.x, v_e.y + shift.y];
+            b.held = self.held_axes(mode);
+            Some(b)
+        } else {
+            None
+        };
+        (area_speed, p, sign, boundary)
+    }
+
+    /// The stiffness of contact `ci`'s terms at `(q, qd)` in `modes` (the sum of each listed
+    /// term's [`crate::forces::Term::rates`]), or none out of the sand.
+    pub fn contact_rates(
+        &self,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        modes: &Modes,
+        ci: usize,
+    ) -> Rates {
+        let (Some(c), Some(mode)) = (self.contacts.get(ci), modes.get(ci)) else {
+            return Rates::NONE;
+        };
+        let pose = self.mechanism.pose(q);
+        let geom = self.geometry(c, &pose);
+        if !mode.in_contact || (geom.depth <= 0.0 && !self.forces.reads_frame) {
+            return Rates::NONE;
+        }
+        let v_e = self
+            .mechanism
+            .point_velocity(&pose, c.link(), geom.centroid, qd);
+        let e = geom.cross_axis;
+        let cross_signed = e.x * v_e.y - e.y * v_e.x;
+        let (area_speed, _, sign, boundary) =
+            self.immersed_state(c, &pose, qd, mode, &geom, v_e, cross_signed);
+        let state = ContactState {
+            depth: geom.depth,
+            volume: geom.volume,
+            width: geom.width,
+            l_ref: geom.l_ref,
+            v: [v_e.x, v_e.y],
+            area_speed,
+            sign,
+            boundary: boundary.as_ref(),
+        };
+        self.forces.per_contact[ci]
+            .iter()
+            .fold(Rates::NONE, |r, t| r.plus(t.rates(&state, &self.medium)))
+    }
+
     /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
     ///
     /// A single rigid rod whose root is its centre of mass (the free link) has a constant,
@@ -488,32 +570,8 @@ impl<const N: usize> Model<N> {
             if at_entry {
                 continue;
             }
-            // A_r |v_E|; for a rod |e x v_E| times d_c l: in `Modes` the sign is held (the
-            // kink at 0 is a located event).
-            let area_speed = match (&geom.sole, &c.shape) {
-                _ if !self.forces.reads_area_speed => 0.0,
-                (Some(sg), Shape::Sole(sole)) => sole.drag_area_speed(sg, v_e),
-                _ => geom.factor * self.held_cross(mode, cross_signed),
-            };
-            let p = self.application_point(c, geom.centroid);
-            let sign = self.signs(mode, v_e);
-            let boundary = if self.forces.reads_frame {
-                let mut b = self.boundary(c, &pose, qd, &geom, p);
-                let shift = held_shift(
-                    sign,
-                    v_e,
-                    [
-                        self.forces.owns(Switch::SlipX),
-                        self.forces.owns(Switch::SlipY),
-                    ],
-                );
-                b.frame.v = [b.frame.v[0] + shift.x, b.frame.v[1] + shift.y];
-                b.v_centroid = [v_e.x + shift.x, v_e.y + shift.y];
-                b.held = self.held_axes(mode);
-                Some(b)
-            } else {
-                None
-            };
+            let (area_speed, p, sign, boundary) =
+                self.immersed_state(c, &pose, qd, mode, &geom, v_e, cross_signed);
             let state = ContactState {
                 depth: geom.depth,
                 volume: geom.volume,

@@ -10,7 +10,7 @@
 //! - **Parameters:** `fx`, `fy` [N], default 0.
 //! - **Switches:** none. **Series:** `F_cx`, `F_cy`.
 
-use super::{Acts, Class, ContactState, Medium, Param, Real, Term, TermForce, TermInfo};
+use super::{Acts, Class, ContactState, Medium, Param, Rates, Real, Term, TermForce, TermInfo};
 
 /// A constant force on each contact in the sand.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,6 +70,11 @@ impl Term for Constant {
 
     fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
         TermForce::force([F::splat(self.fx), F::splat(self.fy)])
+    }
+
+    /// None: the force is the same at every velocity and depth.
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
     }
 }
 

@@ -19,7 +19,9 @@
 //!   the crossing is a located event.
 //! - **Series:** `F_dx`, `F_dy`.
 
-use super::{Acts, Class, ContactState, Medium, Param, Real, Switch, Term, TermForce, TermInfo};
+use super::{
+    Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo,
+};
 
 /// The dynamic drag F_d.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,6 +68,22 @@ impl Term for Drag {
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         Drag::law(F::splat(self.eta_d), c, m)
+    }
+
+    /// With `k = eta_d rho_g A_r |v_E|` (so `|F| = k |v_E|`): `dF/dv = -k (I + v^ v^T)` for
+    /// a point moving freely, at most `2 k`; in depth, `A_r` grows with the immersed length
+    /// (`|F| / d`).
+    fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates {
+        let k = self.eta_d * m.rho_g * c.area_speed.abs();
+        let speed = c.v[0].hypot(c.v[1]);
+        Rates {
+            damping: 2.0 * k,
+            spring: if c.depth > 0.0 {
+                k * speed / c.depth
+            } else {
+                0.0
+            },
+        }
     }
 }
 

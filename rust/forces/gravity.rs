@@ -12,7 +12,7 @@
 //! - **Energy:** with this term the potential energy is gravity's, m g y; without it the
 //!   body has none from gravity (a free link with nothing acting keeps E = KE).
 
-use super::{Acts, Class, Term, TermInfo};
+use super::{Acts, Class, ContactState, Medium, Rates, Term, TermInfo};
 
 /// Gravity on the body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,5 +42,10 @@ impl Term for Gravity {
 
     fn params(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    /// None at a contact: a constant force on each link.
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
     }
 }

@@ -15,7 +15,7 @@
 //! - **Switches:** none.
 //! - **Energy:** the springs' energy is potential energy; the dampers' loss is `joint_loss`.
 
-use super::{Acts, Class, Term, TermInfo};
+use super::{Acts, Class, ContactState, Medium, Rates, Term, TermInfo};
 
 /// The joints' spring-dampers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,5 +45,10 @@ impl Term for JointSprings {
 
     fn params(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    /// None at a contact: it acts through the mechanism, at the joints (a body term).
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
     }
 }

@@ -400,6 +400,39 @@ pub struct TermInfo {
     pub columns: &'static [(&'static str, usize)],
 }
 
+/// How stiff a term's force is at one contact: what the step-size check reads
+/// (`Outcome::h_lambda`). With the body's inverse effective mass `w` at the contact
+/// [1/kg], `w damping` is the fastest decay rate the term gives a fixed step (RK4 is stable
+/// below 2.785 on the negative real axis) and `sqrt(w spring)` its oscillation rate (2.83
+/// on the imaginary axis).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Rates {
+    /// The largest |dF/dv| [N s/m]: how fast the force grows with the contact's speed (a
+    /// quadratic drag's 2 |F| / |v|) or turns with its direction (a rate-independent force
+    /// of magnitude F that follows the velocity: F / |v|, unbounded as |v| -> 0).
+    pub damping: f64,
+    /// The largest |dF/dx| [N/m]: how fast the force grows with the contact's position
+    /// (its depth).
+    pub spring: f64,
+}
+
+impl Rates {
+    /// No stiffness at the contact (a body term, a constant force).
+    pub const NONE: Rates = Rates {
+        damping: 0.0,
+        spring: 0.0,
+    };
+
+    /// The sum of two terms' rates (their forces add, so do their derivatives' bounds).
+    #[inline]
+    pub fn plus(self, other: Rates) -> Rates {
+        Rates {
+            damping: self.damping + other.damping,
+            spring: self.spring + other.spring,
+        }
+    }
+}
+
 /// A force term. Implemented by one struct per file; the registry lists them.
 pub trait Term: Copy + Debug + PartialEq {
     /// The term's description.
@@ -413,4 +446,9 @@ pub trait Term: Copy + Debug + PartialEq {
     fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
         TermForce::force([F::splat(0.0); 2])
     }
+    /// Its stiffness at one contact in the sand (`c` as [`Term::contact_force`] reads it),
+    /// for the step-size check. No default: each term says how its force changes with the
+    /// contact's velocity and position, or why it does not ([`Rates::NONE`]), so that a new
+    /// term cannot leave the check blind to it.
+    fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates;
 }

@@ -6,7 +6,7 @@
 
 use super::{
     drag, gravity, joint_springs, poncelet, rft, static_h, static_v, Acts, Class, ContactState,
-    Medium, Real, Switch, Term, TermForce, TermInfo,
+    Medium, Rates, Real, Switch, Term, TermForce, TermInfo,
 };
 use crate::error::{suggest, GranrsError, Result};
 
@@ -69,6 +69,13 @@ macro_rules! registry {
             pub fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
                 match self {
                     $($(#[$m])* AnyTerm::$variant(t) => t.contact_force(c, m),)*
+                }
+            }
+
+            /// Its stiffness at one contact in the sand ([`Term::rates`]).
+            pub fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => t.rates(c, m),)*
                 }
             }
 

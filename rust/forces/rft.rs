@@ -51,8 +51,8 @@
 use super::outline::rod_plates;
 use super::outline::Plate;
 use super::{
-    Acts, Boundary, Class, ContactState, Medium, Outline, Param, Real, Switch, Term, TermForce,
-    TermInfo,
+    Acts, Boundary, Class, ContactState, Medium, Outline, Param, Rates, Real, Switch, Term,
+    TermForce, TermInfo,
 };
 
 /// Elements per plate unless the scene says otherwise (the convergence in docs/laws.md:
@@ -443,6 +443,31 @@ impl Term for Rft {
         }
         self.force_base(&co, c)
     }
+
+    /// Per element, `zeta |z| dA (g0 + G v^)`: in depth, `zeta |alpha| dA`, summed over the
+    /// immersed elements. Rate-independent: it does not grow with speed. Its direction
+    /// turns with each element's velocity (`|G| zeta |z| dA / |v_k|` across it), which is
+    /// not counted, as for `poncelet`'s friction: it grows as 1 / |v_k| wherever an element
+    /// passes through rest (a pivot in the sand, the approach to a stop), and read about
+    /// 1 / dt there on converged runs too.
+    fn rates(&self, c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        let Some(b) = c.boundary else {
+            return Rates::NONE;
+        };
+        let co = self.coefficients_in::<f64>();
+        let mut rates = Rates::NONE;
+        b.outline.for_each_plate(&b.frame, |p| {
+            let (c2, s2) = line_angle(p);
+            let (g0, gx, gy) = alpha_affine(&co.k, c2, s2);
+            // The largest |alpha| over the directions: |g0| + |G| (Frobenius norm).
+            let turn = (gx[0] * gx[0] + gx[1] * gx[1] + gy[0] * gy[0] + gy[1] * gy[1]).sqrt();
+            let el = p.elements(self.elements);
+            // Every element of the immersed part: zeta dA |alpha| each.
+            rates.spring +=
+                co.zeta * el.width * el.length * self.elements as f64 * (g0[0].hypot(g0[1]) + turn);
+        });
+        rates
+    }
 }
 
 /// Most elements per plate of a lone rod's fast paths ([`Rft::rod_avx2`],
@@ -639,6 +664,30 @@ impl Term for RftInertial {
             }
         }
         self.force_with(F::splat(self.lam), c, m)
+    }
+
+    /// Per element a quadratic drag along its normal: `dF/dv = -2 lam rho_g |v_n| n n^T dA`.
+    /// It does not grow with depth (the immersed area does, as the elements' sum shows).
+    fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates {
+        let Some(b) = c.boundary else {
+            return Rates::NONE;
+        };
+        let mut damping = 0.0;
+        b.outline.for_each_plate(&b.frame, |p| {
+            let n = [-p.u[1], p.u[0]];
+            let el = p.elements(self.elements);
+            for k in 0..self.elements {
+                let t = k as f64 + 0.5;
+                let mid = [el.start[0] + t * el.step[0], el.start[1] + t * el.step[1]];
+                let v = b.frame.velocity_at(mid);
+                let vn = (v[0] * n[0] + v[1] * n[1]).abs();
+                damping += 2.0 * self.lam * m.rho_g * vn * el.length * el.width;
+            }
+        });
+        Rates {
+            damping,
+            spring: 0.0,
+        }
     }
 }
 

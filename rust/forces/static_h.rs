@@ -17,7 +17,9 @@
 //!   the term's magnitude (Karnopp).
 //! - **Series:** `F_sh` (and `mode_x`, the held sign).
 
-use super::{Acts, Class, ContactState, Medium, Param, Real, Switch, Term, TermForce, TermInfo};
+use super::{
+    Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo,
+};
 
 /// The static horizontal term F_sh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +66,14 @@ impl Term for StaticH {
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         StaticH::law(F::splat(self.eta_h), c, m)
+    }
+
+    /// None that a step meets: its velocity enters only through a sign that the `modes`
+    /// sign model holds through a step (the switch is a located event), and its depth law
+    /// is located where it is not smooth (the entry). A secant F / d would be unbounded at
+    /// the entry while the energy it stores is not (the thesis's runs are resolved there).
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
     }
 }
 

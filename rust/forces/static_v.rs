@@ -17,7 +17,9 @@
 //!   of the engine, polished on the RK4 map).
 //! - **Series:** `F_sv` (and `mode_y`, the held sign).
 
-use super::{Acts, Class, ContactState, Medium, Param, Real, Switch, Term, TermForce, TermInfo};
+use super::{
+    Acts, Class, ContactState, Medium, Param, Rates, Real, Switch, Term, TermForce, TermInfo,
+};
 
 /// The static vertical term F_sv.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,6 +83,14 @@ impl Term for StaticV {
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         StaticV::law(F::splat(self.eta_v), F::splat(self.lam), c, m)
+    }
+
+    /// None that a step meets: its velocity enters only through a sign that the `modes`
+    /// sign model holds through a step (the switch is a located event), and its depth law
+    /// is located where it is not smooth (the entry). A secant F / d would be unbounded at
+    /// the entry while the energy it stores is not (the thesis's runs are resolved there).
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
     }
 }
 

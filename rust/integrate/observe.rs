@@ -39,6 +39,13 @@ impl Record {
 /// `h lambda` beyond which the classical RK4 is unstable for a real, negative rate.
 pub const RK4_STABILITY_LIMIT: f64 = 2.785;
 
+/// The largest error of a located stop time, as a fraction of t_s, that counts as resolved
+/// (`Stats::unresolved_stops`): 1 %, the change that `benches/step_warning.py` counts as a
+/// result that moves with the step. The error is estimated at the located stop from its
+/// switching function, the tip's vertical velocity (zero there when the step resolves the
+/// stop): that velocity over the tip's vertical acceleration.
+pub const STOP_TIME_ERROR: f64 = 0.01;
+
 /// The fastest rate [1/s] of a quadratic drag `F = -c |v| v` on a point of inverse effective
 /// mass `w`, with `k = |F| / |v|` and `dir` the unit velocity: the largest eigenvalue of
 /// `w K`, `K = dF/dv = -k (I + dir dir^T)` (twice as stiff along the motion as across).
@@ -48,6 +55,58 @@ fn drag_rate(w: &nalgebra::Matrix2<f64>, k: f64, dir: Vector2<f64>) -> f64 {
     let p = w * stiffness;
     let (tr, det) = (p.trace(), p.determinant());
     // Both factors are symmetric positive semi-definite: the eigenvalues are real, >= 0.
+    0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
+}
+
+/// The listed terms' stiffest moments so far: the largest damping D [N s/m] and the
+/// largest spring K [N/m] met, each with the coordinates and the contact where it was (the
+/// inverse effective mass there is taken once, at the end, as for the drag).
+#[derive(Debug, Clone, Copy)]
+struct TermStiffest<const N: usize> {
+    damping: (f64, SVector<f64, N>, usize),
+    spring: (f64, SVector<f64, N>, usize),
+}
+
+impl<const N: usize> TermStiffest<N> {
+    /// The terms' rates at `y`, over the contacts in the sand and not stopped.
+    fn offer(&mut self, model: &Model<N>, y: &State<N>, modes: &Modes) {
+        for ci in 0..model.contacts.len() {
+            if modes[ci].stopped || !modes[ci].in_contact {
+                continue;
+            }
+            let r = model.contact_rates(&y.q, &y.qd, modes, ci);
+            if r.damping > self.damping.0 {
+                self.damping = (r.damping, y.q, ci);
+            }
+            if r.spring > self.spring.0 {
+                self.spring = (r.spring, y.q, ci);
+            }
+        }
+    }
+
+    /// The fastest rate [1/s]: with `w` the largest eigenvalue of E's inverse effective
+    /// mass (`Model::centroid_inverse_mass`) where each was met, `w D` (a decay) or
+    /// `sqrt(w K)` (an oscillation), whichever is faster.
+    fn rate(&self, model: &Model<N>) -> f64 {
+        let w = |q: &SVector<f64, N>, ci: usize| {
+            largest_eigenvalue(&model.centroid_inverse_mass(q, ci))
+        };
+        let (d, qd, cd) = self.damping;
+        let (k, qk, ck) = self.spring;
+        let decay = if d > 0.0 { w(&qd, cd) * d } else { 0.0 };
+        let oscillation = if k > 0.0 {
+            (w(&qk, ck) * k).sqrt()
+        } else {
+            0.0
+        };
+        decay.max(oscillation)
+    }
+}
+
+/// The largest eigenvalue of a symmetric positive semi-definite 2 x 2 matrix (an inverse
+/// effective mass [1/kg]); NaN in, NaN out.
+fn largest_eigenvalue(w: &nalgebra::Matrix2<f64>) -> f64 {
+    let (tr, det) = (w.trace(), w.determinant());
     0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())
 }
 
@@ -79,6 +138,15 @@ pub(super) struct Observer<const N: usize> {
     /// contact, the stages meet a stiffness the ends do not). Squared norms: a square root
     /// only when a maximum is beaten.
     stiffest: Stiffest<N>,
+    /// Whether the terms' own stiffness is sampled ([`Observer::sample_rates`]): a listed
+    /// term reads the contact's boundary (`rft`, `rft_inertial`, `poncelet`), whose rates the
+    /// drag's |F_d| / |v_E| does not see. The thesis's terms keep the drag's estimate alone.
+    rates_on: bool,
+    /// Stops whose estimated time error was past [`STOP_TIME_ERROR`]
+    /// (`Stats::unresolved_stops`).
+    unresolved_stops: usize,
+    /// The terms' stiffest moments at the start, the step ends and the events so far.
+    terms: TermStiffest<N>,
     recorder: Recorder,
     /// Record every `stride`-th grid step.
     stride: u64,
@@ -132,6 +200,18 @@ impl<const N: usize> Observer<N> {
                 best: DragStiffness::default(),
                 q: y.q,
             },
+            rates_on: model.forces.reads_frame,
+            unresolved_stops: 0,
+            terms: {
+                let mut terms = TermStiffest {
+                    damping: (0.0, y.q, 0),
+                    spring: (0.0, y.q, 0),
+                };
+                if model.forces.reads_frame {
+                    terms.offer(model, y, modes);
+                }
+                terms
+            },
             recorder: Recorder::new(record, &model.forces, N, nc, n_links, joint_loads(model)),
             stride: record.stride.max(1) as u64,
             q0: y.q,
@@ -157,7 +237,14 @@ impl<const N: usize> Observer<N> {
     /// reports no joint loads.
     #[inline]
     pub(super) fn drag_only(&self, model: &Model<N>) -> bool {
-        !self.recorder.on.any() && !joint_loads(model)
+        !self.recorder.on.any() && !joint_loads(model) && !self.rates_on
+    }
+
+    /// The terms' stiffness at a step's end or an event `y` ([`Observer::rates_on`]).
+    pub(super) fn sample_rates(&mut self, model: &Model<N>, y: &State<N>, modes: &Modes) {
+        if self.rates_on {
+            self.terms.offer(model, y, modes);
+        }
     }
 
     /// Show the drag's stiffness `s` at an RK4 stage with coordinates `q()` (read only when
@@ -263,6 +350,18 @@ impl<const N: usize> Observer<N> {
         e: &Eval<N>,
     ) {
         let energies = model.energies(&y.q, &y.qd);
+        // The stop's switching function there (zero where the step resolves the stop) over
+        // its rate, the tip's vertical acceleration: the stop time's error.
+        let contact = &model.contacts[ci];
+        let (link, tip) = (contact.link(), contact.reference_point());
+        let pose = model.mechanism.pose(&y.q);
+        let accel = model.mechanism.point_velocity(&pose, link, tip, &e.qdd)
+            + model
+                .mechanism
+                .point_bias_acceleration(&pose, link, tip, &y.qd);
+        if e.contacts[ci].v_tip.y.abs() > STOP_TIME_ERROR * t * accel.y.abs() {
+            self.unresolved_stops += 1;
+        }
         let s = &mut self.summaries[ci];
         s.stopped = true;
         s.t_s = t;
@@ -323,12 +422,17 @@ impl<const N: usize> Observer<N> {
         let best = &self.stiffest.best;
         let h_lambda = if options.method != Method::Rk4 {
             f64::NAN
-        } else if best.k2() > 0.0 {
-            let inverse_mass = model.centroid_inverse_mass(&self.stiffest.q, best.contact);
-            options.dt * drag_rate(&inverse_mass, best.k2().sqrt(), best.v.normalize())
         } else {
-            0.0
+            let drag = if best.k2() > 0.0 {
+                let inverse_mass = model.centroid_inverse_mass(&self.stiffest.q, best.contact);
+                drag_rate(&inverse_mass, best.k2().sqrt(), best.v.normalize())
+            } else {
+                0.0
+            };
+            options.dt * drag.max(self.terms.rate(model))
         };
+        let mut stats = stats;
+        stats.unresolved_stops = self.unresolved_stops;
         let out = Outcome {
             h_lambda,
             status,

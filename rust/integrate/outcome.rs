@@ -54,6 +54,14 @@ pub struct Stats {
     ///
     /// [`MAX_EVENTS_PER_STEP`]: super::events::MAX_EVENTS_PER_STEP
     pub unresolved: usize,
+    /// Stops the step did not resolve: at the located stop the tip's vertical velocity (the
+    /// stop's switching function, zero there when the step resolves it) over its vertical
+    /// acceleration, an estimate of the stop time's error, was above [`STOP_TIME_ERROR`] of
+    /// t_s. The stop is located on the step's interpolant; an impact over in a few steps
+    /// misses it, by up to several per cent in t_s.
+    ///
+    /// [`STOP_TIME_ERROR`]: super::observe::STOP_TIME_ERROR
+    pub unresolved_stops: usize,
 }
 
 /// The results of one contact.
@@ -151,12 +159,14 @@ pub struct Outcome {
     pub joints: Vec<JointSummary>,
     /// The impulses of the table-driven joints, in time order.
     pub impulses: Vec<Impulse>,
-    /// Largest `dt * lambda` of the drag over the run: the step times the drag's fastest
-    /// rate, `2 |F_d| / |v_E|` times E's inverse effective mass (see
+    /// Largest `dt * lambda` over the run: the step times the contact's fastest rate. The
+    /// drag's, `2 |F_d| / |v_E|` times E's inverse effective mass (see
     /// [`Model::centroid_inverse_mass`]), at the state where the drag was stiffest (step
-    /// ends, events and RK4 stages: see [`crate::integrate::stepper::step_sampling`]). Above
-    /// [`RK4_STABILITY_LIMIT`] the fixed step does not resolve the impact. NaN with the
-    /// adaptive method, 0 without drag.
+    /// ends, events and RK4 stages: see [`crate::integrate::stepper::step_sampling`]); with
+    /// a term that reads the contact's boundary (`rft`, `rft_inertial`, `poncelet`), also
+    /// every listed term's own stiffness ([`crate::forces::Term::rates`]) at the start, the
+    /// step ends and the events. Above [`RK4_STABILITY_LIMIT`] the fixed step does not
+    /// resolve the impact. NaN with the adaptive method, 0 without a stiff term.
     ///
     /// [`Model::centroid_inverse_mass`]: crate::dynamics::Model::centroid_inverse_mass
     /// [`RK4_STABILITY_LIMIT`]: super::observe::RK4_STABILITY_LIMIT
@@ -275,6 +285,7 @@ pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
         count("events", |o| Count(o.stats.events)),
         count("rejected", |o| Count(o.stats.rejected)),
         count("unresolved", |o| Count(o.stats.unresolved)),
+        count("unresolved_stops", |o| Count(o.stats.unresolved_stops)),
         real("energy_start", "J", |o| Real(o.energy_start)),
         real("energy_end", "J", |o| Real(o.energy_end)),
         real("dissipated", "J", |o| Real(o.dissipated)),

@@ -458,6 +458,7 @@ impl<const N: usize> Run<N> {
             *t = t_next;
             stats.steps += 1;
             obs.step_end(model, y, &evals[*cur], modes);
+            obs.sample_rates(model, y, modes);
             if !clamped {
                 let n = control.advance();
                 events.next_step();
@@ -488,6 +489,7 @@ impl<const N: usize> Run<N> {
         if h_star > 0.0 {
             stats.steps += 1;
             obs.step_end(model, &y_star, &e_star, modes);
+            obs.sample_rates(model, &y_star, modes);
         }
         // An event at the very start of the step is judged at the step's end.
         let probe = if h_star <= 1e-12 * options.dt {

@@ -206,6 +206,9 @@ pub(super) struct RunOutcome {
     /// Steps the sign modes chattered through (see `Stats::unresolved`).
     #[pyo3(get)]
     unresolved: usize,
+    /// Stops the step did not resolve (see `Stats::unresolved_stops`).
+    #[pyo3(get)]
+    unresolved_stops: usize,
     /// The rest, moved out (series included, without a copy) by the one `to_dict` call.
     out: Mutex<Option<Outcome>>,
 }
@@ -286,6 +289,7 @@ pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<Ru
         run_seconds: seconds,
         h_lambda: out.h_lambda,
         unresolved: out.stats.unresolved,
+        unresolved_stops: out.stats.unresolved_stops,
         out: Mutex::new(Some(out)),
     })
 }

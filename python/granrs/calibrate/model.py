@@ -453,6 +453,8 @@ class _Model:
         run_unresolved = np.zeros(len(frame), dtype=bool)
         if "unresolved" in frame.columns:
             run_unresolved |= frame["unresolved"].to_numpy(dtype=float) > 0
+        if "unresolved_stops" in frame.columns:
+            run_unresolved |= frame["unresolved_stops"].to_numpy(dtype=float) > 0
         if "h_lambda" in frame.columns:
             run_unresolved |= frame["h_lambda"].to_numpy(dtype=float) > _RK4_LIMIT
         unresolved = np.zeros((len(vectors), len(rows)), dtype=bool)

@@ -1,0 +1,217 @@
+"""The step-size warning under every force law: each term's own stiffness enters
+``h_lambda``, a stop that falls between the steps is flagged, and the random-set study of
+``benches/step_warning.py`` in small.
+
+Before, ``h_lambda`` read only the thesis drag's |F_d| / |v_E| and stayed 0.0 under ``rft``
+and ``poncelet``: a ``poncelet`` rod at dt = 1e-2 "stopped" with its energy going from 922.5 J
+to 1144.0 J, without a warning. Each test below says how it failed on that code.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import sys
+import warnings
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+import granrs
+from granrs import cases
+from granrs import forces as f
+
+MASS, LENGTH, DIAMETER, RHO_G = 0.184, 0.190, 0.0127, 1650.0
+
+
+def _bench() -> ModuleType:
+    path = Path(__file__).resolve().parents[1] / "benches" / "step_warning.py"
+    spec = importlib.util.spec_from_file_location("granrs_bench_step_warning", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def simulate_caught(scene: granrs.Scene) -> tuple[granrs.Result, list[str]]:
+    """The run and the texts of the StepSizeWarnings it raised."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = granrs.simulate(scene)
+    return r, [str(w.message) for w in caught if issubclass(w.category, granrs.StepSizeWarning)]
+
+
+def poncelet_fast(dt: float) -> granrs.Scene:
+    """The reproducer: a poncelet rod (c 0.8, k 150) at the centroid, vertical, at 100 m/s
+    down and 5 m/s sideways."""
+    return cases.free_link(0.0, 100.0, dt=dt).replace(
+        vx0=5.0, apply_at="centroid", forces=[f.gravity(), f.poncelet(c=0.8, k=150.0)]
+    )
+
+
+def test_poncelet_past_the_stability_limit_warns_with_dt_and_what_to_do() -> None:
+    """At dt = 1e-2 the run "stops" in its first step with its energy risen from 922.5 J to
+    1144.0 J. It warned nothing (h_lambda 0.0). The drag's rate at the start alone, worked
+    by hand: dF/dv of c rho_g A |v| v is at most 2 c rho_g A |v| (A = pi d_c^2 / 4 moving
+    along the axis), and E (the tip, at depth 0) has inverse effective mass at most
+    1/m + (L/2)^2 / (m L^2 / 12) = 4 / m; so h_lambda >= dt 2 c rho_g A |v| 4 / m = 7.3."""
+    r, texts = simulate_caught(poncelet_fast(1e-2))
+    area = math.pi * DIAMETER**2 / 4.0
+    speed = math.hypot(100.0, 5.0)
+    at_start = 1e-2 * 2.0 * 0.8 * RHO_G * area * speed * 4.0 / MASS
+    assert at_start > granrs.RK4_STABILITY_LIMIT
+    assert r.summary["h_lambda"] >= 0.99 * at_start, (r.summary["h_lambda"], at_start)
+    assert r.summary["energy_end"] > r.summary["energy_start"]  # the reproducer's symptom
+    assert len(texts) == 1
+    assert "dt = 0.01 s" in texts[0] and "use dt <=" in texts[0], texts[0]
+    # At dt = 1e-4 it is resolved: no warning, and within 1e-6 of dt = 1e-5.
+    fine, texts = simulate_caught(poncelet_fast(1e-4))
+    finer, _ = simulate_caught(poncelet_fast(1e-5))
+    assert not texts
+    assert fine.depth == pytest.approx(finer.depth, rel=1e-6)
+
+
+@pytest.mark.parametrize(
+    "law",
+    [
+        [f.gravity(), f.rft(zeta=1e6)],
+        [f.gravity(), f.poncelet(c=1.0, k=200.0)],
+        [f.gravity(), f.rft_inertial()],
+    ],
+    ids=["rft", "poncelet", "rft_inertial"],
+)
+def test_each_boundary_law_has_a_stiffness(law: list[f.Term]) -> None:
+    """Each law's own stiffness enters h_lambda: positive while the rod is in the sand, and
+    dt times a rate, so a tenth of the step gives about a tenth of it (the rate is sampled at
+    the step ends: 10 % slack). ``rft`` and ``poncelet`` read 0.0 before."""
+    scene = cases.free_link(30.0, 2.0).replace(forces=law)
+    a = granrs.simulate(scene).summary["h_lambda"]
+    b = granrs.simulate(scene.replace(dt=1e-5)).summary["h_lambda"]
+    assert a > 0.0
+    assert 10.0 * b == pytest.approx(a, rel=0.1), (a, b)
+
+
+#: A poncelet rod at the centroid whose impact is over in 6 steps at dt = 1e-3 (scene 8 of
+#: ``benches/step_warning.py --seed 7``): t_s 5.819 ms against 5.625 ms at dt = 1e-4 (3.4 %),
+#: at h_lambda 0.34. Not a stiffness: the stop is located on the step's interpolant, and the
+#: tip's vertical velocity there is still 0.022 m/s (1e-2 of its speed).
+SHORT_IMPACT = {
+    "q_deg": -59.36603674137732,
+    "v0": 2.257535989222119,
+    "vx0": -0.5208720763409533,
+    "omega0": -1.9500340379203678,
+    "mass": 0.01561018995462787,
+    "c": 2.022590768128497,
+    "k": 344.6961170301384,
+}
+
+
+def short_impact(dt: float) -> granrs.Scene:
+    p = SHORT_IMPACT
+    return cases.free_link(p["q_deg"], p["v0"], dt=dt).replace(
+        vx0=p["vx0"],
+        omega0=p["omega0"],
+        mass=p["mass"],
+        apply_at="centroid",
+        forces=[f.gravity(), f.poncelet(c=p["c"], k=p["k"])],
+    )
+
+
+def test_a_stop_that_falls_between_the_steps_warns() -> None:
+    """SHORT_IMPACT at dt = 1e-3 is 3.4 % off in t_s, below the stability limit: it warned
+    nothing before. Now its stop counts as unresolved (``unresolved_stops``) and it warns,
+    naming dt; at dt = 1e-4 it is resolved (1e-5 of dt = 1e-5) and silent."""
+    coarse, texts = simulate_caught(short_impact(1e-3))
+    fine, fine_texts = simulate_caught(short_impact(1e-4))
+    finer, _ = simulate_caught(short_impact(1e-5))
+    assert abs(coarse.t_s - fine.t_s) > 0.01 * fine.t_s  # the miss is real
+    assert coarse.summary["h_lambda"] < granrs.RK4_STABILITY_LIMIT
+    assert coarse.summary["unresolved_stops"] == 1
+    assert len(texts) == 1 and "dt = 0.001 s" in texts[0], texts
+    assert fine.t_s == pytest.approx(finer.t_s, rel=1e-5)
+    assert fine.summary["unresolved_stops"] == 0 and not fine_texts
+
+
+def test_a_sweep_flags_an_unresolved_stop() -> None:
+    """The sweep's one warning counts the row whose stop the step missed (SHORT_IMPACT)."""
+    with pytest.warns(granrs.StepSizeWarning, match="1 of 2 runs"):
+        table = granrs.sweep([short_impact(1e-3), short_impact(1e-4)], progress=False)
+    assert list(table["unresolved_stops"]) == [1, 0]
+
+
+@pytest.mark.parametrize("q_deg", [0.0, 15.0, 25.0, 45.0, 65.0, 75.0])
+def test_thesis_cases_resolved_today_stay_silent(q_deg: float) -> None:
+    """The thesis's free link at its Table 3.1 angles, at the default dt (resolved: the
+    regression tests hold them to 1e-9): no warning, no unresolved stop. A guard for the new
+    checks (it passed before too)."""
+    r, texts = simulate_caught(cases.free_link(q_deg, 2.0))
+    assert not texts and r.summary["unresolved_stops"] == 0
+
+
+#: ``rft`` rod of the issue: at dt = 1e-4 t_s 0.1747 s against 0.0892 s at dt = 1e-6, and
+#: its mirror image 0.1316 s. E sticks in y and the rod turns slowly about it: each
+#: element's RFT force follows its own velocity's direction, which flips where an element
+#: passes through rest, a discontinuity inside the step that no mode holds. Neither the
+#: terms' stiffness (h_lambda 0.028), nor the stop's residual, nor an energy rise in a step
+#: sees it (measured: docs, benches/step_warning.py).
+RFT_CREEP = {"q_deg": 20.2322, "v0": 1.8494, "mass": 0.0113, "vx0": -0.7602, "omega0": -3.8926}
+
+
+def rft_creep(mirror: bool = False) -> granrs.Scene:
+    s = -1.0 if mirror else 1.0
+    p = RFT_CREEP
+    return cases.free_link(s * p["q_deg"], p["v0"]).replace(
+        mass=p["mass"],
+        vx0=s * p["vx0"],
+        omega0=s * p["omega0"],
+        forces=[f.gravity(), f.rft(zeta=1e6)],
+        t_end=1.0,
+    )
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="an RFT element passing through rest flips its force inside a step: not a "
+    "stiffness, and not yet detected (the rft rod is 96 % off at dt = 1e-4, silent)",
+)
+def test_the_rft_creep_warns() -> None:
+    r, texts = simulate_caught(rft_creep())
+    assert texts, r.summary["h_lambda"]
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the same rft rod: silent at dt = 1e-4, and its mirror image stops at 0.1316 s "
+    "against 0.1747 s",
+)
+def test_the_rft_creep_mirror_agrees_when_silent() -> None:
+    a, texts_a = simulate_caught(rft_creep())
+    b, texts_b = simulate_caught(rft_creep(mirror=True))
+    assert texts_a or texts_b or a.t_s == pytest.approx(b.t_s, rel=1e-9)
+
+
+def test_mirror_images_of_silent_runs_agree_on_a_random_set() -> None:
+    """The small random set (8 scenes of ``benches/step_warning.py``, seed 11, both dts): every
+    run that does not warn agrees with its mirror image to 1e-9 in t_s and depth."""
+    bench = _bench()
+    drawn = bench.scenes(8, 11)
+    study = bench.study(drawn, dts=(1e-3,), mirrors=True)
+    assert study.mirror, "no silent run to compare"
+    bad = [(i, dt, gap) for i, dt, gap in study.mirror if gap > 1e-9]
+    assert not bad, bad
+
+
+def test_the_random_set_in_small() -> None:
+    """The acceptance of ``benches/step_warning.py`` on its first 8 scenes (seed 11) at
+    dt = 1e-3: every scene that moves by more than 1 % at dt / 10 warns, and none that does
+    not. The counts are printed by the script; over 200 scenes they are not all met (see the
+    script's output)."""
+    bench = _bench()
+    drawn = bench.scenes(8, 11)
+    study = bench.study(drawn, dts=(1e-3,), mirrors=False)
+    counts = study.counts[1e-3]
+    assert sum(counts.values()) == len(drawn)
+    assert counts["moved&silent"] == 0, bench.report(study, drawn)
+    assert counts["still&warned"] == 0, bench.report(study, drawn)
