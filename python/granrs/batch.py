@@ -270,9 +270,13 @@ def _axis_columns(axes: dict[str, list[Any]], start: int, stop: int) -> dict[str
     cols: dict[str, np.ndarray] = {}
     values: dict[str, np.ndarray] = {}
     for name, vs in axes.items():
-        if all(isinstance(v, (int, float, np.number)) and not isinstance(v, bool) for v in vs):
+        if all(
+            isinstance(v, float | np.floating)
+            or (isinstance(v, int | np.integer) and not isinstance(v, bool) and abs(v) < 2**1023)
+            for v in vs
+        ):
             values[name] = np.asarray(vs, dtype=float)
-        else:
+        else:  # text, lists, terms, and integers no float holds (a text field's value)
             values[name] = np.empty(len(vs), dtype=object)
             values[name][:] = vs
         cols[name] = np.empty(n, dtype=values[name].dtype)
