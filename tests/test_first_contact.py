@@ -308,3 +308,26 @@ def test_near_miss_names_suggest_the_field() -> None:
     with pytest.raises(InvalidParameterError, match="needs q_deg"):
         cases.free_link(v0=2.0)
     assert math.isfinite(cases.free_link(45.0, 2.27).q_deg)
+
+
+def test_reproduce_shows_a_bar_of_its_chapters_on_a_terminal(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``granrs reproduce`` runs for minutes: on a terminal it shows a tqdm bar of the
+    chapters done (as animate, calibrate, compare and long sweeps do), beside its one line
+    per table and figure; off a terminal only the lines. (Before, only the lines.)"""
+    from granrs.report import framework
+
+    monkeypatch.setitem(
+        framework.CHAPTERS, "fake", framework.Chapter("fake", "A short chapter", lambda ctx: "x")
+    )
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    framework.reproduce(tmp_path / "on_a_terminal", chapters=["fake"])
+    err = capsys.readouterr().err
+    assert "granrs reproduce: A short chapter" in err
+    assert "granrs reproduce" in err and "1/1" in err and "chapter" in err
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
+    framework.reproduce(tmp_path / "in_a_pipe", chapters=["fake"])
+    err = capsys.readouterr().err
+    assert "granrs reproduce: A short chapter" in err and "1/1" not in err

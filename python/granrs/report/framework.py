@@ -22,9 +22,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from tqdm import tqdm
 
 from .. import __version__, cases
 from .._files import write_bytes
+from .._progress import progress_bar
 from ..api import simulate
 from ..errors import InvalidParameterError, UnknownNameError
 from ..result import Result
@@ -115,7 +117,8 @@ class ReportContext:
     def log(self, message: str) -> None:
         """Print one progress line to stderr (nothing when ``progress`` is False)."""
         if self.progress:
-            print(f"granrs reproduce: {message}", file=sys.stderr, flush=True)
+            # Through tqdm, so that a line does not break the chapters' bar on a terminal.
+            tqdm.write(f"granrs reproduce: {message}", file=sys.stderr)
 
     @contextmanager
     def step(self, label: str) -> Iterator[None]:
@@ -352,7 +355,8 @@ def reproduce(
             every chapter, as the command line does.
         dt: the integration step of every scene [s]; an invalid one raises the scene's
             :class:`~granrs.errors.InvalidParameterError` (``field="dt"``).
-        progress: print one line per table and figure to stderr.
+        progress: print one line per table and figure to stderr, and on a terminal a bar
+            of the chapters done.
 
     Returns:
         The path of the report, ``out_dir/README.md``.
@@ -384,9 +388,15 @@ def reproduce(
     start = time.perf_counter()
     ctx = ReportContext(dt=dt, progress=progress)
     bodies = []
-    for chapter in selected:
-        ctx.log(f"{chapter.title}")
-        bodies.append(f"## {chapter.title}\n\n{chapter.build(ctx).strip()}\n")
+    # A bar of the chapters on a terminal (stderr), beside the lines of each table and figure.
+    bar = progress_bar(len(selected), None if progress else False, "granrs reproduce", "chapter")
+    try:
+        for chapter in selected:
+            ctx.log(f"{chapter.title}")
+            bodies.append(f"## {chapter.title}\n\n{chapter.build(ctx).strip()}\n")
+            bar.update(1)
+    finally:
+        bar.close()
     seconds = time.perf_counter() - start
     report = _header(ctx, selected, dt, seconds) + "\n" + "\n".join(bodies)
     path = _write(out_path, report, ctx.figures, ctx.files)
