@@ -331,3 +331,18 @@ def test_reproduce_shows_a_bar_of_its_chapters_on_a_terminal(
     framework.reproduce(tmp_path / "in_a_pipe", chapters=["fake"])
     err = capsys.readouterr().err
     assert "granrs reproduce: A short chapter" in err and "1/1" not in err
+
+
+@pytest.mark.parametrize("make", ["replace", "sweep"])
+def test_an_angle_past_any_float_is_the_cores_typed_error(make: str) -> None:
+    """Following the row must not get in the way of the field's own check: an integer
+    angle no float holds (10**400) is the core's typed error naming ``q_deg``, in
+    ``replace`` and in a sweep's axis, not an OverflowError from the row lookup (found by
+    the adversarial suite once both were in)."""
+    base = cases.free_link(q_deg=0.0, v0=2.0)
+    with pytest.raises(InvalidParameterError) as info:
+        if make == "replace":
+            base.replace(q_deg=10**400)
+        else:
+            granrs.sweep(base, q_deg=[10**400], progress=False)
+    assert info.value.field == "q_deg"

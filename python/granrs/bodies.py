@@ -416,7 +416,7 @@ class Linkage:
                     f"unknown key body.{k}: a linkage has {', '.join(allowed)}", field=f"body.{k}"
                 )
         if "links" not in body:
-            raise InvalidParameterError("a linkage needs links", field="links")
+            raise InvalidParameterError("a linkage needs links (body.links)", field="body.links")
         return cls(**dict(body))
 
     @classmethod

@@ -249,7 +249,10 @@ def _row_change(scene: Any, value: Any) -> tuple[tuple[Term, ...], str] | _Kept 
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         return None
-    if not math.isfinite(value):
+    try:
+        if not math.isfinite(value):  # an integer past any float overflows here
+            return None
+    except OverflowError:
         return None
     try:
         new, new_source = rule.row(float(value))
