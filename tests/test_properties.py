@@ -165,6 +165,10 @@ def check_finite(r: Result) -> None:
 # The whole domain
 
 
+# Resolved here means the step resolves the contact's stiffness (step_resolves); a stop
+# that falls between two steps (a spinning tip that only grazes the sand) still warns,
+# which is right and not what this property is about.
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @SETTINGS
 @given(scenes(resolved=True))
 def test_finite_or_typed_error_and_no_force_above_the_surface(scene: Scene) -> None:
@@ -279,6 +283,10 @@ def powers(r: Result) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     return p, tol
 
 
+# Resolved here means the step resolves the contact's stiffness (step_resolves); a stop
+# that falls between two steps (a spinning tip that only grazes the sand) still warns,
+# which is right and not what this property is about.
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @SETTINGS
 @given(scenes(resolved=True))
 def test_each_force_term_does_non_positive_power(scene: Scene) -> None:
