@@ -442,7 +442,7 @@ class Scene:
         the closest field name). Changing the free link's ``q_deg`` (the leg's ``v0``) of
         a scene made from a thesis coefficient row takes the new value's row (see the module
         doc); new ``forces`` (without a ``coefficients_source``) make the source
-        :data:`OWN_FORCES`."""
+        ``"the scene's forces"`` (``granrs.scene.OWN_FORCES``)."""
         known = [f.name for f in dataclasses.fields(self)]
         for name in changes:
             if name in _REPLACED:
