@@ -14,7 +14,7 @@ use std::borrow::Cow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-use crate::bodies::AnyScene;
+use crate::bodies::LinkageScene;
 use crate::error::{GranrsError, Result};
 use crate::integrate::cancel::Watch;
 use crate::integrate::lanes::{run_lanes, LaneIsa, LaneScene};
@@ -32,19 +32,21 @@ pub const STATUS_FAILED: f64 = 3.0;
 /// The run was not started (the batch was cancelled).
 pub const STATUS_CANCELLED: f64 = 4.0;
 
-/// Contacts and reported joints of a body.
-pub fn body_shape(body: &str) -> (usize, usize) {
-    match body {
-        "chain" => (2, 2),
-        "leg" => (1, 4),
-        _ => (1, 0),
-    }
+/// Contacts and reported joints of a scene: each contact (at least one column set, NaN for
+/// a body without contacts), and each link's joint where there are several links (a single
+/// link hangs from nothing but its root).
+pub fn body_shape(scene: &LinkageScene) -> (usize, usize) {
+    let links = scene.links.len();
+    (
+        scene.contacts.len().max(1),
+        if links > 1 { links } else { 0 },
+    )
 }
 
-/// The summary columns of a body, in row order: the run's fields of [`OUTCOME_FIELDS`],
-/// then each contact's (prefixed `c{i}.`) and each reported joint's (`joint{j}.`).
-pub fn columns(body: &str) -> Vec<String> {
-    let (nc, nj) = body_shape(body);
+/// The summary columns of a body of `shape` ([`body_shape`]), in row order: the run's
+/// fields of [`OUTCOME_FIELDS`], then each contact's (prefixed `c{i}.`) and each reported
+/// joint's (`joint{j}.`).
+pub fn columns((nc, nj): (usize, usize)) -> Vec<String> {
     let fields = &OUTCOME_FIELDS;
     let mut out: Vec<String> = fields.run.iter().map(|f| f.name.to_string()).collect();
     for i in 0..nc {
@@ -56,7 +58,7 @@ pub fn columns(body: &str) -> Vec<String> {
     out
 }
 
-/// Write one outcome into its row (`row.len() == columns(body).len()`).
+/// Write one outcome into its row (`row.len() == columns(shape).len()`).
 pub fn summarize(out: &Outcome, row: &mut [f64]) {
     let fields = &OUTCOME_FIELDS;
     let mut cells = row.iter_mut();
@@ -102,7 +104,7 @@ pub struct Listed {
     /// The scene's spec.
     pub spec: Arc<SceneSpec>,
     /// The scene built from `spec` and validated.
-    pub built: Option<Arc<AnyScene>>,
+    pub built: Option<Arc<LinkageScene>>,
 }
 
 impl Listed {
@@ -147,7 +149,7 @@ impl Source {
     }
 
     /// The scene of run `i`, built and validated (or as the caller built it).
-    pub fn scene(&self, i: usize) -> Result<Cow<'_, AnyScene>> {
+    pub fn scene(&self, i: usize) -> Result<Cow<'_, LinkageScene>> {
         match self {
             Source::List(runs) => match &runs[i].built {
                 Some(scene) => Ok(Cow::Borrowed(scene.as_ref())),
@@ -155,6 +157,15 @@ impl Source {
             },
             Source::Product { .. } => self.spec(i).build().map(Cow::Owned),
         }
+    }
+
+    /// The shape of the batch's body ([`body_shape`]): that of the first of its first runs
+    /// that builds (a body's shape does not depend on the fields a sweep varies), or one
+    /// contact where none does (every run then fails).
+    pub fn shape(&self) -> (usize, usize) {
+        (0..self.len().min(16))
+            .find_map(|i| self.scene(i).ok().map(|s| body_shape(&s)))
+            .unwrap_or((1, 0))
     }
 
     /// The one body of the batch (every run must share it).
@@ -392,13 +403,12 @@ impl Rows {
 pub fn run(
     src: &Source,
     range: std::ops::Range<usize>,
-    body: &str,
     workers: usize,
     done: &AtomicUsize,
     cancel: &AtomicBool,
     path: Path,
 ) -> BatchOut {
-    let columns = columns(body);
+    let columns = columns(src.shape());
     let width = columns.len();
     let start = range.start;
     let mut data = vec![f64::NAN; range.len() * width];
@@ -417,7 +427,7 @@ pub fn run(
     };
     let n = range.len();
     let rows = Rows::new(&mut data, width);
-    if path == Path::Lanes && body == "free_link" {
+    if path == Path::Lanes {
         let isa = LaneIsa::detect();
         // Every thread runs its own four lanes and takes the batch's next scene whenever a
         // lane frees: no thread waits on another's tail, and no lane idles until the batch
@@ -437,15 +447,16 @@ pub fn run(
                         continue;
                     }
                     match src.scene(start + j) {
-                        Ok(scene) => match &*scene {
-                            AnyScene::FreeLink(s) => {
-                                let (q0, qd0) = s.initial_state();
-                                return Some((j, s.model(), q0, qd0, s.options));
-                            }
-                            other => match other.run() {
-                                Ok(out) => summarize(&out, row),
-                                Err(e) => fail(start + j, row, e),
-                            },
+                        // A one-link body without a clock (no joint, so no table) goes to
+                        // the lanes, which take it where they cover its model
+                        // ([`run_lanes`]).
+                        Ok(scene) if scene.size() == 1 => {
+                            let (q0, qd0) = scene.initial_state::<3>();
+                            return Some((j, scene.model::<3>(), q0, qd0, scene.options));
+                        }
+                        Ok(scene) => match scene.run() {
+                            Ok(out) => summarize(&out, row),
+                            Err(e) => fail(start + j, row, e),
                         },
                         Err(e) => fail(start + j, row, e),
                     }
@@ -580,7 +591,7 @@ mod tests {
         let cancel = AtomicBool::new(false);
         let out = pool()
             .unwrap()
-            .install(|| run(src, 0..src.len(), "free_link", 2, &done, &cancel, path));
+            .install(|| run(src, 0..src.len(), 2, &done, &cancel, path));
         assert_eq!(done.load(Ordering::Relaxed), src.len());
         assert!(out.failures.is_empty(), "{:?}", out.failures);
         out.data.iter().map(|x| x.to_bits()).collect()
@@ -641,8 +652,8 @@ mod tests {
         };
         let mut lean_steps = 0;
         for i in 0..src.len() {
-            let Ok(AnyScene::FreeLink(s)) = src.spec(i).build() else {
-                panic!("run {i} is not a free link");
+            let Ok(s) = src.spec(i).build() else {
+                panic!("run {i} does not build");
             };
             let lean = crate::dynamics::rod_lanes::lean_equals_general(&s, &format!("run {i}"));
             lean_steps += lean.stats.steps;
@@ -692,7 +703,7 @@ mod tests {
                 });
                 pool()
                     .unwrap()
-                    .install(|| run(&src, 0..src.len(), "free_link", 2, &done, &cancel, path))
+                    .install(|| run(&src, 0..src.len(), 2, &done, &cancel, path))
             });
             let took = t0.elapsed();
             assert!(took.as_secs_f64() < 2.0, "{path:?}: stopped after {took:?}");

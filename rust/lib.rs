@@ -17,6 +17,7 @@ pub mod error;
 pub mod evaluate;
 pub mod forces;
 pub mod integrate;
+pub mod presets;
 pub mod simd;
 pub mod spec;
 

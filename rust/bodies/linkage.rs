@@ -94,6 +94,10 @@ pub enum ContactShape {
         width: f64,
         /// Reference length of the depth factor [m].
         l_ref: f64,
+        /// `Some(i)`: the thesis's form of the sole (eqs. 5.5-5.7, `body::sole`), whose
+        /// reference area and volume read the angle of link `i` (the leg's shank); `None`:
+        /// the geometric box.
+        thesis_angle_of: Option<usize>,
     },
     /// A thin circular arc (`body::arc`): centre, radius, from `start` over `span` (angles
     /// from +s towards +n), `width` out of the plane, cut into `chords` chords.
@@ -438,7 +442,14 @@ impl LinkageScene {
                     height,
                     width,
                     l_ref,
+                    thesis_angle_of,
                 } => {
+                    if thesis_angle_of.is_some_and(|i| i >= self.links.len()) {
+                        return Err(bad(
+                            f("thesis_angle_of"),
+                            "names no link of this linkage".into(),
+                        ));
+                    }
                     check_point(&f("at"), corner)?;
                     check_range(&f("length"), length, 0.0, true)?;
                     check_range(&f("height"), height, 0.0, true)?;
@@ -689,15 +700,20 @@ impl LinkageScene {
                             height,
                             width,
                             l_ref,
+                            thesis_angle_of,
                         } => Shape::Sole(SoleContact {
                             link,
-                            angle_link: link,
+                            angle_link: thesis_angle_of.map_or(link, |i| slot(&self.links[i].name)),
                             heel: corner,
                             length,
                             height,
                             width,
                             l_ref,
-                            model: SoleModel::Box,
+                            model: if thesis_angle_of.is_some() {
+                                SoleModel::Thesis
+                            } else {
+                                SoleModel::Box
+                            },
                         }),
                         ContactShape::Arc {
                             centre,
@@ -811,166 +827,11 @@ impl LinkageScene {
     }
 }
 
-/// Names of a built-in body's parts, for [`LinkageScene::from_model`].
-pub struct PartNames<'a> {
-    /// Each link's, in the model's order.
-    pub links: &'a [&'a str],
-    /// The joint that carries each link (the root link's is not used).
-    pub joints: &'a [&'a str],
-    /// Each contact's.
-    pub contacts: &'a [&'a str],
-    /// Each link's length [m].
-    pub lengths: &'a [f64],
-}
-
-impl LinkageScene {
-    /// A built-in body's model and initial state as a linkage with a free root: the same
-    /// links, joints, contacts, medium, terms and numerics, so that it runs to the same
-    /// result. Fails (naming `sole_model`) for a contact a linkage cannot hold (the thesis
-    /// form of the sole).
-    pub fn from_model<const N: usize>(
-        model: &Model<N>,
-        q0: &SVector<f64, N>,
-        qd0: &SVector<f64, N>,
-        names: &PartNames<'_>,
-        options: &SolveOptions,
-    ) -> Result<LinkageScene> {
-        let m = &model.mechanism;
-        let name = |i: usize| names.links[i].to_string();
-        let links = m
-            .links
-            .iter()
-            .enumerate()
-            .map(|(i, l)| LinkSpec {
-                name: name(i),
-                mass: l.mass,
-                inertia: l.inertia,
-                com: l.com,
-                length: names.lengths[i],
-                q: q0[2 + i],
-                omega: qd0[2 + i],
-            })
-            .collect();
-        let joints = m
-            .links
-            .iter()
-            .enumerate()
-            .filter_map(|(i, l)| {
-                l.parent.map(|p| JointSpec {
-                    name: names.joints[i].to_string(),
-                    parent: name(p),
-                    child: name(i),
-                    at: l.joint_on_parent,
-                    joint: l.joint,
-                    table: None,
-                })
-            })
-            .collect();
-        let mut contacts = Vec::with_capacity(model.contacts.len());
-        for (ci, c) in model.contacts.iter().enumerate() {
-            let (link, shape) =
-                match c.shape {
-                    Shape::Rod(r) => (
-                        r.link,
-                        ContactShape::Rod {
-                            tip: r.tip,
-                            length: r.length,
-                            diameter: r.diameter,
-                        },
-                    ),
-                    Shape::Sole(s) if s.model == SoleModel::Box => (
-                        s.link,
-                        ContactShape::Box {
-                            corner: s.heel,
-                            length: s.length,
-                            height: s.height,
-                            width: s.width,
-                            l_ref: s.l_ref,
-                        },
-                    ),
-                    Shape::Arc(a) => (
-                        a.link,
-                        ContactShape::Arc {
-                            centre: a.centre,
-                            radius: a.radius,
-                            start: a.start,
-                            end: a.start + a.span,
-                            width: a.width,
-                            chords: a.chords as f64,
-                        },
-                    ),
-                    Shape::Sole(_) => return Err(bad(
-                        "sole_model".into(),
-                        "the thesis form of the sole (eqs. 5.5-5.7) reads the shank's angle; a \
-                         linkage's box contact is the geometric box (sole_model = \"box\")"
-                            .into(),
-                    )),
-                };
-            contacts.push(ContactSpec {
-                name: names.contacts[ci].to_string(),
-                link: name(link),
-                shape,
-            });
-        }
-        let root = m.links.iter().position(|l| l.parent.is_none()).unwrap_or(0);
-        Ok(LinkageScene {
-            links,
-            joints,
-            contacts,
-            root: RootSpec {
-                kind: RootKind::Free,
-                link: name(root),
-                position: Vector2::new(q0[0], q0[1]),
-                velocity: Vector2::new(qd0[0], qd0[1]),
-                mass: m.root_mass,
-                rate: m.root_rate,
-            },
-            medium: model.medium,
-            apply_at: model.apply_at,
-            sign_model: model.sign_model,
-            forces: model.forces.clone(),
-            options: *options,
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bodies::{AnyScene, ChainScene, FreeLinkScene, LegScene};
-
-    /// Each built-in body as a linkage runs to the same outcome, bit for bit (the same
-    /// model and initial state through the same engine).
-    #[test]
-    fn built_in_bodies_run_the_same_as_linkages() {
-        let options = SolveOptions {
-            t_end: 0.05,
-            ..SolveOptions::default()
-        };
-        let scenes = [
-            AnyScene::FreeLink(FreeLinkScene {
-                q_deg: 30.0,
-                options,
-                ..FreeLinkScene::default()
-            }),
-            AnyScene::Chain(ChainScene {
-                options,
-                ..ChainScene::default()
-            }),
-            AnyScene::Leg(LegScene {
-                options,
-                ..LegScene::default()
-            }),
-        ];
-        for scene in scenes {
-            let linkage = scene.linkage().unwrap();
-            let a = scene.run().unwrap();
-            let b = linkage.run().unwrap();
-            // (Debug text: a NaN, a contact that has not stopped, equals itself there.)
-            assert_eq!(format!("{:?}", a.contacts), format!("{:?}", b.contacts));
-            assert_eq!(a.t_final, b.t_final);
-        }
-    }
+    use crate::presets::free_link::FreeLink;
+    use crate::presets::Setting;
 
     fn pendulum(joint: Joint) -> LinkageScene {
         let link = |name: &str, q: f64| LinkSpec {
@@ -982,8 +843,7 @@ mod tests {
             q,
             omega: 0.0,
         };
-        let scene = AnyScene::FreeLink(FreeLinkScene::default());
-        let base = scene.linkage().unwrap();
+        let base = FreeLink::default().scene(Setting::default());
         LinkageScene {
             links: vec![link("a", 2.0), link("b", 2.5)],
             joints: vec![JointSpec {

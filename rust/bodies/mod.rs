@@ -1,32 +1,24 @@
-//! What a run is, body by body: the body, its contacts, the medium, the force terms (with
-//! their parameters), the initial state, the time step, the end condition and the outputs
-//! wanted. One file per body model (`free_link.rs`, `chain.rs`, `leg.rs`); here, the checks
-//! they share and [`AnyScene`].
+//! What a run is: a linkage (its links, joints, contacts and root, with its initial
+//! state), the medium, the force terms (with their parameters), the time step, the end
+//! condition and the outputs wanted ([`LinkageScene`]). Every body is one: the thesis's
+//! bodies are presets that build it (`crate::presets`). Here, the checks of the numerics.
 //!
 //! Field names are those of the Python `granrs.Scene`, so that an error names the field the
-//! user wrote. Angles are in degrees here (`*_deg`, the API edge) and radians inside the
-//! engine.
+//! user wrote. Angles are in degrees at the API edge and radians inside the engine.
 
 use nalgebra::SVector;
 
 use crate::body::Joint;
 use crate::dynamics::{Model, SignModel};
-use crate::error::{check_finite, check_range, fmt_num, GranrsError, Result};
+use crate::error::{check_range, fmt_num, GranrsError, Result};
 use crate::forces::Medium;
-use crate::integrate::{Method, Outcome, SolveOptions, RTOL_MIN};
+use crate::integrate::{Method, SolveOptions, RTOL_MIN};
 use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
 
-pub mod chain;
-pub mod free_link;
-pub mod leg;
 pub mod linkage;
 
-pub use chain::{chain_defaults, ChainScene};
-pub use free_link::{free_link_defaults, FreeLinkScene};
-pub use leg::{leg_defaults, LegScene, Segment, LEG_JOINTS};
 pub use linkage::{
-    ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, PartNames, RootKind, RootSpec,
-    MAX_LINKS,
+    ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, RootKind, RootSpec, MAX_LINKS,
 };
 
 /// Validate the medium.
@@ -88,16 +80,6 @@ pub fn validate_options(o: &SolveOptions, sign_model: &SignModel) -> Result<()> 
     Ok(())
 }
 
-/// Check a joint's parameters; `field` names it.
-fn validate_joint(field: &str, j: &Joint) -> Result<()> {
-    if let Joint::Spring { k, c, rest } = j {
-        check_range(&format!("{field}.k"), *k, 0.0, false)?;
-        check_range(&format!("{field}.c"), *c, 0.0, false)?;
-        check_finite(&format!("{field}.rest"), *rest)?;
-    }
-    Ok(())
-}
-
 /// Largest `h lambda` the fixed-step RK4 is given for a joint's fastest mode (its stability
 /// limit is 2.78 on the negative real axis and 2.83 on the imaginary one).
 const RK4_STABLE: f64 = 2.5;
@@ -107,7 +89,7 @@ const RK4_STABLE: f64 = 2.5;
 /// `c a^T M^-1 a` and the spring's angular frequency `sqrt(k a^T M^-1 a)`; each times `dt`
 /// must stay below [`RK4_STABLE`]. A stiffer joint is refused before any work starts, with the
 /// largest value that would run (or use a smaller `dt`, or `method="dopri5"`).
-fn validate_joint_stiffness<const N: usize>(
+pub(crate) fn validate_joint_stiffness<const N: usize>(
     model: &Model<N>,
     q0: &SVector<f64, N>,
     options: &SolveOptions,
@@ -158,107 +140,4 @@ fn validate_joint_stiffness<const N: usize>(
         }
     }
     Ok(())
-}
-
-/// Check an angle from the vertical at which a rod's tip meets the sand first.
-fn validate_rod_angle(field: &str, q_deg: f64) -> Result<()> {
-    check_finite(field, q_deg)?;
-    if q_deg.abs() >= 90.0 {
-        return Err(GranrsError::InvalidParameter {
-            field: field.into(),
-            value: q_deg,
-            allowed: format!("-90 < {field} < 90 (the tip must meet the sand first)"),
-        });
-    }
-    Ok(())
-}
-
-/// Check the fields every body shares: medium, initial motion and numerics.
-fn validate_common(
-    medium: &Medium,
-    v0: f64,
-    depth0: f64,
-    vx0: f64,
-    options: &SolveOptions,
-    sign_model: &SignModel,
-) -> Result<()> {
-    validate_medium(medium)?;
-    check_range("v0", v0, 0.0, false)?;
-    check_range("depth0", depth0, 0.0, false)?;
-    check_finite("vx0", vx0)?;
-    validate_options(options, sign_model)
-}
-
-/// Any of the body models.
-#[derive(Debug, Clone, PartialEq)]
-pub enum AnyScene {
-    /// The free link.
-    FreeLink(FreeLinkScene),
-    /// The two-link chain.
-    Chain(ChainScene),
-    /// The leg.
-    Leg(LegScene),
-    /// A user-defined linkage.
-    Linkage(LinkageScene),
-}
-
-impl AnyScene {
-    /// Check every field.
-    pub fn validate(&self) -> Result<()> {
-        match self {
-            AnyScene::FreeLink(s) => s.validate(),
-            AnyScene::Chain(s) => s.validate(),
-            AnyScene::Leg(s) => s.validate(),
-            AnyScene::Linkage(s) => s.validate(),
-        }
-    }
-
-    /// The body as a linkage: a built-in body's links, joints, contacts and initial state
-    /// (names: the result's link and joint names), or the linkage itself.
-    pub fn linkage(&self) -> Result<LinkageScene> {
-        match self {
-            AnyScene::FreeLink(s) => {
-                let (q0, qd0) = s.initial_state();
-                let names = PartNames {
-                    links: &["rod"],
-                    joints: &["root"],
-                    contacts: &["rod"],
-                    lengths: &[s.length],
-                };
-                LinkageScene::from_model(&s.model(), &q0, &qd0, &names, &s.options)
-            }
-            AnyScene::Chain(s) => {
-                let (q0, qd0) = s.initial_state();
-                let names = PartNames {
-                    links: &["link1", "link2"],
-                    joints: &["pin_on_link1", "pin"],
-                    contacts: &["link1", "link2"],
-                    lengths: &[s.length, s.length],
-                };
-                LinkageScene::from_model(&s.model(), &q0, &qd0, &names, &s.options)
-            }
-            AnyScene::Leg(s) => {
-                let (q0, qd0) = s.initial_state();
-                let seg = s.segments();
-                let names = PartNames {
-                    links: &["foot", "shank", "thigh", "trunk"],
-                    joints: &["root", "ankle", "knee", "hip"],
-                    contacts: &["sole"],
-                    lengths: &[seg[0].length, seg[1].length, seg[2].length, seg[3].length],
-                };
-                LinkageScene::from_model(&s.model(), &q0, &qd0, &names, &s.options)
-            }
-            AnyScene::Linkage(s) => Ok(s.clone()),
-        }
-    }
-
-    /// Validate and run.
-    pub fn run(&self) -> Result<Outcome> {
-        match self {
-            AnyScene::FreeLink(s) => s.run(),
-            AnyScene::Chain(s) => s.run(),
-            AnyScene::Leg(s) => s.run(),
-            AnyScene::Linkage(s) => s.run(),
-        }
-    }
 }

@@ -950,11 +950,11 @@ impl RodEval<F64x4> {
 /// (every field; `what` names the case) and return it. For tests here and in `batch.rs`.
 #[cfg(test)]
 pub(crate) fn lean_equals_general(
-    s: &crate::bodies::FreeLinkScene,
+    s: &crate::bodies::LinkageScene,
     what: &str,
 ) -> crate::integrate::outcome::Outcome {
     use crate::integrate::solve::{solve, Run};
-    let (model, (q0, qd0)) = (s.model(), s.initial_state());
+    let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
     let lean = solve(&model, q0, qd0, &s.options).unwrap();
     let mut run = Run::new(&model, q0, qd0, &s.options).general();
     while let Some(h) = run.next_step(&model) {
@@ -968,9 +968,10 @@ pub(crate) fn lean_equals_general(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bodies::FreeLinkScene;
+    use crate::bodies::LinkageScene;
     use crate::dynamics::{Modes, MAX_CONTACTS};
     use crate::forces::{ForceSet, TermSpec};
+    use crate::presets::{free_link::FreeLink, Setting};
     use proptest::prelude::*;
 
     /// A free link with its own mass, length, law and point of application.
@@ -1002,18 +1003,21 @@ mod tests {
             specs.push(TermSpec::new("gravity", &[]));
         }
         specs.extend(thesis_subset(eta, terms));
-        let scene = FreeLinkScene {
+        let scene = FreeLink {
             mass,
             length,
+            ..FreeLink::default()
+        }
+        .scene(Setting {
             apply_at: if centroid {
                 ApplyAt::Centroid
             } else {
                 ApplyAt::Tip
             },
             forces: ForceSet::build(&specs, 1).unwrap(),
-            ..FreeLinkScene::default()
-        };
-        let mut model = scene.model();
+            ..Setting::default()
+        });
+        let mut model = scene.model::<3>();
         model.sign_model = sign_model;
         model
     }
@@ -1214,7 +1218,7 @@ mod tests {
         sign: &'static str,
         at: &'static str,
         law: &[TermSpec],
-    ) -> FreeLinkScene {
+    ) -> LinkageScene {
         use crate::spec::Value;
         let mut spec = crate::spec::free_link_spec();
         for (field, x) in ["q_deg", "v0", "vx0"].into_iter().zip(start) {
@@ -1222,8 +1226,8 @@ mod tests {
         }
         spec.set("sign_model", Value::Str(sign.into()));
         spec.set("apply_at", Value::Str(at.into()));
-        let Ok(crate::bodies::AnyScene::FreeLink(mut s)) = spec.build() else {
-            panic!("not a free link");
+        let Ok(mut s) = spec.build() else {
+            panic!("the free link does not build");
         };
         let mut specs = vec![TermSpec::new("gravity", &[])];
         specs.extend_from_slice(law);
@@ -1233,10 +1237,10 @@ mod tests {
 
     /// [`lean_equals_general`] for a scene the lean path covers (asserted).
     fn lean_run_is_the_general_one(
-        s: &FreeLinkScene,
+        s: &LinkageScene,
         what: &str,
     ) -> crate::integrate::outcome::Outcome {
-        assert!(RodParams::of(&s.model()).is_some(), "{what}");
+        assert!(RodParams::of(&s.model::<3>()).is_some(), "{what}");
         lean_equals_general(s, what)
     }
 
@@ -1361,7 +1365,7 @@ mod tests {
                         let s = drop_scene([q, v0, vx0], sign, at, law);
                         let what = format!("law {k} {sign} {at} q {q}");
                         lean_steps += lean_run_is_the_general_one(&s, &what).stats.steps;
-                        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+                        let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
                         // Steps the lean path takes with y stuck (its sticking row).
                         let mut run = Run::new(&model, q0, qd0, &s.options);
                         while let Some(h) = run.next_step(&model) {

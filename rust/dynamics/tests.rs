@@ -1,7 +1,7 @@
 //! The free link's closed form against the general engine, and the inverse effective mass.
 
 use super::*;
-use crate::bodies::FreeLinkScene;
+use crate::presets::{free_link::FreeLink, Setting};
 use nalgebra::Matrix2;
 use proptest::prelude::*;
 
@@ -52,7 +52,7 @@ proptest! {
             sign: [slip(sx).sign(), slip(sy).sign()],
             boundary: None,
         };
-        let mut model = FreeLinkScene::default().model();
+        let mut model = FreeLink::default().scene(Setting::default()).model::<3>();
         let terms = [
             TermSpec::new("drag", &[("eta_d", 11.0)]),
             TermSpec::new("static_h", &[("eta_h", 5.5)]),
@@ -90,16 +90,17 @@ proptest! {
         sx in 0u8..3, sy in 0u8..3, cross in 0u8..2, effects in 0u8..16,
         root_mass in prop_oneof![Just(0.0f64), Just(0.05f64)],
     ) {
-        let mut model = FreeLinkScene {
-            apply_at: if centroid { ApplyAt::Centroid } else { ApplyAt::Tip },
-            sign_model: [
-                SignModel::Modes,
-                SignModel::Raw,
-                SignModel::Smooth { eps: 1e-3 },
-            ][sign as usize],
-            ..Default::default()
-        }
-        .model();
+        let mut model = FreeLink::default()
+            .scene(Setting {
+                apply_at: if centroid { ApplyAt::Centroid } else { ApplyAt::Tip },
+                sign_model: [
+                    SignModel::Modes,
+                    SignModel::Raw,
+                    SignModel::Smooth { eps: 1e-3 },
+                ][sign as usize],
+                ..Setting::default()
+            })
+            .model::<3>();
         model.mechanism.root_mass = root_mass;
         model.forces = thesis_subset(effects, 1);
         let rod = model.rigid_rod().copied();
@@ -136,7 +137,7 @@ proptest! {
         }
         // Power is a force times a speed: its round-off scale is m a |v| (seen: 4e-14 W
         // against 0 with an absolute scale of 1e-12).
-        let p_scale = FreeLinkScene::default().mass * scale * qd.amax() * (1.0 + length);
+        let p_scale = FreeLink::default().mass * scale * qd.amax() * (1.0 + length);
         prop_assert!(close(a.power, b.power, p_scale.max(1e-12)), "{} vs {}", a.power, b.power);
         let (ca, cb) = (&a.contacts[0], &b.contacts[0]);
         let pairs = [
@@ -171,7 +172,7 @@ proptest! {
         exact in any::<bool>(),
     ) {
         let (w, drift) = if exact { (0.0, 0.0) } else { (w, drift) };
-        let model = FreeLinkScene::default().model();
+        let model = FreeLink::default().scene(Setting::default()).model::<3>();
         let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
         modes[0] = ContactMode {
             in_contact: true,
@@ -209,7 +210,7 @@ proptest! {
 fn centroid_inverse_mass_of_a_rod_and_of_a_locked_chain() {
     // A free rod at q = 0.3 with its tip 0.05 m deep: E is l/2 above the tip, at
     // r = L/2 - l/2 from the centre; the trace is 2/m + r^2/I.
-    let model = FreeLinkScene::default().model();
+    let model = FreeLink::default().scene(Setting::default()).model::<3>();
     let link = &model.mechanism.links[0];
     let (m, inertia, big_l) = (link.mass, link.inertia, 0.19);
     let q0: f64 = 0.3;
@@ -250,7 +251,7 @@ fn centroid_inverse_mass_of_a_rod_and_of_a_locked_chain() {
 
 #[test]
 fn only_a_rod_about_its_centre_of_mass_is_closed_form() {
-    let mut model = FreeLinkScene::default().model();
+    let mut model = FreeLink::default().scene(Setting::default()).model::<3>();
     assert!(model.rigid_rod().is_some());
     model.mechanism.links[0].com = Vector2::new(0.01, 0.0);
     assert!(model.rigid_rod().is_none());

@@ -80,22 +80,26 @@ impl Term for Constant {
 
 #[cfg(test)]
 mod tests {
-    use crate::bodies::FreeLinkScene;
     use crate::forces::{ForceSet, TermSpec};
     use crate::integrate::{EndCondition, Record};
+    use crate::presets::{free_link::FreeLink, Setting, Start};
 
     /// A new term takes one file and one registry line, and then runs. A vertical
     /// rod already in the sand, pushed up by a constant 2 m g at its tip against gravity,
     /// decelerates at exactly g: it stops at t = v0 / g, v0^2 / (2 g) deeper.
     #[test]
     fn a_constant_force_term_runs_end_to_end() {
-        let mut scene = FreeLinkScene {
+        let rod = FreeLink {
             q_deg: 0.0,
-            v0: 1.5,
-            depth0: 0.01,
+            start: Start {
+                v0: 1.5,
+                depth0: 0.01,
+                vx0: 0.0,
+            },
             ..Default::default()
         };
-        let (m, g) = (scene.mass, scene.medium.g);
+        let mut scene = rod.scene(Setting::default());
+        let (m, g) = (rod.mass, scene.medium.g);
         scene.forces = ForceSet::build(
             &[
                 TermSpec::new("gravity", &[]),

@@ -799,7 +799,6 @@ fn fail<T>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bodies::AnyScene;
     use crate::forces::{ForceSet, TermSpec};
     use crate::spec::Value;
 
@@ -816,12 +815,12 @@ mod tests {
     }
 
     /// The free link at `q` deg and `v0` m/s under `law` (the thesis's by default).
-    fn scene(q: f64, v0: f64, law: Option<&[TermSpec]>) -> crate::bodies::FreeLinkScene {
+    fn scene(q: f64, v0: f64, law: Option<&[TermSpec]>) -> crate::bodies::LinkageScene {
         let mut spec = crate::spec::free_link_spec();
         spec.set("q_deg", Value::Num(q));
         spec.set("v0", Value::Num(v0));
-        let Ok(AnyScene::FreeLink(mut s)) = spec.build() else {
-            panic!("not a free link");
+        let Ok(mut s) = spec.build() else {
+            panic!("the free link does not build");
         };
         if let Some(law) = law {
             s.forces = ForceSet::build(law, 1).unwrap();
@@ -836,7 +835,7 @@ mod tests {
         law: Option<&[TermSpec]>,
     ) -> Vec<(RodParams<f64>, RodModes<f64>, LaneStart<f64>)> {
         let s = scene(q, v0, law);
-        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+        let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
         let mut run = Run::new(&model, q0, qd0, &s.options);
         let p = RodParams::of(&model).unwrap();
         let mut starts = Vec::new();
@@ -864,7 +863,7 @@ mod tests {
                 0.5 + 0.05 * k as f64,
                 laws[law].as_deref(),
             );
-            let (model, (q0, qd0)) = (s.model(), s.initial_state());
+            let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
             scenes.push((k, model, q0, qd0, s.options));
         }
         let expected: Vec<String> = scenes
@@ -924,10 +923,10 @@ mod tests {
     fn the_lanes_accept_only_a_plain_finite_step() {
         let mut spec = crate::spec::free_link_spec();
         spec.set("q_deg", Value::Num(45.0));
-        let Ok(AnyScene::FreeLink(s)) = spec.build() else {
-            panic!("not a free link");
+        let Ok(s) = spec.build() else {
+            panic!("the free link does not build");
         };
-        let (model, (q0, qd0)) = (s.model(), s.initial_state());
+        let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
         let mut run = Run::new(&model, q0, qd0, &s.options);
         // Into the sand, alone: the run's switching functions are listed.
         for _ in 0..50 {

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 use super::terms;
-use crate::bodies::AnyScene;
+use crate::bodies::LinkageScene;
 use crate::error::GranrsError;
 use crate::spec::{word, SceneSpec, Value};
 
@@ -119,7 +119,7 @@ pub(super) fn spec_from_dict(d: &Bound<'_, PyDict>) -> SceneSpec {
 }
 
 /// Convert a scene dict to an owned, validated scene (GIL held).
-pub(super) fn scene_from_dict(d: &Bound<'_, PyDict>) -> Result<AnyScene, GranrsError> {
+pub(super) fn scene_from_dict(d: &Bound<'_, PyDict>) -> Result<LinkageScene, GranrsError> {
     spec_from_dict(d).build()
 }
 
@@ -234,10 +234,7 @@ pub fn body_linkage<'py>(
     use crate::bodies::{ContactShape, RootKind};
     use crate::body::Joint;
     let err = |e| super::errors::to_pyerr(py, e);
-    let l = spec_from_dict(scene)
-        .body_scene()
-        .and_then(|s| s.linkage())
-        .map_err(err)?;
+    let l = spec_from_dict(scene).body_scene().map_err(err)?;
     if check {
         l.validate_body().map_err(err)?;
     }
@@ -316,11 +313,24 @@ pub fn body_linkage<'py>(
                 d.set_item("diameter", diameter)?;
             }
             ContactShape::Box {
+                thesis_angle_of: Some(_),
+                ..
+            } => {
+                return Err(err(crate::error::GranrsError::InvalidScene {
+                    field: "sole_model".into(),
+                    message: "the thesis form of the sole (eqs. 5.5-5.7) reads the shank's \
+                              angle; a linkage's box contact is the geometric box (sole_model \
+                              = \"box\")"
+                        .into(),
+                }))
+            }
+            ContactShape::Box {
                 corner,
                 length,
                 height,
                 width,
                 l_ref,
+                thesis_angle_of: None,
             } => {
                 d.set_item("shape", "box")?;
                 d.set_item("at", pair(corner))?;

@@ -13,7 +13,7 @@ use pyo3::types::{PyDict, PyList, PyTuple};
 
 use super::convert::{scene_from_dict, spec_from_dict, spec_from_fields, value_from_py};
 use super::errors::to_pyerr;
-use crate::bodies::AnyScene;
+use crate::bodies::LinkageScene;
 use crate::error::GranrsError;
 use crate::integrate::cancel::Watch;
 use crate::integrate::{FieldValue, Outcome, OUTCOME_FIELDS};
@@ -106,7 +106,7 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
 #[pyclass(frozen, module = "granrs._granrs")]
 pub(super) struct Compiled {
     pub(super) spec: Arc<SceneSpec>,
-    pub(super) scene: Arc<AnyScene>,
+    pub(super) scene: Arc<LinkageScene>,
 }
 
 impl Compiled {
@@ -321,8 +321,8 @@ pub(super) fn leg_segments<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let leg = spec_from_dict(scene).leg().map_err(|e| to_pyerr(py, e))?;
-    leg.validate().map_err(|e| to_pyerr(py, e))?;
+    let leg =
+        crate::presets::leg::Leg::read(&spec_from_dict(scene)).map_err(|e| to_pyerr(py, e))?;
     let out = PyList::empty(py);
     for (name, s) in ["foot", "shank", "thigh", "half_trunk"]
         .iter()

@@ -227,7 +227,7 @@ pub(super) fn sweep<'py>(
     // One job on the shared pool validates every run, then runs them.
     let out = on_pool(py, &pool, &done, progress.as_ref(), |cancel| {
         batch::validate(&src, range.clone(), workers, cancel)
-            .map(|()| batch::run(&src, range.clone(), &body, workers, &done, cancel, path))
+            .map(|()| batch::run(&src, range.clone(), workers, &done, cancel, path))
     })?
     .map_err(err)?;
     let rows = range.len();

@@ -11,15 +11,15 @@ use std::borrow::Cow;
 use nalgebra::Vector2;
 
 use crate::bodies::{
-    AnyScene, ChainScene, ContactShape, ContactSpec, FreeLinkScene, JointSpec, LegScene, LinkSpec,
-    LinkageScene, RootKind, RootSpec, LEG_JOINTS,
+    ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, RootKind, RootSpec,
 };
 use crate::body::rod::ApplyAt;
-use crate::body::{DriveTable, Joint, SoleModel};
+use crate::body::{DriveTable, Joint};
 use crate::dynamics::SignModel;
 use crate::error::{check_range, GranrsError, Result};
 use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
 use crate::integrate::{EndCondition, Method, Record, SolveOptions};
+use crate::presets::{self, Fields, Setting};
 
 pub mod fields;
 #[cfg(test)]
@@ -37,8 +37,6 @@ pub use value::{word, Value};
 pub const EFFECTS: [&str; 5] = ["gravity", "drag", "static_h", "static_v", "joint_springs"];
 /// Names of the series a scene may record.
 pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
-/// Names of the bodies.
-pub const BODIES: [&str; 3] = ["free_link", "chain", "leg"];
 
 /// A scene as named fields. Fields that a body does not use are ignored.
 #[derive(Debug, Clone, PartialEq)]
@@ -294,8 +292,7 @@ impl SceneSpec {
         Ok(r)
     }
 
-    /// The fields every body shares but the initial motion (a linkage's is in its
-    /// elements).
+    /// The fields every body shares but its forces.
     fn common_numerics(&self) -> Result<Common> {
         // The fields that one sign model or one method reads are checked whichever is
         // chosen: a scene holding a bad one is refused, not kept until it is switched on.
@@ -345,135 +342,87 @@ impl SceneSpec {
                 end,
                 record: self.record()?,
             },
-            v0: 0.0,
-            depth0: 0.0,
-            vx0: 0.0,
         })
     }
 
-    fn common(&self) -> Result<Common> {
-        let c = self.common_numerics()?;
-        Ok(Common {
-            v0: self.f64("v0")?,
-            depth0: self.f64_or("depth0", 0.0)?,
-            vx0: self.f64_or("vx0", 0.0)?,
-            ..c
-        })
-    }
-
-    fn free_link(&self) -> Result<FreeLinkScene> {
-        let c = self.common()?;
-        Ok(FreeLinkScene {
-            length: self.f64("length")?,
-            diameter: self.f64("diameter")?,
-            mass: self.f64("mass")?,
-            inertia: self.opt_f64("inertia")?,
-            medium: c.medium,
-            q_deg: self.f64("q_deg")?,
-            v0: c.v0,
-            depth0: c.depth0,
-            vx0: c.vx0,
-            omega0: self.f64_or("omega0", 0.0)?,
-            apply_at: c.apply_at,
-            sign_model: c.sign_model,
-            forces: self.forces(1)?,
-            options: c.options,
-        })
-    }
-
-    /// Link 2's angle defaults to the mirror of link 1's, its coefficients to link 1's.
-    fn chain(&self) -> Result<ChainScene> {
-        let c = self.common()?;
-        let q1 = self.f64("q_deg")?;
-        Ok(ChainScene {
-            length: self.f64("length")?,
-            diameter: self.f64("diameter")?,
-            mass: self.f64("mass")?,
-            inertia: self.opt_f64("inertia")?,
-            pin_mass: self.f64_or("pin_mass", 0.0)?,
-            joint: self.joint("pin_joint", Joint::Free)?,
-            medium: c.medium,
-            q_deg: [q1, self.opt_f64("q2_deg")?.unwrap_or(-q1)],
-            v0: c.v0,
-            depth0: c.depth0,
-            vx0: c.vx0,
-            omega0: self.f64_or("omega0", 0.0)?,
-            apply_at: c.apply_at,
-            sign_model: c.sign_model,
-            forces: self.forces(2)?,
-            options: c.options,
-        })
-    }
-
-    /// The leg (fields left out take the [`LegScene`] defaults).
-    pub fn leg(&self) -> Result<LegScene> {
-        let c = self.common()?;
-        let defaults = LegScene::default();
-        let sole_model = if self.has("sole_model") {
-            match self.str("sole_model")? {
-                "box" => SoleModel::Box,
-                "thesis" => SoleModel::Thesis,
-                other => return Err(unknown("sole_model", other, &["box", "thesis"])),
-            }
-        } else {
-            SoleModel::Box
-        };
-        let mut joints = [Joint::Locked; 3];
-        for (j, name) in joints.iter_mut().zip(LEG_JOINTS) {
-            *j = self.joint(name, Joint::Locked)?;
-        }
-        Ok(LegScene {
-            body_mass: self.f64_or("body_mass", defaults.body_mass)?,
-            height: self.f64_or("height", defaults.height)?,
-            foot_length: self.f64_or("foot_length", defaults.foot_length)?,
-            shoe_width: self.f64_or("shoe_width", defaults.shoe_width)?,
-            tibia_length: self.f64_or("tibia_length", defaults.tibia_length)?,
-            sole_height: self.opt_f64("sole_height")?,
-            joints,
-            knee_deg: self.f64_or("knee_deg", defaults.knee_deg)?,
-            hip_deg: self.f64_or("hip_deg", defaults.hip_deg)?,
-            trunk_deg: self.f64_or("trunk_deg", defaults.trunk_deg)?,
-            foot_deg: self.f64_or("foot_deg", defaults.foot_deg)?,
-            sole_model,
-            medium: c.medium,
-            v0: c.v0,
-            depth0: c.depth0,
-            vx0: c.vx0,
-            apply_at: c.apply_at,
-            sign_model: c.sign_model,
-            forces: self.forces(1)?,
-            options: c.options,
-        })
-    }
-
-    /// The body named by the `body` field (`"linkage"` for a linkage's mapping).
+    /// The body named by the `body` field (`"linkage"` for a linkage's mapping, else a
+    /// preset's name).
     pub fn body(&self) -> Result<&str> {
         if let Some(Value::Map(_)) = self.get("body") {
             return Ok("linkage");
         }
         let body = self.str("body")?;
-        if BODIES.contains(&body) {
-            Ok(body)
-        } else {
-            Err(unknown("body", body, &BODIES))
+        match presets::preset(body) {
+            Some(p) => Ok(p.name),
+            None => Err(unknown("body", body, &presets::names())),
         }
     }
 
-    /// Build the scene and validate every field; the error names the first bad one.
-    pub fn build(&self) -> Result<AnyScene> {
+    /// Build the scene (a preset's linkage, or the linkage given) and validate every field;
+    /// the error names the first bad one, as the user wrote it.
+    pub fn build(&self) -> Result<LinkageScene> {
         let scene = self.body_scene()?;
-        scene.validate()?;
+        match self.body()? {
+            "linkage" => scene.validate()?,
+            name => {
+                if let Some(preset) = presets::preset(name) {
+                    scene.validate().map_err(|e| preset.rename(e))?;
+                }
+            }
+        }
         Ok(scene)
     }
 
-    /// Build the scene, checking only what building needs (types, names); [`Self::build`]
-    /// validates the rest.
-    pub fn body_scene(&self) -> Result<AnyScene> {
-        Ok(match self.body()? {
-            "free_link" => AnyScene::FreeLink(self.free_link()?),
-            "chain" => AnyScene::Chain(self.chain()?),
-            "linkage" => AnyScene::Linkage(self.linkage()?),
-            _ => AnyScene::Leg(self.leg()?),
+    /// Build the scene, checking what building needs (types, names, and a preset's own
+    /// parameters); [`Self::build`] validates the rest.
+    pub fn body_scene(&self) -> Result<LinkageScene> {
+        match self.body()? {
+            "linkage" => self.linkage(),
+            name => match presets::preset(name) {
+                Some(preset) => (preset.build)(self),
+                None => Err(unknown("body", name, &presets::names())),
+            },
+        }
+    }
+}
+
+impl Fields for SceneSpec {
+    fn f64(&self, field: &str) -> Result<f64> {
+        SceneSpec::f64(self, field)
+    }
+
+    fn opt_f64(&self, field: &str) -> Result<Option<f64>> {
+        SceneSpec::opt_f64(self, field)
+    }
+
+    fn f64_or(&self, field: &str, default: f64) -> Result<f64> {
+        SceneSpec::f64_or(self, field, default)
+    }
+
+    fn joint(&self, field: &str, default: Joint) -> Result<Joint> {
+        SceneSpec::joint(self, field, default)
+    }
+
+    fn choice<'a>(&'a self, field: &str, default: &'a str, allowed: &[&str]) -> Result<&'a str> {
+        if !self.has(field) {
+            return Ok(default);
+        }
+        let v = self.str(field)?;
+        if allowed.contains(&v) {
+            Ok(v)
+        } else {
+            Err(unknown(field, v, allowed))
+        }
+    }
+
+    fn setting(&self, n_contacts: usize) -> Result<Setting> {
+        let c = self.common_numerics()?;
+        Ok(Setting {
+            medium: c.medium,
+            apply_at: c.apply_at,
+            sign_model: c.sign_model,
+            forces: self.forces(n_contacts)?,
+            options: c.options,
         })
     }
 }
@@ -814,6 +763,7 @@ impl SceneSpec {
                     height: e.num("height")?,
                     width: e.num("width")?,
                     l_ref: e.num_or("l_ref", length)?,
+                    thesis_angle_of: None,
                 },
                 other => return Err(unknown(&e.field("shape"), other, &["rod", "box", "arc"])),
             };
@@ -879,9 +829,8 @@ impl SceneSpec {
             }
             Some(other) => return Err(wrong("root", "a mapping", other)),
         };
-        let c = self.common_numerics()?;
+        let c = self.setting(contacts.len())?;
         Ok(LinkageScene {
-            forces: self.forces(contacts.len())?,
             links,
             joints,
             contacts,
@@ -889,6 +838,7 @@ impl SceneSpec {
             medium: c.medium,
             apply_at: c.apply_at,
             sign_model: c.sign_model,
+            forces: c.forces,
             options: c.options,
         })
     }
@@ -916,13 +866,10 @@ pub fn thesis_law(
     ForceSet::build(&listed, per_contact.len())
 }
 
-/// The fields every body shares.
+/// The fields every body shares but its forces.
 struct Common {
     medium: Medium,
     apply_at: ApplyAt,
     sign_model: SignModel,
     options: SolveOptions,
-    v0: f64,
-    depth0: f64,
-    vx0: f64,
 }

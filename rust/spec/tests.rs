@@ -2,6 +2,8 @@
 //! and every field has its own slot.
 
 use super::*;
+use crate::presets::free_link::FreeLink;
+use crate::presets::Start;
 
 /// (Tests.) The Table 3.5 row q = 45 deg as a spec (what `granrs.Scene().to_dict()` sends).
 pub(crate) fn free_link_spec() -> SceneSpec {
@@ -42,21 +44,27 @@ pub(crate) fn free_link_spec() -> SceneSpec {
 
 #[test]
 fn spec_builds_the_same_scene_as_rust_defaults() {
-    let AnyScene::FreeLink(built) = free_link_spec().build().unwrap() else {
-        panic!("not a free link");
-    };
-    let mut by_hand = FreeLinkScene {
-        q_deg: 45.0,
-        v0: 2.27,
+    let built = free_link_spec().build().unwrap();
+    let mut setting = Setting {
         forces: ForceSet::thesis(&[Coefficients {
             eta_h: 5.5,
             eta_d: 11.0,
             eta_v: 53.0,
             lambda: 0.25,
         }]),
-        ..Default::default()
+        ..Setting::default()
     };
-    by_hand.options.record.stride = 1; // the spec's record_stride default
+    setting.options.record.stride = 1; // the spec's record_stride default
+    let by_hand = FreeLink {
+        q_deg: 45.0,
+        start: Start {
+            v0: 2.27,
+            depth0: 0.0,
+            vx0: 0.0,
+        },
+        ..Default::default()
+    }
+    .scene(setting);
     assert_eq!(built, by_hand);
 }
 
@@ -131,10 +139,8 @@ fn springs_are_free_without_the_effect() {
             ("c".into(), Value::Num(0.01)),
         ]),
     );
-    let AnyScene::Chain(with) = s.build().unwrap() else {
-        panic!()
-    };
-    assert!(matches!(with.joint, Joint::Spring { .. }));
+    let with = s.build().unwrap();
+    assert!(matches!(with.joints[0].joint, Joint::Spring { .. }));
     s.set(
         "forces",
         Value::Terms(vec![
@@ -142,12 +148,10 @@ fn springs_are_free_without_the_effect() {
             TermSpec::new("static_v", &[]),
         ]),
     );
-    let AnyScene::Chain(without) = s.build().unwrap() else {
-        panic!()
-    };
+    let without = s.build().unwrap();
     // The joint keeps its spring-damper; without the `joint_springs` term it exerts
     // nothing (the engine reads the force set, not a rewritten joint).
-    assert!(matches!(without.joint, Joint::Spring { .. }));
+    assert!(matches!(without.joints[0].joint, Joint::Spring { .. }));
     assert!(!without.forces.joint_springs);
     assert_eq!(without.forces.names, vec!["gravity", "static_v"]);
 }

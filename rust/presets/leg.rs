@@ -1,14 +1,34 @@
-//! The leg (thesis ch. 5): foot, shank, thigh and half trunk landing on the sole.
+//! The leg (thesis ch. 5): foot, shank, thigh and half trunk landing on the sole, for one
+//! leg of a person landing on both feet (so it carries half the body's mass above the
+//! feet). A linkage rooted at the ankle, angles from the vertical: the foot's axis points
+//! from heel to toe (90 deg when flat), the others from their lower joint up.
 
-use nalgebra::{SVector, Vector2};
+use nalgebra::Vector2;
 
-use super::{validate_common, validate_joint, validate_joint_stiffness};
-use crate::body::rod::ApplyAt;
-use crate::body::{Joint, Link, Mechanism, SoleContact, SoleModel};
-use crate::dynamics::{Contact, Model, Shape, SignModel};
+use super::{check_joint, relaxed_at, Fields, Preset, Setting, Start};
+use crate::bodies::{
+    ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, RootKind, RootSpec,
+};
+use crate::body::{Joint, SoleModel};
+use crate::dynamics::Shape;
 use crate::error::{check_finite, check_range, GranrsError, Result};
-use crate::forces::{Coefficients, ForceSet, Medium};
-use crate::integrate::{solve, Outcome, SolveOptions};
+
+/// The preset's registration.
+pub const PRESET: Preset = Preset {
+    name: "leg",
+    build,
+    renames: &[
+        ("joints.ankle", "ankle"),
+        ("joints.knee", "knee"),
+        ("joints.hip", "hip"),
+    ],
+};
+
+/// Names of the leg's joints, in order (each a scene field).
+pub const JOINTS: [&str; 3] = ["ankle", "knee", "hip"];
+
+/// Names of the leg's links, from the foot up.
+pub const LINKS: [&str; 4] = ["foot", "shank", "thigh", "trunk"];
 
 /// Anthropometric data of the leg model.
 ///
@@ -17,7 +37,7 @@ use crate::integrate::{solve, Outcome, SolveOptions};
 /// Wiley 2009, Table 4.1. Segment lengths as fractions of the body height H: Winter's
 /// Fig. 4.1 (after Drillis and Contini 1966): ankle 0.039 H, knee 0.285 H, hip (greater
 /// trochanter) 0.530 H, shoulder (glenohumeral joint) 0.818 H above the floor.
-pub mod leg_defaults {
+pub mod defaults {
     /// Body mass [kg] (thesis sec. 5.2.1: 75.35 +- 0.568 kg, five subjects).
     pub const BODY_MASS: f64 = 75.35;
     /// Body height [m] (thesis sec. 5.2.1: 1.78 +- 0.032 m).
@@ -73,15 +93,9 @@ pub struct Segment {
     pub inertia: f64,
 }
 
-/// A planar leg landing on its foot (MODEL.md, "Bodies"): foot, shank, thigh and half of
-/// head-arms-trunk, with ankle, knee and hip joints, for one leg of a person landing on
-/// both feet (so it carries half the body's mass above the feet).
-///
-/// Generalized coordinates `(x_ankle, y_ankle, q_foot, q_shank, q_thigh, q_trunk)`, angles
-/// from the vertical; the foot's axis points from heel to toe (90 deg when flat), the
-/// others from their lower joint up.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LegScene {
+/// A planar leg landing on its foot (MODEL.md, "Bodies").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Leg {
     /// Body mass [kg].
     pub body_mass: f64,
     /// Body height [m].
@@ -109,66 +123,74 @@ pub struct LegScene {
     pub foot_deg: f64,
     /// Reference area and volume of the sole.
     pub sole_model: SoleModel,
-    /// The sand.
-    pub medium: Medium,
-    /// Initial downward speed [m/s].
-    pub v0: f64,
-    /// Initial depth of the sole's lowest point [m].
-    pub depth0: f64,
-    /// Initial horizontal velocity [m/s].
-    pub vx0: f64,
-    /// Point of application of the force: the middle of the sole (`Tip`) or E.
-    pub apply_at: ApplyAt,
-    /// Sign model of the static terms.
-    pub sign_model: SignModel,
-    /// The force terms that act, with their parameters per contact.
-    pub forces: ForceSet,
-    /// Step, end and recording.
-    pub options: SolveOptions,
+    /// Initial motion: every segment at (vx0, -v0) without rotation, the sole's lowest
+    /// point `depth0` deep.
+    pub start: Start,
 }
 
-impl Default for LegScene {
+impl Default for Leg {
     fn default() -> Self {
-        LegScene {
-            body_mass: leg_defaults::BODY_MASS,
-            height: leg_defaults::HEIGHT,
-            foot_length: leg_defaults::FOOT_LENGTH,
-            shoe_width: leg_defaults::SHOE_WIDTH,
-            tibia_length: leg_defaults::TIBIA_LENGTH,
+        Leg {
+            body_mass: defaults::BODY_MASS,
+            height: defaults::HEIGHT,
+            foot_length: defaults::FOOT_LENGTH,
+            shoe_width: defaults::SHOE_WIDTH,
+            tibia_length: defaults::TIBIA_LENGTH,
             sole_height: None,
             joints: [Joint::Locked; 3],
-            knee_deg: leg_defaults::KNEE_DEG,
-            hip_deg: leg_defaults::HIP_DEG,
-            trunk_deg: leg_defaults::TRUNK_DEG,
-            foot_deg: leg_defaults::FOOT_DEG,
+            knee_deg: defaults::KNEE_DEG,
+            hip_deg: defaults::HIP_DEG,
+            trunk_deg: defaults::TRUNK_DEG,
+            foot_deg: defaults::FOOT_DEG,
             sole_model: SoleModel::Box,
-            medium: Medium {
-                rho_g: leg_defaults::RHO_G,
-                g: 9.81,
+            start: Start {
+                v0: 3.28,
+                depth0: 0.0,
+                vx0: 0.0,
             },
-            v0: 3.28,
-            depth0: 0.0,
-            vx0: 0.0,
-            apply_at: ApplyAt::Tip,
-            sign_model: SignModel::Modes,
-            // Thesis sec. 5.3.2, v0 = 3.28 m/s.
-            forces: ForceSet::thesis(&[Coefficients {
-                eta_h: 10.0,
-                eta_d: 13.0,
-                eta_v: 195.0,
-                lambda: 1.05,
-            }]),
-            options: SolveOptions::default(),
         }
     }
 }
 
-/// Names of the leg's joints, in order.
-pub const LEG_JOINTS: [&str; 3] = ["ankle", "knee", "hip"];
+fn build(f: &dyn Fields) -> Result<LinkageScene> {
+    let leg = Leg::read(f)?;
+    let setting = f.setting(1)?;
+    Ok(leg.scene(setting))
+}
 
-impl LegScene {
-    /// Check every field; the error names the first bad one.
-    pub fn validate(&self) -> Result<()> {
+impl Leg {
+    /// Read the leg's fields (those left out take the defaults) and check them.
+    pub fn read(f: &dyn Fields) -> Result<Leg> {
+        let d = Leg::default();
+        let sole_model = match f.choice("sole_model", "box", &["box", "thesis"])? {
+            "thesis" => SoleModel::Thesis,
+            _ => SoleModel::Box,
+        };
+        let mut joints = [Joint::Locked; 3];
+        for (j, name) in joints.iter_mut().zip(JOINTS) {
+            *j = f.joint(name, Joint::Locked)?;
+        }
+        let leg = Leg {
+            body_mass: f.f64_or("body_mass", d.body_mass)?,
+            height: f.f64_or("height", d.height)?,
+            foot_length: f.f64_or("foot_length", d.foot_length)?,
+            shoe_width: f.f64_or("shoe_width", d.shoe_width)?,
+            tibia_length: f.f64_or("tibia_length", d.tibia_length)?,
+            sole_height: f.opt_f64("sole_height")?,
+            joints,
+            knee_deg: f.f64_or("knee_deg", d.knee_deg)?,
+            hip_deg: f.f64_or("hip_deg", d.hip_deg)?,
+            trunk_deg: f.f64_or("trunk_deg", d.trunk_deg)?,
+            foot_deg: f.f64_or("foot_deg", d.foot_deg)?,
+            sole_model,
+            start: Start::read(f)?,
+        };
+        leg.check()?;
+        Ok(leg)
+    }
+
+    /// Check every parameter; the error names the first bad one.
+    pub fn check(&self) -> Result<()> {
         check_range("body_mass", self.body_mass, 0.0, true)?;
         check_range("height", self.height, 0.0, true)?;
         check_range("foot_length", self.foot_length, 0.0, true)?;
@@ -177,8 +199,8 @@ impl LegScene {
         if let Some(h) = self.sole_height {
             check_range("sole_height", h, 0.0, true)?;
         }
-        for (name, j) in LEG_JOINTS.iter().zip(&self.joints) {
-            validate_joint(name, j)?;
+        for (name, j) in JOINTS.iter().zip(&self.joints) {
+            check_joint(name, j)?;
         }
         for (field, v, lo, hi) in [
             ("knee_deg", self.knee_deg, 0.0, 150.0),
@@ -208,20 +230,7 @@ impl LegScene {
                 });
             }
         }
-        validate_common(
-            &self.medium,
-            self.v0,
-            self.depth0,
-            self.vx0,
-            &self.options,
-            &self.sign_model,
-        )?;
-        validate_joint_stiffness(
-            &self.model(),
-            &self.initial_state().0,
-            &self.options,
-            &["", "ankle", "knee", "hip"],
-        )
+        self.start.check()
     }
 
     /// Absolute angles from the vertical at touchdown [rad]: foot, shank, thigh, trunk.
@@ -233,20 +242,15 @@ impl LegScene {
         [foot, shank, thigh, trunk]
     }
 
-    /// Height of the contact box above the sole [m].
-    pub fn sole_height(&self) -> f64 {
-        self.sole_height.unwrap_or(self.tibia_length)
-    }
-
     /// Height of the ankle above the sole [m]: 0.039 H (Winter Fig. 4.1).
     pub fn ankle_height(&self) -> f64 {
-        leg_defaults::ANKLE_HEIGHT * self.height
+        defaults::ANKLE_HEIGHT * self.height
     }
 
     /// The four segments, scaled to body mass and height: foot, shank, thigh, half trunk.
     pub fn segments(&self) -> [Segment; 4] {
         let m = self.body_mass;
-        let fr = leg_defaults::MASS_FRACTION;
+        let fr = defaults::MASS_FRACTION;
         let h = self.ankle_height();
         let foot_mass = fr[0] * m;
         let foot = Segment {
@@ -257,20 +261,20 @@ impl LegScene {
         };
         let lengths = [
             self.tibia_length,
-            leg_defaults::THIGH_LENGTH * self.height,
-            leg_defaults::TRUNK_LENGTH * self.height,
+            defaults::THIGH_LENGTH * self.height,
+            defaults::TRUNK_LENGTH * self.height,
         ];
         let mut out = [foot; 4];
         for i in 0..3 {
             let l = lengths[i];
             let mass = fr[i + 1] * m;
-            let rg = leg_defaults::GYRATION[i] * l;
+            let rg = defaults::GYRATION[i] * l;
             // Shank and thigh: from the proximal (upper) end; the trunk from the hip, its
             // lower end.
             let com = if i < 2 {
-                (1.0 - leg_defaults::COM_FROM_PROXIMAL[i]) * l
+                (1.0 - defaults::COM_FROM_PROXIMAL[i]) * l
             } else {
-                leg_defaults::COM_FROM_PROXIMAL[i] * l
+                defaults::COM_FROM_PROXIMAL[i] * l
             };
             out[i + 1] = Segment {
                 mass,
@@ -282,95 +286,79 @@ impl LegScene {
         out
     }
 
-    /// The sole contact: the box on the sole under the ankle, centred on it (granrs
-    /// assumption: the ankle above the middle of the sole).
-    pub fn sole(&self) -> SoleContact {
-        SoleContact {
-            link: 0,
-            angle_link: 1,
-            heel: Vector2::new(-0.5 * self.foot_length, self.ankle_height()),
-            length: self.foot_length,
-            height: self.sole_height(),
-            width: self.shoe_width,
-            l_ref: self.tibia_length,
-            model: self.sole_model,
-        }
-    }
-
-    /// The leg as a mechanism rooted at the ankle.
-    pub fn model(&self) -> Model<6> {
+    /// The leg as a linkage in `setting`: the ankle above x = 0, the sole's lowest point
+    /// `depth0` below the surface. The sole contact is the box on the sole under the ankle,
+    /// centred on it (granrs assumption: the ankle above the middle of the sole).
+    pub fn scene(&self, setting: Setting) -> LinkageScene {
         let seg = self.segments();
         let a = self.angles();
         let h = self.ankle_height();
-        let mut links = Vec::with_capacity(4);
-        links.push(Link {
-            mass: seg[0].mass,
-            inertia: seg[0].inertia,
-            com: Vector2::new(0.0, 0.5 * h),
-            parent: None,
-            joint_on_parent: Vector2::zeros(),
-            joint: Joint::Free,
-        });
-        for i in 1..4 {
-            let rest = a[i] - a[i - 1];
-            let joint = match self.joints[i - 1] {
-                Joint::Spring { k, c, .. } => Joint::Spring { k, c, rest },
-                j => j,
-            };
-            links.push(Link {
+        let links = (0..4)
+            .map(|i| LinkSpec {
+                name: LINKS[i].into(),
                 mass: seg[i].mass,
                 inertia: seg[i].inertia,
-                com: Vector2::new(seg[i].com, 0.0),
-                parent: Some(i - 1),
+                com: if i == 0 {
+                    Vector2::new(0.0, 0.5 * h)
+                } else {
+                    Vector2::new(seg[i].com, 0.0)
+                },
+                length: seg[i].length,
+                q: a[i],
+                omega: 0.0,
+            })
+            .collect();
+        let joints = (1..4)
+            .map(|i| JointSpec {
+                name: JOINTS[i - 1].into(),
+                parent: LINKS[i - 1].into(),
+                child: LINKS[i].into(),
                 // The ankle is the foot's origin; knee and hip are the top of the segment
                 // below.
-                joint_on_parent: if i == 1 {
+                at: if i == 1 {
                     Vector2::zeros()
                 } else {
                     Vector2::new(seg[i - 1].length, 0.0)
                 },
-                joint,
-            });
-        }
-        Model {
-            mechanism: Mechanism {
-                links,
-                root_mass: 0.0,
-                root_fixed: false,
-                root_rate: None,
+                joint: relaxed_at(self.joints[i - 1], a[i] - a[i - 1]),
+                table: None,
+            })
+            .collect();
+        let sole = ContactSpec {
+            name: "sole".into(),
+            link: "foot".into(),
+            shape: ContactShape::Box {
+                corner: Vector2::new(-0.5 * self.foot_length, h),
+                length: self.foot_length,
+                height: self.sole_height.unwrap_or(self.tibia_length),
+                width: self.shoe_width,
+                l_ref: self.tibia_length,
+                // The thesis's form reads the shank's angle (link 1).
+                thesis_angle_of: (self.sole_model == SoleModel::Thesis).then_some(1),
             },
-            contacts: vec![Contact {
-                shape: Shape::Sole(self.sole()),
-            }],
-            medium: self.medium,
-            apply_at: self.apply_at,
-            sign_model: self.sign_model,
-            forces: self.forces.clone(),
-        }
-    }
-
-    /// Initial state: the ankle above x = 0, the sole's lowest point `depth0` below the
-    /// surface, every segment moving at (vx0, -v0) without rotation.
-    pub fn initial_state(&self) -> (SVector<f64, 6>, SVector<f64, 6>) {
-        let a = self.angles();
-        let model = self.model();
-        let mut q0 = SVector::<f64, 6>::new(0.0, 0.0, a[0], a[1], a[2], a[3]);
+        };
+        let root = RootSpec {
+            kind: RootKind::Free,
+            link: "foot".into(),
+            position: Vector2::zeros(),
+            velocity: Vector2::new(self.start.vx0, -self.start.v0),
+            mass: 0.0,
+            rate: None,
+        };
+        let mut scene = setting.scene(links, joints, vec![sole], root);
+        // Lift the ankle so that the sole's lowest corner is `depth0` deep.
+        let model = scene.model::<6>();
+        let (q0, _) = scene.initial_state::<6>();
         let pose = model.mechanism.pose(&q0);
-        let sole = self.sole();
-        let lowest = sole
-            .corners_local()
-            .iter()
-            .map(|r| model.mechanism.point(&pose, 0, *r).y)
-            .fold(f64::INFINITY, f64::min);
-        q0[1] = -lowest - self.depth0;
-        let qd0 = SVector::<f64, 6>::new(self.vx0, -self.v0, 0.0, 0.0, 0.0, 0.0);
-        (q0, qd0)
-    }
-
-    /// Validate and run.
-    pub fn run(&self) -> Result<Outcome> {
-        self.validate()?;
-        let (q0, qd0) = self.initial_state();
-        solve(&self.model(), q0, qd0, &self.options)
+        let lowest = match &model.contacts[0].shape {
+            Shape::Sole(s) => s
+                .corners_local()
+                .iter()
+                .map(|r| model.mechanism.point(&pose, 0, *r).y)
+                .fold(f64::INFINITY, f64::min),
+            _ => 0.0,
+        };
+        scene.root.position.y = -lowest - self.start.depth0;
+        scene
     }
 }

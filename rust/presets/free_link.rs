@@ -1,0 +1,125 @@
+//! The free link (thesis sec. 3.2.1): a round-ended rod dropped onto sand, tip first; a
+//! linkage of one link whose root is its centre of mass, with one rod contact.
+
+use nalgebra::Vector2;
+
+use super::{check_rod, check_rod_angle, rod_inertia, Fields, Preset, Setting, Start};
+use crate::bodies::{ContactShape, ContactSpec, LinkSpec, LinkageScene, RootKind, RootSpec};
+use crate::error::{check_finite, Result};
+
+/// The preset's registration.
+pub const PRESET: Preset = Preset {
+    name: "free_link",
+    build,
+    renames: &[],
+};
+
+/// The thesis's free link (sec. 3.2.1): a steel rod with round ends.
+pub mod defaults {
+    /// Length L [m] (thesis sec. 3.2.1).
+    pub const LENGTH: f64 = 0.190;
+    /// Diameter d_c [m] (thesis sec. 3.2.1).
+    pub const DIAMETER: f64 = 0.0127;
+    /// Mass m [kg] (thesis sec. 3.2.1).
+    pub const MASS: f64 = 0.184;
+}
+
+/// A free round-ended link dropped onto sand, tip first (MODEL.md, "Bodies").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FreeLink {
+    /// Rod length L [m].
+    pub length: f64,
+    /// Rod diameter d_c [m].
+    pub diameter: f64,
+    /// Mass m [kg].
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass [kg m^2]; `None`: a solid cylinder,
+    /// m (L^2/12 + d_c^2/16).
+    pub inertia: Option<f64>,
+    /// Initial angle from the vertical q [deg], |q| < 90.
+    pub q_deg: f64,
+    /// Initial motion: the tip's velocity is (vx0, -v0), its depth depth0.
+    pub start: Start,
+    /// Initial angular velocity dq/dt [rad/s].
+    pub omega0: f64,
+}
+
+impl Default for FreeLink {
+    fn default() -> Self {
+        FreeLink {
+            length: defaults::LENGTH,
+            diameter: defaults::DIAMETER,
+            mass: defaults::MASS,
+            inertia: None,
+            q_deg: 0.0,
+            start: Start {
+                v0: 2.214,
+                depth0: 0.0,
+                vx0: 0.0,
+            },
+            omega0: 0.0,
+        }
+    }
+}
+
+fn build(f: &dyn Fields) -> Result<LinkageScene> {
+    let p = FreeLink {
+        length: f.f64("length")?,
+        diameter: f.f64("diameter")?,
+        mass: f.f64("mass")?,
+        inertia: f.opt_f64("inertia")?,
+        q_deg: f.f64("q_deg")?,
+        start: Start::read(f)?,
+        omega0: f.f64_or("omega0", 0.0)?,
+    };
+    let setting = f.setting(1)?;
+    p.check()?;
+    Ok(p.scene(setting))
+}
+
+impl FreeLink {
+    /// Check every parameter; the error names the first bad one.
+    pub fn check(&self) -> Result<()> {
+        check_rod(self.length, self.diameter, self.mass, self.inertia)?;
+        check_rod_angle("q_deg", self.q_deg)?;
+        check_finite("omega0", self.omega0)?;
+        self.start.check()
+    }
+
+    /// The rod as a linkage in `setting`: the root is its centre of mass, the tip at x = 0,
+    /// `depth0` below the surface, moving at (vx0, -v0) and turning at omega0.
+    pub fn scene(&self, setting: Setting) -> LinkageScene {
+        let q = self.q_deg.to_radians();
+        let half = 0.5 * self.length;
+        // The tip's velocity is (vx0, -v0); the centre moves with it plus the spin.
+        let normal = Vector2::new(q.cos(), -q.sin());
+        let v_c = Vector2::new(self.start.vx0, -self.start.v0) + self.omega0 * half * normal;
+        let link = LinkSpec {
+            name: "rod".into(),
+            mass: self.mass,
+            inertia: rod_inertia(self.inertia, self.mass, self.length, self.diameter),
+            com: Vector2::zeros(),
+            length: self.length,
+            q,
+            omega: self.omega0,
+        };
+        let contact = ContactSpec {
+            name: "rod".into(),
+            link: "rod".into(),
+            shape: ContactShape::Rod {
+                tip: Vector2::new(-half, 0.0),
+                length: self.length,
+                diameter: self.diameter,
+            },
+        };
+        let root = RootSpec {
+            kind: RootKind::Free,
+            link: "rod".into(),
+            position: Vector2::new(half * q.sin(), half * q.cos() - self.start.depth0),
+            velocity: v_c,
+            mass: 0.0,
+            rate: None,
+        };
+        setting.scene(vec![link], vec![], vec![contact], root)
+    }
+}
