@@ -102,7 +102,7 @@ fn out_of_range(field: &str, value: f64, min: f64, strict: bool) -> GranrsError 
 
 /// ` [unit]` of a scene field from the field table (empty for a field without a unit).
 fn unit_of(field: &str) -> String {
-    match crate::spec::fields::info(field) {
+    match crate::fields::info(field) {
         Some(f) if !f.unit.is_empty() && f.unit != "-" && !field.contains('.') => {
             format!(" [{}]", f.unit)
         }

@@ -15,10 +15,11 @@ pub mod body;
 pub mod dynamics;
 pub mod error;
 pub mod evaluate;
+pub mod fields;
 pub mod forces;
 pub mod integrate;
+pub mod num;
 pub mod presets;
-pub mod simd;
 pub mod spec;
 
 #[cfg(feature = "python")]

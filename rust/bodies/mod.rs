@@ -11,9 +11,9 @@ use nalgebra::SVector;
 use crate::body::Joint;
 use crate::dynamics::{Model, SignModel};
 use crate::error::{check_range, fmt_num, GranrsError, Result};
+use crate::fields::{MAX_SAMPLES, MAX_STEPS};
 use crate::forces::Medium;
 use crate::integrate::{Method, SolveOptions, RTOL_MIN};
-use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
 
 pub mod linkage;
 

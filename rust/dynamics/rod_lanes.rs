@@ -46,7 +46,7 @@ use crate::forces::static_v::StaticV;
 use crate::forces::{
     AnyTerm, Boundary, ContactState, Frame, Medium, Outline, Real, Term, TermForce,
 };
-use crate::simd::{F64x4, LANES};
+use crate::num::{F64x4, LANES};
 
 /// What the evaluation of one free link under the thesis's terms or a [`FrameLaw`] reads
 /// that is fixed through a run: its mass, geometry, medium and the terms' parameters (one

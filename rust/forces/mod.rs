@@ -24,7 +24,6 @@
 //! (`registry.rs`), one constructor in `python/granrs/forces.py`. See `docs/forces.md`.
 
 use std::fmt::Debug;
-use std::ops::{Add, Div, Mul, Neg, Sub};
 
 #[cfg(test)]
 pub mod constant;
@@ -38,99 +37,8 @@ pub mod rft;
 pub mod static_h;
 pub mod static_v;
 
+pub use crate::num::Real;
 pub use registry::{AnyTerm, Coefficients, ForceSet, TermSpec, TERMS};
-
-/// The number type of a term's arithmetic: `f64` for one scene; [`crate::simd::F64x4`] for
-/// four scenes at once, one per SIMD lane (the sweep's lanes, `dynamics::rod_lanes`). Only
-/// the operations the terms and the free link's mechanics use; a lane type does each lane
-/// by lane with the same IEEE operation as `f64`, so that a lane's result is bit for bit the
-/// scalar one.
-pub trait Real:
-    Copy
-    + Debug
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
-{
-    /// Scenes per value: 1 for `f64`, 4 for the lanes' `F64x4`.
-    const LANES: usize;
-    /// The value `x` (in every lane).
-    fn splat(x: f64) -> Self;
-    /// `self^e` (libm's, in each lane).
-    fn powf(self, e: Self) -> Self;
-    /// `1 / self`.
-    fn recip(self) -> Self;
-    /// Square root.
-    fn sqrt(self) -> Self;
-    /// Absolute value.
-    fn abs(self) -> Self;
-    /// The larger of the two (per lane).
-    fn max(self, other: Self) -> Self;
-    /// The smaller of the two (per lane).
-    fn min(self, other: Self) -> Self;
-    /// `a` where `self > 0`, else `b` (per lane: a blend, no branch).
-    fn select_pos(self, a: Self, b: Self) -> Self;
-    /// Whether it is zero (in every lane).
-    fn all_zero(self) -> bool;
-    /// Sine and cosine (libm's, in each lane).
-    fn sin_cos(self) -> (Self, Self);
-    /// Hyperbolic tangent (libm's, in each lane).
-    fn tanh(self) -> Self;
-}
-
-impl Real for f64 {
-    const LANES: usize = 1;
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn powf(self, e: Self) -> Self {
-        f64::powf(self, e)
-    }
-    #[inline(always)]
-    fn recip(self) -> Self {
-        1.0 / self
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        f64::abs(self)
-    }
-    #[inline(always)]
-    fn max(self, other: Self) -> Self {
-        f64::max(self, other)
-    }
-    #[inline(always)]
-    fn min(self, other: Self) -> Self {
-        f64::min(self, other)
-    }
-    #[inline(always)]
-    fn select_pos(self, a: Self, b: Self) -> Self {
-        if self > 0.0 {
-            a
-        } else {
-            b
-        }
-    }
-    #[inline(always)]
-    fn all_zero(self) -> bool {
-        self == 0.0
-    }
-    #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
-        f64::sin_cos(self)
-    }
-    #[inline(always)]
-    fn tanh(self) -> Self {
-        f64::tanh(self)
-    }
-}
 
 /// The granular medium (and the gravity that loads it).
 #[derive(Debug, Clone, Copy, PartialEq)]

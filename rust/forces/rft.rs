@@ -424,8 +424,7 @@ impl Term for Rft {
     fn contact_force<F: Real>(&self, c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
         let co = self.coefficients_in();
         #[cfg(target_arch = "x86_64")]
-        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::simd::avx2()
-        {
+        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::num::avx2() {
             if let Some(b) = c.boundary {
                 if let Outline::Rod { diameter, immersed } = b.outline {
                     if (b.held[0] + b.held[1]).all_zero() {
@@ -493,7 +492,7 @@ impl Rft {
     /// change here is to be measured (`benches/bench_laws.py`).
     ///
     /// # Safety
-    /// The CPU must have AVX2 ([`crate::simd::avx2`]).
+    /// The CPU must have AVX2 ([`crate::num::avx2`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
@@ -648,8 +647,7 @@ impl Term for RftInertial {
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         #[cfg(target_arch = "x86_64")]
-        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::simd::avx2()
-        {
+        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::num::avx2() {
             if let Some(b) = c.boundary {
                 if let Outline::Rod { diameter, immersed } = b.outline {
                     let k = -(F::splat(self.lam) * m.rho_g);
@@ -755,7 +753,7 @@ impl RftInertial {
     /// the same order: the same bits), as [`Rft`]'s (docs/laws.md, "Cost").
     ///
     /// # Safety
-    /// The CPU must have AVX2 ([`crate::simd::avx2`]).
+    /// The CPU must have AVX2 ([`crate::num::avx2`]).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
@@ -998,7 +996,7 @@ mod tests {
             ];
             // The fast paths are what ran (where this CPU has them).
             #[cfg(target_arch = "x86_64")]
-            if crate::simd::avx2() && held == [0.0; 2] && n <= 8 {
+            if crate::num::avx2() && held == [0.0; 2] && n <= 8 {
                 // SAFETY: this CPU has AVX2 (checked).
                 let (f, m) = unsafe { t.rod_avx2(&t.coefficients_in(), (0.0127, immersed), &b) };
                 prop_assert_eq!(

@@ -4,8 +4,8 @@
 //! The grid is computed by multiplication, so that round-off never adds a step past `t_end`;
 //! after an event the step to the next grid point is shortened.
 
+use super::options::SolveOptions;
 use super::outcome::Stats;
-use super::solve::SolveOptions;
 use super::stepper::Method;
 use crate::error::{GranrsError, Result};
 

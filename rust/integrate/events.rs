@@ -5,8 +5,8 @@
 //! and the mode changes an event makes (`choose_slip`, `enter_contact`).
 
 use super::observe::Observer;
+use super::options::EndCondition;
 use super::outcome::Stats;
-use super::solve::EndCondition;
 use super::stepper::{deriv_of, step, Deriv, Hermite, State};
 use crate::body::{SoleContact, SoleModel};
 use crate::dynamics::{

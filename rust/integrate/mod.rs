@@ -9,17 +9,20 @@ pub mod cancel;
 pub mod control;
 pub mod drives;
 pub mod events;
+pub mod lane_step;
 pub mod lanes;
 pub mod observe;
+pub mod options;
 pub mod outcome;
 pub mod solve;
 pub mod stepper;
 
 pub use drives::Drives;
-pub use observe::{Record, DIVERGENCE_FACTOR, RK4_STABILITY_LIMIT};
+pub use observe::{DIVERGENCE_FACTOR, RK4_STABILITY_LIMIT};
+pub use options::{EndCondition, Record, SolveOptions};
 pub use outcome::{
     ContactSummary, Field, FieldValue, Impulse, JointSummary, Outcome, OutcomeFields, Series,
     Stats, Status, OUTCOME_FIELDS,
 };
-pub use solve::{solve, solve_driven, EndCondition, Run, SolveOptions};
+pub use solve::{solve, solve_driven, Run};
 pub use stepper::{Method, RTOL_MIN};

@@ -7,34 +7,14 @@
 
 use nalgebra::{SVector, Vector2};
 
+use super::options::{Record, SolveOptions};
 use super::outcome::{
     ContactSummary, Impulse, JointSummary, Outcome, Series, Stats, Status, OUTCOME_FIELDS,
 };
-use super::solve::SolveOptions;
 use super::stepper::{Method, State};
 use crate::dynamics::{ContactEval, DragStiffness, Eval, Model, Modes, Shape, SignModel, Slip};
 use crate::error::{GranrsError, Result};
 use crate::forces::{ForceSet, Switch};
-
-/// What to record as time series. Nothing is stored for a field that is off.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Record {
-    /// Generalized coordinates and rates, and the work of the sand.
-    pub state: bool,
-    /// Per contact: tip position and velocity, depth, and the four force components.
-    pub forces: bool,
-    /// Kinetic and potential energy.
-    pub energy: bool,
-    /// Record every `stride`-th grid step (events are always recorded). 0 means 1.
-    pub stride: usize,
-}
-
-impl Record {
-    /// Whether anything is recorded.
-    pub fn any(&self) -> bool {
-        self.state || self.forces || self.energy
-    }
-}
 
 /// `h lambda` beyond which the classical RK4 is unstable for a real, negative rate.
 pub const RK4_STABILITY_LIMIT: f64 = 2.785;

@@ -14,51 +14,14 @@ use super::cancel;
 use super::control::Control;
 use super::drives::Drives;
 use super::events::{self, Events, Landing, Span};
-use super::lanes::{LaneContact, LaneEnd, LaneIsa, LaneStart};
-use super::observe::{Observer, Record};
+use super::lane_step::{LaneContact, LaneEnd, LaneIsa, LaneStart};
+use super::observe::Observer;
+use super::options::{EndCondition, SolveOptions};
 use super::outcome::{Outcome, Stats, Status};
 use super::stepper::{deriv_of, full_step, partial_step, Deriv, Method, State};
 use crate::dynamics::rod_lanes::{pivot_ok, RodEval, RodLayout, RodModes, RodParams};
 use crate::dynamics::{Eval, Model, Modes};
 use crate::error::{GranrsError, Result};
-
-/// When a run ends.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EndCondition {
-    /// At the first stop of any contact (the thesis's end of the penetration phase).
-    FirstStop,
-    /// When every contact has stopped.
-    AllStops,
-    /// At `t_end`, whatever happens before.
-    Time,
-}
-
-/// Options of one run.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolveOptions {
-    /// Step size of the fixed grid [s] (thesis: 10 kHz, 1e-4 s); the first step of Dopri5.
-    pub dt: f64,
-    /// The time stepper.
-    pub method: Method,
-    /// Latest end time [s].
-    pub t_end: f64,
-    /// When to end.
-    pub end: EndCondition,
-    /// What to record.
-    pub record: Record,
-}
-
-impl Default for SolveOptions {
-    fn default() -> Self {
-        SolveOptions {
-            dt: 1e-4,
-            method: Method::Rk4,
-            t_end: 1.0,
-            end: EndCondition::FirstStop,
-            record: Record::default(),
-        }
-    }
-}
 
 /// The evaluations at a step's start (`evals[cur]`) and the slot for its end.
 #[inline]
@@ -545,11 +508,11 @@ impl<const N: usize> Run<N> {
     pub fn accept_plain(
         &mut self,
         model: &Model<N>,
-        end: &LaneEnd<crate::simd::F64x4>,
+        end: &LaneEnd<crate::num::F64x4>,
         i: usize,
     ) -> bool {
         debug_assert!(self.may_stay_in_lanes(model) && !self.clamped);
-        let lane = |x: crate::simd::F64x4| x.0[i];
+        let lane = |x: crate::num::F64x4| x.0[i];
         if !(end.stages.iter().all(|st| pivot_ok(lane(st.pivot))) && pivot_ok(lane(end.eval.pivot)))
         {
             return false;

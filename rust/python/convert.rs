@@ -66,7 +66,7 @@ pub(super) fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         }
         return names_from_py(l.iter());
     }
-    if is_numpy_bool(v) {
+    if terms::is_numpy_bool(v) {
         return Value::Bool(v.is_truthy().unwrap_or(false));
     }
     let type_name = v
@@ -82,15 +82,6 @@ pub(super) fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
         Ok(x) => Value::Num(x),
         Err(_) => Value::Other(type_name),
     }
-}
-
-/// Whether `v` is numpy's boolean scalar (`np.True_`: `numpy.bool`, `numpy.bool_` before
-/// numpy 2), which converts to a float as 1.0 but is refused wherever a bool is: a truth
-/// value is never a number here.
-pub(super) fn is_numpy_bool(v: &Bound<'_, PyAny>) -> bool {
-    let ty = v.get_type();
-    matches!(ty.name(), Ok(n) if n == "bool_" || n == "bool")
-        && matches!(ty.module(), Ok(m) if m == "numpy")
 }
 
 /// A list or tuple of names (`effects`, `record`) as a spec value.

@@ -99,7 +99,7 @@ fn params_from_py<'py>(
     params: impl Iterator<Item = (Bound<'py, PyAny>, Bound<'py, PyAny>)>,
 ) -> Vec<(String, Vec<f64>)> {
     let one = |v: &Bound<'_, PyAny>| -> f64 {
-        if v.is_instance_of::<pyo3::types::PyBool>() || super::convert::is_numpy_bool(v) {
+        if v.is_instance_of::<pyo3::types::PyBool>() || is_numpy_bool(v) {
             return f64::NAN;
         }
         v.extract::<f64>().unwrap_or(f64::NAN)
@@ -165,6 +165,15 @@ pub fn check_term<'py>(
         }
     }
     Ok(out)
+}
+
+/// Whether `v` is numpy's boolean scalar (`np.True_`: `numpy.bool`, `numpy.bool_` before
+/// numpy 2), which converts to a float as 1.0 but is refused wherever a bool is: a truth
+/// value is never a number here.
+pub(super) fn is_numpy_bool(v: &Bound<'_, PyAny>) -> bool {
+    let ty = v.get_type();
+    matches!(ty.name(), Ok(n) if n == "bool_" || n == "bool")
+        && matches!(ty.module(), Ok(m) if m == "numpy")
 }
 
 /// `Scene.forces` (a sequence of `granrs.forces.Term`, each with `name` and `params`) as a

@@ -21,13 +21,12 @@ use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
 use crate::integrate::{EndCondition, Method, Record, SolveOptions};
 use crate::presets::{self, Fields, Setting};
 
-pub mod fields;
 #[cfg(test)]
 mod tests;
 mod value;
 
-use fields::field_slot;
-pub use fields::{ElementField, FieldInfo, ELEMENT_FIELDS, FIELDS, SCENE_FIELDS};
+use crate::fields::field_slot;
+pub use crate::fields::{ElementField, FieldInfo, ELEMENT_FIELDS, FIELDS, SCENE_FIELDS};
 
 #[cfg(test)]
 pub(crate) use tests::free_link_spec;

@@ -202,7 +202,7 @@ fn a_series_listed_twice_is_refused() {
 
 #[test]
 fn the_work_of_a_run_is_bounded_naming_the_field() {
-    use crate::spec::fields::{MAX_SAMPLES, MAX_STEPS};
+    use crate::fields::{MAX_SAMPLES, MAX_STEPS};
     // Too many steps: t_end is blamed (it was dt), with the limit in short numbers.
     let mut s = free_link_spec();
     s.set("t_end", Value::Num(1e300));
@@ -275,7 +275,7 @@ fn numbers_in_messages_are_short() {
 #[test]
 fn the_notes_state_the_work_bounds() {
     // The field table's notes (TOML comments, docs, errors) say the bounds the checks use.
-    use crate::spec::fields::{info, MAX_SAMPLES, MAX_STEPS};
+    use crate::fields::{info, MAX_SAMPLES, MAX_STEPS};
     let steps = format!("t_end / dt <= {MAX_STEPS:e} steps");
     assert!(info("t_end").unwrap().note.contains(&steps));
     let samples = format!("t_end / dt / record_stride <= {MAX_SAMPLES:e} samples");
