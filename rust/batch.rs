@@ -559,7 +559,6 @@ mod tests {
             run(
                 &src,
                 0..src.len(),
-                "free_link",
                 2,
                 &done,
                 &cancel,
@@ -746,7 +745,6 @@ mod tests {
         let out = run(
             &src,
             0..src.len(),
-            "free_link",
             2,
             &done,
             &cancel,

@@ -22,7 +22,7 @@ use crate::body::{
 };
 use crate::dynamics::{Contact, Model, Shape, SignModel, MAX_CONTACTS, MAX_LOCKED};
 use crate::error::{check_finite, check_range, GranrsError, Result};
-use crate::forces::{ForceSet, Medium};
+use crate::forces::{ContactKind, ForceSet, Medium};
 use crate::integrate::{solve_driven, Drives, Outcome, SolveOptions};
 
 /// How far [rad] a table's angle at t = 0 may be from its joint's initial relative angle
@@ -115,6 +115,17 @@ pub enum ContactShape {
         /// The chords (1..=MAX_CHORDS; a non-integer is refused).
         chords: f64,
     },
+}
+
+impl ContactShape {
+    /// Its kind, as a term's list of shapes names it.
+    pub fn kind(&self) -> ContactKind {
+        match self {
+            ContactShape::Rod { .. } => ContactKind::Rod,
+            ContactShape::Box { .. } => ContactKind::Box,
+            ContactShape::Arc { .. } => ContactKind::Arc,
+        }
+    }
 }
 
 /// A contact of a linkage.
@@ -579,34 +590,41 @@ impl LinkageScene {
         })
     }
 
-    /// Refuse a contact term that is not defined on a contact's shape (an arc: only the
-    /// terms of [`TermInfo::on_arc`](crate::forces::TermInfo::on_arc) act on it), naming the term and
-    /// the contact.
+    /// Refuse a contact term that is not defined on a contact's shape (the term's
+    /// [`TermInfo::shapes`](crate::forces::TermInfo::shapes)), naming the term and the
+    /// contact, with the terms that act on that shape.
     pub fn validate_terms_on_shapes(&self) -> Result<()> {
         for (i, c) in self.contacts.iter().enumerate() {
-            if !matches!(c.shape, ContactShape::Arc { .. }) {
+            let kind = c.shape.kind();
+            let Some(info) = self
+                .forces
+                .contact_info
+                .iter()
+                .find(|t| !t.shapes.contains(&kind))
+            else {
                 continue;
-            }
+            };
             let name = if c.name.is_empty() {
                 format!("{i}")
             } else {
                 c.name.clone()
             };
-            if let Some(info) = self.forces.contact_info.iter().find(|t| !t.on_arc) {
-                let fine: Vec<&str> = crate::forces::TERMS
-                    .iter()
-                    .filter(|t| t.on_arc)
-                    .map(|t| t.name)
-                    .collect();
-                return Err(bad(
-                    format!("forces.{}", info.name),
-                    format!(
-                        "the term {:?} is not defined on an arc, and contacts.{name} is one;                          the terms that act on an arc: {}",
-                        info.name,
-                        fine.join(", ")
-                    ),
-                ));
-            }
+            let fine: Vec<&str> = crate::forces::TERMS
+                .iter()
+                .filter(|t| t.acts == crate::forces::Acts::Contact && t.shapes.contains(&kind))
+                .map(|t| t.name)
+                .collect();
+            let shape = kind.name();
+            let a = if shape.starts_with('a') { "an" } else { "a" };
+            return Err(bad(
+                format!("forces.{}", info.name),
+                format!(
+                    "the term {:?} is not defined on {a} {shape} contact, and contacts.{name} \
+                     is one; the terms that act on {a} {shape}: {}",
+                    info.name,
+                    fine.join(", ")
+                ),
+            ));
         }
         Ok(())
     }

@@ -226,19 +226,18 @@ fn centroid_inverse_mass_of_a_rod_and_of_a_locked_chain() {
         "{w} {expected}"
     );
     // A chain: locking the pin can only make the tip's E heavier.
-    use crate::bodies::ChainScene;
     use crate::body::mechanism::Joint;
+    use crate::presets::chain::Chain;
     let q = SVector::<f64, 4>::new(0.0, 0.0, 0.2, 0.5);
-    let free = ChainScene {
-        joint: Joint::Free,
-        ..ChainScene::default()
-    }
-    .model();
-    let locked = ChainScene {
-        joint: Joint::Locked,
-        ..ChainScene::default()
-    }
-    .model();
+    let chain = |joint| {
+        Chain {
+            joint,
+            ..Chain::default()
+        }
+        .scene(Setting::default())
+        .model::<4>()
+    };
+    let (free, locked) = (chain(Joint::Free), chain(Joint::Locked));
     let last = free.contacts.len() - 1;
     let (wf, wl) = (
         free.centroid_inverse_mass(&q, last),

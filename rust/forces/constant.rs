@@ -55,7 +55,7 @@ impl Term for Constant {
         reads: "nothing",
         reads_area_speed: false,
         reads_frame: false,
-        on_arc: true,
+        shapes: super::EVERY_SHAPE,
         switches: &[],
         columns: &[("F_cx", 0), ("F_cy", 1)],
     };

@@ -52,7 +52,7 @@ impl Term for Drag {
         reads: "rho_g; the contact's A_r |v_E| and v_E",
         reads_area_speed: true,
         reads_frame: false,
-        on_arc: false,
+        shapes: super::SOLID_SHAPES,
         switches: &[Switch::Cross],
         columns: &[("F_dx", 0), ("F_dy", 1)],
     };

@@ -31,7 +31,7 @@ impl Term for Gravity {
         reads: "each link's mass and centre of mass; g of the medium",
         reads_area_speed: false,
         reads_frame: false,
-        on_arc: true,
+        shapes: super::EVERY_SHAPE,
         switches: &[],
         columns: &[],
     };

@@ -34,7 +34,7 @@ impl Term for JointSprings {
         reads: "each spring-damper joint's relative angle and rate",
         reads_area_speed: false,
         reads_frame: false,
-        on_arc: true,
+        shapes: super::EVERY_SHAPE,
         switches: &[],
         columns: &[],
     };

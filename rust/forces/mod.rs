@@ -269,6 +269,34 @@ impl Param {
     }
 }
 
+/// The shape of a contact, as a term's [`TermInfo::shapes`] names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactKind {
+    /// A round rod (`body::rod`).
+    Rod,
+    /// A box: a sole, a plate (`body::sole`).
+    Box,
+    /// A thin circular arc (`body::arc`).
+    Arc,
+}
+
+impl ContactKind {
+    /// Its name (`granrs.bodies.Contact.shape`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            ContactKind::Rod => "rod",
+            ContactKind::Box => "box",
+            ContactKind::Arc => "arc",
+        }
+    }
+}
+
+/// Every contact shape (a term that reads nothing of the shape, or its boundary's elements).
+pub const EVERY_SHAPE: &[ContactKind] = &[ContactKind::Rod, ContactKind::Box, ContactKind::Arc];
+
+/// The shapes with an immersed volume and area of their own (the thesis's law, Poncelet's).
+pub const SOLID_SHAPES: &[ContactKind] = &[ContactKind::Rod, ContactKind::Box];
+
 /// Everything known about a term, for validation, docs, TOML and errors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TermInfo {
@@ -296,10 +324,11 @@ pub struct TermInfo {
     /// Whether it reads [`ContactState::boundary`] (filled only
     /// when a listed term does).
     pub reads_frame: bool,
-    /// Whether it is defined on an arc contact (`body::arc`): a term that reads the
-    /// boundary's chords, or none of the contact's shape. A contact term that is not is
-    /// refused on an arc before any work, naming the term and the contact.
-    pub on_arc: bool,
+    /// The contact shapes it is defined on. A contact term listed in a scene with a contact
+    /// of another shape is refused before any work, naming the term and the contact (an arc,
+    /// `body::arc`, takes the terms that read the boundary's chords, or none of the
+    /// contact's shape).
+    pub shapes: &'static [ContactKind],
     /// The switches it owns.
     pub switches: &'static [Switch],
     /// Its per-contact series columns (`c{i}.{column}` with `record=("forces",)`) and the

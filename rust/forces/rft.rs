@@ -399,7 +399,7 @@ impl Term for Rft {
                 velocity; the held signs of v_E (sticking)",
         reads_area_speed: false,
         reads_frame: true,
-        on_arc: true,
+        shapes: super::EVERY_SHAPE,
         switches: &[Switch::SlipY],
         columns: &[("F_rft_x", 0), ("F_rft_y", 1)],
     };
@@ -628,7 +628,7 @@ impl Term for RftInertial {
                 velocity normal to it",
         reads_area_speed: false,
         reads_frame: true,
-        on_arc: true,
+        shapes: super::EVERY_SHAPE,
         switches: &[],
         columns: &[("F_ri_x", 0), ("F_ri_y", 1)],
     };

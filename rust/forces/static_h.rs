@@ -50,7 +50,7 @@ impl Term for StaticH {
         reads: "g, rho_g; the contact's width w, depth d and the sign of v_Ex",
         reads_area_speed: false,
         reads_frame: false,
-        on_arc: false,
+        shapes: super::SOLID_SHAPES,
         switches: &[Switch::SlipX],
         columns: &[("F_sh", 0)],
     };

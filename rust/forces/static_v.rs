@@ -64,7 +64,7 @@ impl Term for StaticV {
         reads: "g, rho_g; the contact's depth d, L_ref, immersed volume V and the sign of v_Ey",
         reads_area_speed: false,
         reads_frame: false,
-        on_arc: false,
+        shapes: super::SOLID_SHAPES,
         switches: &[Switch::SlipY],
         columns: &[("F_sv", 1)],
     };

@@ -20,7 +20,7 @@ mod terms;
 
 use pyo3::prelude::*;
 
-use crate::spec::{EFFECTS, RECORDS, SCENE_FIELDS};
+use crate::spec::{effects, RECORDS, SCENE_FIELDS};
 
 #[pymodule]
 fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -42,7 +42,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<mujoco::GeomCoupling>()?;
     m.add("GEOM_STATE", crate::evaluate::geoms::STATE.to_vec())?;
     m.add("GEOM_OUTPUTS", crate::evaluate::geoms::OUTPUTS.to_vec())?;
-    m.add("EFFECTS", EFFECTS.to_vec())?;
+    m.add("EFFECTS", effects())?;
     m.add("RECORDS", RECORDS.to_vec())?;
     m.add("SCENE_FIELDS", SCENE_FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(run::leg_segments, m)?)?;

@@ -10,7 +10,8 @@ use crate::spec::Value;
 use super::errors::to_pyerr;
 
 /// Every registered term's description, in the registry's order: name, summary, equation,
-/// source, acts (`"contact"` or `"body"`), class, velocity_dependent, reads, switches,
+/// source, acts (`"contact"` or `"body"`), class, velocity_dependent, reads, shapes (the
+/// contact shapes it is defined on: `"rod"`, `"box"`, `"arc"`), switches,
 /// columns and params (each: name, unit, default, source, min, max, description, integer,
 /// required).
 #[pyfunction]
@@ -38,6 +39,8 @@ pub fn term_infos(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
         )?;
         d.set_item("velocity_dependent", t.velocity_dependent)?;
         d.set_item("reads", t.reads)?;
+        let shapes: Vec<&str> = t.shapes.iter().map(|s| s.name()).collect();
+        d.set_item("shapes", shapes)?;
         let switches: Vec<&str> = t.switches.iter().map(|s| s.name()).collect();
         d.set_item("switches", switches)?;
         let columns: Vec<&str> = t.columns.iter().map(|(c, _)| *c).collect();

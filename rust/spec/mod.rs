@@ -32,8 +32,6 @@ pub use crate::fields::{ElementField, FieldInfo, ELEMENT_FIELDS, FIELDS, SCENE_F
 pub(crate) use tests::free_link_spec;
 pub use value::{word, Value};
 
-/// Names of the effects (force terms) a scene may list.
-pub const EFFECTS: [&str; 5] = ["gravity", "drag", "static_h", "static_v", "joint_springs"];
 /// Names of the series a scene may record.
 pub const RECORDS: [&str; 3] = ["state", "forces", "energy"];
 
@@ -843,6 +841,12 @@ impl SceneSpec {
     }
 }
 
+/// The names of the terms of the thesis's law ([`ForceSet::thesis`]), which a law of
+/// `effects` selects from.
+pub fn effects() -> Vec<&'static str> {
+    ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]).names
+}
+
 /// The thesis's law with coefficients (eta_h, eta_d, eta_v, lambda) per contact, its terms
 /// limited to `names` (every term when `None`).
 pub fn thesis_law(
@@ -853,9 +857,10 @@ pub fn thesis_law(
     let Some(names) = names else {
         return ForceSet::build(&all, per_contact.len());
     };
+    let effects = effects();
     for n in names {
-        if !EFFECTS.contains(&n.as_ref()) {
-            return Err(unknown("effects", n, &EFFECTS));
+        if !effects.contains(&n.as_ref()) {
+            return Err(unknown("effects", n, &effects));
         }
     }
     let listed: Vec<TermSpec> = all
