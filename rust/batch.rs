@@ -555,16 +555,9 @@ mod tests {
         let src = product();
         let done = AtomicUsize::new(0);
         let cancel = AtomicBool::new(false);
-        let out = pool().unwrap().install(|| {
-            run(
-                &src,
-                0..src.len(),
-                2,
-                &done,
-                &cancel,
-                Path::Lanes,
-            )
-        });
+        let out = pool()
+            .unwrap()
+            .install(|| run(&src, 0..src.len(), 2, &done, &cancel, Path::Lanes));
         assert_eq!(done.load(Ordering::Relaxed), 6);
         let width = out.columns.len();
         let depth = out.columns.iter().position(|c| c == "c0.depth").unwrap();
@@ -742,14 +735,7 @@ mod tests {
         let src = product();
         let done = AtomicUsize::new(0);
         let cancel = AtomicBool::new(true);
-        let out = run(
-            &src,
-            0..src.len(),
-            2,
-            &done,
-            &cancel,
-            Path::Lanes,
-        );
+        let out = run(&src, 0..src.len(), 2, &done, &cancel, Path::Lanes);
         assert!(out.cancelled);
         assert_eq!(done.load(Ordering::Relaxed), 0);
         assert!(out

@@ -52,6 +52,40 @@ pub enum GranrsError {
 
 pub type Result<T> = std::result::Result<T, GranrsError>;
 
+impl GranrsError {
+    /// The same error about another field, `rename(field)` (an element's key named within
+    /// its element, a linkage's joint named as the preset's field); an error without a
+    /// field is returned as it is.
+    pub fn map_field(self, rename: impl FnOnce(String) -> String) -> GranrsError {
+        use GranrsError::*;
+        match self {
+            InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => InvalidParameter {
+                field: rename(field),
+                value,
+                allowed,
+            },
+            WrongType {
+                field,
+                expected,
+                got,
+            } => WrongType {
+                field: rename(field),
+                expected,
+                got,
+            },
+            InvalidScene { field, message } => InvalidScene {
+                field: rename(field),
+                message,
+            },
+            other => other,
+        }
+    }
+}
+
 /// A number for a message: as written when that is short (`0.184`, `1e-5`, `250`), else
 /// in `%.3g`'s spirit (`1e300`, `1.23e-300`), never a line of digits.
 pub fn fmt_num(x: f64) -> String {

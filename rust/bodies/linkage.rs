@@ -204,31 +204,14 @@ fn check_point(field: &str, p: Vector2<f64>) -> Result<()> {
 /// Run `$body` with `const $n: usize` set to `2 + $links` (1 to [`MAX_LINKS`] links).
 macro_rules! with_size {
     ($links:expr, $n:ident => $body:expr) => {
+        with_size!(@sizes $links, $n, $body, 1 3, 2 4, 3 5, 4 6, 5 7, 6 8)
+    };
+    (@sizes $links:expr, $n:ident, $body:expr, $($l:literal $size:literal),*) => {
         match $links {
-            1 => {
-                const $n: usize = 3;
+            $($l => {
+                const $n: usize = $size;
                 $body
-            }
-            2 => {
-                const $n: usize = 4;
-                $body
-            }
-            3 => {
-                const $n: usize = 5;
-                $body
-            }
-            4 => {
-                const $n: usize = 6;
-                $body
-            }
-            5 => {
-                const $n: usize = 7;
-                $body
-            }
-            6 => {
-                const $n: usize = 8;
-                $body
-            }
+            })*
             n => unreachable!("{n} links passed validation"),
         }
     };

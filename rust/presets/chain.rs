@@ -22,17 +22,6 @@ pub const PRESET: Preset = Preset {
     renames: &[("joints.pin", "pin_joint")],
 };
 
-/// The thesis's two-link chain (sec. 4.1) and the mass the thesis does not give.
-pub mod defaults {
-    /// Link length L1 = L2 [m] (thesis sec. 4.1).
-    pub const LENGTH: f64 = 0.135;
-    /// Link diameter d1 = d2 [m] (thesis sec. 4.1).
-    pub const DIAMETER: f64 = 0.0064;
-    /// Link mass [kg]: not in the thesis; a solid steel cylinder (7850 kg/m^3) of the
-    /// stated size, pi/4 d^2 L rho = 0.0341 kg (`shared/thesis/bodies.csv`).
-    pub const MASS: f64 = 0.0341;
-}
-
 /// Two rods pinned at their top ends (MODEL.md, "Bodies").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Chain {
@@ -60,9 +49,11 @@ pub struct Chain {
 impl Default for Chain {
     fn default() -> Self {
         Chain {
-            length: defaults::LENGTH,
-            diameter: defaults::DIAMETER,
-            mass: defaults::MASS,
+            // L1 = L2 and d1 = d2 (thesis sec. 4.1); the mass is not in the thesis: a solid
+            // steel cylinder (7850 kg/m^3) of the stated size, pi/4 d^2 L rho = 0.0341 kg.
+            length: 0.135,
+            diameter: 0.0064,
+            mass: 0.0341,
             inertia: None,
             pin_mass: 0.0,
             joint: Joint::Free,

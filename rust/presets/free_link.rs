@@ -14,16 +14,6 @@ pub const PRESET: Preset = Preset {
     renames: &[],
 };
 
-/// The thesis's free link (sec. 3.2.1): a steel rod with round ends.
-pub mod defaults {
-    /// Length L [m] (thesis sec. 3.2.1).
-    pub const LENGTH: f64 = 0.190;
-    /// Diameter d_c [m] (thesis sec. 3.2.1).
-    pub const DIAMETER: f64 = 0.0127;
-    /// Mass m [kg] (thesis sec. 3.2.1).
-    pub const MASS: f64 = 0.184;
-}
-
 /// A free round-ended link dropped onto sand, tip first (MODEL.md, "Bodies").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FreeLink {
@@ -44,12 +34,14 @@ pub struct FreeLink {
     pub omega0: f64,
 }
 
+/// The thesis's free link at q = 0 and the Table 3.5 mean speed.
 impl Default for FreeLink {
     fn default() -> Self {
         FreeLink {
-            length: defaults::LENGTH,
-            diameter: defaults::DIAMETER,
-            mass: defaults::MASS,
+            // The thesis's steel rod with round ends (sec. 3.2.1): L, d_c, m.
+            length: 0.190,
+            diameter: 0.0127,
+            mass: 0.184,
             inertia: None,
             q_deg: 0.0,
             start: Start {

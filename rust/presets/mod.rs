@@ -95,7 +95,7 @@ impl Preset {
     /// `e` with a field of the linkage's (`joints.pin.k`) renamed to the preset's
     /// (`pin_joint.k`).
     pub fn rename(&self, e: GranrsError) -> GranrsError {
-        let swap = |field: String| -> String {
+        e.map_field(|field| {
             for (from, to) in self.renames {
                 if let Some(rest) = field.strip_prefix(from) {
                     if rest.is_empty() || rest.starts_with('.') {
@@ -104,23 +104,7 @@ impl Preset {
                 }
             }
             field
-        };
-        match e {
-            GranrsError::InvalidParameter {
-                field,
-                value,
-                allowed,
-            } => GranrsError::InvalidParameter {
-                field: swap(field),
-                value,
-                allowed,
-            },
-            GranrsError::InvalidScene { field, message } => GranrsError::InvalidScene {
-                field: swap(field),
-                message,
-            },
-            other => other,
-        }
+        })
     }
 }
 

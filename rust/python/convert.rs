@@ -44,27 +44,20 @@ pub(super) fn value_from_py(v: &Bound<'_, PyAny>) -> Value {
                 .collect(),
         );
     }
-    if let Ok(t) = v.cast::<PyTuple>() {
-        if let Some(first) = t.iter().next() {
-            if first.cast::<PyString>().is_err() {
-                if let Some(terms) = terms::terms_from_py(t.iter()) {
-                    return terms;
-                }
-                return Value::List(t.iter().map(|x| value_from_py(&x)).collect());
+    let items: Option<Vec<Bound<'_, PyAny>>> = match (v.cast::<PyTuple>(), v.cast::<PyList>()) {
+        (Ok(t), _) => Some(t.iter().collect()),
+        (_, Ok(l)) => Some(l.iter().collect()),
+        _ => None,
+    };
+    if let Some(items) = items {
+        // Names (`record`), force terms, or a list of values (a drive's table).
+        if items.first().is_some_and(|x| x.cast::<PyString>().is_err()) {
+            if let Some(terms) = terms::terms_from_py(items.iter().cloned()) {
+                return terms;
             }
+            return Value::List(items.iter().map(value_from_py).collect());
         }
-        return names_from_py(t.iter());
-    }
-    if let Ok(l) = v.cast::<PyList>() {
-        if let Some(first) = l.iter().next() {
-            if first.cast::<PyString>().is_err() {
-                if let Some(terms) = terms::terms_from_py(l.iter()) {
-                    return terms;
-                }
-                return Value::List(l.iter().map(|x| value_from_py(&x)).collect());
-            }
-        }
-        return names_from_py(l.iter());
+        return names_from_py(items.into_iter());
     }
     if terms::is_numpy_bool(v) {
         return Value::Bool(v.is_truthy().unwrap_or(false));
@@ -180,14 +173,10 @@ thread_local! {
 pub fn scene_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     let out = PyList::empty(py);
     for f in crate::spec::FIELDS.iter() {
-        let d = PyDict::new(py);
-        d.set_item("name", f.name)?;
-        d.set_item("part", f.part)?;
-        d.set_item("bodies", f.bodies.to_vec())?;
-        d.set_item("unit", f.unit)?;
-        d.set_item("note", f.note)?;
-        d.set_item("doc", f.doc)?;
-        out.append(d)?;
+        out.append(py_dict!(py, {
+            "name": f.name, "part": f.part, "bodies": f.bodies.to_vec(), "unit": f.unit,
+            "note": f.note, "doc": f.doc,
+        }))?;
     }
     Ok(out)
 }
@@ -198,13 +187,9 @@ pub fn scene_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
 pub fn element_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     let out = PyList::empty(py);
     for f in crate::spec::ELEMENT_FIELDS.iter() {
-        let d = PyDict::new(py);
-        d.set_item("element", f.element)?;
-        d.set_item("name", f.name)?;
-        d.set_item("unit", f.unit)?;
-        d.set_item("note", f.note)?;
-        d.set_item("doc", f.doc)?;
-        out.append(d)?;
+        out.append(py_dict!(py, {
+            "element": f.element, "name": f.name, "unit": f.unit, "note": f.note, "doc": f.doc,
+        }))?;
     }
     Ok(out)
 }
@@ -232,23 +217,16 @@ pub fn body_linkage<'py>(
     let pair = |v: nalgebra::Vector2<f64>| (v.x, v.y);
     let links = PyList::empty(py);
     for k in &l.links {
-        let d = PyDict::new(py);
-        d.set_item("name", &k.name)?;
-        d.set_item("mass", k.mass)?;
-        d.set_item("inertia", k.inertia)?;
-        d.set_item("length", k.length)?;
-        d.set_item("com", pair(k.com))?;
-        d.set_item("q_deg", k.q.to_degrees())?;
-        d.set_item("omega0", k.omega)?;
-        links.append(d)?;
+        links.append(py_dict!(py, {
+            "name": &k.name, "mass": k.mass, "inertia": k.inertia, "length": k.length,
+            "com": pair(k.com), "q_deg": k.q.to_degrees(), "omega0": k.omega,
+        }))?;
     }
     let joints = PyList::empty(py);
     for j in &l.joints {
-        let d = PyDict::new(py);
-        d.set_item("name", &j.name)?;
-        d.set_item("parent", &j.parent)?;
-        d.set_item("child", &j.child)?;
-        d.set_item("at", pair(j.at))?;
+        let d = py_dict!(py, {
+            "name": &j.name, "parent": &j.parent, "child": &j.child, "at": pair(j.at),
+        });
         match j.joint {
             Joint::Free => d.set_item("kind", "free")?,
             Joint::Locked => d.set_item("kind", "locked")?,
@@ -289,20 +267,14 @@ pub fn body_linkage<'py>(
     }
     let contacts = PyList::empty(py);
     for c in &l.contacts {
-        let d = PyDict::new(py);
-        d.set_item("name", &c.name)?;
-        d.set_item("link", &c.link)?;
-        match c.shape {
+        let d = match c.shape {
             ContactShape::Rod {
                 tip,
                 length,
                 diameter,
-            } => {
-                d.set_item("shape", "rod")?;
-                d.set_item("at", pair(tip))?;
-                d.set_item("length", length)?;
-                d.set_item("diameter", diameter)?;
-            }
+            } => py_dict!(py, {
+                "shape": "rod", "at": pair(tip), "length": length, "diameter": diameter,
+            }),
             ContactShape::Box {
                 thesis_angle_of: Some(_),
                 ..
@@ -322,14 +294,10 @@ pub fn body_linkage<'py>(
                 width,
                 l_ref,
                 thesis_angle_of: None,
-            } => {
-                d.set_item("shape", "box")?;
-                d.set_item("at", pair(corner))?;
-                d.set_item("length", length)?;
-                d.set_item("height", height)?;
-                d.set_item("width", width)?;
-                d.set_item("l_ref", l_ref)?;
-            }
+            } => py_dict!(py, {
+                "shape": "box", "at": pair(corner), "length": length, "height": height,
+                "width": width, "l_ref": l_ref,
+            }),
             ContactShape::Arc {
                 centre,
                 radius,
@@ -337,29 +305,24 @@ pub fn body_linkage<'py>(
                 end,
                 width,
                 chords,
-            } => {
-                d.set_item("shape", "arc")?;
-                d.set_item("at", pair(centre))?;
-                d.set_item("radius", radius)?;
-                d.set_item("start_deg", start.to_degrees())?;
-                d.set_item("end_deg", end.to_degrees())?;
-                d.set_item("width", width)?;
-                d.set_item("chords", chords as usize)?;
-            }
-        }
+            } => py_dict!(py, {
+                "shape": "arc", "at": pair(centre), "radius": radius,
+                "start_deg": start.to_degrees(), "end_deg": end.to_degrees(), "width": width,
+                "chords": chords as usize,
+            }),
+        };
+        d.set_item("name", &c.name)?;
+        d.set_item("link", &c.link)?;
         contacts.append(d)?;
     }
-    let root = PyDict::new(py);
-    root.set_item(
-        "kind",
-        match l.root.kind {
-            RootKind::Free => "free",
-            RootKind::Pinned => "pinned",
-            RootKind::Moving => "moving",
-        },
-    )?;
-    root.set_item("link", &l.root.link)?;
-    root.set_item("position", pair(l.root.position))?;
+    let kind = match l.root.kind {
+        RootKind::Free => "free",
+        RootKind::Pinned => "pinned",
+        RootKind::Moving => "moving",
+    };
+    let root = py_dict!(py, {
+        "kind": kind, "link": &l.root.link, "position": pair(l.root.position),
+    });
     root.set_item("velocity", pair(l.root.velocity))?;
     root.set_item("mass", l.root.mass)?;
     if let Some(rate) = l.root.rate {

@@ -10,6 +10,16 @@
 //! `force.rs` (`resistance_force`), `mujoco.rs` (`SandGeoms`, for `granrs.mujoco`) and
 //! `terms.rs` (the force terms' registry). This file only registers them.
 
+/// A dict of `key: value` pairs (each value converted with `IntoPyObject`), or the error of
+/// the first that does not convert: the one way a core value becomes a Python dict here.
+macro_rules! py_dict {
+    ($py:expr, { $($k:literal: $v:expr),* $(,)? }) => {{
+        let d = pyo3::types::PyDict::new($py);
+        $(d.set_item($k, $v)?;)*
+        d
+    }};
+}
+
 mod convert;
 mod errors;
 mod force;

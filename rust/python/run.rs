@@ -328,13 +328,10 @@ pub(super) fn leg_segments<'py>(
         .iter()
         .zip(leg.segments())
     {
-        let d = PyDict::new(py);
-        d.set_item("name", name)?;
-        d.set_item("mass", s.mass)?;
-        d.set_item("length", s.length)?;
-        d.set_item("com", s.com)?;
-        d.set_item("inertia", s.inertia)?;
-        out.append(d)?;
+        out.append(py_dict!(py, {
+            "name": name, "mass": s.mass, "length": s.length, "com": s.com,
+            "inertia": s.inertia,
+        }))?;
     }
     Ok(out)
 }

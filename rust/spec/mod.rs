@@ -87,15 +87,9 @@ fn unknown(field: &str, value: &str, allowed: &[&str]) -> GranrsError {
 #[inline(never)]
 fn within(e: GranrsError, field: &str, k: &str) -> GranrsError {
     match e {
-        GranrsError::InvalidScene { message, .. } => GranrsError::InvalidScene {
-            field: format!("{field}.{k}"),
-            message,
-        },
-        GranrsError::WrongType { expected, got, .. } => GranrsError::WrongType {
-            field: format!("{field}.{k}"),
-            expected,
-            got,
-        },
+        GranrsError::InvalidScene { .. } | GranrsError::WrongType { .. } => {
+            e.map_field(|_| format!("{field}.{k}"))
+        }
         other => other,
     }
 }
