@@ -16,14 +16,15 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from . import _granrs, bodies, cases, coefficients, data, forces, scenefile
-from .animate import animate
+from . import _granrs, animation, bodies, cases, coefficients, data, forces, scenefile
+from .animation import animate
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
 from .compare import compare
 from .errors import (
+    AnimationSizeWarning,
     CoefficientsWarning,
     CoefficientTableError,
     GranrsError,
@@ -46,6 +47,7 @@ __version__: str = _granrs.__version__
 __all__ = [
     "RECORDS",
     "RK4_STABILITY_LIMIT",
+    "AnimationSizeWarning",
     "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
@@ -65,6 +67,7 @@ __all__ = [
     "UnknownNameError",
     "__version__",
     "animate",
+    "animation",
     "bodies",
     "calibrate",
     "cases",
@@ -80,7 +83,7 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    # granrs.ImpactAnimation imports matplotlib: loaded on first use (see granrs.animate).
+    # granrs.ImpactAnimation imports matplotlib: loaded on first use (see granrs.animation).
     if name == "ImpactAnimation":
         from ._animation import ImpactAnimation
 
