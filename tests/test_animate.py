@@ -111,9 +111,10 @@ def test_first_and_last_frames_differ(free_link: granrs.Result) -> None:
 
 
 def test_animate_is_the_animation_module_s_function(free_link: granrs.Result) -> None:
-    """granrs.animate is granrs.animation.animate and returns a FuncAnimation; a Result
-    has no animate method (result.py does not import the animation: no import cycle)."""
-    assert granrs.animate is animation.animate
+    """granrs.animate (loaded with matplotlib on first use) returns a FuncAnimation; a
+    Result has no animate method (result.py does not import the animation: no import
+    cycle)."""
+    assert granrs.animate is drawing.animate
     anim = granrs.animate(free_link, frame_dt=0.005)
     assert isinstance(anim, mpl_animation.FuncAnimation)
     assert anim.result is free_link

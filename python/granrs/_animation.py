@@ -1,7 +1,8 @@
 """The drawing behind :func:`granrs.animate` (see :mod:`granrs.animation` for what a frame
-shows): any body placed from its linkage and the recorded coordinates, the immersed parts,
-the force arrows of every recorded term and :class:`ImpactAnimation`. Kept apart because it
-imports matplotlib, which ``import granrs`` should not pay for.
+shows and the settings): :func:`animate`, any body placed from its linkage and the recorded
+coordinates, the immersed parts, the force arrows of every recorded term and
+:class:`ImpactAnimation`. Kept apart because it imports matplotlib, which ``import granrs``
+should not pay for: ``granrs.animate`` loads it on first use.
 """
 
 from __future__ import annotations
@@ -26,19 +27,27 @@ from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 
 from . import forces as _forces
 from ._files import replacing
-from ._playback import BIG_SAVE_BYTES, DEFAULT_FRAMES, check_output, saved_bytes
 from ._progress import progress_bar
+from .animation import (
+    BIG_SAVE_BYTES,
+    DEFAULT_FRAMES,
+    MAX_FRAMES,
+    _positive,
+    check_output,
+    frame_count,
+    playback,
+    saved_bytes,
+)
 from .bodies import DEFAULT_CHORDS
-from .errors import AnimationSizeWarning
-from .result import _names
+from .errors import AnimationSizeWarning, InvalidParameterError
+from .result import Result, _names
 from .scene import BODY_FIELDS, FIELD_INFO
 
 if TYPE_CHECKING:
     from .bodies import Contact, Joint, Link
-    from .result import Result
     from .scene import Scene
 
-__all__ = ["ImpactAnimation", "term_colour"]
+__all__ = ["ImpactAnimation", "animate", "term_colour"]
 
 #: Longest force arrow, as a fraction of the body's longest link.
 _ARROW_FRACTION = 0.6
@@ -821,3 +830,82 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         finally:
             bar.close()
         return out
+
+
+# --- the entry point ------------------------------------------------------------------------
+
+
+def animate(
+    result: Result,
+    frame_dt: float | None = None,
+    speed: float | None = None,
+    fps: float | None = None,
+    *,
+    out: str | os.PathLike[str] | None = None,
+    dpi: float = 100.0,
+    progress: bool | None = None,
+) -> ImpactAnimation:
+    """An animation of a recorded impact, from its series alone (no second simulation).
+
+    Args:
+        result: a :func:`granrs.simulate` result whose scene recorded ``"state"`` (and
+            ``"forces"`` for the force arrows): ``scene.replace(record=("state", "forces"))``.
+        frame_dt: simulated time per frame [s] (default: ``speed / fps``).
+        speed: playback speed, simulated seconds per second of movie [-] (default 0.02:
+            50x slow motion; faster for a run longer than
+            :data:`granrs.animation.DEFAULT_FRAMES` such frames); ``speed = frame_dt * fps``.
+        fps: frames per second of the movie [1/s] (default 25).
+        out: if given, also write the animation there (``.gif``, ``.mp4`` or ``.html``);
+            checked before anything is drawn.
+        dpi: resolution of written frames [dots per inch].
+        progress: while writing ``out``, a tqdm bar of the frames on stderr (None: when
+            stderr is a terminal; True: always; False: never).
+
+    Returns:
+        An :class:`ImpactAnimation` (a ``matplotlib.animation.FuncAnimation``) with
+        ``floor(t_end / frame_dt) + 1`` frames, ``t_end`` the last recorded time [s]; frame
+        ``k`` shows ``t = k * frame_dt``. In Jupyter it shows inline.
+
+    Raises:
+        InvalidParameterError: before any frame is drawn, naming the field: ``result`` not a
+            Result, or one that recorded no state (``field="record"``); ``frame_dt``,
+            ``speed``, ``fps`` or ``dpi`` not positive (or inconsistent); more than
+            :data:`granrs.animation.MAX_FRAMES` frames (``field="frame_dt"``); ``out`` with
+            an unknown suffix or in a missing or unwritable directory.
+
+    Warns:
+        AnimationSizeWarning: writing ``out`` would hold more than
+            :data:`granrs.animation.BIG_SAVE_BYTES` of frames; the message gives the estimate.
+    """
+    if not isinstance(result, Result):
+        raise InvalidParameterError(
+            f"animate() takes a granrs.Result, got {type(result).__name__}", field="result"
+        )
+    playback(frame_dt, speed, fps)  # the values checked before the series are read
+    dpi_value = _positive(dpi, "dpi")
+    assert dpi_value is not None
+    target = check_output(out) if out is not None else None
+    series = result.series
+    needed = ("t", *_names(result.scene)["coords"])
+    if series is None or any(name not in series for name in needed) or len(series["t"]) == 0:
+        raise InvalidParameterError(
+            "the result recorded no state to animate: run the scene with "
+            "record=('state', 'forces'), e.g. granrs.simulate(scene.replace(record=('state', "
+            "'forces')))",
+            field="record",
+        )
+    t = np.asarray(series["t"], dtype=float)
+    span = float(t[-1] - t[0])
+    frame_dt, speed, fps = playback(frame_dt, speed, fps, span=span)
+    n = frame_count(span, frame_dt)
+    if n > MAX_FRAMES:
+        raise InvalidParameterError(
+            f"frame_dt = {frame_dt:g} s gives {n} frames over {span:g} s; at most {MAX_FRAMES} "
+            f"(use frame_dt >= {span / (MAX_FRAMES - 1):.3g} s)",
+            field="frame_dt",
+        )
+    times = np.minimum(t[0] + frame_dt * np.arange(n), t[-1])
+    anim = ImpactAnimation(result, times, frame_dt, speed, fps, dpi=dpi_value)
+    if target is not None:
+        anim.write(target, progress=progress)
+    return anim

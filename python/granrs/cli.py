@@ -835,7 +835,8 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
 def _cmd_animate(args: argparse.Namespace) -> int:
     """Run ``granrs animate``."""
     from . import scenefile
-    from .animation import animate, check_output, playback
+    from ._animation import animate
+    from .animation import check_output, playback
     from .api import simulate
 
     overrides = dict(scenefile.parse_override(item) for item in args.overrides)

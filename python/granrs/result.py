@@ -117,7 +117,8 @@ class ContactResult:
 
 
 class Result:
-    """The outcome of :func:`granrs.simulate`.
+    """The outcome of :func:`granrs.simulate`; :func:`granrs.animate` draws one recorded with
+    ``record=("state", "forces")``.
 
     The run's numbers stay in the Rust core until they are read: ``status``, ``t_s`` and
     ``depth`` come straight from it, and the rest is converted on first access (so a loop
