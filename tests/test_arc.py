@@ -377,10 +377,9 @@ def test_the_c_leg_is_drawn() -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    from granrs.animate import animate
 
     scene = granrs.scenefile.load(C_LEG).replace(record=("state", "forces"), t_end=0.5)
-    anim = animate(granrs.simulate(scene), frame_dt=0.1)
+    anim = granrs.animate(granrs.simulate(scene), frame_dt=0.1)
     band = anim._pose.contacts[0].shape
     # 2 (chords + 1) points a frame, at 0.95 .. 1.05 radii from the centre (3 cm above
     # the axle, at q = 0: the C's centre is (0, 0.03 + 0.035)).

@@ -24,6 +24,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Patch, Polygon
+from matplotlib.transforms import Bbox
 
 from . import forces as _forces
 from ._files import replacing
@@ -57,8 +58,9 @@ _MIN_WIDTH = 7.2
 #: A view of the contacts alone is added when the whole body is this many times larger.
 _ZOOM_RATIO = 3.0
 _MM = 1e3
-#: A title longer than this many characters is wrapped.
-_TITLE_WIDTH = 72
+#: Size of the titles [pt]; a title is wrapped to its axes' width at about 0.55 of this per
+#: character.
+_TITLE_SIZE = 9.0
 
 
 # --- the terms' arrows ---------------------------------------------------------------------
@@ -399,7 +401,7 @@ def _title(scene: Scene) -> str:
                 continue
             unit = {"deg": "°"}.get(f["unit"], f" {f['unit']}")
             parts.append(f"{field.name} = {value:g}{unit}")
-        return textwrap.fill(f"{kind}: " + ", ".join(parts), width=_TITLE_WIDTH)
+        return f"{kind}: " + ", ".join(parts)
     body = scene.body
     root = body.root  # type: ignore[union-attr]
     n_links = len(body.links)  # type: ignore[union-attr]
@@ -412,7 +414,7 @@ def _title(scene: Scene) -> str:
         text += ", its angle held"
     elif root.rate is not None:
         text += f", turning at {root.rate:g} rad/s"
-    return textwrap.fill(text, width=_TITLE_WIDTH)
+    return text
 
 
 # --- drawing --------------------------------------------------------------------------------
@@ -569,6 +571,12 @@ class _ViewArtists:
         return changed
 
 
+def _wrap(text: str, cell: Bbox, fig: Figure) -> str:
+    """``text`` wrapped to the width of ``cell`` (figure coordinates)."""
+    points = cell.width * fig.get_figwidth() * 72.0
+    return textwrap.fill(text, width=max(20, int(points / (0.55 * _TITLE_SIZE))))
+
+
 def _place(arrow: FancyArrowPatch, start: np.ndarray, end: np.ndarray) -> None:
     """Put an arrow from ``start`` to ``end`` [m]; hide it when shorter than 0.05 mm."""
     visible = bool(np.hypot(*(end - start)) * _MM > 0.05)
@@ -592,6 +600,8 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         fps: frames per second of the movie [1/s].
         depths: depth of each contact at each frame, (n_frames, n_contacts) [m] (the
             series' ``depth``).
+        title: the body and its start, from the scene's own fields (the first view's
+            title; over the views when the contacts get a view of their own).
         force_scale: length of a 1 N arrow [m/N].
     """
 
@@ -667,7 +677,14 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             top=0.90,
             wspace=0.25,
         )
-        title = _title(self.result.scene)
+        self.title = title = _title(self.result.scene)
+        if len(views) > 1:
+            # Over both views (the body's is narrow): the views are named instead.
+            left = grid[0, 0].get_position(fig)
+            cells = Bbox.union([left, grid[0, len(views) - 1].get_position(fig)])
+            fig.suptitle(_wrap(title, cells, fig), x=0.5 * (cells.x0 + cells.x1), y=0.985,
+                         fontsize=_TITLE_SIZE, va="top")  # fmt: skip
+            views[0] = ("body", views[0][1])
         self._views = []
         for i, (name, (lo, hi)) in enumerate(views):
             ax = fig.add_subplot(grid[0, i])
@@ -677,7 +694,9 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             ax.set_xlabel("x [mm]")
             if i == 0:
                 ax.set_ylabel("y [mm]")
-            ax.set_title(name or title, fontsize=9)
+            ax.set_title(
+                _wrap(name or title, grid[0, i].get_position(fig), fig), fontsize=_TITLE_SIZE
+            )
             ax.axhspan((lo[1] - 1.0) * _MM, 0.0, color=_SAND, zorder=0)
             ax.axhline(0.0, color=_SURFACE, lw=1.2, zorder=1)
             self._views.append(_ViewArtists.build(ax, pose))
