@@ -80,8 +80,8 @@ MAX_FRAMES = 10_000
 #: Writing an animation whose frames take more than this many bytes (one a pixel: what a
 #: GIF holds in memory before it is written, and at most the file's size; see
 #: :func:`saved_bytes`) warns first, with the estimate
-#: (:class:`granrs.errors.AnimationSizeWarning`). 200 MB is about 400 frames of the
-#: default figure at 100 dpi.
+#: (:class:`granrs.errors.AnimationSizeWarning`). 200 MB is about 460 frames of the
+#: narrowest figure (720 x 600 px at 100 dpi).
 BIG_SAVE_BYTES = 200_000_000
 #: Round-off allowance of the frame count: ``t_end / frame_dt`` within this of a whole
 #: number counts as that number (0.03 / 0.01 = 2.9999999999999996 gives 4 frames).
