@@ -343,6 +343,55 @@ def test_two_segment_leg_is_drawn_attached_at_its_joints() -> None:
             assert np.min(np.hypot(*(joints - point).T)) < 1e-9
 
 
+def test_a_link_spans_its_own_geometry() -> None:
+    """Each link's bar covers what the link defines along its axis, at least its length:
+    hanging below its joint (the docs' rods, joints at (-L, 0)), rising from it (the leg's
+    segments), about its centre of mass (the free link, a bare rod). Before, every bar ran
+    over [0, L] from the joint, whatever the link's geometry."""
+    length = 0.4
+    hanging = Link("a", 1.0, 0.01, length, com=(-length / 2, 0.0))
+    below = Joint("j", "a", "b", at=(-length, 0.0))
+    assert drawing._link_span(hanging, [below], []) == (-length, 0.0)
+    assert drawing._link_span(hanging, [], []) == (-length, 0.0)
+    rising = Link("b", 1.0, 0.01, length, com=(0.3 * length, 0.0))
+    assert drawing._link_span(rising, [], []) == (0.0, length)
+    bare = Link("c", 1.0, 0.01, length)
+    assert drawing._link_span(bare, [], []) == (-length / 2, length / 2)
+    rod = Contact.rod("c", length=length, diameter=0.01, at=(-length / 2, 0.0))
+    assert drawing._link_span(bare, [], [rod]) == (-length / 2, length / 2)
+    longer = Contact.rod("c", length=2 * length, diameter=0.01, at=(-0.5 * length, 0.0))
+    assert drawing._link_span(bare, [], [longer]) == (-0.5 * length, 1.5 * length)
+    c_leg = Contact.arc("c", radius=0.1, start_deg=180.0, end_deg=360.0, width=0.01, at=(0.1, 0))
+    lo, hi = drawing._link_span(Link("c", 1.0, 0.01, 0.2, com=(0.1, -0.06)), [], [c_leg])
+    assert (lo, hi) == pytest.approx((0.0, 0.2), abs=1e-15)
+
+
+def test_a_joint_off_the_axis_gets_a_spoke() -> None:
+    """A joint at (s, n) with n != 0 is joined to its parent's axis by a spoke from (s, 0),
+    so that the child's bar still meets its parent's drawing."""
+    arm = Linkage(
+        links=[
+            Link("upper", 1.0, 0.01, 0.3, com=(0.15, 0.0), q_deg=120.0),
+            Link("lower", 1.0, 0.01, 0.3, com=(0.15, 0.0), q_deg=150.0),
+        ],
+        joints=[Joint("elbow", "upper", "lower", at=(0.3, 0.05))],
+        root=Root("pinned", link="upper", position=(0.0, 1.0)),
+    )
+    scene = granrs.Scene(body=arm, forces=[forces.gravity()], end="time", t_end=0.02)
+    anim = granrs.animate(run(scene), frame_dt=0.01)
+    series = anim.result.series
+    assert series is not None
+    q = series["q_upper"][0]
+    root = np.array([series["x_root"][0], series["y_root"][0]])
+    axis, normal = np.array([math.sin(q), math.cos(q)]), np.array([math.cos(q), -math.sin(q)])
+    (spoke,) = anim._views[0].spokes[0]
+    a, b = spoke.get_xydata() * 1e-3
+    np.testing.assert_allclose(a, root + 0.3 * axis, atol=1e-12)
+    np.testing.assert_allclose(b, root + 0.3 * axis + 0.05 * normal, atol=1e-12)
+    start = anim._views[0].links["lower"].get_xydata()[0] * 1e-3
+    np.testing.assert_allclose(start, b, atol=1e-12)
+
+
 def test_built_in_bodies_are_drawn_from_their_linkages(
     chain: granrs.Result, leg: granrs.Result
 ) -> None:
