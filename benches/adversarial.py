@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 
 import granrs
-from granrs import Scene, cases, forces
+from granrs import Scene, cases, forces, scenefile
 from granrs.bodies import Contact, Joint, Link, Linkage, Root
 from granrs.errors import GranrsError, SimulationError, StepSizeWarning
 
@@ -297,7 +297,7 @@ _TOML_BASE: dict[str, str] = {}
 def toml_case(pick: Pick) -> Case:
     body = pick(granrs.scene.BODIES, "body")
     if body not in _TOML_BASE:
-        _TOML_BASE[body] = Scene(body=body, t_end=0.01).to_toml()
+        _TOML_BASE[body] = scenefile.dumps(Scene(body=body, t_end=0.01))
     lines = _TOML_BASE[body].splitlines()
     keyed = [i for i, line in enumerate(lines) if "=" in line and not line.startswith("#")]
     i = pick(keyed, "line")

@@ -210,7 +210,7 @@ def base_scenes() -> list[Scene]:
             t_end=0.02,
         ),
         # An arc contact on a driven root (issue 19): the C-leg scene file.
-        Scene.from_toml(C_LEG).replace(t_end=0.05),
+        scenefile.load(C_LEG).replace(t_end=0.05),
     ]
 
 

@@ -1,7 +1,7 @@
-"""``granrs.animate``, ``Result.animate`` and ``granrs animate`` (issue 20: an impact you can
-watch): frame count and times, frames that change, the body and the arrows where the recorded
-numbers put them, typed errors before anything is drawn, the CLI writing a GIF per example
-scene, and ``Result._repr_html_``.
+"""``granrs.animate`` (``granrs.animation``) and ``granrs animate`` (issue 20: an impact you
+can watch; issue 33: any linkage, any law): frame count and times, frames that change, the
+body and the arrows where the recorded numbers put them, typed errors before anything is
+drawn, the CLI writing a GIF per example scene, and ``Result._repr_html_``.
 
 Expected positions and forces come from the recorded series (the core's own ``tip_x``,
 ``tip_y``, ``depth``, ``v_E_x`` ... columns), never from the drawing code.
@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -24,11 +25,12 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from PIL import Image
 
 import granrs
-from granrs import cases
+from granrs import animation, cases, forces
 from granrs._animation import ImpactAnimation
-from granrs.animate import check_output, frame_count, playback
+from granrs.animation import DEFAULT_FRAMES, MAX_FRAMES, check_output, frame_count, playback
+from granrs.bodies import Contact, Joint, Link, Linkage, Root
 from granrs.cli import main
-from granrs.errors import GranrsError, InvalidParameterError
+from granrs.errors import AnimationSizeWarning, GranrsError, InvalidParameterError
 from granrs.forces import select, thesis
 
 # The drawing module (it imports matplotlib; granrs.animate, the attribute, is the function).
@@ -108,13 +110,16 @@ def test_first_and_last_frames_differ(free_link: granrs.Result) -> None:
     np.testing.assert_array_equal(first, again)
 
 
-def test_result_animate_is_a_func_animation(free_link: granrs.Result) -> None:
-    """Result.animate delegates to granrs.animate and returns a FuncAnimation."""
-    anim = free_link.animate(frame_dt=0.005)
+def test_animate_is_the_animation_module_s_function(free_link: granrs.Result) -> None:
+    """granrs.animate (loaded with matplotlib on first use) returns a FuncAnimation; a
+    Result has no animate method (result.py does not import the animation: no import
+    cycle)."""
+    assert granrs.animate is drawing.animate
+    anim = granrs.animate(free_link, frame_dt=0.005)
     assert isinstance(anim, mpl_animation.FuncAnimation)
     assert anim.result is free_link
-    assert anim.n_frames == granrs.animate(free_link, frame_dt=0.005).n_frames
-    assert "animate" in granrs.__all__
+    assert "animate" in granrs.__all__ and "animation" in granrs.__all__
+    assert not hasattr(free_link, "animate")
 
 
 def test_animation_shows_inline_as_a_javascript_player(free_link: granrs.Result) -> None:
@@ -236,6 +241,283 @@ def test_only_the_scene_s_terms_get_arrows() -> None:
     assert set(anim._views[0].arrows[0]) == {"static_v", "total"}
     labels = [t.get_text() for t in anim.figure.legends[0].get_texts()]
     assert "static_v" in labels and "drag" not in labels
+
+
+# --- any linkage, any law (issue 33) -------------------------------------------------------
+
+#: Each segment of the two-segment leg [m].
+SEGMENT = 0.3
+
+
+def _segment(name: str, q_deg: float) -> Link:
+    """A segment built as docs/bodies/linkage.md builds links: "a rod runs from its tip along
+    +s", so the axis points up from the segment's lower end, at (-L, 0) from its joint."""
+    return Link(name, mass=1.0, inertia=0.01, length=SEGMENT, com=(-SEGMENT / 2, 0.0), q_deg=q_deg)
+
+
+def two_segment_leg(t_end: float = 1.0) -> granrs.Result:
+    """A thigh and a shank hanging below a pelvis carried along at constant velocity: the
+    hip driven at 2 Hz, the knee a spring, a rod foot at the shank's lower end."""
+    leg = Linkage(
+        links=[_segment("pelvis", 90.0), _segment("thigh", 10.0), _segment("shank", -15.0)],
+        joints=[
+            Joint(
+                "hip",
+                parent="pelvis",
+                child="thigh",
+                at=(-SEGMENT / 2, 0.0),
+                kind="driven",
+                amplitude_deg=20.0,
+                frequency=2.0,
+            ),
+            Joint(
+                "knee",
+                parent="thigh",
+                child="shank",
+                at=(-SEGMENT, 0.0),
+                kind="spring",
+                k=20.0,
+                c=0.1,
+            ),
+        ],
+        contacts=[
+            Contact.rod("shank", length=SEGMENT, diameter=0.02, at=(-SEGMENT, 0.0), name="foot")
+        ],
+        root=Root("moving", link="pelvis", position=(0.0, 0.6), velocity=(0.2, -0.05), rate=0.0),
+    )
+    scene = granrs.Scene(
+        body=leg,
+        forces=[forces.gravity(), forces.joint_springs(), forces.rft(zeta=1e6)],
+        end="time",
+        t_end=t_end,
+    )
+    return run(scene)
+
+
+def _on_segment(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Distance [m] from ``point`` to the segment ``a``-``b``."""
+    ab = b - a
+    t = np.clip(np.dot(point - a, ab) / np.dot(ab, ab), 0.0, 1.0)
+    return float(np.hypot(*(a + t * ab - point)))
+
+
+def test_two_segment_leg_is_drawn_attached_at_its_joints() -> None:
+    """Issue 33: the two-segment leg of docs/bodies (hip driven at 2 Hz, knee spring, foot
+    contact) was drawn with each link from its joint along +s over [0, L], i.e. pointing up
+    and away from the joint it hangs from, and disconnected. Each drawn bar (the line's end
+    points, in mm) must now start at the joint that carries its link and pass through the
+    joints it carries, and the shank's bar must end at the foot's tip the core recorded
+    (tip_x, tip_y). The joints are placed here from the recorded root and angles by the docs'
+    convention (axis (sin q, cos q), normal (cos q, -sin q)), not by the drawing code."""
+    result = two_segment_leg()
+    series = result.series
+    assert series is not None
+    anim = granrs.animate(result, frame_dt=0.01)
+    rows = np.searchsorted(series["t"], anim.frame_times - 1e-12)
+    assert series["depth"][rows].max() > 0.01  # the foot goes into the sand
+
+    def axis(q: float) -> np.ndarray:
+        return np.array([math.sin(q), math.cos(q)])
+
+    bars = anim._views[0].links
+    for k in range(0, anim.n_frames, 7):
+        anim.draw(k)
+        row = rows[k]
+        root = np.array([series["x_root"][row], series["y_root"][row]])
+        hip = root - SEGMENT / 2 * axis(series["q_pelvis"][row])
+        knee = hip - SEGMENT * axis(series["q_thigh"][row])
+        tip = np.array([series["tip_x"][row], series["tip_y"][row]])
+        np.testing.assert_allclose(knee - SEGMENT * axis(series["q_shank"][row]), tip, atol=1e-9)
+        drawn = {name: line.get_xydata() * 1e-3 for name, line in bars.items()}
+        carried_by = {"pelvis": root, "thigh": hip, "shank": knee}
+        carries = {"pelvis": [hip], "thigh": [knee], "shank": [tip]}
+        for name, (a, b) in drawn.items():
+            # The bar runs from the joint that carries the link ...
+            assert min(np.hypot(*(a - carried_by[name])), np.hypot(*(b - carried_by[name]))) < 1e-9
+            # ... and through every joint it carries (the shank: to the foot's tip).
+            for point in carries[name]:
+                assert _on_segment(point, a, b) < 1e-9, (name, k)
+        assert min(np.hypot(*(end - tip)) for end in drawn["shank"]) < 1e-9  # an end, the tip
+        joints = anim._views[0].joints.get_xydata() * 1e-3
+        for point in (root, hip, knee):
+            assert np.min(np.hypot(*(joints - point).T)) < 1e-9
+
+
+def test_a_link_spans_its_own_geometry() -> None:
+    """Each link's bar covers what the link defines along its axis, at least its length:
+    hanging below its joint (the docs' rods, joints at (-L, 0)), rising from it (the leg's
+    segments), about its centre of mass (the free link, a bare rod). Before, every bar ran
+    over [0, L] from the joint, whatever the link's geometry."""
+    length = 0.4
+    hanging = Link("a", 1.0, 0.01, length, com=(-length / 2, 0.0))
+    below = Joint("j", "a", "b", at=(-length, 0.0))
+    assert drawing._link_span(hanging, [below], []) == (-length, 0.0)
+    assert drawing._link_span(hanging, [], []) == (-length, 0.0)
+    rising = Link("b", 1.0, 0.01, length, com=(0.3 * length, 0.0))
+    assert drawing._link_span(rising, [], []) == (0.0, length)
+    bare = Link("c", 1.0, 0.01, length)
+    assert drawing._link_span(bare, [], []) == (-length / 2, length / 2)
+    rod = Contact.rod("c", length=length, diameter=0.01, at=(-length / 2, 0.0))
+    assert drawing._link_span(bare, [], [rod]) == (-length / 2, length / 2)
+    longer = Contact.rod("c", length=2 * length, diameter=0.01, at=(-0.5 * length, 0.0))
+    assert drawing._link_span(bare, [], [longer]) == (-0.5 * length, 1.5 * length)
+    c_leg = Contact.arc("c", radius=0.1, start_deg=180.0, end_deg=360.0, width=0.01, at=(0.1, 0))
+    lo, hi = drawing._link_span(Link("c", 1.0, 0.01, 0.2, com=(0.1, -0.06)), [], [c_leg])
+    assert (lo, hi) == pytest.approx((0.0, 0.2), abs=1e-15)
+
+
+def test_a_joint_off_the_axis_gets_a_spoke() -> None:
+    """A joint at (s, n) with n != 0 is joined to its parent's axis by a spoke from (s, 0),
+    so that the child's bar still meets its parent's drawing."""
+    arm = Linkage(
+        links=[
+            Link("upper", 1.0, 0.01, 0.3, com=(0.15, 0.0), q_deg=120.0),
+            Link("lower", 1.0, 0.01, 0.3, com=(0.15, 0.0), q_deg=150.0),
+        ],
+        joints=[Joint("elbow", "upper", "lower", at=(0.3, 0.05))],
+        root=Root("pinned", link="upper", position=(0.0, 1.0)),
+    )
+    scene = granrs.Scene(body=arm, forces=[forces.gravity()], end="time", t_end=0.02)
+    anim = granrs.animate(run(scene), frame_dt=0.01)
+    series = anim.result.series
+    assert series is not None
+    q = series["q_upper"][0]
+    root = np.array([series["x_root"][0], series["y_root"][0]])
+    axis, normal = np.array([math.sin(q), math.cos(q)]), np.array([math.cos(q), -math.sin(q)])
+    (spoke,) = anim._views[0].spokes[0]
+    a, b = spoke.get_xydata() * 1e-3
+    np.testing.assert_allclose(a, root + 0.3 * axis, atol=1e-12)
+    np.testing.assert_allclose(b, root + 0.3 * axis + 0.05 * normal, atol=1e-12)
+    start = anim._views[0].links["lower"].get_xydata()[0] * 1e-3
+    np.testing.assert_allclose(start, b, atol=1e-12)
+
+
+def test_built_in_bodies_are_drawn_from_their_linkages(
+    chain: granrs.Result, leg: granrs.Result
+) -> None:
+    """The chain's links hang from the pin (each bar from the pin down to its recorded tip);
+    the leg's shank, thigh and trunk rise from the ankle, knee and hip: every body, built-in
+    or not, is drawn from its linkage."""
+    anim = granrs.animate(chain, frame_dt=0.002)
+    series = chain.series
+    assert series is not None
+    rows = np.searchsorted(series["t"], anim.frame_times - 1e-12)
+    k = anim.n_frames - 1
+    anim.draw(k)
+    pin = np.array([series["x_pin"][rows[k]], series["y_pin"][rows[k]]])
+    for i, name in enumerate(("link1", "link2")):
+        a, b = anim._views[0].links[name].get_xydata() * 1e-3
+        tip = np.array([series[f"c{i}.tip_x"][rows[k]], series[f"c{i}.tip_y"][rows[k]]])
+        np.testing.assert_allclose(sorted([tuple(a), tuple(b)]), sorted([tuple(pin), tuple(tip)]),
+                                   atol=1e-9)  # fmt: skip
+    anim = granrs.animate(leg, frame_dt=0.002)
+    anim.draw(0)
+    ends = {n: line.get_xydata() * 1e-3 for n, line in anim._views[0].links.items()}
+    for lower, upper in (("shank", "thigh"), ("thigh", "trunk")):
+        np.testing.assert_allclose(ends[lower][1], ends[upper][0], atol=1e-9)
+    title = "leg: v0 = 3.28 m/s, knee_deg = 20°, hip_deg = 20°, trunk_deg = 10°"
+    assert anim.title == title
+    suptitle = anim.figure.get_suptitle()
+    assert " ".join(suptitle.split()) == title  # over both views, wrapped to their width
+    assert [ax.get_title() for ax in anim.figure.axes] == ["body", "contacts"]
+
+
+@pytest.mark.parametrize(
+    "term", [forces.rft(zeta=1e6), forces.poncelet(c=0.5, k=2e5)], ids=lambda t: t.name
+)
+def test_every_recorded_term_gets_an_arrow_and_a_legend_entry(term: forces.Term) -> None:
+    """Issue 33: under rft or poncelet the legend said "forces not recorded" although the
+    series held the term's force (F_rft_x/y, F_px/y) and no arrow was drawn. The recorded
+    terms are read from the run's terms and the core's columns: the legend lists the term
+    with the arrows' scale, and its arrow ends where the recorded force puts it."""
+    scene = cases.free_link(q_deg=30.0, v0=2.0).replace(forces=[forces.gravity(), term])
+    result = run(scene)
+    series = result.series
+    assert series is not None
+    x, y = forces.info(term.name).columns
+    anim = granrs.animate(result, frame_dt=0.002)
+    legend = anim.figure.legends[0]
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert term.name in labels and "sum" in labels
+    assert legend.get_title().get_text().startswith("force arrows")
+    rows = np.searchsorted(series["t"], anim.frame_times - 1e-12)
+    k = int(np.argmax(np.hypot(series[x][rows], series[y][rows])))
+    anim.draw(k)
+    force = np.array([series[x][rows[k]], series[y][rows[k]]])
+    assert np.hypot(*force) > 0.1
+    start, end = (np.array(p) * 1e-3 for p in anim._views[0].arrows[0][term.name]._posA_posB)
+    np.testing.assert_allclose(end - start, anim.force_scale * force, atol=1e-9)
+
+
+def test_titles_come_from_the_scene_s_own_fields(free_link: granrs.Result) -> None:
+    """Issue 33: a linkage was titled "linkage, v0 = 2.214 m/s" (the default v0 of a field
+    a linkage does not have). A linkage's title names its links and root; a built-in body's
+    its start fields."""
+
+    def drawn_title(anim: ImpactAnimation) -> str:
+        """The title as drawn: over the views, or the only view's (wrapped to its width)."""
+        fig = anim.figure
+        text = fig.get_suptitle() if len(fig.axes) > 1 else fig.axes[0].get_title()
+        return " ".join(text.split())
+
+    title = drawn_title(granrs.animate(two_segment_leg(0.05), frame_dt=0.01))
+    assert "v0" not in title and "2.214" not in title
+    assert title.startswith("linkage: 3 links, root moving") and "(0.2, -0.05) m/s" in title
+    title = drawn_title(granrs.animate(free_link, frame_dt=0.01))
+    assert title == "free_link: q_deg = 45°, v0 = 2.27 m/s"
+
+
+def test_a_long_run_s_default_movie_stays_small(tmp_path: Path) -> None:
+    """Issue 33: left to its defaults, a 1 s run made 1251 frames (50x slow motion at 25
+    fps), whose GIF ran past 10 minutes and 6 GB. A movie left to the defaults has at most
+    DEFAULT_FRAMES frames (a long run plays faster); the GIF has them all."""
+    result = two_segment_leg(t_end=1.0)
+    anim = granrs.animate(result, dpi=40.0)
+    assert anim.n_frames == DEFAULT_FRAMES <= 300
+    assert anim.fps == 25.0 and anim.speed == pytest.approx(1.0 / (DEFAULT_FRAMES - 1) * 25.0)
+    assert anim.frame_times[-1] == pytest.approx(1.0, rel=1e-9)
+    short = granrs.animate(run(cases.free_link(q_deg=45.0, v0=2.27)))
+    assert short.speed == 0.02  # a short impact keeps the 50x slow motion
+    out = tmp_path / "long.gif"
+    anim.write(out)  # no warning (the test suite turns warnings into errors)
+    assert gif_frames(out) == DEFAULT_FRAMES
+
+
+def test_a_big_save_warns_with_its_size_before_any_frame(tmp_path: Path) -> None:
+    """Issue 33: a big save started without a word. Writing more than BIG_SAVE_BYTES of
+    frames warns first with the estimate (an AnimationSizeWarning, a UserWarning); as an
+    error (as this suite runs) it stops the write before any frame is drawn."""
+    anim = granrs.animate(two_segment_leg(t_end=1.0), frame_dt=0.0008)
+    assert anim.n_frames == 1251
+    width, height = anim.frame_pixels()
+    estimate = animation.saved_bytes(anim.n_frames, width, height)
+    assert estimate > animation.BIG_SAVE_BYTES
+    out = tmp_path / "big.gif"
+    with pytest.raises(AnimationSizeWarning, match=rf"1251 frames .* {estimate / 1e6:,.0f} MB"):
+        anim.write(out)
+    assert not out.exists() and not any(tmp_path.iterdir())
+    assert issubclass(AnimationSizeWarning, UserWarning)
+    assert "AnimationSizeWarning" in granrs.__all__
+
+
+def test_the_documented_constants_are_reachable() -> None:
+    """Issue 33: the docstring of animate() named granrs.animate.MAX_FRAMES, but
+    granrs.animate is the function: the constant could not be reached. Every
+    ``granrs.animation.NAME`` (or ``granrs.animate.NAME``) the animation's docstrings name
+    resolves, as an attribute and as an import."""
+    texts = [
+        granrs.animate.__doc__ or "",
+        animation.__doc__ or "",
+        ImpactAnimation.write.__doc__ or "",
+        AnimationSizeWarning.__doc__ or "",
+    ]
+    named = {m for text in texts for m in re.findall(r"granrs\.animat(?:e|ion)\.\w+", text)}
+    assert "granrs.animation.MAX_FRAMES" in named
+    for dotted in sorted(named):
+        _, module, name = dotted.split(".")
+        assert hasattr(getattr(granrs, module), name), dotted
+        assert hasattr(importlib.import_module(f"granrs.{module}"), name), dotted
+    assert granrs.animation.MAX_FRAMES == MAX_FRAMES == 10_000
 
 
 # --- playback -------------------------------------------------------------------------------
@@ -401,7 +683,7 @@ def test_cli_animate_writes_a_gif_per_example_scene(
     _, err = capsys.readouterr()
     assert code == 0, err
     assert f"animation written to {out}" in err
-    series = granrs.simulate(granrs.Scene.from_toml(path).replace(record=("state",))).series
+    series = granrs.simulate(granrs.scenefile.load(path).replace(record=("state",))).series
     assert series is not None
     assert gif_frames(out) == math.floor(series["t"][-1] / 0.01) + 1
 

@@ -357,10 +357,10 @@ C_LEG = SCENES / "c_leg_rft.toml"
 
 
 def test_the_c_leg_scene_round_trips_and_runs_from_the_cli(tmp_path: pathlib.Path) -> None:
-    scene = granrs.Scene.from_toml(C_LEG)
+    scene = granrs.scenefile.load(C_LEG)
     assert isinstance(scene.body, Linkage) and scene.body.contacts[0].shape == "arc"
     assert scene.body.root.rate is not None
-    back = granrs.Scene.from_toml(scene.to_toml())
+    back = granrs.scenefile.loads(granrs.scenefile.dumps(scene))
     assert back == scene
     granrs_cli = pathlib.Path(sys.executable).parent / "granrs"
     done = subprocess.run(
@@ -377,10 +377,9 @@ def test_the_c_leg_is_drawn() -> None:
     import matplotlib
 
     matplotlib.use("Agg")
-    from granrs.animate import animate
 
-    scene = granrs.Scene.from_toml(C_LEG).replace(record=("state", "forces"), t_end=0.5)
-    anim = animate(granrs.simulate(scene), frame_dt=0.1)
+    scene = granrs.scenefile.load(C_LEG).replace(record=("state", "forces"), t_end=0.5)
+    anim = granrs.animate(granrs.simulate(scene), frame_dt=0.1)
     band = anim._pose.contacts[0].shape
     # 2 (chords + 1) points a frame, at 0.95 .. 1.05 radii from the centre (3 cm above
     # the axle, at q = 0: the C's centre is (0, 0.03 + 0.035)).

@@ -275,7 +275,7 @@ def test_scene_new_writes_a_runnable_template(
 ) -> None:
     code, out, _ = run(capsys, "scene", "new", "--body", body)
     assert code == 0
-    assert granrs.Scene.from_toml(out) == expected
+    assert granrs.scenefile.loads(out) == expected
     path = tmp_path / "t.toml"
     path.write_text(out)
     code, out, _ = run(capsys, "run", str(path), "--json")

@@ -466,7 +466,7 @@ def test_a_file_above_the_limit_is_refused_before_it_is_read(tmp_path) -> None:
 def test_a_byte_order_mark_is_accepted(tmp_path) -> None:
     """Issue 34: a UTF-8 scene file starting with a byte-order mark (as some Windows
     editors write it) was refused as invalid TOML. It reads as the same file without it,
-    through every reader: the CLI, ``Scene.from_toml`` and ``scenefile.loads``."""
+    through every reader: the CLI, ``scenefile.load`` and ``scenefile.loads``."""
     from granrs import Scene, scenefile
     from granrs.cli import main
 
@@ -474,7 +474,7 @@ def test_a_byte_order_mark_is_accepted(tmp_path) -> None:
     path = tmp_path / "bom.toml"
     path.write_bytes(b"\xef\xbb\xbf" + text.encode())
     expected = Scene(q_deg=30.0, v0=1.5)
-    assert Scene.from_toml(path) == expected
+    assert scenefile.load(path) == expected
     assert scenefile.loads("\ufeff" + text) == expected
     assert main(["run", str(path), "--json"]) == 0
 
@@ -482,13 +482,13 @@ def test_a_byte_order_mark_is_accepted(tmp_path) -> None:
 def test_a_file_that_is_not_utf8_is_a_typed_error(tmp_path) -> None:
     """Bytes that are not UTF-8 raise the scene file's typed error from every reader (from
     Python it was a UnicodeDecodeError)."""
-    from granrs import Scene
+    from granrs import scenefile
     from granrs.errors import InvalidSceneError
 
     path = tmp_path / "latin1.toml"
     path.write_bytes('apply_at = "tip" # caf\xe9\n'.encode("latin-1"))
     with pytest.raises(InvalidSceneError) as info:
-        Scene.from_toml(path)
+        scenefile.load(path)
     assert info.value.field == "scene" and "UTF-8" in str(info.value)
 
 

@@ -59,7 +59,7 @@ def test_every_example_scene_runs_as_text_and_json(
     assert code == 0, err
     assert "Traceback" not in err
     assert out.startswith(f"{path}: ") and "status" in out
-    scene = granrs.Scene.from_toml(path)
+    scene = scenefile.load(path)
     if not scene.body.contacts:  # type: ignore[union-attr]
         assert "no contacts" in out
     code, out, err = run(capsys, "run", str(path), "--json")
@@ -208,7 +208,7 @@ def test_joint_round_off_is_printed_as_zero(capsys: pytest.CaptureFixture[str]) 
     """chain_case1.toml: pin_on_link1 carries no load (2.68e-15 N of round-off); the table
     prints 0 and says why (before: "2.67895e-15" as if it were a force)."""
     path = next(p for p in EXAMPLES if p.stem == "chain_case1")
-    raw = granrs.simulate(granrs.Scene.from_toml(path)).joints
+    raw = granrs.simulate(scenefile.load(path)).joints
     assert 0.0 < raw["pin_on_link1"]["F_max"] < ROUNDOFF_RTOL * raw["pin"]["F_max"]
     code, out, _ = run(capsys, "run", str(path))
     assert code == 0
@@ -223,7 +223,7 @@ def test_joint_round_off_is_printed_as_zero(capsys: pytest.CaptureFixture[str]) 
 
 
 def _recorded(path: Path) -> granrs.Result:
-    scene = granrs.Scene.from_toml(path).replace(record=("state", "forces"))
+    scene = scenefile.load(path).replace(record=("state", "forces"))
     return granrs.simulate(scene)
 
 
@@ -284,7 +284,7 @@ def test_series_columns_carry_their_units(
     for column in columns:
         assert re.fullmatch(r"\S+ \[[^\]]+\]", column), column
     units = dict(c[:-1].split(" [") for c in columns)
-    scene = granrs.Scene.from_toml(path)
+    scene = scenefile.load(path)
     names = granrs.result._names(scene)
     for name in names["coords"][2:]:
         assert units[name] in ("rad", "s"), name

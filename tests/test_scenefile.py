@@ -64,10 +64,9 @@ def test_round_trip_thesis_scenes(body: str, tmp_path: Path) -> None:
     scene = THESIS_SCENES[body]
     same_bits(loads(dumps(scene)), scene)
     path = tmp_path / "scene.toml"
-    scene.to_toml(path)
-    same_bits(Scene.from_toml(path), scene)
-    same_bits(Scene.from_toml(str(path)), scene)
-    same_bits(Scene.from_toml(scene.to_toml()), scene)
+    granrs.scenefile.dump(scene, path)
+    same_bits(load(path), scene)
+    same_bits(load(str(path)), scene)
 
 
 @pytest.mark.parametrize("body", list(THESIS_SCENES))
@@ -424,9 +423,9 @@ def test_missing_format_reads_as_current() -> None:
     assert loads("q_deg = 12.5\n") == Scene(q_deg=12.5)
 
 
-def test_from_toml_missing_file_raises_os_error(tmp_path: Path) -> None:
+def test_load_missing_file_raises_os_error(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
-        Scene.from_toml(tmp_path / "missing.toml")
+        load(tmp_path / "missing.toml")
 
 
 # --- overrides and key lines --------------------------------------------------------------

@@ -52,7 +52,7 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     (
         "Results",
         "What a run returns, and how to watch it.",
-        ("Result", "ContactResult", "animate", "ImpactAnimation"),
+        ("Result", "ContactResult", "animate", "animation", "ImpactAnimation"),
     ),
     (
         "The force law",
@@ -88,6 +88,7 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
             "MeasurementError",
             "SimulationError",
             "StepSizeWarning",
+            "AnimationSizeWarning",
         ),
     ),
     ("Version", "", ("__version__",)),

@@ -16,14 +16,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from . import _granrs, bodies, cases, coefficients, data, forces, scenefile
-from .animate import animate
+from . import _granrs, animation, bodies, cases, coefficients, data, forces, scenefile
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
 from .compare import compare
 from .errors import (
+    AnimationSizeWarning,
     CoefficientsWarning,
     CoefficientTableError,
     GranrsError,
@@ -39,13 +39,14 @@ from .result import ContactResult, Result
 from .scene import RECORDS, Scene
 
 if TYPE_CHECKING:
-    from ._animation import ImpactAnimation
+    from ._animation import ImpactAnimation, animate
 
 __version__: str = _granrs.__version__
 
 __all__ = [
     "RECORDS",
     "RK4_STABILITY_LIMIT",
+    "AnimationSizeWarning",
     "CalibrationResult",
     "CoefficientTableError",
     "Coefficients",
@@ -65,6 +66,7 @@ __all__ = [
     "UnknownNameError",
     "__version__",
     "animate",
+    "animation",
     "bodies",
     "calibrate",
     "cases",
@@ -80,9 +82,10 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    # granrs.ImpactAnimation imports matplotlib: loaded on first use (see granrs.animate).
-    if name == "ImpactAnimation":
-        from ._animation import ImpactAnimation
+    # granrs.animate and granrs.ImpactAnimation import matplotlib (granrs._animation): loaded
+    # on first use, so that `import granrs` does not pay for it.
+    if name in ("animate", "ImpactAnimation"):
+        from . import _animation
 
-        return ImpactAnimation
+        return getattr(_animation, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,13 +1,19 @@
-"""The drawing behind :func:`granrs.animate` (see :mod:`granrs.animate` for what a frame
-shows): the body placed from the recorded coordinates, the immersed parts, the force arrows
-and :class:`ImpactAnimation`. Kept apart because it imports matplotlib, which
-``import granrs`` should not pay for.
+"""The drawing behind :func:`granrs.animate` (see :mod:`granrs.animation` for what a frame
+shows and the settings): :func:`animate`, any body placed from its linkage and the recorded
+coordinates, the immersed parts, the force arrows of every recorded term and
+:class:`ImpactAnimation`. Kept apart because it imports matplotlib, which ``import granrs``
+should not pay for: ``granrs.animate`` loads it on first use.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import math
 import os
+import textwrap
+import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -18,27 +24,78 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Patch, Polygon
+from matplotlib.transforms import Bbox
 
+from . import forces as _forces
 from ._files import replacing
 from ._progress import progress_bar
-from .animate import TERM_COLOURS, check_output
+from .animation import (
+    BIG_SAVE_BYTES,
+    DEFAULT_FRAMES,
+    MAX_FRAMES,
+    _positive,
+    check_output,
+    frame_count,
+    playback,
+    saved_bytes,
+)
 from .bodies import DEFAULT_CHORDS
-from .errors import InvalidParameterError
+from .errors import AnimationSizeWarning, InvalidParameterError
+from .result import Result, _names
+from .scene import BODY_FIELDS, FIELD_INFO
 
 if TYPE_CHECKING:
-    from .result import Result
+    from .bodies import Contact, Joint, Link
+    from .scene import Scene
 
-__all__ = ["ANKLE_HEIGHT_FRACTION", "ImpactAnimation"]
+__all__ = ["ImpactAnimation", "animate", "term_colour"]
 
-#: Height of the ankle above the sole, fraction of body height H (Winter 2009, Fig. 4.1;
-#: the core's ``leg_defaults::ANKLE_HEIGHT``, which it does not expose).
-ANKLE_HEIGHT_FRACTION = 0.039
-#: Longest force arrow, as a fraction of the body's reference length (rod length, tibia).
+#: Longest force arrow, as a fraction of the body's longest link.
 _ARROW_FRACTION = 0.6
 #: The narrowest figure [in]: a tall, thin scene (a vertical rod) still leaves its axes'
 #: cell room for the title, clear of the legend's column.
 _MIN_WIDTH = 7.2
+#: A view of the contacts alone is added when the whole body is this many times larger.
+_ZOOM_RATIO = 3.0
 _MM = 1e3
+#: Size of the titles [pt]; a title is wrapped to its axes' width at about 0.55 of this per
+#: character.
+_TITLE_SIZE = 9.0
+
+
+# --- the terms' arrows ---------------------------------------------------------------------
+
+#: Colours of the terms' arrows, in the order of the registry's terms that record a force
+#: (drag, static_h, static_v, ... as matplotlib's first colours); grey is the sum's.
+_PALETTE = (
+    "tab:blue",
+    "tab:orange",
+    "tab:green",
+    "tab:red",
+    "tab:purple",
+    "tab:brown",
+    "tab:pink",
+    "tab:olive",
+    "tab:cyan",
+)
+#: The force component a term's single series column holds, by the column's last letter
+#: (``F_sh``: horizontal, ``F_sv``: vertical); a term with two columns holds (x, y).
+_ONE_COLUMN_AXIS = {"h": 0, "x": 0, "v": 1, "y": 1}
+
+
+def _term_columns(term: str) -> tuple[tuple[str, int], ...]:
+    """The series columns of ``term``'s force on a contact (the core's registry) with the
+    component each holds (0: x, 1: y); none for a body term (gravity, joint springs)."""
+    columns = _forces.info(term).columns
+    if len(columns) == 2:
+        return ((columns[0], 0), (columns[1], 1))
+    return tuple((c, _ONE_COLUMN_AXIS[c[-1]]) for c in columns if c[-1] in _ONE_COLUMN_AXIS)
+
+
+def term_colour(term: str) -> str:
+    """The colour of ``term``'s arrow: one per registered term that records a force."""
+    recorded = [t for t in _forces.TERMS if _forces.info(t).columns]
+    return _PALETTE[recorded.index(term) % len(_PALETTE)] if term in recorded else "black"
 
 
 # --- geometry -------------------------------------------------------------------------------
@@ -56,7 +113,7 @@ def _normal(q: np.ndarray) -> np.ndarray:
 
 def _local(joint: np.ndarray, q: np.ndarray, s: float, n: float) -> np.ndarray:
     """World position of the point (s, n) of a link with joint ``joint`` and angle ``q``
-    (``rust/body/mechanism.rs``: J + s e + n n), shape (n_frames, 2) [m]."""
+    (``docs/bodies/linkage.md``: J + s e + n n), shape (n_frames, 2) [m]."""
     return joint + s * _axis(q) + n * _normal(q)
 
 
@@ -89,66 +146,28 @@ def _polygon_centroid(polygon: np.ndarray) -> np.ndarray | None:
     return np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
 
 
+def _polyline_centroid(points: np.ndarray) -> np.ndarray | None:
+    """Length centroid of the part of a polyline (k, 2) with y <= 0, or None."""
+    total, moment = 0.0, np.zeros(2)
+    for a, b in itertools.pairwise(points):
+        if a[1] > 0.0 and b[1] > 0.0:
+            continue
+        if a[1] > 0.0 or b[1] > 0.0:
+            t = a[1] / (a[1] - b[1])
+            cut = a + t * (b - a)
+            a, b = (cut, b) if a[1] > 0.0 else (a, cut)
+        length = float(np.hypot(*(b - a)))
+        total += length
+        moment += length * 0.5 * (a + b)
+    return moment / total if total > 0.0 else None
+
+
 def _rod_outline(tip: np.ndarray, top: np.ndarray, diameter: float) -> np.ndarray:
     """The rectangle of a rod from ``tip`` to ``top`` (each (n, 2)), shape (n, 4, 2)."""
     along = top - tip
     along = along / np.linalg.norm(along, axis=-1, keepdims=True)
     side = 0.5 * diameter * np.stack([along[:, 1], -along[:, 0]], axis=-1)
     return np.stack([tip + side, top + side, top - side, tip - side], axis=1)
-
-
-@dataclass
-class _Contact:
-    """One contact's drawing data over the frames (world coordinates [m])."""
-
-    name: str
-    #: Outline of the contact's shape, (n, k, 2): a rod, or the foot's contact box.
-    shape: np.ndarray
-    #: The reference point whose depth the series records (rod tip, middle of the sole), (n, 2).
-    reference: np.ndarray
-    #: Point of application of the force, (n, 2).
-    applied: np.ndarray
-    #: Force of each term that the scene has on, (n, 2) [N].
-    forces: dict[str, np.ndarray]
-
-    @property
-    def total(self) -> np.ndarray:
-        """The sum of the recorded terms, (n, 2) [N]."""
-        return sum(self.forces.values(), np.zeros_like(self.applied))
-
-
-@dataclass
-class _Pose:
-    """The body over the frames: filled outlines, stick segments and joints [m]."""
-
-    outlines: list[np.ndarray]  # each (n, k, 2)
-    sticks: np.ndarray | None  # (n, m, 2): a polyline through the joints
-    contacts: list[_Contact]
-    #: Reference length for the force scale [m].
-    size: float
-
-
-def _column(series: dict[str, np.ndarray], name: str, frames: np.ndarray) -> np.ndarray:
-    t = np.asarray(series["t"], dtype=float)
-    return np.interp(frames, t, np.asarray(series[name], dtype=float))
-
-
-def _contact_forces(
-    series: dict[str, np.ndarray], prefix: str, frames: np.ndarray
-) -> dict[str, np.ndarray]:
-    """The recorded force terms of one contact as vectors, (n, 2) each [N]."""
-    zeros = np.zeros_like(frames)
-    out: dict[str, np.ndarray] = {}
-    if f"{prefix}F_dx" in series:
-        out["drag"] = np.stack(
-            [_column(series, f"{prefix}F_dx", frames), _column(series, f"{prefix}F_dy", frames)],
-            axis=-1,
-        )
-    if f"{prefix}F_sh" in series:
-        out["static_h"] = np.stack([_column(series, f"{prefix}F_sh", frames), zeros], axis=-1)
-    if f"{prefix}F_sv" in series:
-        out["static_v"] = np.stack([zeros, _column(series, f"{prefix}F_sv", frames)], axis=-1)
-    return out
 
 
 def _rod_centroid(tip: np.ndarray, top: np.ndarray, length: float) -> np.ndarray:
@@ -161,135 +180,241 @@ def _rod_centroid(tip: np.ndarray, top: np.ndarray, length: float) -> np.ndarray
     return tip + 0.5 * immersed[:, None] * e
 
 
+def _arc_angles(c: Contact) -> np.ndarray:
+    """The angles of an arc contact's chord ends [rad], from ``start_deg`` to ``end_deg``."""
+    chords = c.chords or DEFAULT_CHORDS
+    return np.radians(np.linspace(c.start_deg or 0.0, c.end_deg or 0.0, chords + 1))
+
+
+def _contact_s(c: Contact) -> list[float]:
+    """The places along its link's axis that a contact reaches [m]."""
+    s0 = c.at[0]
+    if c.shape == "arc":
+        return list(s0 + (c.radius or 0.0) * np.cos(_arc_angles(c)))
+    return [s0, s0 + (c.length or 0.0)]
+
+
+def _link_span(
+    link: Link, joints: Sequence[Joint], contacts: Sequence[Contact]
+) -> tuple[float, float]:
+    """The part ``[s_lo, s_hi]`` of a link's axis to draw [m]: what its own geometry spans
+    (its joint at s = 0, its centre of mass, the joints it carries, its contacts), at least
+    ``link.length`` long: grown away from the joint when everything lies on one side of it
+    (a link hanging from its joint either way), about the middle otherwise."""
+    s = [0.0, link.com[0], *(j.at[0] for j in joints)]
+    s += [x for c in contacts for x in _contact_s(c)]
+    lo, hi = min(s), max(s)
+    length = link.length
+    if hi - lo >= length:
+        return lo, hi
+    if lo >= 0.0 and hi > 0.0:
+        return 0.0, length
+    if hi <= 0.0 and lo < 0.0:
+        return -length, 0.0
+    middle = 0.5 * (lo + hi)
+    return middle - 0.5 * length, middle + 0.5 * length
+
+
+@dataclass
+class _Contact:
+    """One contact's drawing data over the frames (world coordinates [m])."""
+
+    name: str
+    #: ``"rod"``, ``"box"`` or ``"arc"``.
+    shape_kind: str
+    #: Outline of the contact's shape, (n, k, 2).
+    shape: np.ndarray
+    #: The reference point T the series records (``tip_x``, ``tip_y``: a rod's tip, the
+    #: middle of a box's sole, an arc's middle), (n, 2).
+    reference: np.ndarray
+    #: Point of application of the force, (n, 2).
+    applied: np.ndarray
+    #: Force of each recorded term, (n, 2) [N], in the order of ``Result.terms``.
+    forces: dict[str, np.ndarray]
+    #: Depth of the contact (the series' ``depth``), (n,) [m].
+    depth: np.ndarray
+    #: Its size [m]: a rod's or a box's length, an arc's diameter.
+    size: float
+
+    @property
+    def total(self) -> np.ndarray:
+        """The sum of the recorded terms, (n, 2) [N]."""
+        return sum(self.forces.values(), np.zeros_like(self.applied))
+
+
+@dataclass
+class _Link:
+    """One link's drawing data over the frames [m]."""
+
+    name: str
+    #: The ends of its bar along its axis, (n, 2, 2).
+    bar: np.ndarray
+    #: From its axis out to each joint it carries off the axis, each (n, 2, 2).
+    spokes: list[np.ndarray]
+
+
+@dataclass
+class _Pose:
+    """The body over the frames: its links, joints and contacts [m]."""
+
+    links: list[_Link]
+    #: The root point and every joint, (n, j, 2).
+    joints: np.ndarray
+    contacts: list[_Contact]
+    #: Reference length for the force scale: the longest link [m].
+    size: float
+
+
+def _column(series: dict[str, np.ndarray], name: str, frames: np.ndarray) -> np.ndarray:
+    t = np.asarray(series["t"], dtype=float)
+    return np.interp(frames, t, np.asarray(series[name], dtype=float))
+
+
+def _contact_forces(
+    series: dict[str, np.ndarray], prefix: str, frames: np.ndarray, terms: Sequence[str]
+) -> dict[str, np.ndarray]:
+    """The recorded force of each of ``terms`` on one contact as vectors, (n, 2) each [N]:
+    the terms whose columns the series holds."""
+    out: dict[str, np.ndarray] = {}
+    for term in terms:
+        columns = [(c, axis) for c, axis in _term_columns(term) if f"{prefix}{c}" in series]
+        if not columns:
+            continue
+        force = np.zeros((len(frames), 2))
+        for c, axis in columns:
+            force[:, axis] = _column(series, f"{prefix}{c}", frames)
+        out[term] = force
+    return out
+
+
+def _contact(
+    c: Contact,
+    origin: np.ndarray,
+    q: np.ndarray,
+    centroid: bool,
+    forces: dict[str, np.ndarray],
+    depth: np.ndarray | None,
+) -> _Contact:
+    """One contact placed on its link (joint ``origin``, angle ``q``) over the frames."""
+    s0, n0 = c.at
+    length = c.length or 0.0
+    if c.shape == "rod":
+        tip = _local(origin, q, s0, n0)
+        top = _local(origin, q, s0 + length, n0)
+        shape = _rod_outline(tip, top, c.diameter or 0.0)
+        reference = tip
+        applied = _rod_centroid(tip, top, length) if centroid else tip
+    elif c.shape == "arc":
+        r = c.radius or 0.0
+        phi = _arc_angles(c)
+        # A thin band about the arc (10 % of its radius thick), through its chords' ends.
+        band = [(s0 + k * r * np.cos(f), n0 + k * r * np.sin(f)) for k, f in
+                [(1.05, f) for f in phi] + [(0.95, f) for f in phi[::-1]]]  # fmt: skip
+        shape = np.stack([_local(origin, q, s, n) for s, n in band], axis=1)
+        mid = math.radians(0.5 * ((c.start_deg or 0.0) + (c.end_deg or 0.0)))
+        reference = _local(origin, q, s0 + r * math.cos(mid), n0 + r * math.sin(mid))
+        applied = reference.copy()
+        if centroid:
+            chords = np.stack(
+                [_local(origin, q, s0 + r * np.cos(f), n0 + r * np.sin(f)) for f in phi], axis=1
+            )
+            for k in range(len(q)):
+                e = _polyline_centroid(chords[k])
+                if e is not None:
+                    applied[k] = e
+    else:
+        h = c.height or 0.0
+        corners = ((s0, n0), (s0 + length, n0), (s0 + length, n0 - h), (s0, n0 - h))
+        shape = np.stack([_local(origin, q, s, n) for s, n in corners], axis=1)
+        reference = _local(origin, q, s0 + 0.5 * length, n0)
+        applied = reference.copy()
+        if centroid:
+            for k in range(len(q)):
+                e = _polygon_centroid(_clip_below_surface(shape[k]))
+                if e is not None:
+                    applied[k] = e
+    if depth is None:  # no series column: the lowest point of the outline
+        depth = np.maximum(-shape[:, :, 1].min(axis=1), 0.0)
+    name = c.name or c.link
+    size = 2.0 * (c.radius or 0.0) if c.shape == "arc" else length
+    return _Contact(name, c.shape, shape, reference, applied, forces, depth, size)
+
+
 def _pose(result: Result, frames: np.ndarray) -> _Pose:
-    """Place the body at each frame from the recorded coordinates and the scene."""
+    """Place the body at each frame from its linkage (``scene.body``: links, joints,
+    contacts) and the recorded root position and link angles."""
     scene, series = result.scene, result.series
     assert series is not None
-    col = lambda name: _column(series, name, frames)  # noqa: E731
-    centroid = scene.apply_at == "centroid"
-    if scene.kind == "free_link":
-        centre = np.stack([col("x"), col("y")], axis=-1)
-        q = col("q")
-        tip = _local(centre, q, -0.5 * scene.length, 0.0)
-        top = _local(centre, q, 0.5 * scene.length, 0.0)
-        rod = _rod_outline(tip, top, scene.diameter)
-        applied = _rod_centroid(tip, top, scene.length) if centroid else tip
-        contact = _Contact("rod", rod, tip, applied, _contact_forces(series, "", frames))
-        return _Pose([rod], None, [contact], scene.length)
-    if scene.kind == "chain":
-        pin = np.stack([col("x_pin"), col("y_pin")], axis=-1)
-        outlines, contacts = [], []
-        for i in range(2):
-            tip = _local(pin, col(f"q{i + 1}"), -scene.length, 0.0)
-            rod = _rod_outline(tip, pin, scene.diameter)
-            applied = _rod_centroid(tip, pin, scene.length) if centroid else tip
-            outlines.append(rod)
-            forces = _contact_forces(series, f"c{i}.", frames)
-            contacts.append(_Contact(f"link{i + 1}", rod, tip, applied, forces))
-        return _Pose(outlines, None, contacts, scene.length)
-    if scene.kind == "leg":
-        return _leg_pose(result, frames)
-    if scene.kind == "linkage":
-        return _linkage_pose(result, frames)
-    raise InvalidParameterError(f"cannot draw body {scene.kind!r}", field="body")
-
-
-def _linkage_pose(result: Result, frames: np.ndarray) -> _Pose:
-    """A linkage: each link a bar from its joint along its axis (its joints placed on their
-    parents, the root link at the root), each contact's rod or box outline."""
-    scene, series = result.scene, result.series
-    assert series is not None
-    col = lambda name: _column(series, name, frames)  # noqa: E731
     body = scene.body
+    coords = _names(scene)["coords"]
+    order = body.order  # type: ignore[union-attr]
     links = {link.name: link for link in body.links}  # type: ignore[union-attr]
-    joint_of = {j.child: j for j in body.joints}  # type: ignore[union-attr]
+    joints = body.joints  # type: ignore[union-attr]
+    contacts = body.contacts  # type: ignore[union-attr]
+    joint_of = {j.child: j for j in joints}
+    root = np.stack([_column(series, coords[0], frames), _column(series, coords[1], frames)], -1)
     origin: dict[str, np.ndarray] = {}
     q: dict[str, np.ndarray] = {}
-    for name in body.order:  # type: ignore[union-attr]
-        q[name] = col(f"q_{name}")
+    for i, name in enumerate(order):
+        q[name] = _column(series, coords[2 + i], frames)
         j = joint_of.get(name)
-        if j is None:
-            origin[name] = np.stack([col("x_root"), col("y_root")], axis=-1)
-        else:
-            origin[name] = _local(origin[j.parent], q[j.parent], *j.at)
+        origin[name] = root if j is None else _local(origin[j.parent], q[j.parent], *j.at)
+    drawn = []
+    for name in order:
+        carried = [j for j in joints if j.parent == name]
+        on_it = [c for c in contacts if c.link == name]
+        lo, hi = _link_span(links[name], carried, on_it)
+        o, a = origin[name], q[name]
+        bar = np.stack([_local(o, a, lo, 0.0), _local(o, a, hi, 0.0)], axis=1)
+        spokes = [
+            np.stack([_local(o, a, j.at[0], 0.0), _local(o, a, *j.at)], axis=1)
+            for j in carried
+            if j.at[1] != 0.0
+        ]
+        drawn.append(_Link(name, bar, spokes))
+    several = len(contacts) > 1
+    placed = []
+    for i, c in enumerate(contacts):
+        prefix = f"c{i}." if several else ""
+        forces = _contact_forces(series, prefix, frames, result.terms)
+        depth = _column(series, f"{prefix}depth", frames) if f"{prefix}depth" in series else None
+        placed.append(
+            _contact(c, origin[c.link], q[c.link], scene.apply_at == "centroid", forces, depth)
+        )
+    joint_points = np.stack([root] + [origin[j.child] for j in joints], axis=1)
     size = max(link.length for link in links.values())
-    bars = [
-        _rod_outline(origin[n], _local(origin[n], q[n], links[n].length, 0.0), 0.04 * size)
-        for n in body.order  # type: ignore[union-attr]
-    ]
-    contacts = []
-    several = len(body.contacts) > 1  # type: ignore[union-attr]
-    for i, c in enumerate(body.contacts):  # type: ignore[union-attr]
-        o, a = origin[c.link], q[c.link]
-        s0, n0 = c.at
-        length = c.length or 0.0
-        if c.shape == "rod":
-            tip = _local(o, a, s0, n0)
-            top = _local(o, a, s0 + length, n0)
-            shape = _rod_outline(tip, top, c.diameter or 0.0)
-            reference = tip
-        elif c.shape == "arc":
-            # A thin band about the arc (10 % of its radius thick), through its vertices.
-            r, start, end = c.radius or 0.0, c.start_deg or 0.0, c.end_deg or 0.0
-            phi = np.radians(np.linspace(start, end, (c.chords or DEFAULT_CHORDS) + 1))
-            band = [(s0 + k * r * np.cos(f), n0 + k * r * np.sin(f)) for k, f in
-                    [(1.05, f) for f in phi] + [(0.95, f) for f in phi[::-1]]]  # fmt: skip
-            shape = np.stack([_local(o, a, s, n) for s, n in band], axis=1)
-            mid = math.radians(0.5 * (start + end))
-            reference = _local(o, a, s0 + r * math.cos(mid), n0 + r * math.sin(mid))
-        else:
-            h = c.height or 0.0
-            corners = ((s0, n0), (s0 + length, n0), (s0 + length, n0 - h), (s0, n0 - h))
-            shape = np.stack([_local(o, a, s, n) for s, n in corners], axis=1)
-            reference = _local(o, a, s0 + 0.5 * length, n0)
-        forces = _contact_forces(series, f"c{i}." if several else "", frames)
-        contacts.append(_Contact(c.name or c.link, shape, reference, reference, forces))
-    return _Pose(bars, None, contacts, size)
+    return _Pose(drawn, joint_points, placed, size)
 
 
-def _leg_pose(result: Result, frames: np.ndarray) -> _Pose:
-    """The leg (``rust/bodies/leg.rs`` LegScene::model): the ankle is the root; the foot's axis
-    runs heel to toe with the sole at n = h (the ankle height) below it; the shank, thigh and
-    trunk rise from the ankle, the knee and the hip along their axes."""
-    scene, series = result.scene, result.series
-    assert series is not None
-    col = lambda name: _column(series, name, frames)  # noqa: E731
-    segments = {s["name"]: s for s in scene.leg_segments()}
-    foot_length = scene.foot_length
-    h = ANKLE_HEIGHT_FRACTION * scene.height
-    box_height = scene.tibia_length if scene.sole_height is None else scene.sole_height
-    ankle = np.stack([col("x_ankle"), col("y_ankle")], axis=-1)
-    q_foot = col("q_foot")
-    half = 0.5 * foot_length
-    foot = np.stack(
-        [
-            _local(ankle, q_foot, s, n)
-            for s, n in ((-half, h), (half, h), (half, 0.0), (-half, 0.0))
-        ],
-        axis=1,
-    )
-    box = np.stack(
-        [
-            _local(ankle, q_foot, s, n)
-            for s, n in ((-half, h), (half, h), (half, h - box_height), (-half, h - box_height))
-        ],
-        axis=1,
-    )
-    knee = _local(ankle, col("q_shank"), segments["shank"]["length"], 0.0)
-    hip = _local(knee, col("q_thigh"), segments["thigh"]["length"], 0.0)
-    head = _local(hip, col("q_trunk"), segments["half_trunk"]["length"], 0.0)
-    sticks = np.stack([ankle, knee, hip, head], axis=1)
-    sole_middle = _local(ankle, q_foot, 0.0, h)
-    if scene.apply_at == "centroid":
-        applied = sole_middle.copy()
-        for k in range(len(frames)):
-            c = _polygon_centroid(_clip_below_surface(box[k]))
-            if c is not None:
-                applied[k] = c
-    else:
-        applied = sole_middle
-    contact = _Contact("foot", box, sole_middle, applied, _contact_forces(series, "", frames))
-    return _Pose([foot], sticks, [contact], scene.tibia_length)
+def _title(scene: Scene) -> str:
+    """The body and the scene's own start: a built-in body's start fields that apply to it
+    (``v0``, ``q_deg``, ...; those at zero left out), or a linkage's links and root."""
+    kind = scene.kind
+    if kind != "linkage":
+        parts = []
+        for field in dataclasses.fields(scene):
+            f = FIELD_INFO[field.name]
+            if f["part"] != "start" or kind not in BODY_FIELDS.get(field.name, (kind,)):
+                continue
+            value = getattr(scene, field.name)
+            if value is None or value == 0.0:
+                continue
+            unit = {"deg": "°"}.get(f["unit"], f" {f['unit']}")
+            parts.append(f"{field.name} = {value:g}{unit}")
+        return f"{kind}: " + ", ".join(parts)
+    body = scene.body
+    root = body.root  # type: ignore[union-attr]
+    n_links = len(body.links)  # type: ignore[union-attr]
+    text = f"linkage: {n_links} link{'s' if n_links > 1 else ''}, root {root.kind}"
+    if root.kind == "pinned":
+        text += f" at ({root.position[0]:g}, {root.position[1]:g}) m"
+    elif any(root.velocity):
+        text += f", v = ({root.velocity[0]:g}, {root.velocity[1]:g}) m/s"
+    if root.rate == 0.0:
+        text += ", its angle held"
+    elif root.rate is not None:
+        text += f", turning at {root.rate:g} rad/s"
+    return text
 
 
 # --- drawing --------------------------------------------------------------------------------
@@ -300,25 +425,16 @@ _WET = "#6b4a1f"
 _BODY_FACE = "#9aa4b1"
 _BODY_EDGE = "#2f3b4c"
 _TOTAL_COLOUR = "#7f7f7f"
-#: Order in which the terms are laid tip to tail.
-_TERMS = ("drag", "static_h", "static_v")
 
 
-def _force_scale(result: Result, size: float) -> float:
-    """Arrow length per newton [m/N]: the largest term or sum of any contact at any recorded
-    sample is drawn ``_ARROW_FRACTION`` of the body's reference length ``size`` [m] long (so
-    the scale does not depend on frame_dt); 0 without forces."""
-    series = result.series
-    assert series is not None
-    t = np.asarray(series["t"], dtype=float)
+def _force_scale(pose: _Pose) -> float:
+    """Arrow length per newton [m/N]: the largest term or sum of any contact at any frame
+    is drawn ``_ARROW_FRACTION`` of the body's longest link long; 0 without forces."""
     largest = 0.0
-    for i in range(len(result.contacts)):
-        prefix = f"c{i}." if len(result.contacts) > 1 else ""
-        forces = _contact_forces(series, prefix, t)
-        total = sum(forces.values(), np.zeros((len(t), 2)))
-        for f in [*forces.values(), total]:
+    for c in pose.contacts:
+        for f in [*c.forces.values(), c.total]:
             largest = max(largest, float(np.nanmax(np.linalg.norm(f, axis=-1), initial=0.0)))
-    return _ARROW_FRACTION * size / largest if largest > 0.0 else 0.0
+    return _ARROW_FRACTION * pose.size / largest if largest > 0.0 else 0.0
 
 
 def _limits(points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -334,15 +450,29 @@ def _limits(points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return lo - pad, hi + pad
 
 
+def _near_contacts(pose: _Pose) -> list[np.ndarray]:
+    """The points a view of the contacts shows: each contact's reference point and the
+    vertices of its outline within its own size of it (a leg's sole, not its whole box)."""
+    points = []
+    for c in pose.contacts:
+        points.append(c.reference)
+        near = np.linalg.norm(c.shape - c.reference[:, None, :], axis=-1) <= c.size
+        points.append(c.shape[near])
+    return points
+
+
 @dataclass
 class _ViewArtists:
-    """The artists of one axes (the whole body, or the leg's contact zoomed)."""
+    """The artists of one axes (the whole body, or its contacts zoomed)."""
 
-    outlines: list[Polygon]
-    #: The outlines' edges again, above the immersed shading.
-    edges: list[Polygon]
-    boxes: list[Polygon]
-    sticks: Line2D | None
+    #: Per link (by name): its bar.
+    links: dict[str, Line2D]
+    #: Per link, its spokes to off-axis joints.
+    spokes: list[list[Line2D]]
+    #: The root and the joints, as dots.
+    joints: Line2D
+    #: Per contact: its outline.
+    shapes: list[Polygon]
     wet: list[Polygon]
     #: Per contact: the sum's arrow, then the terms', by name.
     arrows: list[dict[str, FancyArrowPatch]]
@@ -350,29 +480,27 @@ class _ViewArtists:
     @classmethod
     def build(cls, ax: Any, pose: _Pose) -> _ViewArtists:
         empty = np.zeros((3, 2))
-        outlines = [
-            ax.add_patch(
-                Polygon(empty, closed=True, fc=_BODY_FACE, ec=_BODY_EDGE, lw=1.0, zorder=3)
-            )
-            for _ in pose.outlines
-        ]
-        edges = [
-            ax.add_patch(Polygon(empty, closed=True, fill=False, ec=_BODY_EDGE, lw=1.0, zorder=4.5))
-            for _ in pose.outlines
-        ]
-        boxes = []
-        sticks = None
-        if pose.sticks is not None:
-            # The leg: its contact box (dashed) is not the foot's outline.
-            boxes = [
-                ax.add_patch(
-                    Polygon(
-                        empty, closed=True, fill=False, ec=_BODY_EDGE, lw=0.8, ls="--", zorder=2
-                    )
+        shapes = []
+        for c in pose.contacts:
+            if c.shape_kind == "box":
+                patch = Polygon(
+                    empty, closed=True, fill=False, ec=_BODY_EDGE, lw=0.9, ls="--", zorder=2
                 )
-                for _ in pose.contacts
-            ]
-            (sticks,) = ax.plot([], [], "-o", color=_BODY_EDGE, lw=3.0, ms=5, zorder=3)
+            else:
+                patch = Polygon(empty, closed=True, fc=_BODY_FACE, ec=_BODY_EDGE, lw=1.0, zorder=3)
+            shapes.append(ax.add_patch(patch))
+        links = {}
+        spokes = []
+        for link in pose.links:
+            (links[link.name],) = ax.plot(
+                [], [], "-", color=_BODY_EDGE, lw=3.0, solid_capstyle="butt", zorder=3.5
+            )
+            spokes.append(
+                [ax.plot([], [], "-", color=_BODY_EDGE, lw=1.5, zorder=3.5)[0] for _ in link.spokes]
+            )
+        (joints,) = ax.plot(
+            [], [], "o", ms=5, mfc="white", mec=_BODY_EDGE, mew=1.5, ls="none", zorder=5.5
+        )
         wet = [
             ax.add_patch(
                 Polygon(empty, closed=True, fc=_WET, ec="none", alpha=0.55, hatch="///", zorder=4)
@@ -402,44 +530,51 @@ class _ViewArtists:
                         (0.0, 0.0),
                         arrowstyle="-|>",
                         mutation_scale=9,
-                        color=TERM_COLOURS[term],
+                        color=term_colour(term),
                         lw=1.8,
                         zorder=6,
                     )
                 )
             arrows.append(mine)
-        return cls(outlines, edges, boxes, sticks, wet, arrows)
+        return cls(links, spokes, joints, shapes, wet, arrows)
 
     def draw(self, pose: _Pose, k: int, scale: float) -> list[Any]:
         changed: list[Any] = []
-        for patch, edge, outline in zip(self.outlines, self.edges, pose.outlines, strict=True):
-            patch.set_xy(outline[k] * _MM)
-            edge.set_xy(outline[k] * _MM)
-            changed += [patch, edge]
-        for patch, contact in zip(self.boxes, pose.contacts, strict=False):
+        for link, spokes in zip(pose.links, self.spokes, strict=True):
+            line = self.links[link.name]
+            line.set_data(link.bar[k, :, 0] * _MM, link.bar[k, :, 1] * _MM)
+            changed.append(line)
+            for spoke, ends in zip(spokes, link.spokes, strict=True):
+                spoke.set_data(ends[k, :, 0] * _MM, ends[k, :, 1] * _MM)
+                changed.append(spoke)
+        self.joints.set_data(pose.joints[k, :, 0] * _MM, pose.joints[k, :, 1] * _MM)
+        changed.append(self.joints)
+        for patch, wet, arrows, contact in zip(
+            self.shapes, self.wet, self.arrows, pose.contacts, strict=True
+        ):
             patch.set_xy(contact.shape[k] * _MM)
-            changed.append(patch)
-        if self.sticks is not None and pose.sticks is not None:
-            self.sticks.set_data(pose.sticks[k, :, 0] * _MM, pose.sticks[k, :, 1] * _MM)
-            changed.append(self.sticks)
-        for patch, arrows, contact in zip(self.wet, self.arrows, pose.contacts, strict=True):
-            wet = _clip_below_surface(contact.shape[k])
-            patch.set_visible(len(wet) >= 3)
-            if len(wet) >= 3:
-                patch.set_xy(wet * _MM)
-            changed.append(patch)
+            immersed = _clip_below_surface(contact.shape[k])
+            wet.set_visible(len(immersed) >= 3)
+            if len(immersed) >= 3:
+                wet.set_xy(immersed * _MM)
+            changed += [patch, wet]
             start = contact.applied[k]
             if "total" in arrows:
                 _place(arrows["total"], start, start + scale * contact.total[k])
             # The terms tip to tail, so that together they end where the sum does.
             at = start
-            for term in _TERMS:
-                if term in arrows:
-                    end = at + scale * contact.forces[term][k]
-                    _place(arrows[term], at, end)
-                    at = end
+            for term, force in contact.forces.items():
+                end = at + scale * force[k]
+                _place(arrows[term], at, end)
+                at = end
             changed += list(arrows.values())
         return changed
+
+
+def _wrap(text: str, cell: Bbox, fig: Figure) -> str:
+    """``text`` wrapped to the width of ``cell`` (figure coordinates)."""
+    points = cell.width * fig.get_figwidth() * 72.0
+    return textwrap.fill(text, width=max(20, int(points / (0.55 * _TITLE_SIZE))))
 
 
 def _place(arrow: FancyArrowPatch, start: np.ndarray, end: np.ndarray) -> None:
@@ -455,7 +590,7 @@ def _place(arrow: FancyArrowPatch, start: np.ndarray, end: np.ndarray) -> None:
 
 class ImpactAnimation(mpl_animation.FuncAnimation):
     """A :class:`matplotlib.animation.FuncAnimation` of one recorded impact (see
-    :func:`animate`).
+    :func:`granrs.animate`).
 
     Attributes:
         result: the run it shows.
@@ -463,8 +598,10 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         frame_dt: simulated time per frame [s].
         speed: simulated seconds per second of movie [-].
         fps: frames per second of the movie [1/s].
-        depths: depth of each contact's reference point at each frame, (n_frames,
-            n_contacts) [m] (the rod's tip, the middle of the sole; as the series' ``depth``).
+        depths: depth of each contact at each frame, (n_frames, n_contacts) [m] (the
+            series' ``depth``).
+        title: the body and its start, from the scene's own fields (the first view's
+            title; over the views when the contacts get a view of their own).
         force_scale: length of a 1 N arrow [m/N].
     """
 
@@ -485,9 +622,7 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         self.dpi = dpi
         self._pose = _pose(result, frame_times)
         self.depths = np.stack(
-            [np.maximum(-c.reference[:, 1], 0.0) for c in self._pose.contacts]
-            or [np.zeros(len(frame_times))],
-            axis=-1,
+            [c.depth for c in self._pose.contacts] or [np.zeros(len(frame_times))], axis=-1
         )[:, : len(self._pose.contacts)]
         self.figure = self._build_figure()
         super().__init__(
@@ -512,16 +647,18 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
 
     def _build_figure(self) -> Figure:
         pose = self._pose
-        scale = self.force_scale = _force_scale(self.result, pose.size)
+        scale = self.force_scale = _force_scale(pose)
         ends = [c.applied + scale * c.total for c in pose.contacts if c.forces]
-        body = [o.reshape(-1, 2) for o in pose.outlines]
+        body = [link.bar.reshape(-1, 2) for link in pose.links]
         body += [c.shape.reshape(-1, 2) for c in pose.contacts]
-        if pose.sticks is not None:
-            body.append(pose.sticks.reshape(-1, 2))
-        views = [("", _limits(body + ends))]
-        if pose.sticks is not None:
-            # The leg is a metre and a half tall; its contact gets a view of its own.
-            views.append(("contact", _limits([o.reshape(-1, 2) for o in pose.outlines] + ends)))
+        body.append(pose.joints.reshape(-1, 2))
+        whole = _limits(body + ends)
+        views = [("", whole)]
+        if pose.contacts:
+            near = _limits(_near_contacts(pose) + ends)
+            if (whole[1] - whole[0]).max() > _ZOOM_RATIO * (near[1] - near[0]).max():
+                # A body much larger than its contacts (a leg): they get a view of their own.
+                views.append(("contacts", near))
         widths = [(hi[0] - lo[0]) / (hi[1] - lo[1]) for _, (lo, hi) in views]
         height = 6.0
         side = 2.4  # the legend's column [in]
@@ -537,12 +674,19 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             left=0.9 / fig.get_figwidth() * 1.0,
             right=plot_right - 0.02,
             bottom=0.09,
-            top=0.92,
+            top=0.90,
             wspace=0.25,
         )
-        scene = self.result.scene
+        self.title = title = _title(self.result.scene)
+        if len(views) > 1:
+            # Over both views (the body's is narrow): the views are named instead.
+            left = grid[0, 0].get_position(fig)
+            cells = Bbox.union([left, grid[0, len(views) - 1].get_position(fig)])
+            fig.suptitle(_wrap(title, cells, fig), x=0.5 * (cells.x0 + cells.x1), y=0.985,
+                         fontsize=_TITLE_SIZE, va="top")  # fmt: skip
+            views[0] = ("body", views[0][1])
         self._views = []
-        for i, (title, (lo, hi)) in enumerate(views):
+        for i, (name, (lo, hi)) in enumerate(views):
             ax = fig.add_subplot(grid[0, i])
             ax.set_xlim(lo[0] * _MM, hi[0] * _MM)
             ax.set_ylim(lo[1] * _MM, hi[1] * _MM)
@@ -550,25 +694,27 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
             ax.set_xlabel("x [mm]")
             if i == 0:
                 ax.set_ylabel("y [mm]")
-            ax.set_title(title or f"{scene.kind}, v0 = {scene.v0:g} m/s", fontsize=10)
+            ax.set_title(
+                _wrap(name or title, grid[0, i].get_position(fig), fig), fontsize=_TITLE_SIZE
+            )
             ax.axhspan((lo[1] - 1.0) * _MM, 0.0, color=_SAND, zorder=0)
             ax.axhline(0.0, color=_SURFACE, lw=1.2, zorder=1)
             self._views.append(_ViewArtists.build(ax, pose))
-        present = [t for t in TERM_COLOURS if any(t in c.forces for c in pose.contacts)]
+        present = list(dict.fromkeys(t for c in pose.contacts for t in c.forces))
         handles: list[Any] = [
-            Line2D([], [], color=TERM_COLOURS[t], lw=2.0, label=t) for t in present
+            Line2D([], [], color=term_colour(t), lw=2.0, label=t) for t in present
         ]
         if present:
-            handles.append(
-                Line2D([], [], color=_TOTAL_COLOUR, lw=6.0, alpha=0.5, label="sum (F_r)")
-            )
+            handles.append(Line2D([], [], color=_TOTAL_COLOUR, lw=6.0, alpha=0.5, label="sum"))
         handles.append(Patch(fc=_WET, alpha=0.55, hatch="///", label="immersed"))
         if scale > 0.0:
             note = f"force arrows\n10 mm = {0.01 / scale:.3g} N"
-        elif not any(c.forces for c in pose.contacts):
+        elif present:
+            note = "no force"
+        elif "forces" not in self.result.scene.record:
             note = "forces not recorded"
         else:
-            note = "no force"
+            note = "no force on a contact"
         x_side = plot_right + 0.01
         fig.legend(
             handles=handles,
@@ -606,14 +752,76 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         fps: Any = self.fps  # see write()
         return html if html is not None else str(self.to_jshtml(fps=fps))
 
+    def frame_pixels(self) -> tuple[int, int]:
+        """Width and height of a written frame [px] (the figure at ``dpi``)."""
+        width, height = self.figure.get_size_inches() * self.dpi
+        return round(float(width)), round(float(height))
+
+    def _write_gif(self, path: Path, tick: Any) -> None:
+        """Write the frames as a GIF: the still parts (axes, ticks, sand, legend) drawn once,
+        each frame only the moving artists over them (what matplotlib calls blitting), and
+        each frame reduced to the first frame's palette (the legend holds every arrow's
+        colour). Drawing every frame whole through matplotlib's writer drew it twice and
+        quantized it apart: about four times slower."""
+        from PIL import Image
+
+        canvas = self.figure.canvas
+        assert isinstance(canvas, FigureCanvasAgg)
+        moving = self.draw(0)
+        for artist in moving:
+            artist.set_animated(True)
+        try:
+            canvas.draw()  # everything but the moving artists
+            background = canvas.copy_from_bbox(self.figure.bbox)
+            frames: list[Any] = []
+            palette: Any = None
+            for k in range(self.n_frames):
+                canvas.restore_region(background)
+                changed = self.draw(k)
+                for artist in sorted(changed, key=lambda a: a.get_zorder()):
+                    self.figure.draw_artist(artist)
+                rgb = Image.frombuffer(
+                    "RGBA", canvas.get_width_height(), canvas.buffer_rgba(), "raw", "RGBA", 0, 1
+                ).convert("RGB")
+                if palette is None:
+                    palette = rgb.quantize(colors=255, method=Image.Quantize.MEDIANCUT)
+                frames.append(rgb.quantize(palette=palette, dither=Image.Dither.NONE))
+                tick(k, self.n_frames)
+        finally:
+            for artist in moving:
+                artist.set_animated(False)
+        frames[0].save(
+            path,
+            format="GIF",
+            save_all=True,
+            append_images=frames[1:],
+            duration=1000.0 / self.fps,
+            loop=0,
+        )
+
     def write(self, path: str | os.PathLike[str], progress: bool | None = None) -> Path:
         """Write the animation to ``path``: ``.gif`` (Pillow), ``.mp4`` (ffmpeg) or ``.html``
-        (a self-contained JavaScript player). The path is checked first, before any frame is drawn.
+        (a self-contained JavaScript player). The path is checked first, before any frame is
+        drawn; frames that would take more than :data:`granrs.animation.BIG_SAVE_BYTES` as
+        pixels warn first (:class:`~granrs.errors.AnimationSizeWarning`, with the estimate).
         ``progress``: a tqdm bar of the frames on stderr (None: when stderr is a terminal).
         Returns the path."""
 
         out = check_output(path)
         suffix = out.suffix.lower()
+        width, height = self.frame_pixels()
+        estimate = saved_bytes(self.n_frames, width, height)
+        if estimate > BIG_SAVE_BYTES:
+            span = float(self.frame_times[-1] - self.frame_times[0])
+            warnings.warn(
+                AnimationSizeWarning(
+                    f"writing {out}: {self.n_frames} frames of {width} x {height} px take "
+                    f"about {estimate / 1e6:,.0f} MB (one byte a pixel, held in memory until "
+                    f"written); frame_dt = {span / (DEFAULT_FRAMES - 1):.3g} s gives "
+                    f"{DEFAULT_FRAMES} frames, and a lower dpi smaller ones"
+                ),
+                stacklevel=2,
+            )
         # matplotlib annotates fps as int, but only divides by it (1000 / fps, ffmpeg -r):
         # a derived frame rate such as speed / frame_dt = 12.5 is written as it is.
         fps: Any = self.fps
@@ -634,11 +842,89 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
                     )
                     self.save(str(tmp), writer=writer, progress_callback=tick)
                 elif suffix == ".gif":
-                    writer = mpl_animation.PillowWriter(fps=fps)
-                    self.save(str(tmp), writer=writer, dpi=self.dpi, progress_callback=tick)
+                    self._write_gif(tmp, tick)
                 else:
                     writer = mpl_animation.FFMpegWriter(fps=fps)
                     self.save(str(tmp), writer=writer, dpi=self.dpi, progress_callback=tick)
         finally:
             bar.close()
         return out
+
+
+# --- the entry point ------------------------------------------------------------------------
+
+
+def animate(
+    result: Result,
+    frame_dt: float | None = None,
+    speed: float | None = None,
+    fps: float | None = None,
+    *,
+    out: str | os.PathLike[str] | None = None,
+    dpi: float = 100.0,
+    progress: bool | None = None,
+) -> ImpactAnimation:
+    """An animation of a recorded impact, from its series alone (no second simulation).
+
+    Args:
+        result: a :func:`granrs.simulate` result whose scene recorded ``"state"`` (and
+            ``"forces"`` for the force arrows): ``scene.replace(record=("state", "forces"))``.
+        frame_dt: simulated time per frame [s] (default: ``speed / fps``).
+        speed: playback speed, simulated seconds per second of movie [-] (default 0.02:
+            50x slow motion; faster for a run longer than
+            :data:`granrs.animation.DEFAULT_FRAMES` such frames); ``speed = frame_dt * fps``.
+        fps: frames per second of the movie [1/s] (default 25).
+        out: if given, also write the animation there (``.gif``, ``.mp4`` or ``.html``);
+            checked before anything is drawn.
+        dpi: resolution of written frames [dots per inch].
+        progress: while writing ``out``, a tqdm bar of the frames on stderr (None: when
+            stderr is a terminal; True: always; False: never).
+
+    Returns:
+        An :class:`ImpactAnimation` (a ``matplotlib.animation.FuncAnimation``) with
+        ``floor(t_end / frame_dt) + 1`` frames, ``t_end`` the last recorded time [s]; frame
+        ``k`` shows ``t = k * frame_dt``. In Jupyter it shows inline.
+
+    Raises:
+        InvalidParameterError: before any frame is drawn, naming the field: ``result`` not a
+            Result, or one that recorded no state (``field="record"``); ``frame_dt``,
+            ``speed``, ``fps`` or ``dpi`` not positive (or inconsistent); more than
+            :data:`granrs.animation.MAX_FRAMES` frames (``field="frame_dt"``); ``out`` with
+            an unknown suffix or in a missing or unwritable directory.
+
+    Warns:
+        AnimationSizeWarning: writing ``out`` would hold more than
+            :data:`granrs.animation.BIG_SAVE_BYTES` of frames; the message gives the estimate.
+    """
+    if not isinstance(result, Result):
+        raise InvalidParameterError(
+            f"animate() takes a granrs.Result, got {type(result).__name__}", field="result"
+        )
+    playback(frame_dt, speed, fps)  # the values checked before the series are read
+    dpi_value = _positive(dpi, "dpi")
+    assert dpi_value is not None
+    target = check_output(out) if out is not None else None
+    series = result.series
+    needed = ("t", *_names(result.scene)["coords"])
+    if series is None or any(name not in series for name in needed) or len(series["t"]) == 0:
+        raise InvalidParameterError(
+            "the result recorded no state to animate: run the scene with "
+            "record=('state', 'forces'), e.g. granrs.simulate(scene.replace(record=('state', "
+            "'forces')))",
+            field="record",
+        )
+    t = np.asarray(series["t"], dtype=float)
+    span = float(t[-1] - t[0])
+    frame_dt, speed, fps = playback(frame_dt, speed, fps, span=span)
+    n = frame_count(span, frame_dt)
+    if n > MAX_FRAMES:
+        raise InvalidParameterError(
+            f"frame_dt = {frame_dt:g} s gives {n} frames over {span:g} s; at most {MAX_FRAMES} "
+            f"(use frame_dt >= {span / (MAX_FRAMES - 1):.3g} s)",
+            field="frame_dt",
+        )
+    times = np.minimum(t[0] + frame_dt * np.arange(n), t[-1])
+    anim = ImpactAnimation(result, times, frame_dt, speed, fps, dpi=dpi_value)
+    if target is not None:
+        anim.write(target, progress=progress)
+    return anim

@@ -777,7 +777,7 @@ ANIMATE_RECORD: tuple[str, ...] = ("state", "forces")
 
 def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Declare ``granrs animate``."""
-    from .animate import DEFAULT_FPS, DEFAULT_SPEED
+    from .animation import DEFAULT_FPS, DEFAULT_FRAMES, DEFAULT_SPEED
 
     parser = sub.add_parser(
         "animate",
@@ -813,7 +813,8 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
         default=None,
         metavar="X",
         help=f"simulated seconds per second of movie (default: {DEFAULT_SPEED:g}, "
-        "i.e. 50x slow motion)",
+        f"i.e. 50x slow motion, or faster so that the movie has at most {DEFAULT_FRAMES} "
+        "frames)",
     )
     parser.add_argument(
         "--fps",
@@ -834,21 +835,23 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
 def _cmd_animate(args: argparse.Namespace) -> int:
     """Run ``granrs animate``."""
     from . import scenefile
-    from .animate import animate, check_output, playback
+    from ._animation import animate
+    from .animation import check_output, playback
     from .api import simulate
 
     overrides = dict(scenefile.parse_override(item) for item in args.overrides)
     # Every argument is checked before the run: playback, the output path.
-    frame_dt, speed, fps = playback(args.frame_dt, args.speed, args.fps)
+    playback(args.frame_dt, args.speed, args.fps)
     out = check_output(args.out)
     scene = _read_scene(args.scene, overrides)
     record = tuple(dict.fromkeys((*scene.record, *ANIMATE_RECORD)))
     result = simulate(scene.replace(record=record))
-    anim = animate(result, frame_dt, speed, fps, dpi=args.dpi)
+    # The defaults left out resolve against the run's length (at most DEFAULT_FRAMES frames).
+    anim = animate(result, args.frame_dt, args.speed, args.fps, dpi=args.dpi)
     anim.write(out, progress=False if args.quiet else None)
     print(
         f"{PROG}: animation written to {out} ({anim.n_frames} frames, "
-        f"{frame_dt * 1e3:.4g} ms per frame, {fps:.4g} fps, speed {speed:.4g})",
+        f"{anim.frame_dt * 1e3:.4g} ms per frame, {anim.fps:.4g} fps, speed {anim.speed:.4g})",
         file=sys.stderr,
     )
     return 0

@@ -11,6 +11,7 @@ The Rust core raises the same classes: its one error enum is converted exhaustiv
 from __future__ import annotations
 
 __all__ = [
+    "AnimationSizeWarning",
     "CoefficientTableError",
     "CoefficientsWarning",
     "GranrsError",
@@ -72,3 +73,11 @@ class CoefficientsWarning(UserWarning):
     but its force parameters are no longer that row's (they were changed): they are kept
     as given, and ``coefficients_source`` says so. A scene whose parameters are still the
     named row's takes the new row instead, without a warning (:class:`granrs.Scene`)."""
+
+
+class AnimationSizeWarning(UserWarning):
+    """Writing an animation would hold more than :data:`granrs.animation.BIG_SAVE_BYTES` of
+    frames (what the GIF writer keeps in memory before it writes): the message gives the
+    frame count, the frame size and the estimate, and how to make it smaller (a larger
+    ``frame_dt``, a lower ``dpi``). Raised as an error (``warnings.simplefilter("error",
+    AnimationSizeWarning)``) it stops the write before any frame is drawn."""

@@ -4,16 +4,12 @@ from __future__ import annotations
 
 import html
 import math
-import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .scene import Scene
-
-if TYPE_CHECKING:
-    from ._animation import ImpactAnimation
 
 __all__ = ["JOINT_NAMES", "LINK_NAMES", "SUMMARY_UNITS", "ContactResult", "Result"]
 
@@ -121,7 +117,8 @@ class ContactResult:
 
 
 class Result:
-    """The outcome of :func:`granrs.simulate`.
+    """The outcome of :func:`granrs.simulate`; :func:`granrs.animate` draws one recorded with
+    ``record=("state", "forces")``.
 
     The run's numbers stay in the Rust core until they are read: ``status``, ``t_s`` and
     ``depth`` come straight from it, and the rest is converted on first access (so a loop
@@ -254,30 +251,6 @@ class Result:
             raise ValueError("nothing was recorded: set Scene.record, e.g. record=('state',)")
         frame = pd.DataFrame(self.series)
         return frame.set_index("t")
-
-    def animate(
-        self,
-        frame_dt: float | None = None,
-        speed: float | None = None,
-        fps: float | None = None,
-        *,
-        out: str | os.PathLike[str] | None = None,
-        dpi: float = 100.0,
-    ) -> ImpactAnimation:
-        """An animation of this run from its recorded series (the scene must record
-        ``"state"``, and ``"forces"`` for the force arrows): see :func:`granrs.animate`.
-
-        Args:
-            frame_dt: simulated time per frame [s]; the animation has
-                ``floor(t_end / frame_dt) + 1`` frames.
-            speed: simulated seconds per second of movie [-] (``frame_dt * fps``).
-            fps: frames per second of the movie [1/s].
-            out: also write it to this ``.gif``, ``.mp4`` or ``.html`` file.
-            dpi: resolution of written frames [dots per inch].
-        """
-        from .animate import animate
-
-        return animate(self, frame_dt, speed, fps, out=out, dpi=dpi)
 
     def _repr_html_(self) -> str:
         """Jupyter: the status and a compact table of each contact's results with units."""

@@ -524,25 +524,6 @@ class Scene:
         """Initial angle from the vertical [rad]."""
         return math.radians(self.q_deg)
 
-    @classmethod
-    def from_toml(cls, path_or_text: Any) -> Scene:
-        """A validated scene from a TOML scene file (a ``str`` or ``os.PathLike`` path) or
-        TOML text (a ``str`` holding a newline or an ``=``); see :mod:`granrs.scenefile`.
-        Errors name the key and its line."""
-        from . import scenefile
-
-        if isinstance(path_or_text, str) and ("\n" in path_or_text or "=" in path_or_text):
-            return scenefile.loads(path_or_text)
-        return scenefile.load(path_or_text)
-
-    def to_toml(self, path: Any = None) -> str:
-        """The scene as TOML text (every field of its body, floats exact); also written to
-        ``path`` (a ``str`` or ``os.PathLike``) if given.
-        ``Scene.from_toml(scene.to_toml()) == scene``."""
-        from . import scenefile
-
-        return scenefile.dumps(self) if path is None else scenefile.dump(self, path)
-
 
 def _field_doc(name: str) -> str:
     f = FIELD_INFO[name]

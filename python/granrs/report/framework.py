@@ -176,7 +176,7 @@ class ReportContext:
         and the image (one animation per chapter)."""
         import tempfile
 
-        from ..animate import animate
+        from .._animation import animate
 
         with self.step(f"{name}: an animation"):
             result = self.run(scene.replace(record=("state", "forces")))
