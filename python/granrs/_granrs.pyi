@@ -6,6 +6,7 @@ from typing import Any, final
 __all__ = [
     "DEFAULT_CHORDS",
     "EFFECTS",
+    "PRESETS",
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
     "GEOM_OUTPUTS",
@@ -42,6 +43,7 @@ __all__ = [
 ]
 __version__: str
 EFFECTS: list[str]
+PRESETS: list[str]
 RECORDS: list[str]
 RFT_COEFFICIENTS: list[str]
 RFT_GENERIC: list[float]

@@ -70,8 +70,9 @@ __all__ = [
     "Scene",
 ]
 
-#: The built-in bodies.
-BODIES: tuple[str, ...] = ("free_link", "chain", "leg")
+#: The built-in bodies: the core's presets, each a function from a few parameters to a
+#: linkage.
+BODIES: tuple[str, ...] = tuple(_granrs.PRESETS)
 #: What a scene's body may be: a built-in body, or a linkage of your own.
 KINDS: tuple[str, ...] = (*BODIES, "linkage")
 #: Named joint settings; a spring-damper is a mapping ``{"k": N m/rad, "c": N m s/rad}``.

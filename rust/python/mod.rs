@@ -53,6 +53,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("GEOM_STATE", crate::evaluate::geoms::STATE.to_vec())?;
     m.add("GEOM_OUTPUTS", crate::evaluate::geoms::OUTPUTS.to_vec())?;
     m.add("EFFECTS", effects())?;
+    m.add("PRESETS", crate::presets::names())?;
     m.add("RECORDS", RECORDS.to_vec())?;
     m.add("SCENE_FIELDS", SCENE_FIELDS.to_vec())?;
     m.add_function(wrap_pyfunction!(run::leg_segments, m)?)?;
