@@ -1,5 +1,7 @@
-//! The one table of a scene's fields: name, the part of the scene it belongs to, the bodies
-//! that use it, its unit, a short note and its description with the default's source.
+//! The one table of a scene's fields: name, the part of the scene it belongs to, its unit,
+//! a short note and its description with the default's source. Which bodies read a field is
+//! said by the presets that read it (`crate::presets::Preset::fields`); a field no preset
+//! reads applies to every body.
 //!
 //! Everything that describes a field reads this table: the spec's slots (the core's
 //! conversion and validation), the error messages (a field's unit and note follow the
@@ -25,8 +27,6 @@ pub struct FieldInfo {
     /// The part of the scene it belongs to: `body`, `medium`, `forces`, `start`, `solver`,
     /// `outputs`, or `notes` (provenance the run does not read).
     pub part: &'static str,
-    /// The bodies that use it (empty: every body).
-    pub bodies: &'static [&'static str],
     /// Its unit (`-`: none; a name field: empty).
     pub unit: &'static str,
     /// A short note: the allowed values or range (TOML comments, error messages).
@@ -35,15 +35,8 @@ pub struct FieldInfo {
     pub doc: &'static str,
 }
 
-const CHAIN: &[&str] = &["chain"];
-const LEG: &[&str] = &["leg"];
-const RODS: &[&str] = &["free_link", "chain"];
-/// The built-in bodies (a linkage's initial motion is in its elements).
-const BUILT_IN: &[&str] = &["free_link", "chain", "leg"];
-const ALL: &[&str] = &[];
-
 macro_rules! scene_fields {
-    ($($name:literal: $part:literal, $bodies:expr, $unit:literal, $note:literal, $doc:literal;)*) => {
+    ($($name:literal: $part:literal, $unit:literal, $note:literal, $doc:literal;)*) => {
         /// Every field of a scene, sorted by name (the core's slots).
         pub const SCENE_FIELDS: [&str; [$($name,)*].len()] = [$($name,)*];
 
@@ -51,7 +44,6 @@ macro_rules! scene_fields {
         pub static FIELDS: [FieldInfo; SCENE_FIELDS.len()] = [$(FieldInfo {
             name: $name,
             part: $part,
-            bodies: $bodies,
             unit: $unit,
             note: $note,
             doc: $doc,
@@ -70,89 +62,89 @@ macro_rules! scene_fields {
 }
 
 scene_fields! {
-    "ankle": "body", LEG, "", "locked, free or { k = N m/rad, c = N m s/rad }",
+    "ankle": "body", "", "locked, free or { k = N m/rad, c = N m s/rad }",
         "the ankle: \"locked\" (default), \"free\" or a spring-damper {\"k\": N m/rad, \"c\": N m s/rad} relaxed at the touchdown posture (the thesis's CAD model does not say)";
-    "apply_at": "forces", ALL, "", "tip or centroid",
+    "apply_at": "forces", "", "tip or centroid",
         "where the contact terms act: \"tip\" (default; the thesis's CAD runs, sec. 3.3.2) or \"centroid\" (the immersed centroid E, sec. 3.3.1; strictly dissipative)";
-    "atol": "solver", ALL, "-", "> 0",
+    "atol": "solver", "-", "> 0",
         "absolute tolerance of \"dopri5\" [SI units of each coordinate]";
-    "body": "body", ALL, "", "free_link, chain, leg or a linkage",
+    "body": "body", "", "free_link, chain, leg or a linkage",
         "the body: \"free_link\" (a round rod, 3 degrees of freedom), \"chain\" (two rods pinned at their top ends, 4), \"leg\" (foot, shank, thigh, half trunk, 6), each held as a granrs.bodies.Linkage, or a granrs.bodies.Linkage of your own (links, joints, contacts, root)";
-    "body_mass": "body", LEG, "kg", "> 0; the leg carries half",
+    "body_mass": "body", "kg", "> 0; the leg carries half",
         "body mass (thesis sec. 5.2.1: 75.35); the leg carries half of it";
-    "coefficients_source": "notes", ALL, "", "text",
+    "coefficients_source": "notes", "", "text",
         "where the force terms' parameters come from (for reports; not used by the run)";
-    "depth0": "start", BUILT_IN, "m", ">= 0",
+    "depth0": "start", "m", ">= 0",
         "initial depth of the tip (0: at the surface, as in the thesis)";
-    "diameter": "body", RODS, "m", "> 0",
+    "diameter": "body", "m", "> 0",
         "rod diameter d_c (thesis sec. 3.2.1: 0.0127); each chain link's";
-    "dt": "solver", ALL, "s", "> 0",
+    "dt": "solver", "s", "> 0",
         "step of the fixed-step RK4 (thesis sec. 3.3.2: 10 kHz, 1e-4); the first step of \"dopri5\"";
-    "end": "solver", ALL, "", "first_stop, all_stops or time",
+    "end": "solver", "", "first_stop, all_stops or time",
         "when the run ends: \"first_stop\" (the thesis's end of the penetration phase), \"all_stops\" or \"time\"";
-    "foot_deg": "start", LEG, "deg", "-60..60",
+    "foot_deg": "start", "deg", "-60..60",
         "sole pitch at touchdown, toe up (0: flat landing)";
-    "foot_length": "body", LEG, "m", "> 0",
+    "foot_length": "body", "m", "> 0",
         "foot size f_s (thesis sec. 5.3.2: 0.254)";
-    "forces": "forces", ALL, "", "[[forces]] tables: term = name and its parameters",
+    "forces": "forces", "", "[[forces]] tables: term = name and its parameters",
         "the force terms that act (granrs.forces), each with its parameters: one value for every contact or one per contact. Default: the thesis's law (gravity, drag, static_h, static_v, joint_springs) with each term's defaults, Table 3.4 at q = 0. A term not listed is neither computed nor stored, and a spring-damper joint is free without joint_springs; []: nothing acts";
-    "g": "medium", ALL, "m/s^2", ">= 0",
+    "g": "medium", "m/s^2", ">= 0",
         "gravitational acceleration (9.81, as in the thesis); the static terms scale with it, and the gravity term pulls with it";
-    "height": "body", LEG, "m", "> 0",
+    "height": "body", "m", "> 0",
         "body height H (thesis sec. 5.2.1: 1.78)";
-    "hip": "body", LEG, "", "locked, free or { k = N m/rad, c = N m s/rad }",
+    "hip": "body", "", "locked, free or { k = N m/rad, c = N m s/rad }",
         "the hip: as the ankle";
-    "hip_deg": "start", LEG, "deg", "-30..150",
+    "hip_deg": "start", "deg", "-30..150",
         "hip flexion at touchdown (granrs assumption: 20)";
-    "inertia": "body", RODS, "kg m^2", "> 0; left out: solid cylinder",
+    "inertia": "body", "kg m^2", "> 0; left out: solid cylinder",
         "moment of inertia about the centre of mass; None for a solid cylinder, m (L^2/12 + d_c^2/16)";
-    "knee": "body", LEG, "", "locked, free or { k = N m/rad, c = N m s/rad }",
+    "knee": "body", "", "locked, free or { k = N m/rad, c = N m s/rad }",
         "the knee: as the ankle";
-    "knee_deg": "start", LEG, "deg", "0..150",
+    "knee_deg": "start", "deg", "0..150",
         "knee flexion at touchdown (granrs assumption: 20)";
-    "length": "body", RODS, "m", "> 0",
+    "length": "body", "m", "> 0",
         "rod length L (thesis sec. 3.2.1: 0.190); each chain link's";
-    "mass": "body", RODS, "kg", "> 0",
+    "mass": "body", "kg", "> 0",
         "body mass m (thesis sec. 3.2.1: 0.184); each chain link's (not in the thesis: 0.0341, a solid steel link)";
-    "method": "solver", ALL, "", "rk4 or dopri5",
+    "method": "solver", "", "rk4 or dopri5",
         "the integrator: \"rk4\" (default: classical RK4 on the grid n dt) or \"dopri5\" (adaptive Dormand-Prince 5(4) with rtol and atol)";
-    "omega0": "start", RODS, "rad/s", "finite",
+    "omega0": "start", "rad/s", "finite",
         "initial angular velocity dq/dt";
-    "pin_joint": "body", CHAIN, "", "free, locked or { k = N m/rad, c = N m s/rad }",
+    "pin_joint": "body", "", "free, locked or { k = N m/rad, c = N m s/rad }",
         "the pin: \"free\" (the thesis's frictionless joint, sec. 4.1), \"locked\" or a spring-damper (rest angle: the initial one)";
-    "pin_mass": "body", CHAIN, "kg", ">= 0",
+    "pin_mass": "body", "kg", ">= 0",
         "mass of the pin, a point mass at the joint (0)";
-    "q2_deg": "start", CHAIN, "deg", "-90 < q2_deg < 90; left out: -q_deg",
+    "q2_deg": "start", "deg", "-90 < q2_deg < 90; left out: -q_deg",
         "link 2's angle from the vertical; None: -q_deg (mirror image)";
-    "q_deg": "start", RODS, "deg", "-90 < q_deg < 90",
+    "q_deg": "start", "deg", "-90 < q_deg < 90",
         "initial angle of the rod (chain: link 1) from the vertical";
-    "record": "outputs", ALL, "", "from state, forces, energy",
+    "record": "outputs", "", "from state, forces, energy",
         "time series to record, from RECORDS (none by default)";
-    "record_stride": "outputs", ALL, "-", "a whole number >= 1; with record, t_end / dt / record_stride <= 1e7 samples",
+    "record_stride": "outputs", "-", "a whole number >= 1; with record, t_end / dt / record_stride <= 1e7 samples",
         "record every n-th step (events are always recorded)";
-    "rho_g": "medium", ALL, "kg/m^3", "> 0",
+    "rho_g": "medium", "kg/m^3", "> 0",
         "bulk density of the sand, packing included (thesis sec. 3.3.1: 1650; the leg's sand, sec. 5.3.2: 1600)";
-    "rtol": "solver", ALL, "-", ">= 2.2e-14 (100 x f64's epsilon)",
+    "rtol": "solver", "-", ">= 2.2e-14 (100 x f64's epsilon)",
         "relative tolerance of \"dopri5\"";
-    "shoe_width": "body", LEG, "m", "> 0",
+    "shoe_width": "body", "m", "> 0",
         "shoe width w_s (thesis sec. 5.3.2: 0.086)";
-    "sign_model": "forces", ALL, "", "modes, raw or smooth",
+    "sign_model": "forces", "", "modes, raw or smooth",
         "how the static terms take the sign of the velocity: \"modes\" (default: each sign held through a step, switches located exactly, sticking handled), \"raw\" (the thesis's plain sign) or \"smooth\" (tanh(v / smooth_eps))";
-    "smooth_eps": "forces", ALL, "m/s", "> 0",
+    "smooth_eps": "forces", "m/s", "> 0",
         "velocity scale of the \"smooth\" sign model";
-    "sole_height": "body", LEG, "m", "> 0; left out: the tibia length",
+    "sole_height": "body", "m", "> 0; left out: the tibia length",
         "height of the contact box above the sole; None: the tibia length (the sole's footprint carried up the leg, so V keeps growing as f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count";
-    "sole_model": "body", LEG, "", "box or thesis",
+    "sole_model": "body", "", "box or thesis",
         "the sole's contact: \"box\" (the geometric box of docs/model.md) or \"thesis\" (eqs. 5.5-5.7 with the shank's angle; finite only for 1 <= shank angle <= 89 deg)";
-    "t_end": "solver", ALL, "s", "> 0; t_end / dt <= 1e9 steps",
+    "t_end": "solver", "s", "> 0; t_end / dt <= 1e9 steps",
         "latest end time";
-    "tibia_length": "body", LEG, "m", "> 0",
+    "tibia_length": "body", "m", "> 0",
         "tibia l_l (thesis sec. 5.3.2: 0.432): the shank and L_ref of eq. 5.4";
-    "trunk_deg": "start", LEG, "deg", "-60..60",
+    "trunk_deg": "start", "deg", "-60..60",
         "trunk lean forward at touchdown (granrs assumption: 10)";
-    "v0": "start", BUILT_IN, "m/s", ">= 0",
+    "v0": "start", "m/s", ">= 0",
         "initial downward speed";
-    "vx0": "start", BUILT_IN, "m/s", "finite",
+    "vx0": "start", "m/s", "finite",
         "initial horizontal velocity of the tip";
 }
 

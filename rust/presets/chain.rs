@@ -20,6 +20,20 @@ pub const PRESET: Preset = Preset {
     name: "chain",
     build,
     renames: &[("joints.pin", "pin_joint")],
+    fields: &[
+        "length",
+        "diameter",
+        "mass",
+        "inertia",
+        "pin_mass",
+        "pin_joint",
+        "q_deg",
+        "q2_deg",
+        "v0",
+        "depth0",
+        "vx0",
+        "omega0",
+    ],
 };
 
 /// Two rods pinned at their top ends (MODEL.md, "Bodies").

@@ -12,6 +12,9 @@ pub const PRESET: Preset = Preset {
     name: "free_link",
     build,
     renames: &[],
+    fields: &[
+        "length", "diameter", "mass", "inertia", "q_deg", "v0", "depth0", "vx0", "omega0",
+    ],
 };
 
 /// A free round-ended link dropped onto sand, tip first (MODEL.md, "Bodies").

@@ -22,6 +22,25 @@ pub const PRESET: Preset = Preset {
         ("joints.knee", "knee"),
         ("joints.hip", "hip"),
     ],
+    fields: &[
+        "body_mass",
+        "height",
+        "foot_length",
+        "shoe_width",
+        "tibia_length",
+        "sole_height",
+        "ankle",
+        "knee",
+        "hip",
+        "knee_deg",
+        "hip_deg",
+        "trunk_deg",
+        "foot_deg",
+        "sole_model",
+        "v0",
+        "depth0",
+        "vx0",
+    ],
 };
 
 /// Names of the leg's joints, in order (each a scene field).

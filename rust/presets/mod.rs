@@ -20,6 +20,10 @@ use crate::integrate::SolveOptions;
 pub mod chain;
 pub mod free_link;
 pub mod leg;
+#[cfg(test)]
+mod plate;
+#[cfg(test)]
+mod tests;
 
 /// What a preset reads of a scene: its named fields, typed (the error names the field).
 pub trait Fields {
@@ -76,10 +80,20 @@ pub struct Preset {
     /// Joint paths of the linkage (`joints.<name>`) and the scene field that sets each, so
     /// that an error of the linkage's checks names the field the user wrote.
     pub renames: &'static [(&'static str, &'static str)],
+    /// The scene fields it reads besides every scene's ([`Fields::setting`]): the fields
+    /// that apply to it (and to the other presets that read them) only.
+    pub fields: &'static [&'static str],
 }
 
 /// Every preset, one line each.
-pub static PRESETS: [Preset; 3] = [free_link::PRESET, chain::PRESET, leg::PRESET];
+pub static PRESETS: &[Preset] = &[
+    free_link::PRESET,
+    chain::PRESET,
+    leg::PRESET,
+    // The worked example of a new preset (docs/bodies), a fixture of the crate's tests.
+    #[cfg(test)]
+    plate::PRESET,
+];
 
 /// The preset named `name`.
 pub fn preset(name: &str) -> Option<&'static Preset> {
@@ -89,6 +103,15 @@ pub fn preset(name: &str) -> Option<&'static Preset> {
 /// The presets' names.
 pub fn names() -> Vec<&'static str> {
     PRESETS.iter().map(|p| p.name).collect()
+}
+
+/// The presets that read the scene field `field` (empty: a field every body reads).
+pub fn bodies_of(field: &str) -> Vec<&'static str> {
+    PRESETS
+        .iter()
+        .filter(|p| p.fields.contains(&field))
+        .map(|p| p.name)
+        .collect()
 }
 
 impl Preset {

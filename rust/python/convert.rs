@@ -174,7 +174,7 @@ pub fn scene_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     let out = PyList::empty(py);
     for f in crate::spec::FIELDS.iter() {
         out.append(py_dict!(py, {
-            "name": f.name, "part": f.part, "bodies": f.bodies.to_vec(), "unit": f.unit,
+            "name": f.name, "part": f.part, "bodies": crate::presets::bodies_of(f.name), "unit": f.unit,
             "note": f.note, "doc": f.doc,
         }))?;
     }
