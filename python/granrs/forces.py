@@ -126,9 +126,10 @@ class TermInfo:
     columns: tuple[str, ...]
 
 
-def _load() -> dict[str, TermInfo]:
+def _load(registry: Iterable[Mapping[str, Any]] | None = None) -> dict[str, TermInfo]:
+    """The registry's terms by name (``registry``: the core's ``term_infos()`` by default)."""
     out = {}
-    for d in _granrs.term_infos():
+    for d in _granrs.term_infos() if registry is None else registry:
         out[d["name"]] = TermInfo(
             name=d["name"],
             summary=d["summary"],
@@ -447,7 +448,7 @@ def signature(ti: TermInfo) -> inspect.Signature:
     (and all that follow) is keyword-only. A term with the RFT coefficients also takes
     ``coefficients`` (keyword-only)."""
     out = []
-    kind = inspect.Parameter.POSITIONAL_OR_KEYWORD
+    kind: inspect._ParameterKind = inspect.Parameter.POSITIONAL_OR_KEYWORD
     defaulted = False
     for p in ti.params:
         if p.required and defaulted:
