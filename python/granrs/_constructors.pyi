@@ -22,7 +22,9 @@ __all__ = [
 def gravity() -> Term:
     """``gravity``: the weight of every link, at its centre of mass.
 
-    ``F_i = -m_i g y_hat  (each link i)``
+    Equation, in granrs's frame::
+
+        F_i = -m_i g y_hat  (each link i)
 
     Acts on the body (through the mechanism). Reads each link's mass and centre of mass; g
     of the medium. Source: granrs's model, docs/model.md (frame, units and the impact).
@@ -39,7 +41,9 @@ def drag(
 ) -> Term:
     """``drag``: dynamic drag, quadratic in the speed of the immersed centroid E.
 
-    ``F_d = -eta_d rho_g A_r |v_E| v_E,  A_r |v_E| = d_c l |e x v_E| (rod)``
+    Equation, in granrs's frame::
+
+        F_d = -eta_d rho_g A_r |v_E| v_E,  A_r |v_E| = d_c l |e x v_E| (rod)
 
     Acts on each contact in the sand (adds to the thesis's F_d). Reads rho_g; the contact's
     A_r |v_E| and v_E. Owns the switches: sign of e x v_E. Series columns with
@@ -61,7 +65,9 @@ def static_h(
 ) -> Term:
     """``static_h``: static horizontal resistance, Coulomb-like in the sign of v_Ex.
 
-    ``F_sh = -sgn(v_Ex) eta_h g rho_g w d^2  (along x)``
+    Equation, in granrs's frame::
+
+        F_sh = -sgn(v_Ex) eta_h g rho_g w d^2  (along x)
 
     Acts on each contact in the sand (adds to the thesis's F_s). Reads g, rho_g; the
     contact's width w, depth d and the sign of v_Ex. Owns the switches: sign of v_Ex,
@@ -85,7 +91,9 @@ def static_v(
 ) -> Term:
     """``static_v``: static vertical resistance, Coulomb-like in the sign of v_Ey.
 
-    ``F_sv = -sgn(v_Ey) eta_v (d / L_ref)^lam g rho_g V  (along y)``
+    Equation, in granrs's frame::
+
+        F_sv = -sgn(v_Ey) eta_v (d / L_ref)^lam g rho_g V  (along y)
 
     Acts on each contact in the sand (adds to the thesis's F_s). Reads g, rho_g; the
     contact's depth d, L_ref, immersed volume V and the sign of v_Ey. Owns the switches:
@@ -107,7 +115,9 @@ def static_v(
 def joint_springs() -> Term:
     """``joint_springs``: the joints' rotational spring-dampers (k, c on each joint).
 
-    ``tau = -k (theta - theta_rest) - c dtheta/dt  (each spring-damper joint)``
+    Equation, in granrs's frame::
+
+        tau = -k (theta - theta_rest) - c dtheta/dt  (each spring-damper joint)
 
     Acts on the body (through the mechanism). Reads each spring-damper joint's relative
     angle and rate. Source: granrs (docs/bodies/leg.md, docs/bodies/linkage.md).
@@ -125,8 +135,10 @@ def poncelet(
 ) -> Term:
     """``poncelet``: Poncelet / Katsuragi-Durian impact law at the reference point.
 
-    ``F = -c rho_g A |v| v - k d v/|v|  at E (v: E's velocity; d: the depth; A: immersed
-    cross-section normal to v)``
+    Equation, in granrs's frame::
+
+        F = -c rho_g A |v| v - k d v/|v|  at E (v: E's velocity; d: the depth; A: immersed
+            cross-section normal to v)
 
     Acts on each contact in the sand (adds to the thesis's F_s). Reads rho_g; the contact's
     depth d, v_E and E, its axis and immersed outline; the held signs of v_E (sticking).
@@ -164,8 +176,10 @@ def rft(
 ) -> Term:
     """``rft``: planar resistive force theory over the contact's boundary elements.
 
-    ``dF = zeta |z| dA (-alpha_x(beta, gamma), alpha_z(beta, gamma)), summed over the
-    immersed elements``
+    Equation, in granrs's frame::
+
+        dF = zeta |z| dA (-alpha_x(beta, gamma), alpha_z(beta, gamma)), summed over the
+            immersed elements
 
     Acts on each contact in the sand (adds to the thesis's F_s). Reads the contact's
     boundary plates (frame and outline), each element's depth and velocity; the held signs
@@ -215,7 +229,9 @@ def rft_inertial(
     """``rft_inertial``: the inertial term of dynamic RFT: momentum flux on the leading
     elements.
 
-    ``dF = -lam rho_g |v_n| v_n n dA,  v_n = v . n, summed over the immersed elements``
+    Equation, in granrs's frame::
+
+        dF = -lam rho_g |v_n| v_n n dA,  v_n = v . n, summed over the immersed elements
 
     Acts on each contact in the sand (adds to the thesis's F_d). Reads rho_g; the contact's
     boundary plates (frame and outline), each element's velocity normal to it. Series

@@ -15,8 +15,8 @@ A parameter is a number for every contact, or a tuple with one value per contact
 chain's two links)::
 
     >>> import granrs
-    >>> granrs.forces.static_v(eta_v=248.0, lam=0.106)
-    static_v(eta_v=248.0, lam=0.106)
+    >>> granrs.forces.static_v(eta_v=53.0, lam=0.25)
+    static_v(eta_v=53.0, lam=0.25)
     >>> granrs.forces.term("drag", eta_d=(13.0, 10.0)).params["eta_d"]
     (13.0, 10.0)
     >>> granrs.forces.drag().info.params[0].unit
@@ -497,7 +497,8 @@ def docstring(ti: TermInfo) -> str:
         if ti.acts == "contact"
         else "the body (through the mechanism)"
     )
-    lines = [*_fill(f"``{ti.name}``: {ti.summary}."), "", *_fill(f"``{ti.equation}``"), ""]
+    lines = [*_fill(f"``{ti.name}``: {ti.summary}."), "", "Equation, in granrs's frame::", ""]
+    lines += [*_fill(ti.equation, "    "), ""]
     about = f"Acts on {acts}. Reads {ti.reads}."
     if ti.switches:
         about += f" Owns the switches: {'; '.join(ti.switches)}."
