@@ -151,6 +151,20 @@ def test_a_new_registry_term_gets_a_constructor_docstring_and_stub_without_an_ed
         mine(q=1.0)
 
 
+def test_the_shapes_a_term_acts_on_are_read_when_the_core_lists_them() -> None:
+    """A registry entry with ``shapes`` (the contact shapes a term is defined on) has them in
+    its info, docstring and page; without the key (a core that does not list them) the
+    info says ``None`` and nothing is claimed."""
+    raw = _fake_registry()
+    without = forces._load(raw)["my_term"]
+    assert without.shapes is None
+    assert "contact shapes" not in forces.docstring(without)
+    raw[-1] = {**raw[-1], "shapes": ["rod", "box"]}
+    with_shapes = forces._load(raw)["my_term"]
+    assert with_shapes.shapes == ("rod", "box")
+    assert "Defined on the contact shapes: rod, box." in forces.docstring(with_shapes)
+
+
 def test_a_term_whose_name_the_module_uses_is_refused() -> None:
     infos = forces._load(_fake_registry())
     clash = dataclasses.replace(infos["my_term"], name="select")

@@ -244,6 +244,11 @@ def term_rst(name: str) -> str:
         "   * - acts on",
         f"     - {'each contact in the sand' if info.acts == 'contact' else 'the body'}"
         f" (``{info.acts}``)",
+        *(
+            ["   * - contact shapes", f"     - {', '.join(_literal(s) for s in info.shapes)}"]
+            if info.shapes is not None
+            else []
+        ),
         "   * - class",
         f"     - ``{info.klass}`` (adds to the thesis's "
         f"{'F_d' if info.klass == 'dynamic' else 'F_s'})",

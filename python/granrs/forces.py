@@ -111,6 +111,8 @@ class TermInfo:
         reads: what it reads of the state.
         switches: the engine's sign switches it owns (located events with ``"modes"``).
         columns: its per-contact series columns with ``record=("forces",)``.
+        shapes: the contact shapes a contact term is defined on (``"rod"``, ``"box"``,
+            ``"arc"``), when the core lists them; ``None`` if it does not.
     """
 
     name: str
@@ -124,6 +126,7 @@ class TermInfo:
     reads: str
     switches: tuple[str, ...]
     columns: tuple[str, ...]
+    shapes: tuple[str, ...] | None = None
 
 
 def _load(registry: Iterable[Mapping[str, Any]] | None = None) -> dict[str, TermInfo]:
@@ -142,6 +145,7 @@ def _load(registry: Iterable[Mapping[str, Any]] | None = None) -> dict[str, Term
             reads=d["reads"],
             switches=tuple(d["switches"]),
             columns=tuple(d["columns"]),
+            shapes=tuple(d["shapes"]) if d.get("shapes") is not None else None,
         )
     return out
 
@@ -499,7 +503,10 @@ def docstring(ti: TermInfo) -> str:
     )
     lines = [*_fill(f"``{ti.name}``: {ti.summary}."), "", "Equation, in granrs's frame::", ""]
     lines += [*_fill(ti.equation, "    "), ""]
-    about = f"Acts on {acts}. Reads {ti.reads}."
+    about = f"Acts on {acts}."
+    if ti.shapes is not None:
+        about += f" Defined on the contact shapes: {', '.join(ti.shapes) or 'none'}."
+    about += f" Reads {ti.reads}."
     if ti.switches:
         about += f" Owns the switches: {'; '.join(ti.switches)}."
     if ti.columns:
