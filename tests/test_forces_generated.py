@@ -162,7 +162,8 @@ def test_the_shapes_a_term_acts_on_are_read_when_the_core_lists_them() -> None:
     raw[-1] = {**raw[-1], "shapes": ["rod", "box"]}
     with_shapes = forces._load(raw)["my_term"]
     assert with_shapes.shapes == ("rod", "box")
-    assert "Defined on the contact shapes: rod, box." in forces.docstring(with_shapes)
+    doc = " ".join(forces.docstring(with_shapes).split())
+    assert "Defined on the contact shapes: rod, box." in doc
 
 
 def test_a_term_whose_name_the_module_uses_is_refused() -> None:
