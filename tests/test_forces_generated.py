@@ -28,6 +28,13 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "python" / "granrs"
 
 
+def _docs_generator() -> Any:
+    """The docs' page generator (``docs/_ext/granrs_docs.py``), as the docs tests load it."""
+    from test_docs_api import gen
+
+    return gen
+
+
 def _registry() -> list[dict[str, Any]]:
     return list(_granrs.term_infos())
 
@@ -153,17 +160,18 @@ def test_a_new_registry_term_gets_a_constructor_docstring_and_stub_without_an_ed
 
 def test_the_shapes_a_term_acts_on_are_read_when_the_core_lists_them() -> None:
     """A registry entry with ``shapes`` (the contact shapes a term is defined on) has them in
-    its info, docstring and page; without the key (a core that does not list them) the
-    info says ``None`` and nothing is claimed."""
+    its info and its docs page; without the key (a core that does not list them) the info
+    says ``None`` and the page claims nothing."""
     raw = _fake_registry()
-    without = forces._load(raw)["my_term"]
-    assert without.shapes is None
-    assert "contact shapes" not in forces.docstring(without)
+    assert forces._load(raw)["my_term"].shapes is None
     raw[-1] = {**raw[-1], "shapes": ["rod", "box"]}
-    with_shapes = forces._load(raw)["my_term"]
-    assert with_shapes.shapes == ("rod", "box")
-    doc = " ".join(forces.docstring(with_shapes).split())
-    assert "Defined on the contact shapes: rod, box." in doc
+    assert forces._load(raw)["my_term"].shapes == ("rod", "box")
+    for name, d in zip(forces.TERMS, _registry(), strict=True):
+        page = _docs_generator().term_rst(name)
+        if "shapes" in d and d["acts"] == "contact":
+            assert f"contact shapes\n     - {', '.join(f'``{s}``' for s in d['shapes'])}" in page
+        else:
+            assert "contact shapes" not in page
 
 
 def test_a_term_whose_name_the_module_uses_is_refused() -> None:
@@ -176,7 +184,9 @@ def test_a_term_whose_name_the_module_uses_is_refused() -> None:
 def test_the_committed_stub_is_the_registry_s() -> None:
     """``granrs/_constructors.pyi`` is what ``python -m granrs._stubgen`` writes from this
     core: a term added to the core without regenerating it fails here."""
-    assert _stubgen.PATH.read_text(encoding="utf-8") == _stubgen.text()
+    assert _stubgen.PATH.read_text(encoding="utf-8") == _stubgen.text(), (
+        "the stub is not the registry's: run python -m granrs._stubgen"
+    )
     assert _stubgen.main(["--check"]) == 0
 
 

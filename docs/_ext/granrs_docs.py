@@ -246,7 +246,7 @@ def term_rst(name: str) -> str:
         f" (``{info.acts}``)",
         *(
             ["   * - contact shapes", f"     - {', '.join(_literal(s) for s in info.shapes)}"]
-            if info.shapes is not None
+            if info.shapes is not None and info.acts == "contact"
             else []
         ),
         "   * - class",

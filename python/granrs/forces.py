@@ -112,7 +112,8 @@ class TermInfo:
         switches: the engine's sign switches it owns (located events with ``"modes"``).
         columns: its per-contact series columns with ``record=("forces",)``.
         shapes: the contact shapes a contact term is defined on (``"rod"``, ``"box"``,
-            ``"arc"``), when the core lists them; ``None`` if it does not.
+            ``"arc"``), when the core lists them; ``None`` if it does not. (Not in the
+            constructors' docstrings, so that their stub does not change with a shape.)
     """
 
     name: str
@@ -301,9 +302,8 @@ def rft_alpha(beta: Any, gamma: Any, coefficients: Mapping[str, float] | None = 
     return ax.reshape(b.shape), az.reshape(b.shape)
 
 
-#: The thesis's law (its chapters 3-5): the terms that act, in their order. A law is data: a
-#: combination of registered terms.
-THESIS_TERMS: tuple[str, ...] = ("gravity", "drag", "static_h", "static_v", "joint_springs")
+#: The thesis's law (its chapters 3-5): the terms that act, in their order (the core's).
+THESIS_TERMS: tuple[str, ...] = tuple(_granrs.EFFECTS)
 #: The columns of the thesis's coefficient tables (:class:`granrs.Coefficients`), each the
 #: term and parameter it sets.
 THESIS_COLUMNS: Mapping[str, tuple[str, str]] = MappingProxyType(
@@ -503,10 +503,7 @@ def docstring(ti: TermInfo) -> str:
     )
     lines = [*_fill(f"``{ti.name}``: {ti.summary}."), "", "Equation, in granrs's frame::", ""]
     lines += [*_fill(ti.equation, "    "), ""]
-    about = f"Acts on {acts}."
-    if ti.shapes is not None:
-        about += f" Defined on the contact shapes: {', '.join(ti.shapes) or 'none'}."
-    about += f" Reads {ti.reads}."
+    about = f"Acts on {acts}. Reads {ti.reads}."
     if ti.switches:
         about += f" Owns the switches: {'; '.join(ti.switches)}."
     if ti.columns:
