@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from . import forces
+from ._files import replacing
 
 #: The stub's path.
 PATH = Path(__file__).with_name(f"{forces.STUB_MODULE}.pyi")
@@ -31,7 +32,8 @@ def main(argv: list[str] | None = None) -> int:
             return 1
         return 0
     if old != new:
-        PATH.write_text(new, encoding="utf-8")
+        with replacing(PATH) as tmp:
+            tmp.write_text(new, encoding="utf-8")
         print(f"wrote {PATH}")
     return 0
 
