@@ -32,6 +32,7 @@ from __future__ import annotations
 import argparse
 import collections
 import dataclasses
+import inspect
 import math
 import random
 import sys
@@ -211,7 +212,8 @@ def term_case(pick: Pick) -> Case:
     info = forces.info(name)
     params = [p.name for p in info.params]
     constructor = getattr(forces, name)
-    extra = ["coefficients"] if name == "rft" else []
+    # The constructor's own arguments beyond the registry's (rft's coefficients mapping).
+    extra = [a for a in inspect.signature(constructor).parameters if a not in params]
     param = pick([*params, *extra] or ["<none>"], "parameter")
     value = pick([*BAD, 0.5, 8, 1e6, 2000, 1024], "value")
     required = {p.name: (1e6 if p.name == "zeta" else 1.0) for p in info.params if p.required}

@@ -45,7 +45,6 @@ gen = _generator()
 
 #: Python blocks of the pages that are not run, by (page, index among its python blocks).
 NOT_RUN = {
-    ("forces.md", 1): "a constructor to add to python/granrs/forces.py (a worked example)",
     ("sweeps.md", 3): "needs a Dask scheduler",
 }
 #: Blocks that show an error: the exception they must raise.
@@ -103,6 +102,21 @@ def test_every_force_term_has_a_page_from_the_registry() -> None:
         assert f'term = "{name}"' in page
     index = pages[f"{gen.GENERATED}/terms/index.rst"]
     assert all(f"<term-{name}>" in index for name in forces.TERMS)
+
+
+def test_the_forces_page_table_is_the_registry_s() -> None:
+    """docs/forces.md's table of terms is generated (it was typed by hand, with the
+    defaults 15.2, 6.5, 248.0 and 0.106 written there): one row per registered term, each
+    parameter with its registry default and source."""
+    page = (DOCS / "forces.md").read_text(encoding="utf-8")
+    assert ".. granrs-terms-table::" in page
+    assert "| `drag` |" not in page
+    rows = gen.terms_table_rows()
+    assert [r[0] for r in rows] == [f":ref:`{n} <term-{n}>`" for n in forces.TERMS]
+    for row, name in zip(rows, forces.TERMS, strict=True):
+        for p in forces.info(name).params:
+            value = "required" if p.required else repr(int(p.default) if p.integer else p.default)
+            assert f"``{p.name}`` [" in row[3] and f"({value};" in row[3], (name, p.name)
 
 
 def test_scene_docstring_describes_every_field() -> None:

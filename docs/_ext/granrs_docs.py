@@ -17,6 +17,9 @@ In Markdown pages these directives go inside an ``{eval-rst}`` block.
     ``:case:`` expression gives (e.g. ``granrs.cases.chain()``) and the field's description
     from the ``Scene`` docstring (units, default, source). ``:shared:`` lists the fields
     every body has instead.
+``.. granrs-terms-table::``
+    Every registered force term: what it acts on, its equation, its parameters with units,
+    defaults and their sources, and the switches it owns (``granrs.forces.info``).
 ``.. granrs-leg-segments::``
     The leg's segments (mass, length, centre of mass, inertia) of ``granrs.cases.leg()``.
 ``.. granrs-scene-template:: BODY``
@@ -242,6 +245,11 @@ def term_rst(name: str) -> str:
         "   * - acts on",
         f"     - {'each contact in the sand' if info.acts == 'contact' else 'the body'}"
         f" (``{info.acts}``)",
+        *(
+            ["   * - contact shapes", f"     - {', '.join(_literal(s) for s in info.shapes)}"]
+            if info.shapes is not None and info.acts == "contact"
+            else []
+        ),
         "   * - class",
         f"     - ``{info.klass}`` (adds to the thesis's "
         f"{'F_d' if info.klass == 'dynamic' else 'F_s'})",
@@ -317,6 +325,30 @@ def term_rst(name: str) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+def _param_cell(p: Any) -> str:
+    unit = "dimensionless" if p.unit == "-" else rst_escape(p.unit)
+    value = "required" if p.required else _number(int(p.default) if p.integer else p.default)
+    return f"``{p.name}`` [{unit}] ({value}; {rst_escape(p.source)})"
+
+
+def terms_table_rows() -> list[list[str]]:
+    """Rows of the terms' table: term, acts on, equation, parameters (unit, default and its
+    source), switches owned; from the registry, in its order."""
+    rows = []
+    for name in forces.TERMS:
+        info = forces.info(name)
+        rows.append(
+            [
+                f":ref:`{name} <term-{name}>`",
+                info.acts,
+                f"``{info.equation}``",
+                "; ".join(_param_cell(p) for p in info.params) or "none",
+                "; ".join(rst_escape(s) for s in info.switches) or "none",
+            ]
+        )
+    return rows
 
 
 def terms_index_rst() -> str:
@@ -770,6 +802,13 @@ def setup(app: Any) -> dict[str, Any]:
             header = ["element", "field", "unit", "allowed", "what it is"]
             return list_table(header, element_fields_rows(), "10 14 10 20 46")
 
+    class TermsTable(_RstDirective):
+        """``.. granrs-terms-table::``: every registered term, from the registry."""
+
+        def rst(self) -> str:
+            header = ["term", "acts on", "equation (granrs frame)", "parameters", "switches"]
+            return list_table(header, terms_table_rows(), "12 8 30 35 15")
+
     class LegSegments(_RstDirective):
         """``.. granrs-leg-segments::``."""
 
@@ -863,6 +902,7 @@ def setup(app: Any) -> dict[str, Any]:
     app.connect("build-finished", finished)
     app.add_directive("granrs-body-fields", BodyFields)
     app.add_directive("granrs-leg-segments", LegSegments)
+    app.add_directive("granrs-terms-table", TermsTable)
     app.add_directive("granrs-element-fields", ElementFields)
     app.add_directive("granrs-scene-template", SceneTemplate)
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}

@@ -97,8 +97,9 @@ class Law:
             coefficients for the row (Table 3.4, 4.4 or sec. 5.3.2); ``terms`` are then
             added to them.
         terms: the terms (beyond the thesis's, if ``thesis``) as ``(name, {param:
-            value})``; a fitted parameter's value is its start. The body's terms
-            (``gravity``, ``joint_springs``) are added when missing.
+            value})``; a fitted parameter's value is its start. The terms that act on the
+            body (the registry's body terms: ``gravity``, ``joint_springs``) are added when
+            missing.
         fit: the parameters to fit on every dataset: ``{name: (start, low, high)}``, names
             as :func:`granrs.calibrate` takes them (``scale.static_v.eta_v``,
             ``poncelet.c``, ...).
@@ -127,7 +128,7 @@ class Law:
 
     def needs(self) -> tuple[str, ...]:
         """Every term the law lists (the body's included)."""
-        names = ["gravity", "drag", "static_h", "static_v"] if self.thesis else []
+        names = _forces.THESIS_TERMS if self.thesis else ()
         return (*names, *(t for t, _ in self.terms))
 
     def terms_for(self, body: str) -> Callable[[Mapping[str, Any]], tuple[_forces.Term, ...]]:
@@ -143,17 +144,29 @@ class Law:
             held = {k.split(".", 1)[1]: v for k, v in fixed.items() if k.startswith(name + ".")}
             extra.append(_forces.term(name, **{**params, **held, **starts}))
         listed = {t.name for t in extra}
+        head, tail = _body_terms()
 
         def law(row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
             if self.thesis:
                 base = _forces.thesis(base_coefficients(body, row))
-                base = tuple(t for t in base if t.name != "joint_springs")
+                base = tuple(t for t in base if t.name not in tail)
             else:
-                base = () if "gravity" in listed else (_forces.gravity(),)
-            tail = () if "joint_springs" in listed else (_forces.joint_springs(),)
-            return (*base, *extra, *tail)
+                base = tuple(_forces.term(n) for n in head if n not in listed)
+            after = tuple(_forces.term(n) for n in tail if n not in listed)
+            return (*base, *extra, *after)
 
         return law
+
+
+def _body_terms() -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The terms that act on the body (the registry's ``acts == "body"``: its weight, its
+    joints) that a law gets when it does not list them: those the thesis's law lists before
+    its contact terms, and the others, after the law's own terms."""
+    body = [n for n in _forces.TERMS if _forces.info(n).acts == "body"]
+    thesis = _forces.THESIS_TERMS
+    first = next(i for i, n in enumerate(thesis) if _forces.info(n).acts == "contact")
+    head = tuple(n for n in thesis[:first] if n in body)
+    return head, tuple(n for n in body if n not in head)
 
 
 #: The thesis's law refit: scale factors on its published coefficients for the row, which

@@ -25,13 +25,18 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from . import _granrs
+from . import _granrs, forces
 from .coefficients import Coefficients
 from .errors import InvalidParameterError
 
 __all__ = ["ResistanceForce", "resistance_force"]
 
-_TABLE_3_4_VERTICAL = Coefficients(eta_h=6.5, eta_d=15.2, eta_v=248.0, lam=0.106)
+#: The thesis's law at its terms' defaults (Table 3.4 at q = 0), read from the registry.
+_DEFAULT_COEFFICIENTS: Coefficients = forces.thesis_row(forces.thesis())
+#: The thesis's terms that act on a contact (the others have no force here).
+_THESIS_CONTACT_TERMS: tuple[str, ...] = tuple(
+    name for name in forces.THESIS_TERMS if forces.info(name).acts == "contact"
+)
 
 
 class ResistanceForce(NamedTuple):
@@ -91,7 +96,7 @@ def resistance_force(
     diameter: float = 0.0127,
     rho_g: float = 1650.0,
     g: float = 9.81,
-    effects: Iterable[str] = ("drag", "static_h", "static_v"),
+    effects: Iterable[str] = _THESIS_CONTACT_TERMS,
     sign_model: str = "raw",
     smooth_eps: float = 1e-3,
 ) -> ResistanceForce:
@@ -105,7 +110,8 @@ def resistance_force(
         vx, vy: velocity of the tip [m/s] (y up: a sinking tip has vy < 0).
         omega: angular velocity dq/dt [rad/s].
         coefficients: a :class:`granrs.Coefficients`, or a mapping of ``eta_h``, ``eta_d``,
-            ``eta_v``, ``lam`` to numbers or arrays (default: Table 3.4 at q = 0).
+            ``eta_v``, ``lam`` to numbers or arrays (default: the defaults of the terms,
+            :func:`granrs.forces.thesis`: Table 3.4 at q = 0).
         length: rod length L [m] (also L_ref; thesis sec. 3.2.1: 0.190).
         diameter: rod diameter d_c [m] (also the width w; thesis sec. 3.2.1: 0.0127).
         rho_g: bulk density of the sand [kg/m^3] (thesis sec. 3.3.1: 1650).
@@ -131,7 +137,7 @@ def resistance_force(
         >>> round(float(f.F_sv), 2)
         22.07
     """
-    c = _TABLE_3_4_VERTICAL if coefficients is None else coefficients
+    c = _DEFAULT_COEFFICIENTS if coefficients is None else coefficients
     if isinstance(c, Coefficients):
         c = c.as_dict()
     if not isinstance(c, Mapping):

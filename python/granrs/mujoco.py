@@ -541,7 +541,7 @@ def rod_drop(
     v_c = np.array([scene.vx0, -scene.v0]) + scene.omega0 * half * normal
     data.qpos[:] = [half * e[0], half * e[1] - scene.depth0, q]
     data.qvel[:] = [v_c[0], v_c[1], scene.omega0]
-    contact = [t for t in scene.forces if t.name not in ("gravity", "joint_springs")]
+    contact = [t for t in scene.forces if t.info.acts == "contact"]
     sand = Sand(
         model,
         ["rod"],

@@ -41,12 +41,7 @@ except ImportError:  # pragma: no cover - older builds have neither
 __all__: list[str] = []  # all of it is internal to granrs.calibrate
 
 #: The thesis's coefficients by their short names: the term and parameter each is.
-ALIASES: dict[str, tuple[str, str]] = {
-    "eta_h": ("static_h", "eta_h"),
-    "eta_d": ("drag", "eta_d"),
-    "eta_v": ("static_v", "eta_v"),
-    "lam": ("static_v", "lam"),
-}
+ALIASES: Mapping[str, tuple[str, str]] = _forces.THESIS_COLUMNS
 _COEFS = tuple(ALIASES)
 _JOINTS = ("k", "c")
 #: A body's unknowns that a fit may take, by body: Scene fields (``mass``: the link mass

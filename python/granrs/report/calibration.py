@@ -30,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..calibrate import CalibrationResult, Measurements, calibrate, evaluate, within
+from ..coefficients import table_3_4
 from .format import _fmt, md_table, table_3_1_drop, watch_caption
 from .framework import ReportContext, register_chapter
 
@@ -141,7 +142,8 @@ def _fit_vertical(
             out += [(d - r.depth_mean) / r.depth_sd, (t - r.t_s_mean) / r.t_s_sd]
         return np.nan_to_num(np.array(out), nan=1e3)
 
-    x0 = [math.log(248.0), 0.106] + ([math.log(0.05)] if drag else [])
+    row = table_3_4(0.0)[0]
+    x0 = [math.log(row.eta_v), row.lam] + ([math.log(0.05)] if drag else [])
     lo = [-5.0, lam_low] + ([-12.0] if drag else [])
     hi = [15.0, 3.0] + ([3.0] if drag else [])
     fit = least_squares(res, x0, bounds=(lo, hi))
@@ -342,7 +344,8 @@ def _ch_free_link(ctx: ReportContext) -> str:
             tension[qs[0]] = r
     with ctx.step("calibration: q = 0, independent 1-D integration with lambda < 0 allowed"):
         rows0 = vertical_rows.rows
-        check_t, check_d = vertical_drop(248.0, 0.106, float(rows0["v0_mean"].iloc[0]))
+        row = table_3_4(0.0)[0]
+        check_t, check_d = vertical_drop(row.eta_v, row.lam, float(rows0["v0_mean"].iloc[0]))
         g_t = base.loc[0, "t_s_sim"]
         g_d = base.loc[0, "depth_sim"]
         eta_pos, lam_pos, _, res_pos = _fit_vertical(rows0, 0.0)

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .. import forces
 from ..calibrate import Measurements
 from ..compare import BODY_UNKNOWNS, DATASETS, LAWS, compare, scenes, to_json
 from .format import _fmt, md_table
@@ -413,9 +414,9 @@ def _term_shares(ctx: ReportContext, law: Mapping[str, Any], row: Mapping[str, A
     s = res.series
     t = np.asarray(s["t"])
     parts = {}
-    columns = (("drag", ("F_dx", "F_dy")), ("static_h", ("F_sh",)), ("static_v", ("F_sv",)))
-    for name, cols in columns:
-        if all(c in s for c in cols):
+    for name in forces.TERMS:
+        cols = forces.info(name).columns
+        if cols and all(c in s for c in cols):
             mag = np.sqrt(sum(np.asarray(s[c]) ** 2 for c in cols))
             # The impulse by the trapezoid rule (numpy's trapz/trapezoid differ by version).
             parts[name] = float(np.sum(0.5 * (mag[1:] + mag[:-1]) * np.diff(t)))
