@@ -9,15 +9,21 @@
 //!
 //! The bodies (`q` is 3, 4 and 6 generalized coordinates):
 //!
-//! * `free_link_q45`: the free link, Table 3.5 row q = 45 deg, v0 = 2.27 m/s, Table 3.4
+//! * `free_link_q45`: the preset `FreeLink`, Table 3.5 row q = 45 deg, v0 = 2.27 m/s, Table 3.4
 //!   coefficients (the scene of `free_link`'s `impact/table_3_5_q45`);
-//! * `chain_default`: `ChainScene::default()` (q = -15/15 deg, v0 = 2.29 m/s, ends at the
-//!   first stop);
+//! * `chain_default`: the preset `Chain::default()` (q = -15/15 deg, v0 = 2.29 m/s) in the
+//!   default setting with Table 3.4's q = 0 coefficients on both links, ending at the first
+//!   stop;
 //! * `chain_case1`: the thesis's chain case 1 (Table 4.1 angles -16.72/13.48 deg, v0 =
 //!   2.575 m/s, Table 4.4 coefficients per link), run until both links stop;
-//! * `leg_locked`, `leg_spring`, `leg_free`: `LegScene::default()` (v0 = 3.28 m/s) with
+//! * `leg_locked`, `leg_spring`, `leg_free`: the preset `Leg::default()` (v0 = 3.28 m/s) in
+//!   the thesis's fine sand (rho_g = 1600 kg/m^3) under its sec. 5.3.2 coefficients, with
 //!   ankle, knee and hip locked (a constraint solve in every evaluation), spring-dampers
 //!   (k = 300 N m/rad, c = 5 N m s/rad) or free.
+//!
+//! Every body is a preset (`granrs::presets`: `FreeLink`, `Chain`, `Leg`) that builds a
+//! `LinkageScene`; the scenes are those the benches ran before the presets, so that the
+//! numbers pair with an older build's.
 //!
 //! At the initial state every body only touches the surface (depth 0), where an evaluation
 //! skips the force law; hence the mid-impact state, as in `free_link`'s `rhs/eval`.
@@ -34,12 +40,16 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::SVector;
 
-use _granrs::bodies::{ChainScene, FreeLinkScene, LegScene};
+use _granrs::bodies::LinkageScene;
 use _granrs::body::Joint;
-use _granrs::dynamics::{ContactMode, Model, Modes, Slip, MAX_CONTACTS};
-use _granrs::forces::Coefficients;
+use _granrs::dynamics::{ContactMode, Modes, Slip, MAX_CONTACTS};
+use _granrs::forces::{Coefficients, ForceSet, Medium};
 use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Outcome, Record, SolveOptions, Status};
+use _granrs::presets::chain::Chain;
+use _granrs::presets::free_link::FreeLink;
+use _granrs::presets::leg::{self, Leg};
+use _granrs::presets::{Setting, Start};
 
 /// A velocity component below this [m/s] sticks (the solver's own threshold).
 const SLIP_SPEED: f64 = 1e-9;
@@ -52,75 +62,88 @@ const TABLE_3_4_Q45: Coefficients = Coefficients {
     lambda: 0.25,
 };
 
-/// What the benches need of a scene: its model, a run, and its options to change.
-trait Body<const N: usize>: Clone {
-    fn model(&self) -> Model<N>;
-    fn run(&self) -> Outcome;
-    fn options_mut(&mut self) -> &mut SolveOptions;
+/// A run of a bench scene (they are valid).
+fn run(scene: &LinkageScene) -> Outcome {
+    scene.run().expect("bench scenes are valid")
 }
 
-macro_rules! impl_body {
-    ($scene:ty, $n:literal) => {
-        impl Body<$n> for $scene {
-            fn model(&self) -> Model<$n> {
-                <$scene>::model(self)
-            }
-            fn run(&self) -> Outcome {
-                <$scene>::run(self).expect("bench scenes are valid")
-            }
-            fn options_mut(&mut self) -> &mut SolveOptions {
-                &mut self.options
-            }
-        }
-    };
+/// An initial downward speed `v0` [m/s] from the surface, without sideways motion.
+fn drop_at(v0: f64) -> Start {
+    Start {
+        v0,
+        depth0: 0.0,
+        vx0: 0.0,
+    }
 }
 
-impl_body!(FreeLinkScene, 3);
-impl_body!(ChainScene, 4);
-impl_body!(LegScene, 6);
-
-/// The Table 3.5 row q = 45 deg, v0 = 2.27 m/s with Table 3.4 coefficients (force at the tip).
-fn free_link_q45() -> FreeLinkScene {
-    FreeLinkScene {
-        q_deg: 45.0,
-        v0: 2.27,
-        forces: _granrs::forces::ForceSet::thesis(&[TABLE_3_4_Q45]),
+/// The default setting under the thesis's law with `coefficients`, one set per contact.
+fn thesis_setting(coefficients: &[Coefficients]) -> Setting {
+    Setting {
+        forces: ForceSet::thesis(coefficients),
         ..Default::default()
     }
+}
+
+/// The Table 3.5 row q = 45 deg, v0 = 2.27 m/s with Table 3.4 coefficients (force at the tip).
+fn free_link_q45() -> LinkageScene {
+    FreeLink {
+        q_deg: 45.0,
+        start: drop_at(2.27),
+        ..Default::default()
+    }
+    .scene(thesis_setting(&[TABLE_3_4_Q45]))
+}
+
+/// The default chain with Table 3.4's q = 0 coefficients on both links.
+fn chain_default() -> LinkageScene {
+    Chain::default().scene(thesis_setting(&[Coefficients::TABLE_3_4_VERTICAL; 2]))
 }
 
 /// The thesis's chain case 1: Table 4.1 angles and speed, Table 4.4 coefficients of link 1
 /// and link 2, run until both links have stopped.
-fn chain_case1() -> ChainScene {
-    let mut s = ChainScene {
+fn chain_case1() -> LinkageScene {
+    let mut s = Chain {
         q_deg: [-16.72, 13.48],
-        v0: 2.575,
-        forces: _granrs::forces::ForceSet::thesis(&[
-            Coefficients {
-                eta_h: 8.0,
-                eta_d: 13.0,
-                eta_v: 33.0,
-                lambda: 0.125,
-            },
-            Coefficients {
-                eta_h: 11.8,
-                eta_d: 10.0,
-                eta_v: 137.0,
-                lambda: 0.205,
-            },
-        ]),
+        start: drop_at(2.575),
         ..Default::default()
-    };
+    }
+    .scene(thesis_setting(&[
+        Coefficients {
+            eta_h: 8.0,
+            eta_d: 13.0,
+            eta_v: 33.0,
+            lambda: 0.125,
+        },
+        Coefficients {
+            eta_h: 11.8,
+            eta_d: 10.0,
+            eta_v: 137.0,
+            lambda: 0.205,
+        },
+    ]));
     s.options.end = EndCondition::AllStops;
     s
 }
 
-/// The default leg with all three joints set to `joint`.
-fn leg(joint: Joint) -> LegScene {
-    LegScene {
+/// The default leg with all three joints set to `joint`, in the thesis's fine sand
+/// (sec. 5.3.2) under the thesis's coefficients of the landing at v0 = 3.28 m/s.
+fn leg(joint: Joint) -> LinkageScene {
+    Leg {
         joints: [joint; 3],
         ..Default::default()
     }
+    .scene(Setting {
+        medium: Medium {
+            rho_g: leg::defaults::RHO_G,
+            g: 9.81,
+        },
+        ..thesis_setting(&[Coefficients {
+            eta_h: 10.0,
+            eta_d: 13.0,
+            eta_v: 195.0,
+            lambda: 1.05,
+        }])
+    })
 }
 
 /// The spring-damper of the `leg_spring` bench (the rest angle is set by the scene).
@@ -163,25 +186,24 @@ fn report(name: &str, out: &Outcome) {
 /// A mid-impact state of `scene` (half its end time) and the modes the solver holds there:
 /// every contact in the sand, each static term's sign that of E's velocity (sticking below
 /// `SLIP_SPEED`), the drag's e x v_E sign that of its value.
-fn mid_impact<const N: usize, B: Body<N>>(
+fn mid_impact<const N: usize>(
     name: &str,
-    scene: &B,
+    scene: &LinkageScene,
 ) -> (SVector<f64, N>, SVector<f64, N>, Modes) {
-    let out = scene.run();
+    let out = run(scene);
     assert_eq!(out.status, Status::Stopped, "{name}");
     report(name, &out);
     let mut to_half = scene.clone();
-    let options = to_half.options_mut();
-    *options = SolveOptions {
+    to_half.options = SolveOptions {
         t_end: 0.5 * out.t_final,
         end: EndCondition::Time,
         record: Record {
             state: true,
             ..Default::default()
         },
-        ..*options
+        ..scene.options
     };
-    let half = to_half.run();
+    let half = run(&to_half);
     assert_eq!(half.status, Status::EndTime, "{name}");
     let series = half.series.expect("state recorded");
     let last = |column: String| {
@@ -197,7 +219,7 @@ fn mid_impact<const N: usize, B: Body<N>>(
     let q = SVector::<f64, N>::from_fn(|i, _| last(format!("q{i}")));
     let qd = SVector::<f64, N>::from_fn(|i, _| last(format!("qd{i}")));
 
-    let model = scene.model();
+    let model = scene.model::<N>();
     let mut modes: Modes = [ContactMode::default(); MAX_CONTACTS];
     for m in modes.iter_mut().take(model.contacts.len()) {
         *m = ContactMode {
@@ -233,9 +255,9 @@ fn mid_impact<const N: usize, B: Body<N>>(
 }
 
 /// Add `rhs_by_body/<name>`, `step_by_body/<name>` and `impact_by_body/<name>` for `scene`.
-fn bench_body<const N: usize, B: Body<N>>(c: &mut Criterion, name: &str, scene: &B) {
-    let model = scene.model();
-    let (q, qd, modes) = mid_impact(name, scene);
+fn bench_body<const N: usize>(c: &mut Criterion, name: &str, scene: &LinkageScene) {
+    let model = scene.model::<N>();
+    let (q, qd, modes) = mid_impact::<N>(name, scene);
 
     c.benchmark_group("rhs_by_body").bench_function(name, |b| {
         b.iter(|| black_box(&model).eval(black_box(&q), black_box(&qd), black_box(&modes)))
@@ -248,7 +270,7 @@ fn bench_body<const N: usize, B: Body<N>>(c: &mut Criterion, name: &str, scene: 
         dissipated: 0.0,
     };
     let k1 = deriv_of(&y, &model.eval(&q, &qd, &modes));
-    let dt = scene.clone().options_mut().dt;
+    let dt = scene.options.dt;
     c.benchmark_group("step_by_body").bench_function(name, |b| {
         b.iter(|| {
             step(
@@ -262,16 +284,16 @@ fn bench_body<const N: usize, B: Body<N>>(c: &mut Criterion, name: &str, scene: 
     });
 
     c.benchmark_group("impact_by_body")
-        .bench_function(name, |b| b.iter(|| black_box(scene).run()));
+        .bench_function(name, |b| b.iter(|| run(black_box(scene))));
 }
 
 fn bodies(c: &mut Criterion) {
-    bench_body(c, "free_link_q45", &free_link_q45());
-    bench_body(c, "chain_default", &ChainScene::default());
-    bench_body(c, "chain_case1", &chain_case1());
-    bench_body(c, "leg_locked", &leg(Joint::Locked));
-    bench_body(c, "leg_spring", &leg(LEG_SPRING));
-    bench_body(c, "leg_free", &leg(Joint::Free));
+    bench_body::<3>(c, "free_link_q45", &free_link_q45());
+    bench_body::<4>(c, "chain_default", &chain_default());
+    bench_body::<4>(c, "chain_case1", &chain_case1());
+    bench_body::<6>(c, "leg_locked", &leg(Joint::Locked));
+    bench_body::<6>(c, "leg_spring", &leg(LEG_SPRING));
+    bench_body::<6>(c, "leg_free", &leg(Joint::Free));
 }
 
 fn config() -> Criterion {

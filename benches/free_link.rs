@@ -24,7 +24,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::{SVector, Vector2};
 
-use _granrs::bodies::FreeLinkScene;
+use _granrs::bodies::LinkageScene;
 use _granrs::dynamics::terms_on;
 use _granrs::dynamics::{ContactMode, Modes, SignModel, Slip, MAX_CONTACTS};
 use _granrs::forces::rft::{Rft, GENERIC};
@@ -33,6 +33,8 @@ use _granrs::forces::{
 };
 use _granrs::integrate::stepper::{deriv_of, step, State};
 use _granrs::integrate::{EndCondition, Record, SolveOptions, Status};
+use _granrs::presets::free_link::FreeLink;
+use _granrs::presets::{Setting, Start};
 
 /// Table 3.4 of the thesis, row q = 45 deg.
 const TABLE_3_4_Q45: Coefficients = Coefficients {
@@ -42,14 +44,28 @@ const TABLE_3_4_Q45: Coefficients = Coefficients {
     lambda: 0.25,
 };
 
-/// The Table 3.5 row q = 45 deg, v0 = 2.27 m/s with Table 3.4 coefficients (force at the tip).
-fn scene_q45() -> FreeLinkScene {
-    FreeLinkScene {
-        q_deg: 45.0,
-        v0: 2.27,
-        forces: _granrs::forces::ForceSet::thesis(&[TABLE_3_4_Q45]),
+/// The free link (the preset) at `q_deg` dropped at `v0` under the thesis's law with
+/// `coefficients`, in the default setting (force at the tip): the rod and its scene.
+fn rod(q_deg: f64, v0: f64, coefficients: Coefficients) -> (FreeLink, LinkageScene) {
+    let rod = FreeLink {
+        q_deg,
+        start: Start {
+            v0,
+            depth0: 0.0,
+            vx0: 0.0,
+        },
         ..Default::default()
-    }
+    };
+    let scene = rod.scene(Setting {
+        forces: ForceSet::thesis(&[coefficients]),
+        ..Default::default()
+    });
+    (rod, scene)
+}
+
+/// The Table 3.5 row q = 45 deg, v0 = 2.27 m/s with Table 3.4 coefficients (force at the tip).
+fn scene_q45() -> (FreeLink, LinkageScene) {
+    rod(45.0, 2.27, TABLE_3_4_Q45)
 }
 
 /// Read a CSV of the package data folder: header and rows of strings (no quoted commas in
@@ -125,20 +141,15 @@ fn nearest_row(table: &[(f64, Coefficients)], q_deg: f64) -> Coefficients {
     best.1
 }
 
-/// The scenes of Table 3.5 (31 rows as shipped), each with its Table 3.4 row.
-fn table_3_5_scenes() -> Vec<FreeLinkScene> {
+/// The rods and scenes of Table 3.5 (31 rows as shipped), each with its Table 3.4 row.
+fn table_3_5_scenes() -> Vec<(FreeLink, LinkageScene)> {
     let coefficients = table_3_4();
     let (h, rows) = read_csv("table_3_5_free_link_thesis_simulation");
     let (q, v0) = (column(&h, "q_deg"), column(&h, "v0"));
     rows.iter()
         .map(|r| {
             let q_deg = number(r, q);
-            FreeLinkScene {
-                q_deg,
-                v0: number(r, v0),
-                forces: _granrs::forces::ForceSet::thesis(&[nearest_row(&coefficients, q_deg)]),
-                ..Default::default()
-            }
+            rod(q_deg, number(r, v0), nearest_row(&coefficients, q_deg))
         })
         .collect()
 }
@@ -146,7 +157,7 @@ fn table_3_5_scenes() -> Vec<FreeLinkScene> {
 /// A mid-impact state of `scene` (half its stopping time) and the modes the solver holds
 /// there: in contact, each static term's sign that of the centroid's velocity, or sticking
 /// where that component is exactly zero (the vertical drop's horizontal term).
-fn mid_impact(scene: &FreeLinkScene) -> (SVector<f64, 3>, SVector<f64, 3>, Modes) {
+fn mid_impact(scene: &LinkageScene) -> (SVector<f64, 3>, SVector<f64, 3>, Modes) {
     let t_s = scene.run().expect("impact runs").contacts[0].t_s;
     let mut to_half = scene.clone();
     to_half.options = SolveOptions {
@@ -180,7 +191,7 @@ fn mid_impact(scene: &FreeLinkScene) -> (SVector<f64, 3>, SVector<f64, 3>, Modes
         sy: Slip::Neg,
         ..ContactMode::default()
     };
-    let v_e = scene.model().eval(&q, &qd, &modes).contacts[0].v_centroid;
+    let v_e = scene.model::<3>().eval(&q, &qd, &modes).contacts[0].v_centroid;
     let slip = |v: f64| {
         if v < 0.0 {
             Slip::Neg
@@ -276,13 +287,13 @@ fn force(c: &mut Criterion) {
 }
 
 fn rhs(c: &mut Criterion) {
-    let scene = scene_q45();
-    let model = scene.model();
+    let (_, scene) = scene_q45();
+    let model = scene.model::<3>();
     let (q, qd, modes) = mid_impact(&scene);
     assert!(modes[0].sx != Slip::Stick && modes[0].sy != Slip::Stick);
     // The vertical drop holds v_Ex = 0 by a sticking reaction: the costlier path of eval.
-    let vertical = vertical_scene();
-    let vertical_model = vertical.model();
+    let (_, vertical) = vertical_scene();
+    let vertical_model = vertical.model::<3>();
     let (vq, vqd, vmodes) = mid_impact(&vertical);
     assert_eq!(vmodes[0].sx, Slip::Stick, "vertical drop sticks in x");
 
@@ -321,38 +332,30 @@ fn rhs(c: &mut Criterion) {
 }
 
 /// The vertical drop at v0 = 2.214 m/s (Table 3.5, first row) with Table 3.4 row q = 0.
-fn vertical_scene() -> FreeLinkScene {
-    FreeLinkScene {
-        q_deg: 0.0,
-        v0: 2.214,
-        forces: _granrs::forces::ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]),
-        ..Default::default()
-    }
+fn vertical_scene() -> (FreeLink, LinkageScene) {
+    rod(0.0, 2.214, Coefficients::TABLE_3_4_VERTICAL)
 }
 
 fn impact(c: &mut Criterion) {
     let q45 = scene_q45();
-    let vertical = FreeLinkScene {
-        q_deg: 0.0,
-        v0: 2.214,
-        forces: _granrs::forces::ForceSet::thesis(&[Coefficients::TABLE_3_4_VERTICAL]),
-        ..Default::default()
-    };
+    let vertical = vertical_scene();
     // Table 3.5 as shipped has 31 rows (11 angles x 3 speeds, two rows missing in the source).
-    let all = table_3_5_scenes();
-    for s in std::iter::once(&q45)
+    let rows = table_3_5_scenes();
+    for (p, s) in std::iter::once(&q45)
         .chain(std::iter::once(&vertical))
-        .chain(&all)
+        .chain(&rows)
     {
         let out = s.run().expect("Table 3.5 scenes run");
         assert_eq!(
             out.status,
             Status::Stopped,
             "q = {}, v0 = {}",
-            s.q_deg,
-            s.v0
+            p.q_deg,
+            p.start.v0
         );
     }
+    let (q45, vertical) = (q45.1, vertical.1);
+    let all: Vec<LinkageScene> = rows.into_iter().map(|(_, s)| s).collect();
 
     let mut g = c.benchmark_group("impact");
     g.bench_function("table_3_5_q45", |b| {
@@ -373,9 +376,9 @@ fn impact(c: &mut Criterion) {
     });
     // The same table with the thesis's plain sign() (SignModel::Raw): the algorithm of the
     // numba and scipy peers of `benches/peers.py`.
-    let all_raw: Vec<FreeLinkScene> = all
+    let all_raw: Vec<LinkageScene> = all
         .iter()
-        .map(|s| FreeLinkScene {
+        .map(|s| LinkageScene {
             sign_model: SignModel::Raw,
             ..s.clone()
         })
@@ -398,9 +401,9 @@ fn lanes(c: &mut Criterion) {
     let all = table_3_5_scenes();
     let scenes: Vec<_> = all
         .iter()
-        .map(|s| {
-            let (q0, qd0) = s.initial_state();
-            (s.model(), q0, qd0, s.options)
+        .map(|(_, s)| {
+            let (q0, qd0) = s.initial_state::<3>();
+            (s.model::<3>(), q0, qd0, s.options)
         })
         .collect();
     let mut g = c.benchmark_group("sweep");

@@ -6,17 +6,22 @@
 
 mod common;
 
-use _granrs::bodies::FreeLinkScene;
+use _granrs::bodies::LinkageScene;
 use _granrs::dynamics::SignModel;
-use common::{exact_vertical_depth, table_3_4_vertical, vertical_static_work};
+use _granrs::presets::free_link::FreeLink;
+use common::{
+    drop_at, exact_vertical_depth, table_3_4_vertical, thesis_setting, vertical_static_work,
+};
 
 /// t_s = int_0^df dd / v(d), with d = df (1 - u^2) to remove the 1/sqrt singularity at df;
 /// composite 10-point Gauss-Legendre on u in [0, 1].
-fn exact_vertical_stop_time(s: &FreeLinkScene) -> f64 {
+/// For the rod `p` in the scene `s` it built.
+fn exact_vertical_stop_time(p: &FreeLink, s: &LinkageScene) -> f64 {
     let g = s.medium.g;
-    let df = exact_vertical_depth(s);
+    let df = exact_vertical_depth(p, s);
+    let v0 = p.start.v0;
     let v = |d: f64| {
-        let v2 = s.v0 * s.v0 + 2.0 * g * d - 2.0 * vertical_static_work(s, d) / s.mass;
+        let v2 = v0 * v0 + 2.0 * g * d - 2.0 * vertical_static_work(p, s, d) / p.mass;
         v2.max(0.0).sqrt()
     };
     let integrand = |u: f64| 2.0 * df * u / v(df * (1.0 - u * u));
@@ -53,19 +58,19 @@ fn exact_vertical_stop_time(s: &FreeLinkScene) -> f64 {
 #[test]
 fn vertical_drop_depth_and_stop_time_at_10_khz() {
     for v0 in [0.1, 0.3, 1.0, 2.214, 5.0, 10.0] {
-        let s = FreeLinkScene {
-            v0,
-            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
+        let rod = FreeLink {
+            start: drop_at(v0),
             ..Default::default()
         };
+        let s = rod.scene(thesis_setting(&[table_3_4_vertical()]));
         let out = s.run().unwrap();
-        let exact_d = exact_vertical_depth(&s);
-        let exact_t = exact_vertical_stop_time(&s);
+        let exact_d = exact_vertical_depth(&rod, &s);
+        let exact_t = exact_vertical_stop_time(&rod, &s);
         let c = &out.contacts[0];
         let rel_d = (c.depth - exact_d).abs() / exact_d;
         let err_t = (c.t_s - exact_t).abs();
         // The raw sign model, for the record.
-        let raw = FreeLinkScene {
+        let raw = LinkageScene {
             sign_model: SignModel::Raw,
             ..s.clone()
         }

@@ -3,13 +3,16 @@
 
 mod common;
 
-use _granrs::bodies::{ChainScene, FreeLinkScene, LegScene};
 use _granrs::body::rod::ApplyAt;
 use _granrs::body::{Joint, Link, Mechanism, RodContact};
 use _granrs::dynamics::{Contact, Model, Shape};
-use _granrs::forces::Coefficients;
+use _granrs::forces::{Coefficients, ForceSet};
 use _granrs::integrate::{solve, EndCondition, Outcome, Record};
-use common::{exact_vertical_depth, table_3_4_vertical};
+use _granrs::presets::chain::Chain;
+use _granrs::presets::free_link::FreeLink;
+use _granrs::presets::leg::Leg;
+use _granrs::presets::Setting;
+use common::{drop_at, exact_vertical_depth, leg_setting, table_3_4_vertical, thesis_setting};
 use nalgebra::{SVector, Vector2};
 
 /// Table 4.4, case 1 (thesis), written out here independently of the package.
@@ -43,23 +46,22 @@ fn series<'a>(out: &'a Outcome, name: &str) -> &'a [f64] {
 /// force: each behaves as one vertical rod, whose final depth is exact (MODEL.md).
 #[test]
 fn vertical_chain_matches_the_exact_depth() {
-    let mut chain = ChainScene {
+    let chain = Chain {
         q_deg: [0.0, 0.0],
-        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical(); 2]),
-        v0: 1.0,
+        start: drop_at(1.0),
         ..Default::default()
     };
-    chain.options.end = EndCondition::AllStops;
-    let out = chain.run().unwrap();
-    let rod = FreeLinkScene {
+    let mut scene = chain.scene(thesis_setting(&[table_3_4_vertical(); 2]));
+    scene.options.end = EndCondition::AllStops;
+    let out = scene.run().unwrap();
+    let rod = FreeLink {
         length: chain.length,
         diameter: chain.diameter,
         mass: chain.mass,
-        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
-        v0: chain.v0,
+        start: drop_at(chain.start.v0),
         ..Default::default()
     };
-    let exact = exact_vertical_depth(&rod);
+    let exact = exact_vertical_depth(&rod, &rod.scene(thesis_setting(&[table_3_4_vertical()])));
     for c in &out.contacts {
         assert!(c.stopped);
         let err = (c.depth - exact).abs() / exact;
@@ -71,18 +73,18 @@ fn vertical_chain_matches_the_exact_depth() {
 /// and both links stop together; the thesis's asymmetric case does not.
 #[test]
 fn mirror_symmetric_chain_stays_symmetric() {
-    let mut chain = ChainScene {
+    let chain = Chain {
         q_deg: [-15.0, 15.0],
-        forces: _granrs::forces::ForceSet::thesis(&[table_4_4_case_1()[1]; 2]),
-        v0: 2.575,
+        start: drop_at(2.575),
         ..Default::default()
     };
-    chain.options.end = EndCondition::AllStops;
-    chain.options.record = Record {
+    let mut setting = thesis_setting(&[table_4_4_case_1()[1]; 2]);
+    setting.options.end = EndCondition::AllStops;
+    setting.options.record = Record {
         state: true,
         ..Default::default()
     };
-    let out = chain.run().unwrap();
+    let out = chain.scene(setting.clone()).run().unwrap();
     let (x, q1, q2) = (series(&out, "q0"), series(&out, "q2"), series(&out, "q3"));
     let mut worst: f64 = 0.0;
     for i in 0..x.len() {
@@ -95,9 +97,17 @@ fn mirror_symmetric_chain_stays_symmetric() {
     assert!((a.depth - b.depth).abs() < 1e-12);
 
     // The thesis's case 1: angles -16.72 / 13.48 deg, a coefficient set per link.
-    chain.q_deg = [-16.72, 13.48];
-    chain.forces = _granrs::forces::ForceSet::thesis(&table_4_4_case_1());
-    let out = chain.run().unwrap();
+    let case_1 = Chain {
+        q_deg: [-16.72, 13.48],
+        ..chain
+    };
+    let out = case_1
+        .scene(Setting {
+            forces: ForceSet::thesis(&table_4_4_case_1()),
+            ..setting
+        })
+        .run()
+        .unwrap();
     let (a, b) = (&out.contacts[0], &out.contacts[1]);
     assert!(a.stopped && b.stopped);
     assert!((a.t_s - b.t_s).abs() > 1e-3, "{} vs {}", a.t_s, b.t_s);
@@ -107,8 +117,8 @@ fn mirror_symmetric_chain_stays_symmetric() {
     assert!(out.stats.events < 30, "{} events", out.stats.events);
 }
 
-/// The free link built by hand as a one-link mechanism of the general engine (as the chain
-/// and the leg are built) gives the free-link scene's results.
+/// The free link built by hand as a one-link mechanism of the general engine gives the
+/// results of the linkage the free-link preset builds.
 #[test]
 fn one_link_engine_is_the_free_link() {
     for (q_deg, apply_at) in [
@@ -116,14 +126,16 @@ fn one_link_engine_is_the_free_link() {
         (35.0, ApplyAt::Tip),
         (-55.0, ApplyAt::Centroid),
     ] {
-        let scene = FreeLinkScene {
+        let rod = FreeLink {
             q_deg,
-            apply_at,
-            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
             ..Default::default()
         };
+        let scene = rod.scene(Setting {
+            apply_at,
+            ..thesis_setting(&[table_3_4_vertical()])
+        });
         let reference = scene.run().unwrap();
-        let (l, d, m) = (scene.length, scene.diameter, scene.mass);
+        let (l, d, m) = (rod.length, rod.diameter, rod.mass);
         let model = Model::<3> {
             mechanism: Mechanism {
                 links: vec![Link {
@@ -153,7 +165,7 @@ fn one_link_engine_is_the_free_link() {
         };
         let q = q_deg.to_radians();
         let q0 = SVector::<f64, 3>::new(0.5 * l * q.sin(), 0.5 * l * q.cos(), q);
-        let qd0 = SVector::<f64, 3>::new(0.0, -scene.v0, 0.0);
+        let qd0 = SVector::<f64, 3>::new(0.0, -rod.start.v0, 0.0);
         let out = solve(&model, q0, qd0, &scene.options).unwrap();
         let (a, b) = (&out.contacts[0], &reference.contacts[0]);
         assert!(
@@ -173,24 +185,24 @@ fn one_link_engine_is_the_free_link() {
 #[test]
 fn locked_coincident_chain_is_the_free_link_in_other_coordinates() {
     for q_deg in [0.0, 25.0, -40.0] {
-        let mut chain = ChainScene {
+        let mut chain = Chain {
             length: 0.19,
             diameter: 0.0127,
             mass: 0.184,
             q_deg: [q_deg, q_deg],
-            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical(); 2]),
             joint: Joint::Locked,
-            v0: 2.214,
-            ..Default::default()
-        };
-        chain.options.end = EndCondition::FirstStop;
-        let out = chain.run().unwrap();
-        let rod = FreeLinkScene {
-            q_deg,
-            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
-            v0: 2.214,
+            start: drop_at(2.214),
             ..Default::default()
         }
+        .scene(thesis_setting(&[table_3_4_vertical(); 2]));
+        chain.options.end = EndCondition::FirstStop;
+        let out = chain.run().unwrap();
+        let rod = FreeLink {
+            q_deg,
+            start: drop_at(2.214),
+            ..Default::default()
+        }
+        .scene(thesis_setting(&[table_3_4_vertical()]))
         .run()
         .unwrap();
         let (a, b) = (&out.contacts[0], &rod.contacts[0]);
@@ -235,32 +247,40 @@ fn energy_bookkeeping_closes_per_body() {
         let mut leg_w: f64 = 0.0;
         let mut worst: f64 = 0.0;
         for apply_at in [ApplyAt::Tip, ApplyAt::Centroid] {
-            let mut free = FreeLinkScene {
+            let mut free = FreeLink {
                 q_deg: 35.0,
+                ..Default::default()
+            }
+            .scene(Setting {
                 apply_at,
                 ..Default::default()
-            };
+            });
             free.options.dt = dt;
             worst = worst.max(residual(&free.run().unwrap()));
             for joint in [Joint::Free, Joint::Locked, spring] {
-                let mut chain = ChainScene {
+                let mut chain = Chain {
                     q_deg: [-16.72, 13.48],
-                    forces: _granrs::forces::ForceSet::thesis(&table_4_4_case_1()),
                     pin_mass: 0.005,
                     joint: if joint == spring { small_spring } else { joint },
-                    apply_at,
                     ..Default::default()
-                };
+                }
+                .scene(Setting {
+                    apply_at,
+                    ..thesis_setting(&table_4_4_case_1())
+                });
                 chain.options.end = EndCondition::AllStops;
                 chain.options.dt = dt;
                 let out = chain.run().unwrap();
                 assert!(out.contacts.iter().all(|c| c.stopped));
                 worst = worst.max(residual(&out));
-                let mut leg = LegScene {
+                let mut leg = Leg {
                     joints: [joint; 3],
-                    apply_at,
                     ..Default::default()
-                };
+                }
+                .scene(Setting {
+                    apply_at,
+                    ..leg_setting()
+                });
                 leg.options.dt = dt;
                 let out = leg.run().unwrap();
                 assert!(out.contacts[0].stopped);
@@ -286,14 +306,15 @@ fn energy_bookkeeping_closes_per_body() {
 /// joint; with the pin's mass zero the root passes no force to link 1.
 #[test]
 fn joints_behave_as_declared() {
-    let mut leg = LegScene::default();
+    let leg_preset = Leg::default();
+    let mut leg = leg_preset.scene(leg_setting());
     leg.options.record = Record {
         state: true,
         forces: true,
         ..Default::default()
     };
     let out = leg.run().unwrap();
-    let a = leg.angles();
+    let a = leg_preset.angles();
     for (i, name) in ["q3", "q4", "q5"].iter().enumerate() {
         let parent = series(&out, &format!("q{}", 2 + i));
         let child = series(&out, name);
@@ -310,22 +331,24 @@ fn joints_behave_as_declared() {
         c: 0.0,
         rest: 0.0,
     };
-    let free = LegScene {
+    let free = Leg {
         joints: [Joint::Free; 3],
         ..Default::default()
     }
+    .scene(leg_setting())
     .run()
     .unwrap();
-    let soft = LegScene {
+    let soft = Leg {
         joints: [zero; 3],
         ..Default::default()
     }
+    .scene(leg_setting())
     .run()
     .unwrap();
     assert_eq!(free.contacts[0].t_s, soft.contacts[0].t_s);
     assert_eq!(free.contacts[0].depth, soft.contacts[0].depth);
 
-    let mut chain = ChainScene::default();
+    let mut chain = Chain::default().scene(thesis_setting(&[Coefficients::TABLE_3_4_VERTICAL; 2]));
     chain.options.record = Record {
         forces: true,
         ..Default::default()
@@ -345,14 +368,14 @@ fn joints_behave_as_declared() {
 /// F = -m_p (a_pin - g) (Newton on the pin, from the accelerations alone).
 #[test]
 fn pin_force_balances_the_pin_mass() {
-    let chain = ChainScene {
+    let chain = Chain {
         pin_mass: 0.01,
         q_deg: [-16.72, 13.48],
-        forces: _granrs::forces::ForceSet::thesis(&table_4_4_case_1()),
         ..Default::default()
-    };
-    let model = chain.model();
-    let (q0, qd0) = chain.initial_state();
+    }
+    .scene(thesis_setting(&table_4_4_case_1()));
+    let model = chain.model::<4>();
+    let (q0, qd0) = chain.initial_state::<4>();
     // Some way into the impact: take the state after the run's first stop, evaluated fresh.
     let mut opts = chain.options;
     opts.t_end = 0.01;

@@ -3,11 +3,13 @@
 
 mod common;
 
-use _granrs::bodies::FreeLinkScene;
+use _granrs::bodies::LinkageScene;
 use _granrs::dynamics::{ContactMode, Slip, MAX_CONTACTS};
 use _granrs::forces::Coefficients;
 use _granrs::integrate::{EndCondition, Record, Series};
-use common::{exact_vertical_depth, table_3_4_vertical};
+use _granrs::presets::free_link::FreeLink;
+use _granrs::presets::{Setting, Start};
+use common::{drop_at, exact_vertical_depth, table_3_4_vertical, thesis_setting};
 use nalgebra::SVector;
 
 fn col<'a>(s: &'a Series, name: &str) -> &'a [f64] {
@@ -18,7 +20,7 @@ fn col<'a>(s: &'a Series, name: &str) -> &'a [f64] {
         .1
 }
 
-fn recorded(scene: &FreeLinkScene) -> Series {
+fn recorded(scene: &LinkageScene) -> Series {
     let mut s = scene.clone();
     s.options.record = Record {
         state: true,
@@ -34,18 +36,22 @@ fn recorded(scene: &FreeLinkScene) -> Series {
 /// sideways motion of E and then holds it at zero.
 #[test]
 fn horizontal_stick_holds_velocity_at_zero() {
-    let scene = FreeLinkScene {
+    let scene = FreeLink {
         q_deg: 30.0,
-        v0: 0.0,
-        depth0: 0.03,
-        vx0: 0.05,
-        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
+        start: Start {
+            v0: 0.0,
+            depth0: 0.03,
+            vx0: 0.05,
+        },
+        ..Default::default()
+    }
+    .scene(Setting {
         options: _granrs::integrate::SolveOptions {
             t_end: 0.05,
             ..Default::default()
         },
-        ..Default::default()
-    };
+        ..thesis_setting(&[table_3_4_vertical()])
+    });
     let s = recorded(&scene);
     let (t, mode_x, v_ex) = (&s.t, col(&s, "c0.mode_x"), col(&s, "c0.v_E_x"));
     let first = mode_x.iter().position(|&m| m == 0.0).expect("never stuck");
@@ -66,23 +72,28 @@ fn horizontal_stick_holds_velocity_at_zero() {
 /// is released exactly when the holding reaction reaches the static bound.
 #[test]
 fn vertical_stick_releases_when_bound_is_exceeded() {
-    let scene = FreeLinkScene {
+    let scene = FreeLink {
         q_deg: 45.0,
-        v0: 0.5,
-        vx0: 0.3,
-        // Table 3.4, row q = 45 deg.
-        forces: _granrs::forces::ForceSet::thesis(&[Coefficients {
-            eta_h: 5.5,
-            eta_d: 11.0,
-            eta_v: 53.0,
-            lambda: 0.25,
-        }]),
+        start: Start {
+            v0: 0.5,
+            depth0: 0.0,
+            vx0: 0.3,
+        },
+        ..Default::default()
+    }
+    .scene(Setting {
         options: _granrs::integrate::SolveOptions {
             t_end: 0.1,
             ..Default::default()
         },
-        ..Default::default()
-    };
+        // Table 3.4, row q = 45 deg.
+        ..thesis_setting(&[Coefficients {
+            eta_h: 5.5,
+            eta_d: 11.0,
+            eta_v: 53.0,
+            lambda: 0.25,
+        }])
+    });
     let s = recorded(&scene);
     let (t, mode_y, v_ey) = (&s.t, col(&s, "c0.mode_y"), col(&s, "c0.v_E_y"));
     let stick = mode_y.iter().position(|&m| m == 0.0).expect("never stuck");
@@ -126,10 +137,10 @@ fn vertical_stick_releases_when_bound_is_exceeded() {
         Slip::Pos
     };
     // The drag's held sign follows e x v_E at this state.
-    if scene.model().eval(&q, &qd, &modes).contacts[0].cross < 0.0 {
+    if scene.model::<3>().eval(&q, &qd, &modes).contacts[0].cross < 0.0 {
         modes[0].cross = Slip::Neg;
     }
-    let e = scene.model().eval(&q, &qd, &modes);
+    let e = scene.model::<3>().eval(&q, &qd, &modes);
     let c = &e.contacts[0];
     let rel = (c.force.statics.y.abs() - c.bound[1]).abs() / c.bound[1];
     println!(
@@ -163,14 +174,16 @@ fn slope(dts: &[f64], errs: &[f64]) -> f64 {
 /// the entry (it starts 1 cm deep) and crosses located sign switches, is at least 3.8.
 #[test]
 fn rk4_modes_is_fourth_order_away_from_entry() {
-    let base = FreeLinkScene {
+    let base = FreeLink {
         q_deg: 45.0,
-        v0: 1.0,
-        depth0: 0.01,
-        vx0: 0.3,
-        forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
+        start: Start {
+            v0: 1.0,
+            depth0: 0.01,
+            vx0: 0.3,
+        },
         ..Default::default()
-    };
+    }
+    .scene(thesis_setting(&[table_3_4_vertical()]));
     let run = |dt: f64| {
         let mut s = base.clone();
         s.options.dt = dt;
@@ -204,13 +217,13 @@ fn order_over_whole_impact_including_entry() {
     let dts = [4e-4, 2e-4, 1e-4, 5e-5, 2.5e-5];
     let mut errs = Vec::new();
     for &dt in &dts {
-        let mut s = FreeLinkScene {
-            v0: 2.214,
-            forces: _granrs::forces::ForceSet::thesis(&[table_3_4_vertical()]),
+        let rod = FreeLink {
+            start: drop_at(2.214),
             ..Default::default()
         };
+        let mut s = rod.scene(thesis_setting(&[table_3_4_vertical()]));
         s.options.dt = dt;
-        let exact = exact_vertical_depth(&s);
+        let exact = exact_vertical_depth(&rod, &s);
         errs.push((s.run().unwrap().contacts[0].depth - exact).abs() / exact);
     }
     let p = slope(&dts, &errs);

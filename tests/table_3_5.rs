@@ -5,10 +5,10 @@
 
 mod common;
 
-use _granrs::bodies::FreeLinkScene;
 use _granrs::forces::Coefficients;
 use _granrs::integrate::Status;
-use common::read_csv;
+use _granrs::presets::free_link::FreeLink;
+use common::{drop_at, read_csv, thesis_setting};
 
 /// Table 3.4 row at the tabulated angle nearest |q| (ties to the larger |q|).
 fn table_3_4(q_deg: f64) -> (f64, Coefficients) {
@@ -53,12 +53,12 @@ fn table_3_5_depths_median_within_6_percent() {
         let d_th: f64 = r[col("depth")].parse().unwrap();
         let note = r[col("note")].trim().to_string();
         let (q_tab, coefficients) = table_3_4(q);
-        let s = FreeLinkScene {
+        let s = FreeLink {
             q_deg: q,
-            v0,
-            forces: _granrs::forces::ForceSet::thesis(&[coefficients]),
+            start: drop_at(v0),
             ..Default::default()
-        };
+        }
+        .scene(thesis_setting(&[coefficients]));
         let out = s.run().unwrap();
         assert_eq!(out.status, Status::Stopped, "q = {q}, v0 = {v0}");
         let c = &out.contacts[0];

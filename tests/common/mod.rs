@@ -1,11 +1,50 @@
 //! Shared helpers of the cargo integration tests.
 #![allow(dead_code)]
 
-use _granrs::bodies::FreeLinkScene;
-use _granrs::forces::Coefficients;
+use _granrs::bodies::LinkageScene;
+use _granrs::forces::{Coefficients, ForceSet, Medium};
+use _granrs::presets::free_link::FreeLink;
+use _granrs::presets::{Setting, Start};
+
+/// The default setting (the thesis's sand, default numerics) under the thesis's law with
+/// `coefficients`, one set per contact.
+pub fn thesis_setting(coefficients: &[Coefficients]) -> Setting {
+    Setting {
+        forces: ForceSet::thesis(coefficients),
+        ..Default::default()
+    }
+}
+
+/// The setting the leg ran in before it was a preset: the thesis's fine sand (sec. 5.3.2,
+/// rho_g = 1600 kg/m^3) and the thesis's coefficients of the landing at v0 = 3.28 m/s
+/// (sec. 5.3.2), written out here independently of the package.
+pub fn leg_setting() -> Setting {
+    Setting {
+        medium: Medium {
+            rho_g: 1600.0,
+            g: 9.81,
+        },
+        ..thesis_setting(&[Coefficients {
+            eta_h: 10.0,
+            eta_d: 13.0,
+            eta_v: 195.0,
+            lambda: 1.05,
+        }])
+    }
+}
+
+/// An initial downward speed `v0` [m/s] from the surface, without sideways motion (every
+/// preset's default start but for its speed).
+pub fn drop_at(v0: f64) -> Start {
+    Start {
+        v0,
+        depth0: 0.0,
+        vx0: 0.0,
+    }
+}
 
 /// The `static_v` term of a free link's force set (panics without one).
-pub fn static_v_of(s: &FreeLinkScene) -> Coefficients {
+pub fn static_v_of(s: &LinkageScene) -> Coefficients {
     let k = s
         .forces
         .contact_info
@@ -21,12 +60,13 @@ pub fn static_v_of(s: &FreeLinkScene) -> Coefficients {
     }
 }
 
-/// Work done against F_sv by a vertical rod sunk to depth d (force at the tip): with
-/// l = min(d, L), int_0^d eta_v (s/L)^lambda g rho (pi d_c^2/4) min(s, L) ds.
-pub fn vertical_static_work(s: &FreeLinkScene, d: f64) -> f64 {
+/// Work done against F_sv by a vertical rod `p` sunk to depth d in the scene `s` it built
+/// (force at the tip): with l = min(d, L),
+/// int_0^d eta_v (s/L)^lambda g rho (pi d_c^2/4) min(s, L) ds.
+pub fn vertical_static_work(p: &FreeLink, s: &LinkageScene, d: f64) -> f64 {
     let c = static_v_of(s);
-    let a = c.eta_v * s.medium.g * s.medium.rho_g * std::f64::consts::PI * s.diameter.powi(2) / 4.0;
-    let l = s.length;
+    let a = c.eta_v * s.medium.g * s.medium.rho_g * std::f64::consts::PI * p.diameter.powi(2) / 4.0;
+    let l = p.length;
     let lam = c.lambda;
     // Partly immersed: a d^(lam+2) / (L^lam (lam+2)) (MODEL.md, "Exact answers").
     let part = |x: f64| a * x.powf(lam + 2.0) / (l.powf(lam) * (lam + 2.0));
@@ -38,12 +78,14 @@ pub fn vertical_static_work(s: &FreeLinkScene, d: f64) -> f64 {
     }
 }
 
-/// The exact final depth of a vertical drop with the force at the tip (MODEL.md, "Exact
-/// answers"): only F_sv acts, so (1/2) m v0^2 + m g d = W(d), the work of
-/// [`vertical_static_work`]. Solved by bisection to round-off.
-pub fn exact_vertical_depth(s: &FreeLinkScene) -> f64 {
+/// The exact final depth of a vertical drop of the rod `p` in the scene `s` it built, with
+/// the force at the tip (MODEL.md, "Exact answers"): only F_sv acts, so
+/// (1/2) m v0^2 + m g d = W(d), the work of [`vertical_static_work`]. Solved by bisection to
+/// round-off.
+pub fn exact_vertical_depth(p: &FreeLink, s: &LinkageScene) -> f64 {
     let g = s.medium.g;
-    let f = |d: f64| vertical_static_work(s, d) - 0.5 * s.mass * s.v0 * s.v0 - s.mass * g * d;
+    let v0 = p.start.v0;
+    let f = |d: f64| vertical_static_work(p, s, d) - 0.5 * p.mass * v0 * v0 - p.mass * g * d;
     let (mut a, mut b) = (0.0f64, 1.0f64);
     while f(b) < 0.0 {
         b *= 2.0;
