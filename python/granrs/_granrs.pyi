@@ -6,7 +6,6 @@ from typing import Any, final
 __all__ = [
     "DEFAULT_CHORDS",
     "EFFECTS",
-    "PRESETS",
     "FORCE_INPUTS",
     "FORCE_OUTPUTS",
     "GEOM_OUTPUTS",
@@ -14,6 +13,7 @@ __all__ = [
     "MAX_CHORDS",
     "MAX_CONTACTS",
     "MAX_LINKS",
+    "PRESETS",
     "RECORDS",
     "RFT_COEFFICIENTS",
     "RFT_GENERIC",

@@ -1,5 +1,5 @@
 //! A scene as data: named fields with plain values ([`SceneSpec`]), and the one set of rules
-//! that turns them into a validated [`AnyScene`].
+//! that turns them into a validated [`LinkageScene`] (a preset's, or the linkage given).
 //!
 //! Python dicts (`granrs.Scene.to_dict()`), TOML files (through Python) and sweep axes all
 //! arrive as a `SceneSpec`, so that they share every check and every error message. A sweep
