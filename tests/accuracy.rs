@@ -21,7 +21,7 @@ fn exact_vertical_stop_time(p: &FreeLink, s: &LinkageScene) -> f64 {
     let df = exact_vertical_depth(p, s);
     let v0 = p.start.v0;
     let v = |d: f64| {
-        let v2 = v0 * v0 + 2.0 * g * d - 2.0 * vertical_static_work(p, s, d) / p.mass;
+        let v2 = v0 * v0 + 2.0 * g * d - 2.0 * vertical_static_work(p, s, d) / p.rod.mass;
         v2.max(0.0).sqrt()
     };
     let integrand = |u: f64| 2.0 * df * u / v(df * (1.0 - u * u));

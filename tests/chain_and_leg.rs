@@ -55,9 +55,7 @@ fn vertical_chain_matches_the_exact_depth() {
     scene.options.end = EndCondition::AllStops;
     let out = scene.run().unwrap();
     let rod = FreeLink {
-        length: chain.length,
-        diameter: chain.diameter,
-        mass: chain.mass,
+        rod: chain.rod,
         start: drop_at(chain.start.v0),
         ..Default::default()
     };
@@ -135,7 +133,7 @@ fn one_link_engine_is_the_free_link() {
             ..thesis_setting(&[table_3_4_vertical()])
         });
         let reference = scene.run().unwrap();
-        let (l, d, m) = (rod.length, rod.diameter, rod.mass);
+        let (l, d, m) = (rod.rod.length, rod.rod.diameter, rod.rod.mass);
         let model = Model::<3> {
             mechanism: Mechanism {
                 links: vec![Link {
@@ -186,9 +184,7 @@ fn one_link_engine_is_the_free_link() {
 fn locked_coincident_chain_is_the_free_link_in_other_coordinates() {
     for q_deg in [0.0, 25.0, -40.0] {
         let mut chain = Chain {
-            length: 0.19,
-            diameter: 0.0127,
-            mass: 0.184,
+            rod: FreeLink::default().rod,
             q_deg: [q_deg, q_deg],
             joint: Joint::Locked,
             start: drop_at(2.214),

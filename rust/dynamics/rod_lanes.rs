@@ -971,7 +971,7 @@ mod tests {
     use crate::bodies::LinkageScene;
     use crate::dynamics::{Modes, MAX_CONTACTS};
     use crate::forces::{ForceSet, TermSpec};
-    use crate::presets::{free_link::FreeLink, Setting};
+    use crate::presets::{free_link::FreeLink, Rod, Setting};
     use proptest::prelude::*;
 
     /// A free link with its own mass, length, law and point of application.
@@ -1003,9 +1003,13 @@ mod tests {
             specs.push(TermSpec::new("gravity", &[]));
         }
         specs.extend(thesis_subset(eta, terms));
+        let rod = FreeLink::default().rod;
         let scene = FreeLink {
-            mass,
-            length,
+            rod: Rod {
+                mass,
+                length,
+                ..rod
+            },
             ..FreeLink::default()
         }
         .scene(Setting {

@@ -137,7 +137,7 @@ proptest! {
         }
         // Power is a force times a speed: its round-off scale is m a |v| (seen: 4e-14 W
         // against 0 with an absolute scale of 1e-12).
-        let p_scale = FreeLink::default().mass * scale * qd.amax() * (1.0 + length);
+        let p_scale = FreeLink::default().rod.mass * scale * qd.amax() * (1.0 + length);
         prop_assert!(close(a.power, b.power, p_scale.max(1e-12)), "{} vs {}", a.power, b.power);
         let (ca, cb) = (&a.contacts[0], &b.contacts[0]);
         let pairs = [

@@ -99,7 +99,7 @@ mod tests {
             ..Default::default()
         };
         let mut scene = rod.scene(Setting::default());
-        let (m, g) = (rod.mass, scene.medium.g);
+        let (m, g) = (rod.rod.mass, scene.medium.g);
         scene.forces = ForceSet::build(
             &[
                 TermSpec::new("gravity", &[]),

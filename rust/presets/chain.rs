@@ -5,10 +5,7 @@
 
 use nalgebra::Vector2;
 
-use super::{
-    check_joint, check_rod, check_rod_angle, relaxed_at, rod_inertia, Fields, Preset, Setting,
-    Start,
-};
+use super::{check_joint, check_rod_angle, relaxed_at, Fields, Preset, Rod, Setting, Start};
 use crate::bodies::{
     ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, RootKind, RootSpec,
 };
@@ -39,15 +36,8 @@ pub const PRESET: Preset = Preset {
 /// Two rods pinned at their top ends (MODEL.md, "Bodies").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Chain {
-    /// Length of each link [m].
-    pub length: f64,
-    /// Diameter of each link [m].
-    pub diameter: f64,
-    /// Mass of each link [kg].
-    pub mass: f64,
-    /// Moment of inertia of each link about its centre of mass [kg m^2]; `None`: a solid
-    /// cylinder, m (L^2/12 + d^2/16).
-    pub inertia: Option<f64>,
+    /// Each link: length, diameter, mass, inertia.
+    pub rod: Rod,
     /// Mass of the pin (a point mass at the joint) [kg].
     pub pin_mass: f64,
     /// The pin: free (the thesis), locked, or a spring-damper relaxed at the initial angle.
@@ -65,10 +55,12 @@ impl Default for Chain {
         Chain {
             // L1 = L2 and d1 = d2 (thesis sec. 4.1); the mass is not in the thesis: a solid
             // steel cylinder (7850 kg/m^3) of the stated size, pi/4 d^2 L rho = 0.0341 kg.
-            length: 0.135,
-            diameter: 0.0064,
-            mass: 0.0341,
-            inertia: None,
+            rod: Rod {
+                length: 0.135,
+                diameter: 0.0064,
+                mass: 0.0341,
+                inertia: None,
+            },
             pin_mass: 0.0,
             joint: Joint::Free,
             q_deg: [-15.0, 15.0],
@@ -86,25 +78,20 @@ impl Default for Chain {
 fn build(f: &dyn Fields) -> Result<LinkageScene> {
     let q1 = f.f64("q_deg")?;
     let p = Chain {
-        length: f.f64("length")?,
-        diameter: f.f64("diameter")?,
-        mass: f.f64("mass")?,
-        inertia: f.opt_f64("inertia")?,
+        rod: Rod::read(f)?,
         pin_mass: f.f64_or("pin_mass", 0.0)?,
         joint: f.joint("pin_joint", Joint::Free)?,
         q_deg: [q1, f.opt_f64("q2_deg")?.unwrap_or(-q1)],
         start: Start::read(f)?,
         omega0: f.f64_or("omega0", 0.0)?,
     };
-    let setting = f.setting(2)?;
-    p.check()?;
-    Ok(p.scene(setting))
+    super::finish(f, 2, || p.check(), |setting| p.scene(setting))
 }
 
 impl Chain {
     /// Check every parameter; the error names the first bad one.
     pub fn check(&self) -> Result<()> {
-        check_rod(self.length, self.diameter, self.mass, self.inertia)?;
+        self.rod.check()?;
         check_range("pin_mass", self.pin_mass, 0.0, false)?;
         check_joint("pin_joint", &self.joint)?;
         check_rod_angle("q_deg", self.q_deg[0])?;
@@ -117,13 +104,14 @@ impl Chain {
     /// below the surface.
     pub fn scene(&self, setting: Setting) -> LinkageScene {
         let (q1, q2) = (self.q_deg[0].to_radians(), self.q_deg[1].to_radians());
-        let inertia = rod_inertia(self.inertia, self.mass, self.length, self.diameter);
+        let r = &self.rod;
+        let inertia = r.inertia();
         let link = |name: &str, q: f64| LinkSpec {
             name: name.into(),
-            mass: self.mass,
+            mass: r.mass,
             inertia,
-            com: Vector2::new(-0.5 * self.length, 0.0),
-            length: self.length,
+            com: Vector2::new(-0.5 * r.length, 0.0),
+            length: r.length,
             q,
             omega: self.omega0,
         };
@@ -131,9 +119,9 @@ impl Chain {
             name: name.into(),
             link: name.into(),
             shape: ContactShape::Rod {
-                tip: Vector2::new(-self.length, 0.0),
-                length: self.length,
-                diameter: self.diameter,
+                tip: Vector2::new(-r.length, 0.0),
+                length: r.length,
+                diameter: r.diameter,
             },
         };
         let pin = JointSpec {
@@ -147,10 +135,7 @@ impl Chain {
         let root = RootSpec {
             kind: RootKind::Free,
             link: "link1".into(),
-            position: Vector2::new(
-                0.0,
-                self.length * q1.cos().max(q2.cos()) - self.start.depth0,
-            ),
+            position: Vector2::new(0.0, r.length * q1.cos().max(q2.cos()) - self.start.depth0),
             velocity: Vector2::new(self.start.vx0, -self.start.v0),
             mass: self.pin_mass,
             rate: None,

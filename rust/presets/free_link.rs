@@ -3,7 +3,7 @@
 
 use nalgebra::Vector2;
 
-use super::{check_rod, check_rod_angle, rod_inertia, Fields, Preset, Setting, Start};
+use super::{check_rod_angle, Fields, Preset, Rod, Setting, Start};
 use crate::bodies::{ContactShape, ContactSpec, LinkSpec, LinkageScene, RootKind, RootSpec};
 use crate::error::{check_finite, Result};
 
@@ -20,15 +20,8 @@ pub const PRESET: Preset = Preset {
 /// A free round-ended link dropped onto sand, tip first (MODEL.md, "Bodies").
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FreeLink {
-    /// Rod length L [m].
-    pub length: f64,
-    /// Rod diameter d_c [m].
-    pub diameter: f64,
-    /// Mass m [kg].
-    pub mass: f64,
-    /// Moment of inertia about the centre of mass [kg m^2]; `None`: a solid cylinder,
-    /// m (L^2/12 + d_c^2/16).
-    pub inertia: Option<f64>,
+    /// The rod: length L, diameter d_c, mass m, inertia.
+    pub rod: Rod,
     /// Initial angle from the vertical q [deg], |q| < 90.
     pub q_deg: f64,
     /// Initial motion: the tip's velocity is (vx0, -v0), its depth depth0.
@@ -42,10 +35,12 @@ impl Default for FreeLink {
     fn default() -> Self {
         FreeLink {
             // The thesis's steel rod with round ends (sec. 3.2.1): L, d_c, m.
-            length: 0.190,
-            diameter: 0.0127,
-            mass: 0.184,
-            inertia: None,
+            rod: Rod {
+                length: 0.190,
+                diameter: 0.0127,
+                mass: 0.184,
+                inertia: None,
+            },
             q_deg: 0.0,
             start: Start {
                 v0: 2.214,
@@ -59,23 +54,18 @@ impl Default for FreeLink {
 
 fn build(f: &dyn Fields) -> Result<LinkageScene> {
     let p = FreeLink {
-        length: f.f64("length")?,
-        diameter: f.f64("diameter")?,
-        mass: f.f64("mass")?,
-        inertia: f.opt_f64("inertia")?,
+        rod: Rod::read(f)?,
         q_deg: f.f64("q_deg")?,
         start: Start::read(f)?,
         omega0: f.f64_or("omega0", 0.0)?,
     };
-    let setting = f.setting(1)?;
-    p.check()?;
-    Ok(p.scene(setting))
+    super::finish(f, 1, || p.check(), |setting| p.scene(setting))
 }
 
 impl FreeLink {
     /// Check every parameter; the error names the first bad one.
     pub fn check(&self) -> Result<()> {
-        check_rod(self.length, self.diameter, self.mass, self.inertia)?;
+        self.rod.check()?;
         check_rod_angle("q_deg", self.q_deg)?;
         check_finite("omega0", self.omega0)?;
         self.start.check()
@@ -85,16 +75,17 @@ impl FreeLink {
     /// `depth0` below the surface, moving at (vx0, -v0) and turning at omega0.
     pub fn scene(&self, setting: Setting) -> LinkageScene {
         let q = self.q_deg.to_radians();
-        let half = 0.5 * self.length;
+        let rod = &self.rod;
+        let half = 0.5 * rod.length;
         // The tip's velocity is (vx0, -v0); the centre moves with it plus the spin.
         let normal = Vector2::new(q.cos(), -q.sin());
         let v_c = Vector2::new(self.start.vx0, -self.start.v0) + self.omega0 * half * normal;
         let link = LinkSpec {
             name: "rod".into(),
-            mass: self.mass,
-            inertia: rod_inertia(self.inertia, self.mass, self.length, self.diameter),
+            mass: rod.mass,
+            inertia: rod.inertia(),
             com: Vector2::zeros(),
-            length: self.length,
+            length: rod.length,
             q,
             omega: self.omega0,
         };
@@ -103,8 +94,8 @@ impl FreeLink {
             link: "rod".into(),
             shape: ContactShape::Rod {
                 tip: Vector2::new(-half, 0.0),
-                length: self.length,
-                diameter: self.diameter,
+                length: rod.length,
+                diameter: rod.diameter,
             },
         };
         let root = RootSpec {

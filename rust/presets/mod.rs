@@ -131,6 +131,19 @@ impl Preset {
     }
 }
 
+/// The linkage `scene` builds in the setting of `f` (a body of `contacts` contacts), once
+/// `check` has passed: every field's type first, then the preset's ranges.
+fn finish(
+    f: &dyn Fields,
+    contacts: usize,
+    check: impl FnOnce() -> Result<()>,
+    scene: impl FnOnce(Setting) -> LinkageScene,
+) -> Result<LinkageScene> {
+    let setting = f.setting(contacts)?;
+    check()?;
+    Ok(scene(setting))
+}
+
 /// A spring-damper's parameters checked (`field.k`, `field.c`); other joints pass.
 fn check_joint(field: &str, j: &Joint) -> Result<()> {
     if let Joint::Spring { k, c, .. } = j {
@@ -192,21 +205,48 @@ impl Start {
     }
 }
 
-/// A rod's moment of inertia about its centre of mass: `given`, or a solid cylinder's,
-/// m (L^2/12 + d^2/16).
-fn rod_inertia(given: Option<f64>, mass: f64, length: f64, diameter: f64) -> f64 {
-    given.unwrap_or(mass * (length * length / 12.0 + diameter * diameter / 16.0))
+/// A round rod's size and mass: the free link, each link of the chain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rod {
+    /// Length [m].
+    pub length: f64,
+    /// Diameter [m].
+    pub diameter: f64,
+    /// Mass [kg].
+    pub mass: f64,
+    /// Moment of inertia about the centre of mass [kg m^2]; `None`: a solid cylinder,
+    /// m (L^2/12 + d^2/16).
+    pub inertia: Option<f64>,
 }
 
-/// Check a rod's size and mass fields (and its inertia where given).
-fn check_rod(length: f64, diameter: f64, mass: f64, inertia: Option<f64>) -> Result<()> {
-    check_range("length", length, 0.0, true)?;
-    check_range("diameter", diameter, 0.0, true)?;
-    check_range("mass", mass, 0.0, true)?;
-    if let Some(i) = inertia {
-        check_range("inertia", i, 0.0, true)?;
+impl Rod {
+    /// Read `length`, `diameter`, `mass` and `inertia` (optional).
+    fn read(f: &dyn Fields) -> Result<Rod> {
+        Ok(Rod {
+            length: f.f64("length")?,
+            diameter: f.f64("diameter")?,
+            mass: f.f64("mass")?,
+            inertia: f.opt_f64("inertia")?,
+        })
     }
-    Ok(())
+
+    /// Check the values.
+    fn check(&self) -> Result<()> {
+        check_range("length", self.length, 0.0, true)?;
+        check_range("diameter", self.diameter, 0.0, true)?;
+        check_range("mass", self.mass, 0.0, true)?;
+        if let Some(i) = self.inertia {
+            check_range("inertia", i, 0.0, true)?;
+        }
+        Ok(())
+    }
+
+    /// Moment of inertia about the centre of mass [kg m^2].
+    pub fn inertia(&self) -> f64 {
+        let (l, d) = (self.length, self.diameter);
+        self.inertia
+            .unwrap_or(self.mass * (l * l / 12.0 + d * d / 16.0))
+    }
 }
 
 impl Setting {

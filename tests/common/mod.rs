@@ -65,8 +65,9 @@ pub fn static_v_of(s: &LinkageScene) -> Coefficients {
 /// int_0^d eta_v (s/L)^lambda g rho (pi d_c^2/4) min(s, L) ds.
 pub fn vertical_static_work(p: &FreeLink, s: &LinkageScene, d: f64) -> f64 {
     let c = static_v_of(s);
-    let a = c.eta_v * s.medium.g * s.medium.rho_g * std::f64::consts::PI * p.diameter.powi(2) / 4.0;
-    let l = p.length;
+    let a =
+        c.eta_v * s.medium.g * s.medium.rho_g * std::f64::consts::PI * p.rod.diameter.powi(2) / 4.0;
+    let l = p.rod.length;
     let lam = c.lambda;
     // Partly immersed: a d^(lam+2) / (L^lam (lam+2)) (MODEL.md, "Exact answers").
     let part = |x: f64| a * x.powf(lam + 2.0) / (l.powf(lam) * (lam + 2.0));
@@ -85,7 +86,8 @@ pub fn vertical_static_work(p: &FreeLink, s: &LinkageScene, d: f64) -> f64 {
 pub fn exact_vertical_depth(p: &FreeLink, s: &LinkageScene) -> f64 {
     let g = s.medium.g;
     let v0 = p.start.v0;
-    let f = |d: f64| vertical_static_work(p, s, d) - 0.5 * p.mass * v0 * v0 - p.mass * g * d;
+    let f =
+        |d: f64| vertical_static_work(p, s, d) - 0.5 * p.rod.mass * v0 * v0 - p.rod.mass * g * d;
     let (mut a, mut b) = (0.0f64, 1.0f64);
     while f(b) < 0.0 {
         b *= 2.0;
