@@ -757,12 +757,13 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         width, height = self.figure.get_size_inches() * self.dpi
         return round(float(width)), round(float(height))
 
-    def _write_gif(self, path: Path, tick: Any) -> None:
-        """Write the frames as a GIF: the still parts (axes, ticks, sand, legend) drawn once,
-        each frame only the moving artists over them (what matplotlib calls blitting), and
-        each frame reduced to the first frame's palette (the legend holds every arrow's
-        colour). Drawing every frame whole through matplotlib's writer drew it twice and
-        quantized it apart: about four times slower."""
+    def _write_gif(self, tmp: Path, tick: Any) -> None:
+        """Write the frames as a GIF to ``tmp`` (the temporary file of ``replacing``): the
+        still parts (axes, ticks, sand, legend) drawn once, each frame only the moving artists
+        over them (what matplotlib calls blitting), and each frame reduced to the first
+        frame's palette (the legend holds every arrow's colour). Drawing every frame whole
+        through matplotlib's writer drew it twice and quantized it apart: about four times
+        slower."""
         from PIL import Image
 
         canvas = self.figure.canvas
@@ -790,14 +791,8 @@ class ImpactAnimation(mpl_animation.FuncAnimation):
         finally:
             for artist in moving:
                 artist.set_animated(False)
-        frames[0].save(
-            path,
-            format="GIF",
-            save_all=True,
-            append_images=frames[1:],
-            duration=1000.0 / self.fps,
-            loop=0,
-        )
+        gif = {"format": "GIF", "save_all": True, "loop": 0, "duration": 1000.0 / self.fps}
+        frames[0].save(tmp, append_images=frames[1:], **gif)
 
     def write(self, path: str | os.PathLike[str], progress: bool | None = None) -> Path:
         """Write the animation to ``path``: ``.gif`` (Pillow), ``.mp4`` (ffmpeg) or ``.html``

@@ -237,6 +237,22 @@ impl Rod {
         check_range("mass", self.mass, 0.0, true)?;
         if let Some(i) = self.inertia {
             check_range("inertia", i, 0.0, true)?;
+        } else if !self.inertia().is_finite() {
+            // A solid cylinder's inertia overflows: name the size that does it.
+            let (field, value) = if !(self.length * self.length).is_finite() {
+                ("length", self.length)
+            } else if !(self.diameter * self.diameter).is_finite() {
+                ("diameter", self.diameter)
+            } else {
+                ("mass", self.mass)
+            };
+            return Err(GranrsError::InvalidParameter {
+                field: field.into(),
+                value,
+                allowed: "a size whose solid-cylinder inertia m (L^2/12 + d^2/16) is finite \
+                          (or give inertia)"
+                    .into(),
+            });
         }
         Ok(())
     }
