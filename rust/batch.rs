@@ -408,7 +408,8 @@ pub fn run(
     cancel: &AtomicBool,
     path: Path,
 ) -> BatchOut {
-    let columns = columns(src.shape());
+    let shape = src.shape();
+    let columns = columns(shape);
     let width = columns.len();
     let start = range.start;
     let mut data = vec![f64::NAN; range.len() * width];
@@ -427,7 +428,9 @@ pub fn run(
     };
     let n = range.len();
     let rows = Rows::new(&mut data, width);
-    if path == Path::Lanes {
+    // The lanes take one-link bodies (every scene of a batch has its body's shape); a body
+    // of several links runs on the scalar path.
+    if path == Path::Lanes && shape.1 == 0 {
         let isa = LaneIsa::detect();
         // Every thread runs its own four lanes and takes the batch's next scene whenever a
         // lane frees: no thread waits on another's tail, and no lane idles until the batch
