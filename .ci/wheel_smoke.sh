@@ -117,7 +117,7 @@ sdists=("$work"/sdist/granrs-*.tar.gz)
 (cd "$work" && PATH="$tools_path" pip wheel -q --no-deps -w "$work/from-sdist" "${sdists[0]}") ||
     fail "pip wheel of the sdist"
 listing=$("$work/venv/bin/python" -m zipfile -l "$work"/from-sdist/granrs-*.whl)
-for needed in granrs/_granrs granrs/data/table_3_4_free_link_coefficients.csv granrs/animate.py; do
+for needed in granrs/_granrs granrs/data/table_3_4_free_link_coefficients.csv granrs/animation.py granrs/_constructors.pyi granrs/py.typed; do
     echo "$listing" | grep -q "$needed" || fail "the wheel built from the sdist lacks $needed"
 done
 say "the sdist $(basename "${sdists[0]}") builds a wheel with the core and the data"

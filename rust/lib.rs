@@ -20,6 +20,7 @@ pub mod forces;
 pub mod integrate;
 pub mod num;
 pub mod presets;
+pub mod space;
 pub mod spec;
 
 #[cfg(feature = "python")]

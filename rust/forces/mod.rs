@@ -20,8 +20,12 @@
 //! several scenes at once in SIMD lanes (a lane type implementing [`Real`]) without a second
 //! copy of the physics.
 //!
-//! Adding a term: one file with a struct implementing [`Term`], one line in the registry
-//! (`registry.rs`), one constructor in `python/granrs/forces.py`. See `docs/forces.md`.
+//! Terms on a body in space (`rft3d`, `rft3d_inertial`; `poncelet` and `gravity` act there
+//! too) name the shapes in space ([`SPACE_SHAPES`]) and give their element kernels for
+//! `crate::space`; a planar scene refuses them before any work.
+//!
+//! Adding a term: one file with a struct implementing [`Term`] and one line in the registry
+//! (`registry.rs`); its Python constructor is made from the registry. See `docs/forces.md`.
 
 use std::fmt::Debug;
 
@@ -34,6 +38,7 @@ pub mod outline;
 pub mod poncelet;
 pub mod registry;
 pub mod rft;
+pub mod rft3d;
 pub mod static_h;
 pub mod static_v;
 
@@ -278,6 +283,16 @@ pub enum ContactKind {
     Box,
     /// A thin circular arc (`body::arc`).
     Arc,
+    /// A sphere in space (`space::shape`).
+    Sphere,
+    /// A capsule in space: a cylinder with hemispherical ends.
+    Capsule,
+    /// A cylinder in space, with flat ends.
+    Cylinder,
+    /// A cuboid (a box) in space.
+    Cuboid,
+    /// A closed triangle mesh in space.
+    Mesh,
 }
 
 impl ContactKind {
@@ -287,16 +302,41 @@ impl ContactKind {
             ContactKind::Rod => "rod",
             ContactKind::Box => "box",
             ContactKind::Arc => "arc",
+            ContactKind::Sphere => "sphere",
+            ContactKind::Capsule => "capsule",
+            ContactKind::Cylinder => "cylinder",
+            ContactKind::Cuboid => "cuboid",
+            ContactKind::Mesh => "mesh",
         }
     }
 }
 
-/// Every contact shape (a term that reads nothing of the shape, or its boundary's elements).
+/// Every planar contact shape (a term that reads nothing of the shape, or its boundary's
+/// elements).
 pub const EVERY_SHAPE: &[ContactKind] = &[ContactKind::Rod, ContactKind::Box, ContactKind::Arc];
 
 /// The shapes with an immersed volume and area of their own (the thesis's law, Poncelet's).
 pub const SOLID_SHAPES: &[ContactKind] = &[ContactKind::Rod, ContactKind::Box];
 
+/// The shapes of a body in space (`crate::space`).
+pub const SPACE_SHAPES: &[ContactKind] = &[
+    ContactKind::Sphere,
+    ContactKind::Capsule,
+    ContactKind::Cylinder,
+    ContactKind::Cuboid,
+    ContactKind::Mesh,
+];
+
+/// The planar solids and every shape in space (Poncelet's law).
+pub const SOLID_AND_SPACE_SHAPES: &[ContactKind] = &[
+    ContactKind::Rod,
+    ContactKind::Box,
+    ContactKind::Sphere,
+    ContactKind::Capsule,
+    ContactKind::Cylinder,
+    ContactKind::Cuboid,
+    ContactKind::Mesh,
+];
 /// Everything known about a term, for validation, docs, TOML and errors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TermInfo {

@@ -115,7 +115,7 @@ impl Term for Poncelet {
                 held signs of v_E (sticking)",
         reads_area_speed: false,
         reads_frame: true,
-        shapes: super::SOLID_SHAPES,
+        shapes: super::SOLID_AND_SPACE_SHAPES,
         switches: &[Switch::SlipY],
         columns: &[("F_px", 0), ("F_py", 1)],
     };

@@ -5,8 +5,8 @@
 //! [`TermInfo`] in the order the docs list them.
 
 use super::{
-    drag, gravity, joint_springs, poncelet, rft, static_h, static_v, Acts, Class, ContactState,
-    Medium, Rates, Real, Switch, Term, TermForce, TermInfo,
+    drag, gravity, joint_springs, poncelet, rft, rft3d, static_h, static_v, Acts, Class,
+    ContactState, Medium, Rates, Real, Switch, Term, TermForce, TermInfo,
 };
 use crate::error::{suggest, GranrsError, Result};
 
@@ -113,6 +113,8 @@ registry! {
     Poncelet(poncelet::Poncelet),
     Rft(rft::Rft),
     RftInertial(rft::RftInertial),
+    Rft3d(rft3d::Rft3d),
+    Rft3dInertial(rft3d::Rft3dInertial),
     // The worked example of docs/forces.md, a fixture of the crate's own tests.
     #[cfg(test)]
     Constant(super::constant::Constant),
@@ -234,7 +236,9 @@ impl TermSpec {
                 });
             }
             for &v in &values {
-                if !(v.is_finite() && v >= p.min && v <= p.max) || (p.integer && v.fract() != 0.0) {
+                // An infinite default (no bound: `rft3d.mu_surf`) may also be given.
+                let finite = v.is_finite() || (v == f64::INFINITY && p.default == f64::INFINITY);
+                if !(finite && v >= p.min && v <= p.max) || (p.integer && v.fract() != 0.0) {
                     let kind = if p.integer { "an integer" } else { "finite" };
                     let min = if p.min == f64::NEG_INFINITY {
                         String::new()

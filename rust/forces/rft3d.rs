@@ -1,0 +1,492 @@
+//! `rft3d`: three-dimensional resistive force theory, and `rft3d_inertial`, its
+//! rate-dependent term, on the surface elements of a body in space (`crate::space`).
+//!
+//! ```text
+//! dF = zeta |z| dA alpha_gen(n, v^)                          on leading elements (n . v >= 0)
+//! alpha_gen = f1 m + f2 v^ - f3 z^
+//! m  = n if n_z < 0 else -n        (the element as a two-sided plate, normal facing down;
+//!                                    the tie, |n_z| <= 1e-12, is -n)
+//! x1 = -v^_z,  x2 = |n_z|,  x3 = m . v^
+//! f_i = sum_k c_ik T_k(x1, x2, x3),
+//! T = (1, x1, x2, x3, x1^2, x2^2, x3^2, x1 x2, x2 x3, x3 x1, x1^3, x2^3, x3^3,
+//!      x1 x2^2, x2 x1^2, x2 x3^2, x3 x2^2, x3 x1^2, x1 x3^2, x1 x2 x3)
+//! ```
+//!
+//! with `n` the element's outward unit normal, `v^` the direction of its velocity, `z^` up
+//! and `|z|` its depth below the sand's surface. This is the angle form of the source
+//! (velocity angle gamma, plate tilt beta, twist psi, in the frame of the velocity's
+//! horizontal direction r) written in vectors: `x1 = sin gamma`, `x2 = cos beta`,
+//! `x3 = cos psi cos gamma sin beta + sin gamma cos beta`, and
+//! `(alpha_r, alpha_theta, alpha_z) = (f1 sin b cos p + f2 cos g, f1 sin b sin p,
+//! -f1 cos b - f2 sin g - f3)`; the vector form needs no frame, so it has no degenerate
+//! case when v or n is vertical. A horizontal plate pushed straight down has
+//! `alpha_z = 0.87574`; a vertical wall sliding straight down `0.24898`. Trailing elements
+//! (n . v < 0) carry nothing (no suction). Elements whose velocity is exactly zero carry
+//! nothing either: the law gives no force at rest (a stop ends a run, `crate::space`).
+//!
+//! An optional surface-friction cap: where the tangential part of the stress exceeds
+//! `mu_surf` times its normal part, the tangential part is scaled down to it.
+//!
+//! - **Source:** Agarwal, Goldman & Kamrin, "Mechanistic framework for reduced-order
+//!   models in soft materials: Application to three-dimensional granular intrusion", PNAS
+//!   120 (2023) e2214017120, SI section S3 (the fitted functions and their coefficients).
+//!   The paper's SI could not be read here; the form, the coefficients and the rules come
+//!   from four public codes that cite it, cross-read against each other and against the
+//!   physics (`docs/space.md` lists where they disagree and which value is used).
+//! - **Parameters:** `zeta` [N/m^3], required: the material scale multiplying the
+//!   dimensionless generic stress (the paper's xi_n; [`xi_n`] gives it from the medium's
+//!   critical-state density and internal friction); `mu_surf` [-], the surface-friction
+//!   cap, default infinite (no cap); `grazing` [-], 1 (default) to count elements moving
+//!   along their own surface (n . v = 0, within 1e-12 of |v|), as the public codes do, 0
+//!   to leave them out.
+//! - **Reads:** each surface element's normal, depth, area and velocity.
+//! - **Shapes:** the shapes in space (sphere, capsule, cylinder, cuboid, mesh); a planar
+//!   scene refuses it before any work.
+//!
+//! `rft3d_inertial`:
+//!
+//! ```text
+//! dF = -lam rho_g (n . v)^2 n dA      on leading elements (n . v > 0)
+//! ```
+//!
+//! the momentum flux of the sand each leading element brings to its normal speed (as the
+//! planar `rft_inertial`; Agarwal, Karsai, Goldman & Kamrin, Science Advances 7 (2021)
+//! eabe0631).
+
+use super::{
+    Acts, Class, ContactKind, ContactState, Medium, Param, Rates, Real, Term, TermForce, TermInfo,
+    SPACE_SHAPES,
+};
+
+/// The fitted coefficients c_ik of the three functions f_1, f_2, f_3 (rows), in the order of
+/// the monomials T_k (columns; see the module's doc). Where public transcriptions of the SI
+/// table disagree, the value that three of four agree on is used (`docs/space.md`).
+pub const COEFFICIENTS: [[f64; 20]; 3] = [
+    [
+        0.00212, -0.02320, -0.20890, -0.43083, -0.00259, 0.48872, -0.00415, 0.07204, -0.02750,
+        -0.08772, 0.01992, -0.45961, 0.40799, -0.10107, -0.06576, 0.05664, -0.09269, 0.01892,
+        0.01033, 0.15120,
+    ],
+    [
+        -0.06796, -0.10941, 0.04725, -0.06914, -0.05835, -0.65880, -0.11985, -0.25739, -0.26834,
+        0.02692, -0.00736, 0.63758, 0.08997, 0.21069, 0.04748, 0.20406, 0.18519, 0.04934, 0.13527,
+        -0.33207,
+    ],
+    [
+        -0.02634, -0.03436, 0.45256, 0.00835, 0.02553, -1.31290, -0.05532, 0.06790, -0.16404,
+        0.02287, 0.02927, 0.95406, -0.00131, -0.11028, 0.01487, -0.02730, 0.10911, -0.04097,
+        0.07881, -0.27519,
+    ],
+];
+
+/// Tolerance of the leading-edge test on `n . v^` (grazing elements are within it).
+pub const GRAZING_TOL: f64 = 1e-12;
+
+/// The material scale xi_n [N/m^3] of 3D-RFT from the medium's critical-state (bulk)
+/// density `rho_c` [kg/m^3] and internal friction coefficient `mu` [-]:
+/// `xi_n = rho_c g (894 mu^3 - 386 mu^2 + 89 mu)`, g = 9.81 m/s^2 (Agarwal et al. 2023, as
+/// the public codes give it; fitted over mu 0.3 to 0.9).
+pub fn xi_n(rho_c: f64, mu: f64) -> f64 {
+    rho_c * 9.81 * (894.0 * mu * mu * mu - 386.0 * mu * mu + 89.0 * mu)
+}
+
+/// The three fitted functions (f1, f2, f3) at the invariants (x1, x2, x3).
+#[inline(always)]
+pub fn fitted<F: Real>(x1: F, x2: F, x3: F) -> [F; 3] {
+    let t = [
+        F::splat(1.0),
+        x1,
+        x2,
+        x3,
+        x1 * x1,
+        x2 * x2,
+        x3 * x3,
+        x1 * x2,
+        x2 * x3,
+        x3 * x1,
+        x1 * x1 * x1,
+        x2 * x2 * x2,
+        x3 * x3 * x3,
+        x1 * x2 * x2,
+        x2 * x1 * x1,
+        x2 * x3 * x3,
+        x3 * x2 * x2,
+        x3 * x1 * x1,
+        x1 * x3 * x3,
+        x1 * x2 * x3,
+    ];
+    let mut f = [F::splat(0.0); 3];
+    for (fi, c) in f.iter_mut().zip(COEFFICIENTS.iter()) {
+        let mut s = F::splat(0.0);
+        for (tk, &ck) in t.iter().zip(c.iter()) {
+            s = s + F::splat(ck) * *tk;
+        }
+        *fi = s;
+    }
+    f
+}
+
+/// The generic (dimensionless) stress alpha_gen on an element with outward unit normal `n`
+/// moving along the unit direction `vh` (z up), before the leading-edge test and the
+/// friction cap.
+#[inline(always)]
+pub fn generic_stress<F: Real>(n: [F; 3], vh: [F; 3]) -> [F; 3] {
+    // m: the plate's normal facing down (n where n_z < -tol, else -n). The law jumps where
+    // a face turns through vertical (f1 m flips, and f1 is not zero there); the tie within
+    // round-off goes one way, so that a vertical wall is one plate whatever the round-off
+    // of its normal (else a wall tilted by 1e-26 rad pushes sideways).
+    let s = (-n[2] - F::splat(GRAZING_TOL)).select_pos(F::splat(1.0), F::splat(-1.0));
+    let m = [s * n[0], s * n[1], s * n[2]];
+    let x1 = -vh[2];
+    let x2 = n[2].abs();
+    let x3 = m[0] * vh[0] + m[1] * vh[1] + m[2] * vh[2];
+    let [f1, f2, f3] = fitted(x1, x2, x3);
+    [
+        f1 * m[0] + f2 * vh[0],
+        f1 * m[1] + f2 * vh[1],
+        f1 * m[2] + f2 * vh[2] - f3,
+    ]
+}
+
+/// The stress per unit depth [N/m^3] of `rft3d` on an element (normal `n`, velocity `v`):
+/// `zeta alpha_gen`, capped by `mu_surf`, zero on trailing elements, at rest, and (when
+/// `grazing` is 0) on grazing ones. Branch-free, so that it runs in SIMD lanes.
+#[inline(always)]
+pub fn stress<F: Real>(law: &Rft3dLanes<F>, n: [F; 3], v: [F; 3]) -> [F; 3] {
+    let zero = F::splat(0.0);
+    let speed2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    // 1 / |v|, finite at rest (the element is then left out below).
+    let moving = speed2.select_pos(F::splat(1.0), zero);
+    let inv = (speed2 + (F::splat(1.0) - moving)).sqrt().recip();
+    let vh = [v[0] * inv, v[1] * inv, v[2] * inv];
+    let nv = n[0] * vh[0] + n[1] * vh[1] + n[2] * vh[2];
+    // Leading: n . v^ > -tol (grazing counted) or > tol (grazing left out).
+    let leading = (nv + law.threshold).select_pos(F::splat(1.0), zero) * moving;
+    let a = generic_stress(n, vh);
+    // The friction cap: tangential part <= mu_surf |normal part|.
+    let an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+    let at = [a[0] - an * n[0], a[1] - an * n[1], a[2] - an * n[2]];
+    let at_norm = (at[0] * at[0] + at[1] * at[1] + at[2] * at[2]).sqrt();
+    let cap = law.mu_surf * an.abs();
+    let over = at_norm - cap;
+    // scale = cap / |at| where over the cap, else 1.
+    // cap / |at| where over the cap (then |at| > cap >= 0), else 1; with no cap (infinite
+    // mu_surf) `over` is -inf or NaN and the scale is 1.
+    let scale = over.select_pos(
+        cap * at_norm.max(F::splat(f64::MIN_POSITIVE)).recip(),
+        F::splat(1.0),
+    );
+    let k = law.zeta * leading;
+    [
+        k * (an * n[0] + scale * at[0]),
+        k * (an * n[1] + scale * at[1]),
+        k * (an * n[2] + scale * at[2]),
+    ]
+}
+
+/// `rft3d`'s numbers as the element kernel reads them (one value, or one per lane).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rft3dLanes<F> {
+    /// zeta [N/m^3].
+    pub zeta: F,
+    /// The friction cap mu_surf [-] (infinite: none).
+    pub mu_surf: F,
+    /// `GRAZING_TOL` where grazing elements count, `-GRAZING_TOL` where they do not: an
+    /// element leads where `n . v^ + threshold > 0`.
+    pub threshold: F,
+}
+
+/// 3D resistive force theory (Agarwal, Goldman & Kamrin 2023).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rft3d {
+    /// The material scale zeta [N/m^3].
+    pub zeta: f64,
+    /// The surface-friction cap mu_surf [-] (infinite: none).
+    pub mu_surf: f64,
+    /// Whether grazing elements (n . v = 0) count.
+    pub grazing: bool,
+}
+
+impl Rft3d {
+    /// Its numbers for the element kernel.
+    pub fn lanes<F: Real>(&self) -> Rft3dLanes<F> {
+        Rft3dLanes {
+            zeta: F::splat(self.zeta),
+            mu_surf: F::splat(self.mu_surf),
+            threshold: F::splat(if self.grazing {
+                GRAZING_TOL
+            } else {
+                -GRAZING_TOL
+            }),
+        }
+    }
+}
+
+impl Term for Rft3d {
+    const INFO: TermInfo = TermInfo {
+        name: "rft3d",
+        summary: "three-dimensional resistive force theory on a body's surface elements",
+        equation: "dF = zeta |z| dA (f1 m + f2 v^ - f3 z^) on leading elements (n . v >= 0); \
+                   m: the element's normal facing down; f_i: cubic fits in (-v^_z, |n_z|, m . v^)",
+        source: "Agarwal, Goldman & Kamrin, PNAS 120 (2023) e2214017120, SI sec. S3",
+        params: &[
+            Param {
+                name: "zeta",
+                unit: "N/m^3",
+                default: f64::NAN,
+                source: "none: the medium's scale xi_n (granrs.space.xi_n from its density and \
+                         internal friction, or fitted)",
+                min: 0.0,
+                description: "material scale of the generic stress",
+                integer: false,
+                max: f64::INFINITY,
+            },
+            Param {
+                name: "mu_surf",
+                unit: "-",
+                default: f64::INFINITY,
+                source: "no cap unless given (the public codes take 0.15 to 0.4)",
+                min: 0.0,
+                description: "surface friction: cap on the stress's tangential part",
+                integer: false,
+                max: f64::INFINITY,
+            },
+            Param {
+                name: "grazing",
+                unit: "-",
+                default: 1.0,
+                source: "1 as the public codes of the paper (grazing elements count)",
+                min: 0.0,
+                description: "whether elements moving along their own surface count (1 or 0)",
+                integer: true,
+                max: 1.0,
+            },
+        ],
+        acts: Acts::Contact,
+        class: Class::Static,
+        velocity_dependent: false,
+        reads: "each surface element's normal, depth, area and velocity direction",
+        reads_area_speed: false,
+        reads_frame: true,
+        shapes: SPACE_SHAPES,
+        switches: &[],
+        columns: &[],
+    };
+
+    fn from_params(values: &[f64]) -> Self {
+        Rft3d {
+            zeta: values[0],
+            mu_surf: values[1],
+            grazing: values[2] != 0.0,
+        }
+    }
+
+    fn params(&self) -> Vec<f64> {
+        vec![self.zeta, self.mu_surf, f64::from(u8::from(self.grazing))]
+    }
+
+    /// Never evaluated on a planar contact (refused before any work).
+    fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
+    }
+
+    /// Never evaluated on a planar contact; a body in space estimates its own stiffness
+    /// (`crate::space::solve`).
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
+    }
+}
+
+/// The inertial term of dynamic RFT on the surface elements of a body in space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rft3dInertial {
+    /// Scale of the momentum flux lam [-].
+    pub lam: f64,
+}
+
+impl Rft3dInertial {
+    /// Its force per unit area [N/m^2] on an element (normal `n`, velocity `v`):
+    /// `-lam rho_g (n . v)^2 n` where `n . v > 0`.
+    #[inline(always)]
+    pub fn traction<F: Real>(k: F, n: [F; 3], v: [F; 3]) -> [F; 3] {
+        let vn = (n[0] * v[0] + n[1] * v[1] + n[2] * v[2]).max(F::splat(0.0));
+        let p = -(k * vn * vn);
+        [p * n[0], p * n[1], p * n[2]]
+    }
+}
+
+impl Term for Rft3dInertial {
+    const INFO: TermInfo = TermInfo {
+        name: "rft3d_inertial",
+        summary: "the inertial term of dynamic RFT on a body's surface elements in space",
+        equation: "dF = -lam rho_g (n . v)^2 n dA on leading elements (n . v > 0)",
+        source: "Agarwal, Karsai, Goldman & Kamrin, Science Advances 7 (2021) eabe0631 \
+                 (dynamic RFT)",
+        params: &[Param {
+            name: "lam",
+            unit: "-",
+            default: 1.0,
+            source: "the momentum-flux value (sand brought to the element's normal speed)",
+            min: 0.0,
+            description: "scale of the momentum flux rho_g v_n^2",
+            integer: false,
+            max: f64::INFINITY,
+        }],
+        acts: Acts::Contact,
+        class: Class::Dynamic,
+        velocity_dependent: true,
+        reads: "rho_g; each surface element's normal, area and velocity",
+        reads_area_speed: false,
+        reads_frame: true,
+        shapes: SPACE_SHAPES,
+        switches: &[],
+        columns: &[],
+    };
+
+    fn from_params(values: &[f64]) -> Self {
+        Rft3dInertial { lam: values[0] }
+    }
+
+    fn params(&self) -> Vec<f64> {
+        vec![self.lam]
+    }
+
+    /// Never evaluated on a planar contact (refused before any work).
+    fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
+    }
+
+    /// Never evaluated on a planar contact.
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
+    }
+}
+
+/// Whether `kind` is a shape in space.
+pub fn in_space(kind: ContactKind) -> bool {
+    SPACE_SHAPES.contains(&kind)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn law(mu: f64, grazing: bool) -> Rft3dLanes<f64> {
+        Rft3d {
+            zeta: 1.0,
+            mu_surf: mu,
+            grazing,
+        }
+        .lanes()
+    }
+
+    #[test]
+    fn a_plate_pushed_down_and_a_wall_sliding_down_give_the_tabulated_stresses() {
+        // Sums of the table's columns (computed by hand in the docs): -(sum c1 + c2 + c3).
+        let a = stress(
+            &law(f64::INFINITY, true),
+            [0.0, 0.0, -1.0],
+            [0.0, 0.0, -2.0],
+        );
+        assert!((a[2] - 0.87574).abs() < 1e-12, "{a:?}");
+        assert!(a[0].abs() < 1e-15 && a[1].abs() < 1e-15);
+        // A vertical wall (n = +x) sliding down: grazing, counted by default.
+        let w = stress(&law(f64::INFINITY, true), [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]);
+        assert!((w[2] - 0.24898).abs() < 1e-12, "{w:?}");
+        let none = stress(
+            &law(f64::INFINITY, false),
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, -1.0],
+        );
+        assert_eq!(none, [0.0; 3]);
+    }
+
+    #[test]
+    fn trailing_elements_and_rest_carry_nothing() {
+        let l = law(f64::INFINITY, true);
+        assert_eq!(stress(&l, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]), [0.0; 3]);
+        assert_eq!(stress(&l, [0.0, 0.0, -1.0], [0.0, 0.0, 0.0]), [0.0; 3]);
+    }
+
+    #[test]
+    fn the_vector_form_equals_the_angle_form() {
+        // The angle form of the source, written out with its frame, on a grid of pairs.
+        let l = law(f64::INFINITY, true);
+        let mut checked = 0;
+        for i in 0..13 {
+            for j in 0..13 {
+                for k in 0..7 {
+                    let th = std::f64::consts::PI * i as f64 / 12.0;
+                    let ph = 2.0 * std::f64::consts::PI * j as f64 / 13.0 + 0.1;
+                    let n = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
+                    let g = -std::f64::consts::FRAC_PI_2
+                        + std::f64::consts::PI * (k as f64 + 0.5) / 7.0;
+                    // velocity in the (x, z) plane: r = +x
+                    let v = [g.cos(), 0.0, -g.sin()];
+                    if n[0] * v[0] + n[1] * v[1] + n[2] * v[2] <= 1e-9 {
+                        continue;
+                    }
+                    // angle form: frame r = x, theta = z x r = y.
+                    let (nr, nt, nz) = (n[0], n[1], n[2]);
+                    let m = if nz < 0.0 {
+                        [nr, nt, nz]
+                    } else {
+                        [-nr, -nt, -nz]
+                    };
+                    let b = (-m[2]).acos() * if m[0] >= 0.0 { 1.0 } else { -1.0 };
+                    let p = if m[0].abs() < 1e-300 && m[1].abs() < 1e-300 {
+                        0.0
+                    } else if m[0].abs() < 1e-15 {
+                        std::f64::consts::FRAC_PI_2 * m[1].signum() * m[0].signum().max(1.0)
+                    } else {
+                        (m[1] / m[0]).atan()
+                    };
+                    let x1 = g.sin();
+                    let x2 = b.cos();
+                    let x3 = p.cos() * g.cos() * b.sin() + g.sin() * b.cos();
+                    let f = fitted(x1, x2, x3);
+                    let ar = f[0] * b.sin() * p.cos() + f[1] * g.cos();
+                    let at = f[0] * b.sin() * p.sin();
+                    let az = -f[0] * b.cos() - f[1] * g.sin() - f[2];
+                    let a = stress(&l, n, v);
+                    for (x, y) in a.iter().zip([ar, at, az]) {
+                        assert!(
+                            (x - y).abs() < 1e-12,
+                            "n {n:?} v {v:?}: {a:?} vs {:?}",
+                            [ar, at, az]
+                        );
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 300, "{checked}");
+    }
+
+    #[test]
+    fn the_friction_cap_limits_the_tangential_part_and_keeps_the_normal_part() {
+        let n = [0.6, 0.0, -0.8];
+        let v = [1.0, 0.0, -0.3];
+        let free = stress(&law(f64::INFINITY, true), n, v);
+        let capped = stress(&law(0.1, true), n, v);
+        let dot = |a: [f64; 3]| a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+        assert!((dot(free) - dot(capped)).abs() < 1e-15);
+        let tang = |a: [f64; 3]| {
+            let an = dot(a);
+            ((a[0] - an * n[0]).powi(2) + (a[1] - an * n[1]).powi(2) + (a[2] - an * n[2]).powi(2))
+                .sqrt()
+        };
+        assert!(
+            tang(free) > 0.1 * dot(free).abs() * 1.01,
+            "the case must be capped"
+        );
+        assert!((tang(capped) - 0.1 * dot(capped).abs()).abs() < 1e-14);
+    }
+
+    #[test]
+    fn xi_n_is_the_cubic_in_mu() {
+        // 1520 kg/m^3 and mu 0.4: 1520 * 9.81 * (894 * 0.064 - 386 * 0.16 + 35.6)
+        let expect = 1520.0 * 9.81 * (57.216 - 61.76 + 35.6);
+        assert!((xi_n(1520.0, 0.4) - expect).abs() < 1e-6 * expect);
+    }
+}

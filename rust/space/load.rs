@@ -1,0 +1,490 @@
+//! The sand's force and moment on a body in space: each listed term over the immersed
+//! surface elements ([`super::shape::Elements`]).
+//!
+//! `rft3d` and `rft3d_inertial` act per element (their kernels are in their term file,
+//! `forces/rft3d.rs`, generic over the number type, so that four elements go through one
+//! set of SIMD instructions); `poncelet` acts at the centre of the immersed leading area
+//! (see [`Terms3`]); `gravity` is the body's weight.
+
+use nalgebra::{UnitQuaternion, Vector3};
+
+use super::shape::{Elements, Quadrature, Shape};
+use crate::error::{GranrsError, Result};
+use crate::forces::poncelet::Poncelet;
+use crate::forces::rft3d::{stress, Rft3d, Rft3dInertial, Rft3dLanes};
+use crate::forces::{Acts, Medium, Real, TermSpec};
+use crate::num::F64x4;
+
+type V3 = Vector3<f64>;
+
+/// The terms that act on a body in space, each at most once.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Terms3 {
+    /// 3D-RFT.
+    pub rft3d: Option<Rft3d>,
+    /// Its inertial term.
+    pub inertial: Option<Rft3dInertial>,
+    /// Poncelet / Katsuragi-Durian: `F = -c rho_g A |v_E| v_E - k d v_E / |v_E|` at E, with
+    /// A the immersed leading area projected on the plane normal to the centre's velocity,
+    /// E its centre and d the lowest point's depth (a sphere fully under: A = pi r^2).
+    pub poncelet: Option<Poncelet>,
+    /// The body's weight.
+    pub gravity: bool,
+}
+
+impl Terms3 {
+    /// The terms of `specs` for a body of shape `kind`, checked (an unknown term or
+    /// parameter, a term not defined in space, a term listed twice: a typed error naming
+    /// it, `forces[i]`).
+    pub fn from_specs(specs: &[TermSpec], shape: &Shape) -> Result<Terms3> {
+        let mut t = Terms3::default();
+        let kind = shape.kind();
+        for (i, spec) in specs.iter().enumerate() {
+            let (info, values) = spec
+                .resolve(1)
+                .map_err(|e| e.map_field(|f| format!("forces[{i}].{f}")))?;
+            let v = &values[0];
+            let twice = || GranrsError::InvalidScene {
+                field: format!("forces[{i}]"),
+                message: format!("`{}` is listed twice", info.name),
+            };
+            match info.name {
+                "gravity" => {
+                    if t.gravity {
+                        return Err(twice());
+                    }
+                    t.gravity = true;
+                }
+                _ if info.acts == Acts::Body || !info.shapes.contains(&kind) => {
+                    return Err(GranrsError::InvalidScene {
+                        field: format!("forces[{i}]"),
+                        message: format!(
+                            "`{}` does not act on a {} in space (terms in space: rft3d, \
+                             rft3d_inertial, poncelet, gravity)",
+                            info.name,
+                            kind.name()
+                        ),
+                    })
+                }
+                "rft3d" => {
+                    if t.rft3d.is_some() {
+                        return Err(twice());
+                    }
+                    t.rft3d = Some(<Rft3d as crate::forces::Term>::from_params(v));
+                }
+                "rft3d_inertial" => {
+                    if t.inertial.is_some() {
+                        return Err(twice());
+                    }
+                    t.inertial = Some(<Rft3dInertial as crate::forces::Term>::from_params(v));
+                }
+                "poncelet" => {
+                    if t.poncelet.is_some() {
+                        return Err(twice());
+                    }
+                    t.poncelet = Some(<Poncelet as crate::forces::Term>::from_params(v));
+                }
+                other => {
+                    return Err(GranrsError::InvalidScene {
+                        field: format!("forces[{i}]"),
+                        message: format!("`{other}` has no form in space yet"),
+                    })
+                }
+            }
+        }
+        Ok(t)
+    }
+
+    /// Whether any term reads the immersed surface.
+    pub fn any_sand(&self) -> bool {
+        self.rft3d.is_some() || self.inertial.is_some() || self.poncelet.is_some()
+    }
+}
+
+/// The sand's load on the body at one instant.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Load {
+    /// The sand's force, world frame [N] (the weight not included).
+    pub force: V3,
+    /// Its moment about the centre of mass, world frame [N m].
+    pub moment: V3,
+    /// `rft3d`'s share of the force [N].
+    pub rft3d: V3,
+    /// `rft3d_inertial`'s share [N].
+    pub inertial: V3,
+    /// `poncelet`'s share [N].
+    pub poncelet: V3,
+    /// The immersed surface's area [m^2].
+    pub wetted_area: f64,
+    /// The immersed leading area projected normal to the centre's velocity [m^2].
+    pub projected_area: f64,
+    /// How many surface elements were evaluated.
+    pub elements: usize,
+}
+
+/// What an evaluation of the load needs besides the state: the shape, the terms, the
+/// medium, the surface and the rule, with the buffers it reuses.
+#[derive(Debug, Clone)]
+pub struct Sand {
+    /// The body's shape.
+    pub shape: Shape,
+    /// The listed terms.
+    pub terms: Terms3,
+    /// The medium.
+    pub medium: Medium,
+    /// The sand's surface z [m].
+    pub surface: f64,
+    /// The surface rule.
+    pub rule: Quadrature,
+    elements: Elements,
+}
+
+impl Sand {
+    /// The sand acting on `shape`.
+    pub fn new(
+        shape: Shape,
+        terms: Terms3,
+        medium: Medium,
+        surface: f64,
+        rule: Quadrature,
+    ) -> Sand {
+        Sand {
+            shape,
+            terms,
+            medium,
+            surface,
+            rule,
+            elements: Elements::default(),
+        }
+    }
+
+    /// The immersed elements at the pose (for a caller that shows them).
+    pub fn elements_at(
+        &mut self,
+        c: &V3,
+        q: &UnitQuaternion<f64>,
+        v: &V3,
+        omega: &V3,
+    ) -> &Elements {
+        self.elements.clear();
+        self.shape
+            .elements(c, q, v, omega, self.surface, &self.rule, &mut self.elements);
+        &self.elements
+    }
+
+    /// The load at the pose (`c`, `q`) and motion (`v` of the centre, `omega`).
+    pub fn load(&mut self, c: &V3, q: &UnitQuaternion<f64>, v: &V3, omega: &V3) -> Load {
+        let mut out = Load::default();
+        if !self.terms.any_sand() {
+            return out;
+        }
+        self.elements.clear();
+        self.shape
+            .elements(c, q, v, omega, self.surface, &self.rule, &mut self.elements);
+        let e = &self.elements;
+        out.elements = e.len();
+        if e.is_empty() {
+            return out;
+        }
+        let mut moment = V3::zeros();
+        if let Some(law) = self.terms.rft3d {
+            let (f, m) = rft3d_sum(&law.lanes(), e, c, v, omega);
+            out.rft3d = f;
+            moment += m;
+        }
+        if let Some(t) = self.terms.inertial {
+            let k = t.lam * self.medium.rho_g;
+            let mut f = V3::zeros();
+            for i in 0..e.len() {
+                let x = V3::from(e.x[i]);
+                let r = x - c;
+                let vx = v + omega.cross(&r);
+                let tr = Rft3dInertial::traction(k, e.n[i], [vx.x, vx.y, vx.z]);
+                let df = V3::from(tr) * e.area[i];
+                f += df;
+                moment += r.cross(&df);
+            }
+            out.inertial = f;
+        }
+        out.wetted_area = e.area.iter().sum();
+        let speed = v.norm();
+        if speed > 0.0 {
+            let vh = v / speed;
+            let (mut a, mut centre) = (0.0, V3::zeros());
+            for i in 0..e.len() {
+                let p = (V3::from(e.n[i]).dot(&vh)).max(0.0) * e.area[i];
+                a += p;
+                centre += p * V3::from(e.x[i]);
+            }
+            out.projected_area = a;
+            if let Some(p) = self.terms.poncelet {
+                let low = self.shape.lowest_point(c, q);
+                let d = (self.surface - low.z).max(0.0);
+                let at = if a > 0.0 { centre / a } else { low };
+                let r = at - c;
+                let ve = v + omega.cross(&r);
+                let s = ve.norm();
+                if s > 0.0 {
+                    let f = -(p.c * self.medium.rho_g * a * s) * ve - (p.k * d / s) * ve;
+                    out.poncelet = f;
+                    moment += r.cross(&f);
+                }
+            }
+        }
+        out.force = out.rft3d + out.inertial + out.poncelet;
+        out.moment = moment;
+        out
+    }
+}
+
+/// `rft3d` over the elements: the force and its moment about `c`. Four elements at a time
+/// through the term's kernel in SIMD lanes (AVX2 where the CPU has it: the same IEEE
+/// operations, so the same bits as one at a time).
+pub fn rft3d_sum(law: &Rft3dLanes<f64>, e: &Elements, c: &V3, v: &V3, omega: &V3) -> (V3, V3) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::num::avx2() {
+        // SAFETY: this CPU has AVX2 (checked).
+        return unsafe { rft3d_sum_avx2(law, e, c, v, omega) };
+    }
+    rft3d_sum_lanes(law, e, c, v, omega)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn rft3d_sum_avx2(
+    law: &Rft3dLanes<f64>,
+    e: &Elements,
+    c: &V3,
+    v: &V3,
+    omega: &V3,
+) -> (V3, V3) {
+    rft3d_sum_lanes(law, e, c, v, omega)
+}
+
+#[inline(always)]
+fn rft3d_sum_lanes(law: &Rft3dLanes<f64>, e: &Elements, c: &V3, v: &V3, omega: &V3) -> (V3, V3) {
+    let n = e.len();
+    let lanes = Rft3dLanes {
+        zeta: F64x4::splat(law.zeta),
+        mu_surf: F64x4::splat(law.mu_surf),
+        threshold: F64x4::splat(law.threshold),
+    };
+    let (mut f, mut m) = (V3::zeros(), V3::zeros());
+    let mut i = 0;
+    while i + 4 <= n {
+        let mut r = [[0.0; 4]; 3];
+        let mut vel = [[0.0; 4]; 3];
+        let mut nn = [[0.0; 4]; 3];
+        let mut wd = [0.0; 4];
+        for l in 0..4 {
+            let x = e.x[i + l];
+            let (rl, vl) = arm_and_velocity(x, c, v, omega);
+            for k in 0..3 {
+                r[k][l] = rl[k];
+                vel[k][l] = vl[k];
+                nn[k][l] = e.n[i + l][k];
+            }
+            wd[l] = e.area[i + l] * e.depth[i + l];
+        }
+        let s = stress(
+            &lanes,
+            [F64x4(nn[0]), F64x4(nn[1]), F64x4(nn[2])],
+            [F64x4(vel[0]), F64x4(vel[1]), F64x4(vel[2])],
+        );
+        for l in 0..4 {
+            let df = V3::new(s[0].0[l], s[1].0[l], s[2].0[l]) * wd[l];
+            f += df;
+            m += V3::new(r[0][l], r[1][l], r[2][l]).cross(&df);
+        }
+        i += 4;
+    }
+    while i < n {
+        let (rl, vl) = arm_and_velocity(e.x[i], c, v, omega);
+        let s = stress(law, e.n[i], vl);
+        let df = V3::from(s) * (e.area[i] * e.depth[i]);
+        f += df;
+        m += V3::from(rl).cross(&df);
+        i += 1;
+    }
+    (f, m)
+}
+
+/// The arm `x - c` of a point and its velocity `v + omega x (x - c)`, written out once for
+/// the lanes and the rest alike (the same operations, so the same bits).
+#[inline(always)]
+pub fn arm_and_velocity(x: [f64; 3], c: &V3, v: &V3, omega: &V3) -> ([f64; 3], [f64; 3]) {
+    let r = [x[0] - c.x, x[1] - c.y, x[2] - c.z];
+    let u = [
+        v.x + (omega.y * r[2] - omega.z * r[1]),
+        v.y + (omega.z * r[0] - omega.x * r[2]),
+        v.z + (omega.x * r[1] - omega.y * r[0]),
+    ];
+    (r, u)
+}
+
+/// The load at a pose with the rule's error estimated by doubling its nodes: `(load,
+/// |F(2n) - F(n)|, |M(2n) - M(n)|)`.
+pub fn load_with_error(
+    sand: &mut Sand,
+    c: &V3,
+    q: &UnitQuaternion<f64>,
+    v: &V3,
+    omega: &V3,
+) -> (Load, f64, f64) {
+    let coarse = sand.load(c, q, v, omega);
+    let rule = sand.rule.clone();
+    sand.rule = Quadrature::new((2 * rule.nodes).min(2 * Quadrature::MAX_NODES));
+    let fine = sand.load(c, q, v, omega);
+    sand.rule = rule;
+    (
+        coarse,
+        (fine.force - coarse.force).norm(),
+        (fine.moment - coarse.moment).norm(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn sand(shape: Shape, nodes: usize) -> Sand {
+        let terms = Terms3 {
+            rft3d: Some(Rft3d {
+                zeta: 1.0,
+                mu_surf: f64::INFINITY,
+                grazing: true,
+            }),
+            ..Terms3::default()
+        };
+        Sand::new(shape, terms, Medium::default(), 0.0, Quadrature::new(nodes))
+    }
+
+    /// The vertical force on a sphere of radius r whose lowest point is `d` deep, moving
+    /// straight down, by a 1D integral over the polar angle written here (axisymmetric:
+    /// x1 = 1, x2 = x3 = cos(theta) on the lower hemisphere).
+    fn sphere_fz(r: f64, d: f64) -> f64 {
+        let c = &crate::forces::rft3d::COEFFICIENTS;
+        let tmax = (1.0 - d / r).clamp(-1.0, 1.0).acos().min(PI / 2.0);
+        let n = 4000;
+        let mut s = 0.0;
+        for k in 0..n {
+            let th = (k as f64 + 0.5) * tmax / n as f64;
+            let u = th.cos();
+            let t = [
+                1.0,
+                1.0,
+                u,
+                u,
+                1.0,
+                u * u,
+                u * u,
+                u,
+                u * u,
+                u,
+                1.0,
+                u * u * u,
+                u * u * u,
+                u * u,
+                u,
+                u * u * u,
+                u * u * u,
+                u,
+                u * u,
+                u * u,
+            ];
+            let f: Vec<f64> = c
+                .iter()
+                .map(|row| row.iter().zip(t).map(|(a, b)| a * b).sum())
+                .collect();
+            // alpha_z = -f1 cos(b) - f2 sin(g) - f3 with m = n: m_z = -u, v = -z.
+            let az = -(f[0] * u + f[1] + f[2]);
+            let depth = d - r * (1.0 - u);
+            s += az * depth * 2.0 * PI * r * r * th.sin() * tmax / n as f64;
+        }
+        s
+    }
+
+    #[test]
+    fn a_sphere_straight_down_feels_the_axisymmetric_integral_and_no_sideways_force() {
+        for (r, d) in [(0.02, 0.005), (0.02, 0.03), (0.05, 0.2)] {
+            let mut s = sand(Shape::sphere("s", r).unwrap(), 6);
+            let c = V3::new(0.0, 0.0, r - d);
+            let l = s.load(
+                &c,
+                &UnitQuaternion::identity(),
+                &V3::new(0.0, 0.0, -1.5),
+                &V3::zeros(),
+            );
+            let expect = sphere_fz(r, d);
+            assert!(
+                (l.force.z - expect).abs() < 1e-6 * expect,
+                "r {r} d {d}: {} vs {expect}",
+                l.force.z
+            );
+            assert!(l.force.x.abs() < 1e-12 * expect && l.force.y.abs() < 1e-12 * expect);
+            assert!(l.moment.norm() < 1e-12 * expect * r);
+        }
+    }
+
+    #[test]
+    fn rotating_everything_about_the_vertical_rotates_the_load() {
+        let shapes = [
+            Shape::cuboid("b", [0.1, 0.05, 0.03]).unwrap(),
+            Shape::capsule("c", 0.02, 0.1).unwrap(),
+            Shape::cylinder("y", 0.03, 0.08).unwrap(),
+            Shape::sphere("s", 0.04).unwrap(),
+        ];
+        let q = UnitQuaternion::from_euler_angles(0.3, 0.8, -0.4);
+        let (c, v, w) = (
+            V3::new(0.01, -0.02, -0.01),
+            V3::new(0.4, -0.2, -0.9),
+            V3::new(1.0, 2.0, -0.5),
+        );
+        let turn = UnitQuaternion::from_axis_angle(&V3::z_axis(), 0.77);
+        for shape in shapes {
+            let mut s = sand(shape, 6);
+            let a = s.load(&c, &q, &v, &w);
+            let b = s.load(&(turn * c), &(turn * q), &(turn * v), &(turn * w));
+            let scale = a.force.norm();
+            assert!(scale > 0.0);
+            assert!(
+                (turn * a.force - b.force).norm() < 1e-12 * scale,
+                "{:?} {:?}",
+                turn * a.force,
+                b.force
+            );
+            assert!(
+                (turn * a.moment - b.moment).norm() < 1e-12 * scale,
+                "moment"
+            );
+        }
+    }
+
+    #[test]
+    fn lanes_and_one_at_a_time_give_the_same_bits() {
+        let mut s = sand(Shape::capsule("c", 0.02, 0.1).unwrap(), 6);
+        let q = UnitQuaternion::from_euler_angles(0.3, 0.8, -0.4);
+        let (c, v, w) = (
+            V3::new(0.0, 0.0, 0.0),
+            V3::new(0.4, -0.2, -0.9),
+            V3::new(1.0, 2.0, -0.5),
+        );
+        let e = s.elements_at(&c, &q, &v, &w).clone();
+        let law = s.terms.rft3d.unwrap().lanes();
+        let (f, m) = rft3d_sum(&law, &e, &c, &v, &w);
+        let (mut f1, mut m1) = (V3::zeros(), V3::zeros());
+        let mut i = 0;
+        // The same order of sums as the lanes: four at a time, then the rest.
+        while i < e.len() {
+            let (r, vl) = arm_and_velocity(e.x[i], &c, &v, &w);
+            let st = stress(&law, e.n[i], vl);
+            let df = V3::from(st) * (e.area[i] * e.depth[i]);
+            f1 += df;
+            m1 += V3::from(r).cross(&df);
+            i += 1;
+        }
+        assert_eq!(f, f1);
+        assert_eq!(m, m1);
+    }
+}

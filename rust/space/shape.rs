@@ -1,0 +1,981 @@
+//! Shapes in space and their surface elements below the sand.
+//!
+//! Every shape is described in its body frame, with its centre of mass at the origin (a
+//! mesh is moved there when it is built). At a pose (position `c`, orientation `R`) and a
+//! motion (the centre's velocity, the angular velocity `omega`), [`Shape::elements`] gives
+//! the immersed part of the surface as quadrature points: position, outward normal, area
+//! weight and depth below the surface `z = s`. The immersed part is cut exactly:
+//!
+//! - a flat face (a cuboid's, a mesh's triangle) is clipped as a polygon at the surface and
+//!   at its leading edge (`n . v(x) = 0` is a line on a flat face: `v` is linear in `x`); on
+//!   what is left the depth is linear, so a 3-point rule per triangle integrates the depth
+//!   exactly for a translating body, and to second order in the facet's size otherwise;
+//! - a curved surface is a family of lines or circles (a cylinder's generators and a cap's
+//!   radii, a sphere's circles about its velocity) on each of which the depth and `n . v`
+//!   are linear or trigonometric, so each is cut exactly and integrated by Gauss-Legendre;
+//!   the outer integral is cut at every angle where an inner limit changes its kind, and
+//!   split into panels of at most 45 degrees.
+//!
+//! The rule's error is controlled by the nodes per panel ([`Quadrature::nodes`]);
+//! `space::load` estimates it by doubling them.
+
+use std::f64::consts::PI;
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+use super::quad::{arc_below, clip_linear, intersect, pieces, trig_roots, Gauss};
+use crate::error::{GranrsError, Result};
+use crate::forces::ContactKind;
+
+type V3 = Vector3<f64>;
+
+/// Surface elements below the sand (structure of arrays, reused between evaluations).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Elements {
+    /// Positions, world frame [m].
+    pub x: Vec<[f64; 3]>,
+    /// Outward unit normals, world frame.
+    pub n: Vec<[f64; 3]>,
+    /// Area weights [m^2].
+    pub area: Vec<f64>,
+    /// Depths below the surface [m] (>= 0).
+    pub depth: Vec<f64>,
+}
+
+impl Elements {
+    /// Forget every element (keep the buffers).
+    pub fn clear(&mut self) {
+        self.x.clear();
+        self.n.clear();
+        self.area.clear();
+        self.depth.clear();
+    }
+
+    /// How many elements.
+    pub fn len(&self) -> usize {
+        self.area.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.area.is_empty()
+    }
+
+    #[inline]
+    fn push(&mut self, x: V3, n: V3, area: f64, surface: f64) {
+        self.x.push([x.x, x.y, x.z]);
+        self.n.push([n.x, n.y, n.z]);
+        self.area.push(area);
+        self.depth.push((surface - x.z).max(0.0));
+    }
+}
+
+/// How finely a curved surface is integrated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Quadrature {
+    /// Gauss-Legendre nodes per panel along each parameter (a flat face: its triangles are
+    /// cut into `(nodes / 6)^2` before the 3-point rule).
+    pub nodes: usize,
+    gauss: Gauss,
+}
+
+/// Panels of a curved surface's angles are at most this long [rad].
+const PANEL: f64 = PI / 4.0;
+
+impl Quadrature {
+    /// Most nodes per panel a scene may ask for (bounded work per evaluation).
+    pub const MAX_NODES: usize = 64;
+    /// Nodes per panel unless the scene says otherwise.
+    pub const DEFAULT_NODES: usize = 6;
+
+    /// The rule with `nodes` nodes per panel.
+    pub fn new(nodes: usize) -> Self {
+        Quadrature {
+            nodes,
+            gauss: Gauss::new(nodes),
+        }
+    }
+
+    fn subdivisions(&self) -> usize {
+        (self.nodes / 6).max(1)
+    }
+}
+
+/// A closed triangle mesh, its centre of mass at the origin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Vertices, body frame [m] (moved so that the centre of mass is the origin).
+    pub vertices: Vec<V3>,
+    /// Triangles, counter-clockwise seen from outside.
+    pub triangles: Vec<[usize; 3]>,
+    /// Volume [m^3].
+    pub volume: f64,
+    /// Inertia tensor per unit density about the centre of mass [m^5].
+    pub inertia: Matrix3<f64>,
+    /// Where the given vertices' origin is in the body frame [m] (minus the centre of mass).
+    pub offset: V3,
+}
+
+/// A shape in space.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// A sphere of radius `radius` [m].
+    Sphere {
+        /// [m]
+        radius: f64,
+    },
+    /// A capsule along the body's z axis: a cylinder of `2 half_length` between two
+    /// hemispheres of `radius`.
+    Capsule {
+        /// [m]
+        radius: f64,
+        /// Half the length of the cylindrical part [m].
+        half_length: f64,
+    },
+    /// A cylinder along the body's z axis, with flat ends.
+    Cylinder {
+        /// [m]
+        radius: f64,
+        /// Half its length [m].
+        half_length: f64,
+    },
+    /// A cuboid with half edge lengths along the body's axes [m].
+    Cuboid {
+        /// [m]
+        half: [f64; 3],
+    },
+    /// A closed triangle mesh.
+    Mesh(Box<Mesh>),
+}
+
+fn positive(field: &str, v: f64, what: &str) -> Result<f64> {
+    if v.is_finite() && v > 0.0 && v < 1e6 {
+        Ok(v)
+    } else {
+        Err(GranrsError::InvalidParameter {
+            field: field.into(),
+            value: v,
+            allowed: format!("finite, > 0, < 1e6 ({what} [m])"),
+        })
+    }
+}
+
+fn nonneg(field: &str, v: f64, what: &str) -> Result<f64> {
+    if (0.0..1e6).contains(&v) {
+        Ok(v)
+    } else {
+        Err(GranrsError::InvalidParameter {
+            field: field.into(),
+            value: v,
+            allowed: format!("finite, >= 0, < 1e6 ({what} [m])"),
+        })
+    }
+}
+
+impl Shape {
+    /// A sphere, checked (`field`: where the shape is in the scene, e.g. `body.shape`).
+    pub fn sphere(field: &str, radius: f64) -> Result<Shape> {
+        Ok(Shape::Sphere {
+            radius: positive(&format!("{field}.radius"), radius, "radius")?,
+        })
+    }
+
+    /// A capsule of cylindrical length `length` (between its hemispheres' centres), checked.
+    pub fn capsule(field: &str, radius: f64, length: f64) -> Result<Shape> {
+        Ok(Shape::Capsule {
+            radius: positive(&format!("{field}.radius"), radius, "radius")?,
+            half_length: 0.5 * nonneg(&format!("{field}.length"), length, "cylinder length")?,
+        })
+    }
+
+    /// A cylinder of length `length`, checked.
+    pub fn cylinder(field: &str, radius: f64, length: f64) -> Result<Shape> {
+        Ok(Shape::Cylinder {
+            radius: positive(&format!("{field}.radius"), radius, "radius")?,
+            half_length: 0.5 * positive(&format!("{field}.length"), length, "length")?,
+        })
+    }
+
+    /// A cuboid of edge lengths `size`, checked.
+    pub fn cuboid(field: &str, size: [f64; 3]) -> Result<Shape> {
+        let mut half = [0.0; 3];
+        for (k, (h, s)) in half.iter_mut().zip(size).enumerate() {
+            *h = 0.5 * positive(&format!("{field}.size[{k}]"), s, "edge length")?;
+        }
+        Ok(Shape::Cuboid { half })
+    }
+
+    /// A closed mesh from its vertices and triangles (counter-clockwise seen from outside),
+    /// checked: finite vertices, triangles of existing and distinct vertices, every edge
+    /// shared by exactly two triangles in opposite directions (closed and consistently
+    /// oriented), no degenerate triangle, a positive volume (outward normals).
+    pub fn mesh(field: &str, vertices: &[[f64; 3]], triangles: &[[i64; 3]]) -> Result<Shape> {
+        let bad = |what: &str, message: String| GranrsError::InvalidScene {
+            field: format!("{field}.{what}"),
+            message,
+        };
+        if vertices.len() < 4 || triangles.len() < 4 {
+            return Err(bad(
+                "triangles",
+                format!(
+                    "a closed mesh needs at least 4 vertices and 4 triangles, got {} and {}",
+                    vertices.len(),
+                    triangles.len()
+                ),
+            ));
+        }
+        if triangles.len() > 1_000_000 {
+            return Err(bad(
+                "triangles",
+                format!("{} triangles; at most 1000000", triangles.len()),
+            ));
+        }
+        for (i, v) in vertices.iter().enumerate() {
+            for (k, x) in v.iter().enumerate() {
+                if !(x.is_finite() && x.abs() < 1e6) {
+                    return Err(GranrsError::InvalidParameter {
+                        field: format!("{field}.vertices[{i}][{k}]"),
+                        value: *x,
+                        allowed: "finite, |x| < 1e6 [m]".into(),
+                    });
+                }
+            }
+        }
+        let verts: Vec<V3> = vertices.iter().map(|v| V3::new(v[0], v[1], v[2])).collect();
+        let mut tris = Vec::with_capacity(triangles.len());
+        let mut edges = std::collections::HashMap::with_capacity(3 * triangles.len());
+        let mut scale: f64 = 0.0;
+        for v in &verts {
+            scale = scale.max(v.norm());
+        }
+        for (i, t) in triangles.iter().enumerate() {
+            let mut idx = [0usize; 3];
+            for k in 0..3 {
+                if t[k] < 0 || t[k] as usize >= verts.len() {
+                    return Err(bad(
+                        &format!("triangles[{i}]"),
+                        format!("vertex index {} is not in 0..{}", t[k], verts.len()),
+                    ));
+                }
+                idx[k] = t[k] as usize;
+            }
+            if idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2] {
+                return Err(bad(
+                    &format!("triangles[{i}]"),
+                    "a triangle repeats a vertex".into(),
+                ));
+            }
+            let (a, b, c) = (verts[idx[0]], verts[idx[1]], verts[idx[2]]);
+            let area2 = (b - a).cross(&(c - a)).norm();
+            if area2.is_nan() || area2 <= 1e-24 * scale.max(1e-300).powi(2) {
+                return Err(bad(
+                    &format!("triangles[{i}]"),
+                    "a degenerate triangle (zero area)".into(),
+                ));
+            }
+            for k in 0..3 {
+                let e = (idx[k], idx[(k + 1) % 3]);
+                if edges.insert(e, i).is_some() {
+                    return Err(bad(
+                        &format!("triangles[{i}]"),
+                        format!(
+                            "the edge {} -> {} appears twice in the same direction: the mesh is \
+                             not consistently oriented (or an edge has more than two triangles)",
+                            e.0, e.1
+                        ),
+                    ));
+                }
+            }
+            tris.push(idx);
+        }
+        for (&(a, b), &i) in &edges {
+            if !edges.contains_key(&(b, a)) {
+                return Err(bad(
+                    &format!("triangles[{i}]"),
+                    format!("the edge {a} -> {b} has no triangle on its other side: the mesh is not closed"),
+                ));
+            }
+        }
+        // Volume, centre and inertia from signed tetrahedra on the origin.
+        let mut vol = 0.0;
+        let mut first = V3::zeros();
+        let mut second = Matrix3::zeros(); // integral of x x^T dV
+        for t in &tris {
+            let (a, b, c) = (verts[t[0]], verts[t[1]], verts[t[2]]);
+            let d = a.dot(&b.cross(&c)) / 6.0;
+            vol += d;
+            first += d * (a + b + c) / 4.0;
+            let s = a + b + c;
+            second += d / 20.0
+                * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+        }
+        if vol.is_nan() || vol <= 0.0 {
+            return Err(bad(
+                "triangles",
+                format!(
+                    "the mesh's volume is {vol:.3e} m^3: its triangles must be counter-clockwise \
+                     seen from outside (outward normals)"
+                ),
+            ));
+        }
+        let com = first / vol;
+        let second_c = second - vol * com * com.transpose();
+        let inertia = Matrix3::identity() * second_c.trace() - second_c;
+        Ok(Shape::Mesh(Box::new(Mesh {
+            vertices: verts.iter().map(|v| v - com).collect(),
+            triangles: tris,
+            volume: vol,
+            inertia,
+            offset: -com,
+        })))
+    }
+
+    /// Its kind, as a term's list of shapes names it.
+    pub fn kind(&self) -> ContactKind {
+        match self {
+            Shape::Sphere { .. } => ContactKind::Sphere,
+            Shape::Capsule { .. } => ContactKind::Capsule,
+            Shape::Cylinder { .. } => ContactKind::Cylinder,
+            Shape::Cuboid { .. } => ContactKind::Cuboid,
+            Shape::Mesh(_) => ContactKind::Mesh,
+        }
+    }
+
+    /// Its volume [m^3].
+    pub fn volume(&self) -> f64 {
+        match self {
+            Shape::Sphere { radius: r } => 4.0 / 3.0 * PI * r.powi(3),
+            Shape::Capsule {
+                radius: r,
+                half_length: h,
+            } => PI * r * r * 2.0 * h + 4.0 / 3.0 * PI * r.powi(3),
+            Shape::Cylinder {
+                radius: r,
+                half_length: h,
+            } => PI * r * r * 2.0 * h,
+            Shape::Cuboid { half } => 8.0 * half[0] * half[1] * half[2],
+            Shape::Mesh(m) => m.volume,
+        }
+    }
+
+    /// Its inertia tensor about the centre of mass per unit density [m^5], body frame.
+    pub fn unit_inertia(&self) -> Matrix3<f64> {
+        match self {
+            Shape::Sphere { radius: r } => Matrix3::identity() * (0.4 * self.volume() * r * r),
+            Shape::Capsule {
+                radius: r,
+                half_length: h,
+            } => {
+                let mc = PI * r * r * 2.0 * h;
+                let ms = 4.0 / 3.0 * PI * r.powi(3);
+                let l = 2.0 * h;
+                let axial = mc * r * r / 2.0 + ms * 0.4 * r * r;
+                let across =
+                    mc * (l * l / 12.0 + r * r / 4.0) + ms * (0.4 * r * r + h * h + 0.75 * h * r);
+                Matrix3::from_diagonal(&V3::new(across, across, axial))
+            }
+            Shape::Cylinder {
+                radius: r,
+                half_length: h,
+            } => {
+                let m = self.volume();
+                let l = 2.0 * h;
+                let across = m * (3.0 * r * r + l * l) / 12.0;
+                Matrix3::from_diagonal(&V3::new(across, across, m * r * r / 2.0))
+            }
+            Shape::Cuboid { half: [a, b, c] } => {
+                let m = self.volume();
+                Matrix3::from_diagonal(&V3::new(
+                    m * (b * b + c * c) / 3.0,
+                    m * (a * a + c * c) / 3.0,
+                    m * (a * a + b * b) / 3.0,
+                ))
+            }
+            Shape::Mesh(m) => m.inertia,
+        }
+    }
+
+    /// Its lowest point at the pose (position of the centre `c`, orientation `q`), world
+    /// frame.
+    pub fn lowest_point(&self, c: &V3, q: &UnitQuaternion<f64>) -> V3 {
+        let z = V3::z();
+        match self {
+            Shape::Sphere { radius } => c - *radius * z,
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => {
+                let a = q * z;
+                let end = if a.z > 0.0 {
+                    c - *half_length * a
+                } else {
+                    c + *half_length * a
+                };
+                end - *radius * z
+            }
+            Shape::Cylinder {
+                radius,
+                half_length,
+            } => {
+                let a = q * z;
+                let end = if a.z > 0.0 {
+                    c - *half_length * a
+                } else {
+                    c + *half_length * a
+                };
+                let down = z - a.z * a;
+                let norm = down.norm();
+                if norm > 1e-12 {
+                    end - *radius * down / norm
+                } else {
+                    end
+                }
+            }
+            Shape::Cuboid { half } => {
+                let r = q.to_rotation_matrix();
+                let mut p = *c;
+                for (k, h) in half.iter().enumerate() {
+                    let col = r.matrix().column(k).into_owned();
+                    p -= col * *h * col.z.signum_or_zero();
+                }
+                p
+            }
+            Shape::Mesh(m) => {
+                let r = q.to_rotation_matrix();
+                m.vertices
+                    .iter()
+                    .map(|v| c + r * v)
+                    .min_by(|a, b| a.z.total_cmp(&b.z))
+                    .unwrap_or(*c)
+            }
+        }
+    }
+
+    /// A bound on the distance of any of its points from the centre of mass [m].
+    pub fn reach(&self) -> f64 {
+        match self {
+            Shape::Sphere { radius } => *radius,
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => radius + half_length,
+            Shape::Cylinder {
+                radius,
+                half_length,
+            } => radius.hypot(*half_length),
+            Shape::Cuboid { half } => V3::new(half[0], half[1], half[2]).norm(),
+            Shape::Mesh(m) => m.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max),
+        }
+    }
+
+    /// The immersed surface's elements at the pose (`c`, `q`) moving with (`v`, `omega`),
+    /// below the surface `z = surface`, appended to `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn elements(
+        &self,
+        c: &V3,
+        q: &UnitQuaternion<f64>,
+        v: &V3,
+        omega: &V3,
+        surface: f64,
+        rule: &Quadrature,
+        out: &mut Elements,
+    ) {
+        if self.lowest_point(c, q).z >= surface {
+            return;
+        }
+        let motion = Motion {
+            c: *c,
+            v: *v,
+            omega: *omega,
+            surface,
+        };
+        match self {
+            Shape::Sphere { radius } => sphere_patch(&motion, c, *radius, None, rule, out),
+            Shape::Capsule {
+                radius,
+                half_length,
+            } => {
+                let a = q * V3::z();
+                cylinder_side(&motion, &a, *radius, *half_length, rule, out);
+                sphere_patch(
+                    &motion,
+                    &(c + *half_length * a),
+                    *radius,
+                    Some(a),
+                    rule,
+                    out,
+                );
+                sphere_patch(
+                    &motion,
+                    &(c - *half_length * a),
+                    *radius,
+                    Some(-a),
+                    rule,
+                    out,
+                );
+            }
+            Shape::Cylinder {
+                radius,
+                half_length,
+            } => {
+                let a = q * V3::z();
+                cylinder_side(&motion, &a, *radius, *half_length, rule, out);
+                disk(&motion, &(c + *half_length * a), &a, *radius, rule, out);
+                disk(&motion, &(c - *half_length * a), &(-a), *radius, rule, out);
+            }
+            Shape::Cuboid { half } => {
+                let r = q.to_rotation_matrix();
+                let corner = |sx: f64, sy: f64, sz: f64| {
+                    c + r * V3::new(sx * half[0], sy * half[1], sz * half[2])
+                };
+                // Each face counter-clockwise seen from outside.
+                const FACES: [[[f64; 3]; 4]; 6] = [
+                    [[1., -1., -1.], [1., 1., -1.], [1., 1., 1.], [1., -1., 1.]],
+                    [
+                        [-1., -1., -1.],
+                        [-1., -1., 1.],
+                        [-1., 1., 1.],
+                        [-1., 1., -1.],
+                    ],
+                    [[-1., 1., -1.], [-1., 1., 1.], [1., 1., 1.], [1., 1., -1.]],
+                    [
+                        [-1., -1., -1.],
+                        [1., -1., -1.],
+                        [1., -1., 1.],
+                        [-1., -1., 1.],
+                    ],
+                    [[-1., -1., 1.], [1., -1., 1.], [1., 1., 1.], [-1., 1., 1.]],
+                    [
+                        [-1., -1., -1.],
+                        [-1., 1., -1.],
+                        [1., 1., -1.],
+                        [1., -1., -1.],
+                    ],
+                ];
+                for face in FACES {
+                    let pts = face.map(|p| corner(p[0], p[1], p[2]));
+                    polygon(&motion, &pts, rule, out);
+                }
+            }
+            Shape::Mesh(m) => {
+                let r = q.to_rotation_matrix();
+                for t in &m.triangles {
+                    let pts = [
+                        c + r * m.vertices[t[0]],
+                        c + r * m.vertices[t[1]],
+                        c + r * m.vertices[t[2]],
+                    ];
+                    if pts.iter().all(|p| p.z >= surface) {
+                        continue;
+                    }
+                    polygon(&motion, &pts, rule, out);
+                }
+            }
+        }
+    }
+}
+
+trait SignumOrZero {
+    fn signum_or_zero(self) -> f64;
+}
+
+impl SignumOrZero for f64 {
+    fn signum_or_zero(self) -> f64 {
+        if self > 0.0 {
+            1.0
+        } else if self < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The body's motion and the surface, as the elements are cut.
+struct Motion {
+    c: V3,
+    v: V3,
+    omega: V3,
+    surface: f64,
+}
+
+impl Motion {
+    #[inline]
+    fn velocity_at(&self, x: &V3) -> V3 {
+        self.v + self.omega.cross(&(x - self.c))
+    }
+
+    /// Whether `n . v` over a set of points is zero within round-off (a grazing face).
+    fn grazing(&self, n: &V3, points: &[V3]) -> bool {
+        let mut most = 0.0f64;
+        let mut speed = 0.0f64;
+        for p in points {
+            let v = self.velocity_at(p);
+            most = most.max(n.dot(&v).abs());
+            speed = speed.max(v.norm());
+        }
+        most <= 1e-12 * speed
+    }
+}
+
+/// A unit vector perpendicular to the unit `a`, as close to +z as can be (any, where `a`
+/// is vertical).
+fn towards_up(a: &V3) -> V3 {
+    let u = V3::z() - a.z * a;
+    let n = u.norm();
+    if n > 1e-12 {
+        u / n
+    } else {
+        let w = if a.x.abs() < 0.9 { V3::x() } else { V3::y() };
+        let u = w - a.dot(&w) * a;
+        u / u.norm()
+    }
+}
+
+/// The part of a sphere (centre `b`, radius `r`) below the surface on its leading side
+/// (n . v_b >= 0: on a sphere, `omega x (x - b)` is tangent, so every point's `n . v` is
+/// the centre's), and on the side `n . a >= 0` when `half` is given (a capsule's end).
+fn sphere_patch(
+    m: &Motion,
+    b: &V3,
+    r: f64,
+    half: Option<V3>,
+    rule: &Quadrature,
+    out: &mut Elements,
+) {
+    if b.z - r >= m.surface {
+        return;
+    }
+    let vb = m.velocity_at(b);
+    let speed = vb.norm();
+    // The pole: the direction of motion; the leading side is the hemisphere about it.
+    let (p, theta_max) = if speed > 0.0 {
+        (vb / speed, 0.5 * PI)
+    } else {
+        // At rest every element grazes: the law decides whether they count.
+        (-V3::z(), PI)
+    };
+    let e1 = towards_up(&p);
+    let e2 = p.cross(&e1);
+    let depth_ref = m.surface - b.z;
+    let mut breaks = Vec::with_capacity(8);
+    // Where the circle about the pole at theta is wholly in or out of the sand.
+    let qz = e1.z.hypot(e2.z);
+    trig_roots(r * p.z, r * qz, depth_ref, 0.0, theta_max, &mut breaks);
+    trig_roots(r * p.z, -r * qz, depth_ref, 0.0, theta_max, &mut breaks);
+    if let Some(a) = half {
+        let ra = e1.dot(&a).hypot(e2.dot(&a));
+        trig_roots(p.dot(&a), ra, 0.0, 0.0, theta_max, &mut breaks);
+        trig_roots(p.dot(&a), -ra, 0.0, 0.0, theta_max, &mut breaks);
+    }
+    let g = &rule.gauss;
+    pieces(0.0, theta_max, &mut breaks, PANEL, |t0, t1| {
+        g.each(t0, t1, |theta, wt| {
+            let (st, ct) = theta.sin_cos();
+            // Below the surface: r st (cos e1_z + sin e2_z) <= depth_ref - r ct p_z.
+            let Some(wet) = arc_below(r * st * e1.z, r * st * e2.z, depth_ref - r * ct * p.z)
+            else {
+                return;
+            };
+            let (arcs, k) = match half {
+                // n . a >= 0:  -st (cos e1.a + sin e2.a) <= ct p.a
+                Some(a) => match arc_below(-st * e1.dot(&a), -st * e2.dot(&a), ct * p.dot(&a)) {
+                    Some(side) => intersect(wet, side),
+                    None => return,
+                },
+                None => ([Some(wet), None], 1),
+            };
+            for arc in arcs[..k].iter().flatten() {
+                let mut none: [f64; 0] = [];
+                pieces(
+                    arc.start,
+                    arc.start + arc.len,
+                    &mut none,
+                    PANEL,
+                    |f0, f1| {
+                        g.each(f0, f1, |phi, wf| {
+                            let (sp, cp) = phi.sin_cos();
+                            let n = ct * p + st * (cp * e1 + sp * e2);
+                            let x = b + r * n;
+                            out.push(x, n, r * r * st * wt * wf, m.surface);
+                        });
+                    },
+                );
+            }
+        });
+    });
+}
+
+/// A cylinder's side about its axis `a` through the centre (radius `r`, half length `h`).
+fn cylinder_side(m: &Motion, a: &V3, r: f64, h: f64, rule: &Quadrature, out: &mut Elements) {
+    if h <= 0.0 {
+        return;
+    }
+    let u1 = towards_up(a);
+    let u2 = a.cross(&u1);
+    let c = m.c;
+    let wa = m.omega.cross(a);
+    let mut breaks = Vec::with_capacity(8);
+    for t in [-h, h] {
+        // depth at the generator's end: surface - c_z - t a_z - r n_z = 0
+        trig_roots(
+            r * u1.z,
+            r * u2.z,
+            m.surface - c.z - t * a.z,
+            0.0,
+            2.0 * PI,
+            &mut breaks,
+        );
+        // n . v at the end: n . (v + t omega x a) = 0
+        let w = m.v + t * wa;
+        trig_roots(u1.dot(&w), u2.dot(&w), 0.0, 0.0, 2.0 * PI, &mut breaks);
+    }
+    let g = &rule.gauss;
+    let speed = m.v.norm() + m.omega.norm() * (r + h);
+    pieces(0.0, 2.0 * PI, &mut breaks, PANEL, |f0, f1| {
+        g.each(f0, f1, |phi, wf| {
+            let (sp, cp) = phi.sin_cos();
+            let n = cp * u1 + sp * u2;
+            // Depth along the generator: (surface - c_z - r n_z) - t a_z >= 0.
+            let Some((lo, hi)) = clip_linear(-h, h, m.surface - c.z - r * n.z, -a.z) else {
+                return;
+            };
+            // Leading: n . v + t n . (omega x a) >= 0, unless it grazes all along.
+            let (l0, l1) = (n.dot(&m.v), n.dot(&wa));
+            let (lo, hi) = if l0.abs() + h * l1.abs() <= 1e-12 * speed {
+                (lo, hi)
+            } else {
+                match clip_linear(lo, hi, l0, l1) {
+                    Some(x) => x,
+                    None => return,
+                }
+            };
+            g.each(lo, hi, |t, wt| {
+                let x = c + r * n + t * a;
+                out.push(x, n, r * wf * wt, m.surface);
+            });
+        });
+    });
+}
+
+/// A flat disk (centre `e`, outward normal `nu`, radius `r`): a cylinder's end.
+fn disk(m: &Motion, e: &V3, nu: &V3, r: f64, rule: &Quadrature, out: &mut Elements) {
+    let u1 = towards_up(nu);
+    let u2 = nu.cross(&u1);
+    let ve = m.velocity_at(e);
+    let (w1, w2) = (nu.dot(&m.omega.cross(&u1)), nu.dot(&m.omega.cross(&u2)));
+    let depth0 = m.surface - e.z;
+    let mut breaks = Vec::with_capacity(4);
+    trig_roots(r * u1.z, r * u2.z, depth0, 0.0, 2.0 * PI, &mut breaks);
+    trig_roots(r * w1, r * w2, -nu.dot(&ve), 0.0, 2.0 * PI, &mut breaks);
+    let rim = [e + r * u1, e - r * u1, e + r * u2, e - r * u2, *e];
+    let grazing = m.grazing(nu, &rim);
+    let g = &rule.gauss;
+    pieces(0.0, 2.0 * PI, &mut breaks, PANEL, |f0, f1| {
+        g.each(f0, f1, |phi, wf| {
+            let (sp, cp) = phi.sin_cos();
+            let d = cp * u1 + sp * u2;
+            let Some((lo, hi)) = clip_linear(0.0, r, depth0, -d.z) else {
+                return;
+            };
+            let (lo, hi) = if grazing {
+                (lo, hi)
+            } else {
+                match clip_linear(lo, hi, nu.dot(&ve), cp * w1 + sp * w2) {
+                    Some(x) => x,
+                    None => return,
+                }
+            };
+            g.each(lo, hi, |rho, wr| {
+                out.push(e + rho * d, *nu, rho * wf * wr, m.surface);
+            });
+        });
+    });
+}
+
+/// Keep the part of a convex polygon where the linear function `f` is >= 0.
+fn clip_polygon(poly: &[V3], f: impl Fn(&V3) -> f64, out: &mut Vec<V3>) {
+    out.clear();
+    let k = poly.len();
+    for i in 0..k {
+        let (p, q) = (poly[i], poly[(i + 1) % k]);
+        let (fp, fq) = (f(&p), f(&q));
+        if fp >= 0.0 {
+            out.push(p);
+        }
+        if (fp >= 0.0) != (fq >= 0.0) {
+            let t = fp / (fp - fq);
+            out.push(p + t * (q - p));
+        }
+    }
+}
+
+/// A flat convex face (vertices counter-clockwise seen from outside).
+fn polygon(m: &Motion, pts: &[V3], rule: &Quadrature, out: &mut Elements) {
+    let n = (pts[1] - pts[0]).cross(&(pts[2] - pts[0]));
+    let n = n / n.norm();
+    let mut wet = Vec::with_capacity(8);
+    clip_polygon(pts, |x| m.surface - x.z, &mut wet);
+    if wet.len() < 3 {
+        return;
+    }
+    let lead = if m.grazing(&n, &wet) {
+        wet
+    } else {
+        let mut lead = Vec::with_capacity(8);
+        clip_polygon(&wet, |x| n.dot(&m.velocity_at(x)), &mut lead);
+        lead
+    };
+    if lead.len() < 3 {
+        return;
+    }
+    let k = rule.subdivisions();
+    for i in 1..lead.len() - 1 {
+        triangle(&lead[0], &lead[i], &lead[i + 1], &n, k, m.surface, out);
+    }
+}
+
+/// The 3-point rule (degree 2) on each of the `k^2` triangles a triangle is cut into.
+fn triangle(a: &V3, b: &V3, c: &V3, n: &V3, k: usize, surface: f64, out: &mut Elements) {
+    let area = 0.5 * (b - a).cross(&(c - a)).norm();
+    if area <= 0.0 {
+        return;
+    }
+    let sub = area / (k * k) as f64;
+    let (ab, ac) = ((b - a) / k as f64, (c - a) / k as f64);
+    let at = |i: usize, j: usize| a + i as f64 * ab + j as f64 * ac;
+    let mut emit = |p: V3, q: V3, r: V3| {
+        for (wp, wq, wr) in [(4.0, 1.0, 1.0), (1.0, 4.0, 1.0), (1.0, 1.0, 4.0)] {
+            let x = (wp * p + wq * q + wr * r) / 6.0;
+            out.push(x, *n, sub / 3.0, surface);
+        }
+    };
+    for i in 0..k {
+        for j in 0..k - i {
+            emit(at(i, j), at(i + 1, j), at(i, j + 1));
+            if i + j + 2 <= k {
+                emit(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area_below(shape: &Shape, c: V3, q: UnitQuaternion<f64>, nodes: usize) -> f64 {
+        let mut e = Elements::default();
+        // Resting: every element grazes, so the cut is only the surface's.
+        shape.elements(
+            &c,
+            &q,
+            &V3::zeros(),
+            &V3::zeros(),
+            0.0,
+            &Quadrature::new(nodes),
+            &mut e,
+        );
+        e.area.iter().sum()
+    }
+
+    #[test]
+    fn a_half_sunk_sphere_has_half_its_area_below_and_a_cap_its_formula() {
+        let s = Shape::sphere("s", 0.1).unwrap();
+        let a = area_below(&s, V3::zeros(), UnitQuaternion::identity(), 6);
+        assert!((a - 2.0 * PI * 0.01).abs() < 1e-13, "{a}");
+        // A cap of height d: 2 pi r d (the sphere tilted: the same).
+        let q = UnitQuaternion::from_euler_angles(0.3, -0.7, 1.1);
+        let a = area_below(&s, V3::new(0.0, 0.0, 0.07), q, 6);
+        assert!((a - 2.0 * PI * 0.1 * 0.03).abs() < 1e-13, "{a}");
+    }
+
+    #[test]
+    fn a_tilted_cylinder_half_sunk_has_half_its_area_below() {
+        let s = Shape::cylinder("s", 0.05, 0.3).unwrap();
+        let q = UnitQuaternion::from_euler_angles(0.4, 0.9, 0.2);
+        let a = area_below(&s, V3::zeros(), q, 6);
+        let total = 2.0 * PI * 0.05 * 0.3 + 2.0 * PI * 0.05 * 0.05;
+        assert!(
+            (a - total / 2.0).abs() < 1e-12 * total,
+            "{a} vs {}",
+            total / 2.0
+        );
+    }
+
+    #[test]
+    fn a_mesh_and_a_cuboid_agree_on_the_same_box() {
+        let cube = Shape::cuboid("b", [0.2, 0.1, 0.3]).unwrap();
+        let v: Vec<[f64; 3]> = (0..8)
+            .map(|i| {
+                [
+                    if i & 1 != 0 { 0.1 } else { -0.1 },
+                    if i & 2 != 0 { 0.05 } else { -0.05 },
+                    if i & 4 != 0 { 0.15 } else { -0.15 },
+                ]
+            })
+            .collect();
+        let t: Vec<[i64; 3]> = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        let mesh = Shape::mesh("m", &v, &t).unwrap();
+        assert!((mesh.volume() - cube.volume()).abs() < 1e-15);
+        assert!((mesh.unit_inertia() - cube.unit_inertia()).norm() < 1e-15);
+        let q = UnitQuaternion::from_euler_angles(0.3, 0.5, -0.2);
+        let c = V3::new(0.0, 0.0, 0.05);
+        let (a, b) = (area_below(&cube, c, q, 6), area_below(&mesh, c, q, 6));
+        assert!((a - b).abs() < 1e-14, "{a} {b}");
+        // An inward mesh is refused.
+        let flipped: Vec<[i64; 3]> = t.iter().map(|x| [x[0], x[2], x[1]]).collect();
+        assert!(Shape::mesh("m", &v, &flipped).is_err());
+        // An open one too.
+        assert!(Shape::mesh("m", &v, &t[..11]).is_err());
+    }
+
+    #[test]
+    fn the_inertia_of_a_capsule_is_its_parts() {
+        // A capsule's tensor against a fine mesh-free sum: a cylinder plus a sphere split.
+        let (r, h) = (0.1, 0.2);
+        let s = Shape::capsule("c", r, 2.0 * h).unwrap();
+        let i = s.unit_inertia();
+        // Numerical integral over the solid (midpoint rule on a fine grid).
+        let n = 120;
+        let (mut ixx, mut izz) = (0.0, 0.0);
+        let dx = 2.0 * r / n as f64;
+        let dz = 2.0 * (h + r) / (2 * n) as f64;
+        for a in 0..n {
+            for b in 0..n {
+                for k in 0..2 * n {
+                    let x = -r + (a as f64 + 0.5) * dx;
+                    let y = -r + (b as f64 + 0.5) * dx;
+                    let z = -(h + r) + (k as f64 + 0.5) * dz;
+                    let zc = z.abs() - h;
+                    let inside = if zc <= 0.0 {
+                        x * x + y * y <= r * r
+                    } else {
+                        x * x + y * y + zc * zc <= r * r
+                    };
+                    if inside {
+                        let dv = dx * dx * dz;
+                        ixx += (y * y + z * z) * dv;
+                        izz += (x * x + y * y) * dv;
+                    }
+                }
+            }
+        }
+        assert!((i[(0, 0)] - ixx).abs() < 5e-3 * ixx, "{} {ixx}", i[(0, 0)]);
+        assert!((i[(2, 2)] - izz).abs() < 5e-3 * izz, "{} {izz}", i[(2, 2)]);
+    }
+}
