@@ -87,6 +87,8 @@ def test_every_term_describes_itself_from_the_core() -> None:
         "poncelet",
         "rft",
         "rft_inertial",
+        "rft3d",
+        "rft3d_inertial",
     )
     for name in forces.TERMS:
         info = forces.info(name)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from . import _granrs, animation, bodies, cases, coefficients, data, forces, scenefile
+from . import _granrs, animation, bodies, cases, coefficients, data, forces, scenefile, space
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
@@ -77,6 +77,7 @@ __all__ = [
     "resistance_force",
     "scenefile",
     "simulate",
+    "space",
     "sweep",
 ]
 

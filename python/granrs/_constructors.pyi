@@ -4,6 +4,7 @@ Generated from the core's registry by ``python -m granrs._stubgen``: do not edit
 test regenerates it and compares.
 """
 
+import math
 from collections.abc import Mapping
 
 from .forces import ParamValue, Term
@@ -14,6 +15,8 @@ __all__ = [
     "joint_springs",
     "poncelet",
     "rft",
+    "rft3d",
+    "rft3d_inertial",
     "rft_inertial",
     "static_h",
     "static_v",
@@ -246,6 +249,65 @@ def rft_inertial(
             value (sand brought to the element's normal speed)).
         elements: elements per boundary plate [-], an integer from 1 to 1024; default 8
             (granrs (convergence study, docs/laws.md)).
+
+    Returns:
+        The term, its parameters checked by the core.
+    """
+
+def rft3d(
+    zeta: ParamValue,
+    mu_surf: ParamValue = math.inf,
+    grazing: int = 1,
+) -> Term:
+    """``rft3d``: three-dimensional resistive force theory on a body's surface elements.
+
+    Equation, in granrs's frame::
+
+        dF = zeta |z| dA (f1 m + f2 v^ - f3 z^) on leading elements (n . v >= 0); m: the
+            element's normal facing down; f_i: cubic fits in (-v^_z, |n_z|, m . v^)
+
+    Acts on each contact in the sand (adds to the thesis's F_s). Reads each surface
+    element's normal, depth, area and velocity direction. Source: Agarwal, Goldman & Kamrin,
+    PNAS 120 (2023) e2214017120, SI sec. S3.
+
+    Generated from the core's registry (``granrs.forces.info('rft3d')``); unknown or bad
+    parameters raise a :class:`granrs.GranrsError` naming ``rft3d.<parameter>``.
+
+    Args:
+        zeta: material scale of the generic stress [N/m^3]; required (no default; none: the
+            medium's scale xi_n (granrs.space.xi_n from its density and internal friction,
+            or fitted)).
+        mu_surf: surface friction: cap on the stress's tangential part [-]; default inf (no
+            cap unless given (the public codes take 0.15 to 0.4)).
+        grazing: whether elements moving along their own surface count (1 or 0) [-], an
+            integer from 0 to 1; default 1 (1 as the public codes of the paper (grazing
+            elements count)).
+
+    Returns:
+        The term, its parameters checked by the core.
+    """
+
+def rft3d_inertial(
+    lam: ParamValue = 1.0,
+) -> Term:
+    """``rft3d_inertial``: the inertial term of dynamic RFT on a body's surface elements in
+    space.
+
+    Equation, in granrs's frame::
+
+        dF = -lam rho_g (n . v)^2 n dA on leading elements (n . v > 0)
+
+    Acts on each contact in the sand (adds to the thesis's F_d). Reads rho_g; each surface
+    element's normal, area and velocity. Source: Agarwal, Karsai, Goldman & Kamrin, Science
+    Advances 7 (2021) eabe0631 (dynamic RFT).
+
+    Generated from the core's registry (``granrs.forces.info('rft3d_inertial')``); unknown
+    or bad parameters raise a :class:`granrs.GranrsError` naming
+    ``rft3d_inertial.<parameter>``.
+
+    Args:
+        lam: scale of the momentum flux rho_g v_n^2 [-]; default 1.0 (the momentum-flux
+            value (sand brought to the element's normal speed)).
 
     Returns:
         The term, its parameters checked by the core.

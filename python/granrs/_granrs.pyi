@@ -18,10 +18,15 @@ __all__ = [
     "RFT_COEFFICIENTS",
     "RFT_GENERIC",
     "SCENE_FIELDS",
+    "SPACE_DEFAULT_NODES",
+    "SPACE_MAX_NODES",
+    "SPACE_SERIES",
+    "SPACE_SUMMARY",
     "Compiled",
     "GeomCoupling",
     "RunOutcome",
     "SandGeoms",
+    "SpaceScene",
     "__version__",
     "body_linkage",
     "check_term",
@@ -32,14 +37,19 @@ __all__ = [
     "leg_segments",
     "max_threads",
     "resistance_force",
+    "rft3d_alpha",
     "rft_alpha",
     "run",
     "run_scene",
     "scene_fields",
+    "space_load",
+    "space_run",
+    "space_scene",
     "sweep",
     "term_infos",
     "validate",
     "validate_sweep",
+    "xi_n",
 ]
 __version__: str
 EFFECTS: list[str]
@@ -219,3 +229,24 @@ def check_term(name: str, params: dict[str, Any]) -> dict[str, float | tuple[flo
 
 def rft_alpha(beta: Any, gamma: Any, coefficients: list[float]) -> tuple[Any, Any]:
     """RFT (alpha_x, alpha_z) at equal-length float64 arrays of angles [rad]."""
+
+# Bodies in space (granrs.space).
+SPACE_SUMMARY: list[tuple[str, str, str]]
+SPACE_SERIES: list[tuple[str, str, str]]
+SPACE_MAX_NODES: int
+SPACE_DEFAULT_NODES: int
+
+@final
+class SpaceScene:
+    def mass_properties(self) -> tuple[float, list[list[float]], float]: ...
+    def lowest_offset(self) -> tuple[float, float, float]: ...
+
+def space_scene(scene: dict[str, Any]) -> SpaceScene: ...
+def space_run(scene: SpaceScene) -> dict[str, Any]: ...
+def space_load(
+    scene: SpaceScene, position: Any, orientation: Any, velocity: Any, omega: Any
+) -> dict[str, Any]: ...
+def xi_n(rho_c: float, mu: float) -> float: ...
+def rft3d_alpha(
+    n: tuple[float, float, float], v: tuple[float, float, float], grazing: bool
+) -> tuple[float, float, float]: ...

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import warnings
 
-from . import _granrs
+from . import _granrs, space
 from .errors import InvalidParameterError, StepSizeWarning
 from .result import Result
 from .scene import _CORE_FIELDS, Scene
@@ -47,8 +47,9 @@ def step_advice(dt: float, h_lambda: float, unresolved: int = 0, unresolved_stop
     )
 
 
-def simulate(scene: Scene) -> Result:
-    """Run one scene and return its :class:`~granrs.Result`.
+def simulate(scene: Scene | space.Scene) -> Result | space.Result:
+    """Run one scene and return its :class:`~granrs.Result` (a planar scene) or its
+    :class:`granrs.space.Result` (a body in space, :class:`granrs.space.Scene`).
 
     The scene is validated in full before the run starts (an invalid field raises a
     :class:`~granrs.errors.InvalidSceneError` subclass naming it). The run itself releases
@@ -62,9 +63,16 @@ def simulate(scene: Scene) -> Result:
         >>> round(r.depth, 3)
         0.029
     """
+    if isinstance(scene, space.Scene):
+        result3 = space.run(scene)
+        h_lambda = result3.summary["h_lambda"]
+        if h_lambda > RK4_STABILITY_LIMIT:
+            warnings.warn(StepSizeWarning(step_advice(scene.dt, h_lambda)), stacklevel=2)
+        return result3
     if not isinstance(scene, Scene):
         raise InvalidParameterError(
-            f"simulate() takes a granrs.Scene, got {type(scene).__name__}", field="scene"
+            f"simulate() takes a granrs.Scene or a granrs.space.Scene, got {type(scene).__name__}",
+            field="scene",
         )
     # scene._compiled() and _granrs.run in one call of the core.
     outcome = _granrs.run_scene(scene.__dict__, _CORE_FIELDS)

@@ -602,6 +602,14 @@ def constructors(infos: Iterable[TermInfo]) -> dict[str, Callable[..., Term]]:
     return out
 
 
+def _literal(value: Any) -> str:
+    """A default as a stub writes it (an infinite one as ``math.inf``, which the stub
+    imports)."""
+    if isinstance(value, float) and math.isinf(value):
+        return "math.inf" if value > 0 else "-math.inf"
+    return repr(value)
+
+
 def _stub_string(text: str) -> str:
     return text.replace("\\", "\\\\").replace('"""', '\\"\\"\\"')
 
@@ -617,6 +625,7 @@ def stub(infos: Iterable[TermInfo]) -> str:
         "test regenerates it and compares.",
         '"""',
         "",
+        "import math",
         "from collections.abc import Mapping",
         "",
         "from .forces import ParamValue, Term",
@@ -633,7 +642,7 @@ def stub(infos: Iterable[TermInfo]) -> str:
             if p.kind is inspect.Parameter.KEYWORD_ONLY and not star:
                 params.append("    *,")
                 star = True
-            default = "" if p.default is inspect.Parameter.empty else f" = {p.default!r}"
+            default = "" if p.default is inspect.Parameter.empty else f" = {_literal(p.default)}"
             params.append(f"    {p.name}: {p.annotation}{default},")
         head = (
             f"def {ti.name}(" + ("\n" + "\n".join(params) + "\n" if params else "") + ") -> Term:"

@@ -7,8 +7,9 @@
 //!
 //! One file per part: `convert.rs` (Python values to spec values), `errors.rs` (the
 //! exception conversion), `run.rs` (compile and run one scene), `sweep.rs` (batches),
-//! `force.rs` (`resistance_force`), `mujoco.rs` (`SandGeoms`, for `granrs.mujoco`) and
-//! `terms.rs` (the force terms' registry). This file only registers them.
+//! `force.rs` (`resistance_force`), `mujoco.rs` (`SandGeoms`, for `granrs.mujoco`),
+//! `space.rs` (bodies in space, for `granrs.space`) and `terms.rs` (the force terms'
+//! registry). This file only registers them.
 
 /// A dict of `key: value` pairs (each value converted with `IntoPyObject`), or the error of
 /// the first that does not convert: the one way a core value becomes a Python dict here.
@@ -25,6 +26,7 @@ mod errors;
 mod force;
 mod mujoco;
 mod run;
+mod space;
 mod sweep;
 mod terms;
 
@@ -72,6 +74,16 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "RFT_COEFFICIENTS",
         crate::forces::rft::COEFFICIENT_NAMES.to_vec(),
     )?;
+    m.add_class::<space::SpaceScene>()?;
+    m.add_function(wrap_pyfunction!(space::space_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(space::space_run, m)?)?;
+    m.add_function(wrap_pyfunction!(space::space_load, m)?)?;
+    m.add_function(wrap_pyfunction!(space::xi_n, m)?)?;
+    m.add_function(wrap_pyfunction!(space::rft3d_alpha, m)?)?;
+    m.add("SPACE_SUMMARY", space::summary_fields())?;
+    m.add("SPACE_SERIES", space::series_columns())?;
+    m.add("SPACE_MAX_NODES", crate::space::shape::Quadrature::MAX_NODES)?;
+    m.add("SPACE_DEFAULT_NODES", crate::space::shape::Quadrature::DEFAULT_NODES)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -250,14 +250,14 @@ fn on_main_thread(py: Python<'_>) -> bool {
     })
 }
 
-/// Run a compiled scene with the GIL released; its outcome stays in Rust until asked for.
-///
-/// On Python's main thread the run polls the signals about every 20 ms
+/// Run `work` with the GIL released, and give its value and the seconds it took. On
+/// Python's main thread the work polls the signals about every 20 ms
 /// ([`crate::integrate::cancel`]: the GIL is taken back for the poll only), so that Ctrl-C
 /// stops it and raises `KeyboardInterrupt` (or what a signal handler raised).
-#[pyfunction]
-pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
-    let scene = &compiled.get().scene;
+pub(super) fn watched<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<(T, f64)> {
     let main = on_main_thread(py);
     let (out, seconds, raised) = py.detach(|| {
         let t0 = std::time::Instant::now();
@@ -271,15 +271,27 @@ pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<Ru
                     true
                 }
             };
-            Watch::polling(&cancel, &poll).over(|| scene.run())
+            Watch::polling(&cancel, &poll).over(work)
         } else {
-            scene.run()
+            work()
         };
         (out, t0.elapsed().as_secs_f64(), raised.into_inner())
     });
     if let Some(e) = raised {
         return Err(e);
     }
+    Ok((out, seconds))
+}
+
+/// Run a compiled scene with the GIL released; its outcome stays in Rust until asked for.
+///
+/// On Python's main thread the run polls the signals about every 20 ms
+/// ([`crate::integrate::cancel`]: the GIL is taken back for the poll only), so that Ctrl-C
+/// stops it and raises `KeyboardInterrupt` (or what a signal handler raised).
+#[pyfunction]
+pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
+    let scene = &compiled.get().scene;
+    let (out, seconds) = watched(py, || scene.run())?;
     let out = out.map_err(|e| to_pyerr(py, e))?;
     let first = out.contacts.first();
     Ok(RunOutcome {

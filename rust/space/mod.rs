@@ -13,6 +13,7 @@
 //! - [`Scene3`]: what a run is, checked field by field before any work.
 
 pub mod load;
+pub mod outputs;
 pub mod quad;
 pub mod shape;
 pub mod solve;
@@ -187,7 +188,15 @@ impl Scene3 {
             end_at_stop: self.end_at_stop,
             record: self.record,
         };
-        Ok((Body { inertia, sand }, state, opts))
+        Ok((
+            Body {
+                inertia,
+                sand,
+                fastest_rate: 0.0,
+            },
+            state,
+            opts,
+        ))
     }
 }
 

@@ -243,6 +243,9 @@ pub struct Body {
     pub inertia: Inertia,
     /// The sand (its shape, the terms, the medium, the surface, the rule).
     pub sand: Sand,
+    /// The fastest rate of the sand seen at any evaluation of the run so far [1/s]
+    /// (every stage, so that a step that goes in and out of stiff sand is seen).
+    pub fastest_rate: f64,
 }
 
 impl Body {
@@ -263,6 +266,10 @@ impl Body {
             }
         }
         let load = self.sand.load(&y.c, &r, &v_law, &omega);
+        if load.elements > 0 {
+            let rate = self.rate(y, &load);
+            self.fastest_rate = self.fastest_rate.max(rate);
+        }
         let mut f = load.force;
         if self.sand.terms.gravity {
             f.z -= self.inertia.mass * self.sand.medium.g;
@@ -444,7 +451,7 @@ impl Body {
             max_depth = max_depth.max(depth);
             force_max = force_max.max(load.force.norm());
             max_elements = max_elements.max(load.elements);
-            h_lambda = h_lambda.max(dt * self.rate(&y, &load, depth));
+            h_lambda = h_lambda.max(dt * self.fastest_rate);
             if opts.record {
                 series.push(sample(self, t, &y, &load));
             }
@@ -482,8 +489,9 @@ impl Body {
     }
 
     /// The sand's fastest rate at the centre [1/s] (see the module's doc).
-    fn rate(&self, y: &State, load: &Load, depth: f64) -> f64 {
+    fn rate(&self, y: &State, load: &Load) -> f64 {
         let m = self.inertia.mass;
+        let depth = -self.lowest(y).0;
         let spring = if depth > 0.0 {
             (2.0 * load.rft3d.norm() / depth / m).sqrt()
         } else {
