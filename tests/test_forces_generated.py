@@ -216,7 +216,9 @@ def _default_literals() -> set[float]:
         p["default"]
         for raw in _registry()
         for p in raw["params"]
-        if not p["required"] and not (p["default"] == int(p["default"]) and abs(p["default"]) <= 10)
+        if not p["required"]
+        and math.isfinite(p["default"])
+        and not (p["default"] == int(p["default"]) and abs(p["default"]) <= 10)
     }
 
 

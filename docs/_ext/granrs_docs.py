@@ -53,6 +53,11 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
         ("simulate", "sweep", "Scene", "cases", "scenefile", "RECORDS", "RK4_STABILITY_LIMIT"),
     ),
     (
+        "Bodies in space",
+        "A free rigid body of any shape in three dimensions, under 3D resistive force theory.",
+        ("space",),
+    ),
+    (
         "Results",
         "What a run returns, and how to watch it.",
         ("Result", "ContactResult", "animate", "animation", "ImpactAnimation"),
@@ -199,6 +204,10 @@ def _number(value: float) -> str:
 EXAMPLE_BY_UNIT = {"N/m^3": 1e6, "N/m": 100.0, "-": 1.0}
 
 
+#: The contact shapes of planar bodies (a term on none of them acts only in space).
+PLANAR_SHAPES = ("rod", "box", "arc")
+
+
 def example_params(name: str) -> dict[str, float]:
     """A value for each required parameter of the term ``name`` (none has a default)."""
     return {
@@ -311,6 +320,17 @@ def term_rst(name: str) -> str:
         "",
         f"   {call}",
         "",
+    ]
+    if info.shapes is not None and not set(info.shapes) & set(PLANAR_SHAPES):
+        # A term of bodies in space only: its use is a granrs.space scene (scene files hold
+        # planar scenes).
+        lines += [
+            f"It acts on bodies in space (:doc:`/space`), e.g. ``granrs.space.Scene(body=..., "
+            f"forces=[{call}, granrs.forces.gravity()])``.",
+            "",
+        ]
+        return "\n".join(lines)
+    lines += [
         "In a scene file (:doc:`/scenes_toml`), with every parameter at its default"
         + (
             f" ({', '.join(f'``{k}``' for k in example)}: an example value; it has no default)"

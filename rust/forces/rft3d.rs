@@ -153,6 +153,17 @@ pub fn generic_stress<F: Real>(n: [F; 3], vh: [F; 3]) -> [F; 3] {
 /// `grazing` is 0) on grazing ones. Branch-free, so that it runs in SIMD lanes.
 #[inline(always)]
 pub fn stress<F: Real>(law: &Rft3dLanes<F>, n: [F; 3], v: [F; 3]) -> [F; 3] {
+    stress_capped::<F, true>(law, n, v)
+}
+
+/// [`stress`], with the friction cap applied only where `CAP` (a law whose `mu_surf` is
+/// infinite has none: the kernel then skips its arithmetic; the result is the same).
+#[inline(always)]
+pub fn stress_capped<F: Real, const CAP: bool>(
+    law: &Rft3dLanes<F>,
+    n: [F; 3],
+    v: [F; 3],
+) -> [F; 3] {
     let zero = F::splat(0.0);
     let speed2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     // 1 / |v|, finite at rest (the element is then left out below).
@@ -163,20 +174,22 @@ pub fn stress<F: Real>(law: &Rft3dLanes<F>, n: [F; 3], v: [F; 3]) -> [F; 3] {
     // Leading: n . v^ > -tol (grazing counted) or > tol (grazing left out).
     let leading = (nv + law.threshold).select_pos(F::splat(1.0), zero) * moving;
     let a = generic_stress(n, vh);
+    let k = law.zeta * leading;
+    if !CAP {
+        return [k * a[0], k * a[1], k * a[2]];
+    }
     // The friction cap: tangential part <= mu_surf |normal part|.
     let an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
     let at = [a[0] - an * n[0], a[1] - an * n[1], a[2] - an * n[2]];
     let at_norm = (at[0] * at[0] + at[1] * at[1] + at[2] * at[2]).sqrt();
     let cap = law.mu_surf * an.abs();
     let over = at_norm - cap;
-    // scale = cap / |at| where over the cap, else 1.
     // cap / |at| where over the cap (then |at| > cap >= 0), else 1; with no cap (infinite
     // mu_surf) `over` is -inf or NaN and the scale is 1.
     let scale = over.select_pos(
         cap * at_norm.max(F::splat(f64::MIN_POSITIVE)).recip(),
         F::splat(1.0),
     );
-    let k = law.zeta * leading;
     [
         k * (an * n[0] + scale * at[0]),
         k * (an * n[1] + scale * at[1]),

@@ -82,8 +82,14 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(space::rft3d_alpha, m)?)?;
     m.add("SPACE_SUMMARY", space::summary_fields())?;
     m.add("SPACE_SERIES", space::series_columns())?;
-    m.add("SPACE_MAX_NODES", crate::space::shape::Quadrature::MAX_NODES)?;
-    m.add("SPACE_DEFAULT_NODES", crate::space::shape::Quadrature::DEFAULT_NODES)?;
+    m.add(
+        "SPACE_MAX_NODES",
+        crate::space::shape::Quadrature::MAX_NODES,
+    )?;
+    m.add(
+        "SPACE_DEFAULT_NODES",
+        crate::space::shape::Quadrature::DEFAULT_NODES,
+    )?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -64,7 +64,11 @@ fn numbers<const N: usize>(v: &Bound<'_, PyAny>, field: &str) -> Res<[f64; N]> {
     if items.len() != N {
         return Err(GranrsError::InvalidScene {
             field: field.into(),
-            message: format!("{what}, got {}{}", items.len().min(N), if items.len() > N { " or more" } else { "" }),
+            message: format!(
+                "{what}, got {}{}",
+                items.len().min(N),
+                if items.len() > N { " or more" } else { "" }
+            ),
         });
     }
     let mut out = [0.0; N];
@@ -99,15 +103,34 @@ fn shape_of(d: &Bound<'_, PyAny>) -> Res<Shape> {
     let kind: String = item(d, "kind", &format!("{field}.kind"))?
         .extract()
         .map_err(|_| wrong(&format!("{field}.kind"), "a string", d))?;
-    let num = |k: &str| -> Res<f64> { number(&item(d, k, &format!("{field}.{k}"))?, &format!("{field}.{k}")) };
+    let num = |k: &str| -> Res<f64> {
+        number(
+            &item(d, k, &format!("{field}.{k}"))?,
+            &format!("{field}.{k}"),
+        )
+    };
     match kind.as_str() {
         "sphere" => Shape::sphere(field, num("radius")?),
         "capsule" => Shape::capsule(field, num("radius")?, num("length")?),
         "cylinder" => Shape::cylinder(field, num("radius")?, num("length")?),
-        "cuboid" => Shape::cuboid(field, numbers::<3>(&item(d, "size", &format!("{field}.size"))?, &format!("{field}.size"))?),
+        "cuboid" => Shape::cuboid(
+            field,
+            numbers::<3>(
+                &item(d, "size", &format!("{field}.size"))?,
+                &format!("{field}.size"),
+            )?,
+        ),
         "mesh" => {
-            let v = rows::<3>(&item(d, "vertices", &format!("{field}.vertices"))?, &format!("{field}.vertices"), 3_000_000)?;
-            let t = rows::<3>(&item(d, "triangles", &format!("{field}.triangles"))?, &format!("{field}.triangles"), 1_000_001)?;
+            let v = rows::<3>(
+                &item(d, "vertices", &format!("{field}.vertices"))?,
+                &format!("{field}.vertices"),
+                3_000_000,
+            )?;
+            let t = rows::<3>(
+                &item(d, "triangles", &format!("{field}.triangles"))?,
+                &format!("{field}.triangles"),
+                1_000_001,
+            )?;
             let mut tri = Vec::with_capacity(t.len());
             for (i, r) in t.iter().enumerate() {
                 let mut idx = [0i64; 3];
@@ -146,7 +169,10 @@ fn mass_of(d: &Bound<'_, PyDict>) -> Res<MassSpec> {
                     message: "a 3 x 3 tensor [kg m^2]".into(),
                 });
             }
-            Ok(MassSpec::Given(number(&m, "body.mass")?, [r[0], r[1], r[2]]))
+            Ok(MassSpec::Given(
+                number(&m, "body.mass")?,
+                [r[0], r[1], r[2]],
+            ))
         }
         (None, None, Some(_)) => Err(GranrsError::InvalidScene {
             field: "body.inertia".into(),
@@ -172,11 +198,14 @@ fn forces_of(v: &Bound<'_, PyAny>) -> Res<Vec<TermSpec>> {
     {
         let t = t.map_err(|_| wrong("forces", "a list of terms", v))?;
         let field = format!("forces[{i}]");
-        let (name, params): (String, Bound<'_, PyDict>) =
-            t.extract().map_err(|_| wrong(&field, "a (name, params) pair", &t))?;
+        let (name, params): (String, Bound<'_, PyDict>) = t
+            .extract()
+            .map_err(|_| wrong(&field, "a (name, params) pair", &t))?;
         let mut p = Vec::new();
         for (k, x) in params.iter() {
-            let k: String = k.extract().map_err(|_| wrong(&field, "parameter names", &params))?;
+            let k: String = k
+                .extract()
+                .map_err(|_| wrong(&field, "parameter names", &params))?;
             let pf = format!("{field}.{name}.{k}");
             if x.cast::<PyTuple>().is_ok() || x.cast::<PyList>().is_ok() {
                 return Err(GranrsError::InvalidScene {
@@ -193,7 +222,9 @@ fn forces_of(v: &Bound<'_, PyAny>) -> Res<Vec<TermSpec>> {
 
 fn scene_of(d: &Bound<'_, PyDict>) -> Res<Scene3> {
     let body = item(d, "body", "body")?;
-    let body = body.cast::<PyDict>().map_err(|_| wrong("body", "a body", &body))?;
+    let body = body
+        .cast::<PyDict>()
+        .map_err(|_| wrong("body", "a body", &body))?;
     let shape = shape_of(&item(body, "shape", "body.shape")?)?;
     let mass = mass_of(body)?;
     let v3 = |k: &str| numbers::<3>(&item(d, k, k)?, k);
@@ -225,7 +256,10 @@ fn scene_of(d: &Bound<'_, PyDict>) -> Res<Scene3> {
         return Err(GranrsError::InvalidParameter {
             field: "quadrature".into(),
             value: nodes,
-            allowed: format!("an integer in 1..={} (nodes per panel)", Quadrature::MAX_NODES),
+            allowed: format!(
+                "an integer in 1..={} (nodes per panel)",
+                Quadrature::MAX_NODES
+            ),
         });
     }
     Ok(Scene3 {
@@ -264,7 +298,9 @@ impl SpaceScene {
         let t = body.inertia.tensor;
         Ok((
             body.inertia.mass,
-            (0..3).map(|i| (0..3).map(|j| t[(i, j)]).collect()).collect(),
+            (0..3)
+                .map(|i| (0..3).map(|j| t[(i, j)]).collect())
+                .collect(),
             self.scene.shape.volume(),
         ))
     }
@@ -273,8 +309,13 @@ impl SpaceScene {
     /// (world axes).
     fn lowest_offset(&self) -> (f64, f64, f64) {
         let q = self.scene.orientation;
-        let r = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]));
-        let p = self.scene.shape.lowest_point(&nalgebra::Vector3::zeros(), &r);
+        let r = nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(
+            q[0], q[1], q[2], q[3],
+        ));
+        let p = self
+            .scene
+            .shape
+            .lowest_point(&nalgebra::Vector3::zeros(), &r);
         (p.x, p.y, p.z)
     }
 }
@@ -291,7 +332,10 @@ pub(super) fn space_scene(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult
 /// Run a checked scene with the GIL released: a dict with `status`, `summary` (the fields of
 /// `SPACE_SUMMARY`), `series` (the columns of `SPACE_SERIES`, or None) and `run_seconds`.
 #[pyfunction]
-pub(super) fn space_run<'py>(py: Python<'py>, scene: &Bound<'py, SpaceScene>) -> PyResult<Bound<'py, PyDict>> {
+pub(super) fn space_run<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, SpaceScene>,
+) -> PyResult<Bound<'py, PyDict>> {
     let (mut body, y0, opts) = scene.get().scene.build().map_err(|e| to_pyerr(py, e))?;
     let (out, seconds) = watched(py, move || body.run(y0, &opts))?;
     let out = out.map_err(|e| to_pyerr(py, e))?;
@@ -364,12 +408,18 @@ pub(super) fn space_load<'py>(
 
 /// Each summary field of a run in space: (name, unit, description).
 pub(super) fn summary_fields() -> Vec<(&'static str, &'static str, &'static str)> {
-    SUMMARY.iter().map(|f| (f.name, f.unit, f.description)).collect()
+    SUMMARY
+        .iter()
+        .map(|f| (f.name, f.unit, f.description))
+        .collect()
 }
 
 /// Each series column of a run in space: (name, unit, description).
 pub(super) fn series_columns() -> Vec<(&'static str, &'static str, &'static str)> {
-    SERIES.iter().map(|f| (f.name, f.unit, f.description)).collect()
+    SERIES
+        .iter()
+        .map(|f| (f.name, f.unit, f.description))
+        .collect()
 }
 
 /// 3D-RFT's material scale xi_n [N/m^3] from the medium's critical-state density rho_c

@@ -11,9 +11,8 @@ use nalgebra::{UnitQuaternion, Vector3};
 use super::shape::{Elements, Quadrature, Shape};
 use crate::error::{GranrsError, Result};
 use crate::forces::poncelet::Poncelet;
-use crate::forces::rft3d::{stress, Rft3d, Rft3dInertial, Rft3dLanes};
-use crate::forces::{Acts, Medium, Real, TermSpec};
-use crate::num::F64x4;
+use crate::forces::rft3d::{stress, stress_capped, Rft3d, Rft3dInertial, Rft3dLanes};
+use crate::forces::{Acts, Medium, TermSpec};
 
 type V3 = Vector3<f64>;
 
@@ -196,10 +195,10 @@ impl Sand {
             let k = t.lam * self.medium.rho_g;
             let mut f = V3::zeros();
             for i in 0..e.len() {
-                let x = V3::from(e.x[i]);
-                let r = x - c;
+                let r = e.point(i) - c;
                 let vx = v + omega.cross(&r);
-                let tr = Rft3dInertial::traction(k, e.n[i], [vx.x, vx.y, vx.z]);
+                let nn = e.normal(i);
+                let tr = Rft3dInertial::traction(k, [nn.x, nn.y, nn.z], [vx.x, vx.y, vx.z]);
                 let df = V3::from(tr) * e.area[i];
                 f += df;
                 moment += r.cross(&df);
@@ -212,9 +211,9 @@ impl Sand {
             let vh = v / speed;
             let (mut a, mut centre) = (0.0, V3::zeros());
             for i in 0..e.len() {
-                let p = (V3::from(e.n[i]).dot(&vh)).max(0.0) * e.area[i];
+                let p = (e.normal(i).dot(&vh)).max(0.0) * e.area[i];
                 a += p;
-                centre += p * V3::from(e.x[i]);
+                centre += p * e.point(i);
             }
             out.projected_area = a;
             if let Some(p) = self.terms.poncelet {
@@ -237,16 +236,17 @@ impl Sand {
     }
 }
 
-/// `rft3d` over the elements: the force and its moment about `c`. Four elements at a time
-/// through the term's kernel in SIMD lanes (AVX2 where the CPU has it: the same IEEE
-/// operations, so the same bits as one at a time).
+/// `rft3d` over the elements: the force and its moment about `c`. The term's kernel runs
+/// over a block of elements in a loop the compiler vectorizes (each coordinate contiguous;
+/// AVX2 where the CPU has it: the same IEEE operations, so the same bits), then the block's
+/// forces are summed in order.
 pub fn rft3d_sum(law: &Rft3dLanes<f64>, e: &Elements, c: &V3, v: &V3, omega: &V3) -> (V3, V3) {
     #[cfg(target_arch = "x86_64")]
     if crate::num::avx2() {
         // SAFETY: this CPU has AVX2 (checked).
         return unsafe { rft3d_sum_avx2(law, e, c, v, omega) };
     }
-    rft3d_sum_lanes(law, e, c, v, omega)
+    rft3d_sum_blocks(law, e, c, v, omega)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -258,55 +258,88 @@ unsafe fn rft3d_sum_avx2(
     v: &V3,
     omega: &V3,
 ) -> (V3, V3) {
-    rft3d_sum_lanes(law, e, c, v, omega)
+    rft3d_sum_blocks(law, e, c, v, omega)
+}
+
+/// Elements per block of the kernel (its force buffer lives on the stack).
+const BLOCK: usize = 256;
+
+#[inline(always)]
+fn rft3d_sum_blocks(law: &Rft3dLanes<f64>, e: &Elements, c: &V3, v: &V3, omega: &V3) -> (V3, V3) {
+    if law.mu_surf == f64::INFINITY {
+        rft3d_sum_blocks_with::<false>(law, e, c, v, omega)
+    } else {
+        rft3d_sum_blocks_with::<true>(law, e, c, v, omega)
+    }
 }
 
 #[inline(always)]
-fn rft3d_sum_lanes(law: &Rft3dLanes<f64>, e: &Elements, c: &V3, v: &V3, omega: &V3) -> (V3, V3) {
+fn rft3d_sum_blocks_with<const CAP: bool>(
+    law: &Rft3dLanes<f64>,
+    e: &Elements,
+    c: &V3,
+    v: &V3,
+    omega: &V3,
+) -> (V3, V3) {
     let n = e.len();
-    let lanes = Rft3dLanes {
-        zeta: F64x4::splat(law.zeta),
-        mu_surf: F64x4::splat(law.mu_surf),
-        threshold: F64x4::splat(law.threshold),
-    };
-    let (mut f, mut m) = (V3::zeros(), V3::zeros());
-    let mut i = 0;
-    while i + 4 <= n {
-        let mut r = [[0.0; 4]; 3];
-        let mut vel = [[0.0; 4]; 3];
-        let mut nn = [[0.0; 4]; 3];
-        let mut wd = [0.0; 4];
-        for l in 0..4 {
-            let x = e.x[i + l];
-            let (rl, vl) = arm_and_velocity(x, c, v, omega);
-            for k in 0..3 {
-                r[k][l] = rl[k];
-                vel[k][l] = vl[k];
-                nn[k][l] = e.n[i + l][k];
-            }
-            wd[l] = e.area[i + l] * e.depth[i + l];
-        }
-        let s = stress(
-            &lanes,
-            [F64x4(nn[0]), F64x4(nn[1]), F64x4(nn[2])],
-            [F64x4(vel[0]), F64x4(vel[1]), F64x4(vel[2])],
+    // Per block: the force and its moment about c of each element, then their sums.
+    let mut out = [[0.0f64; BLOCK]; 6];
+    let mut total = [0.0f64; 6];
+    let mut start = 0;
+    while start < n {
+        let len = BLOCK.min(n - start);
+        let (xs, ns) = (&e.x, &e.n);
+        let (area, depth) = (&e.area[start..start + len], &e.depth[start..start + len]);
+        let (x0, x1, x2) = (
+            &xs[0][start..start + len],
+            &xs[1][start..start + len],
+            &xs[2][start..start + len],
         );
-        for l in 0..4 {
-            let df = V3::new(s[0].0[l], s[1].0[l], s[2].0[l]) * wd[l];
-            f += df;
-            m += V3::new(r[0][l], r[1][l], r[2][l]).cross(&df);
+        let (n0, n1, n2) = (
+            &ns[0][start..start + len],
+            &ns[1][start..start + len],
+            &ns[2][start..start + len],
+        );
+        let [f0, f1, f2, m0, m1, m2] = &mut out;
+        for j in 0..len {
+            let (r, vel) = arm_and_velocity([x0[j], x1[j], x2[j]], c, v, omega);
+            let s = stress_capped::<f64, CAP>(law, [n0[j], n1[j], n2[j]], vel);
+            let w = area[j] * depth[j];
+            let d = [s[0] * w, s[1] * w, s[2] * w];
+            f0[j] = d[0];
+            f1[j] = d[1];
+            f2[j] = d[2];
+            m0[j] = r[1] * d[2] - r[2] * d[1];
+            m1[j] = r[2] * d[0] - r[0] * d[2];
+            m2[j] = r[0] * d[1] - r[1] * d[0];
         }
-        i += 4;
+        for (t, col) in total.iter_mut().zip(out.iter()) {
+            *t += sum4(&col[..len]);
+        }
+        start += len;
     }
-    while i < n {
-        let (rl, vl) = arm_and_velocity(e.x[i], c, v, omega);
-        let s = stress(law, e.n[i], vl);
-        let df = V3::from(s) * (e.area[i] * e.depth[i]);
-        f += df;
-        m += V3::from(rl).cross(&df);
-        i += 1;
+    (
+        V3::new(total[0], total[1], total[2]),
+        V3::new(total[3], total[4], total[5]),
+    )
+}
+
+/// The sum of `a` in four interleaved partial sums (a fixed order, so the same bits every
+/// time; vectorizable, unlike one running sum).
+#[inline(always)]
+fn sum4(a: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let mut chunks = a.chunks_exact(4);
+    for ch in &mut chunks {
+        for k in 0..4 {
+            acc[k] += ch[k];
+        }
     }
-    (f, m)
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for x in chunks.remainder() {
+        s += x;
+    }
+    s
 }
 
 /// The arm `x - c` of a point and its velocity `v + omega x (x - c)`, written out once for
@@ -462,8 +495,8 @@ mod tests {
     }
 
     #[test]
-    fn lanes_and_one_at_a_time_give_the_same_bits() {
-        let mut s = sand(Shape::capsule("c", 0.02, 0.1).unwrap(), 6);
+    fn the_vectorized_kernel_is_the_element_sum_to_round_off() {
+        let mut s = sand(Shape::capsule("c", 0.02, 0.1).unwrap(), 12);
         let q = UnitQuaternion::from_euler_angles(0.3, 0.8, -0.4);
         let (c, v, w) = (
             V3::new(0.0, 0.0, 0.0),
@@ -471,20 +504,23 @@ mod tests {
             V3::new(1.0, 2.0, -0.5),
         );
         let e = s.elements_at(&c, &q, &v, &w).clone();
+        assert!(e.len() > 2 * BLOCK, "several blocks: {}", e.len());
         let law = s.terms.rft3d.unwrap().lanes();
         let (f, m) = rft3d_sum(&law, &e, &c, &v, &w);
         let (mut f1, mut m1) = (V3::zeros(), V3::zeros());
-        let mut i = 0;
-        // The same order of sums as the lanes: four at a time, then the rest.
-        while i < e.len() {
-            let (r, vl) = arm_and_velocity(e.x[i], &c, &v, &w);
-            let st = stress(&law, e.n[i], vl);
-            let df = V3::from(st) * (e.area[i] * e.depth[i]);
+        // One element at a time, summed in one running sum: equal to round-off (the kernel
+        // sums in four interleaved partial sums per block).
+        for i in 0..e.len() {
+            let (r, vl) = arm_and_velocity([e.x[0][i], e.x[1][i], e.x[2][i]], &c, &v, &w);
+            let st = stress(&law, [e.n[0][i], e.n[1][i], e.n[2][i]], vl);
+            let wd = e.area[i] * e.depth[i];
+            let df = V3::new(st[0] * wd, st[1] * wd, st[2] * wd);
             f1 += df;
             m1 += V3::from(r).cross(&df);
-            i += 1;
         }
-        assert_eq!(f, f1);
-        assert_eq!(m, m1);
+        assert!((f - f1).norm() <= 1e-13 * f1.norm(), "{f:?} {f1:?}");
+        assert!((m - m1).norm() <= 1e-13 * m1.norm(), "{m:?} {m1:?}");
+        // And the same bits every time.
+        assert_eq!(rft3d_sum(&law, &e, &c, &v, &w), (f, m));
     }
 }

@@ -29,13 +29,14 @@ use crate::forces::ContactKind;
 
 type V3 = Vector3<f64>;
 
-/// Surface elements below the sand (structure of arrays, reused between evaluations).
+/// Surface elements below the sand: a structure of arrays (each coordinate contiguous, so
+/// that the element kernels run in SIMD lanes), reused between evaluations.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Elements {
-    /// Positions, world frame [m].
-    pub x: Vec<[f64; 3]>,
-    /// Outward unit normals, world frame.
-    pub n: Vec<[f64; 3]>,
+    /// Positions' x, y and z, world frame [m].
+    pub x: [Vec<f64>; 3],
+    /// Outward unit normals' x, y and z, world frame.
+    pub n: [Vec<f64>; 3],
     /// Area weights [m^2].
     pub area: Vec<f64>,
     /// Depths below the surface [m] (>= 0).
@@ -45,10 +46,24 @@ pub struct Elements {
 impl Elements {
     /// Forget every element (keep the buffers).
     pub fn clear(&mut self) {
-        self.x.clear();
-        self.n.clear();
+        for k in 0..3 {
+            self.x[k].clear();
+            self.n[k].clear();
+        }
         self.area.clear();
         self.depth.clear();
+    }
+
+    /// Element `i`'s position [m].
+    #[inline]
+    pub fn point(&self, i: usize) -> V3 {
+        V3::new(self.x[0][i], self.x[1][i], self.x[2][i])
+    }
+
+    /// Element `i`'s outward normal.
+    #[inline]
+    pub fn normal(&self, i: usize) -> V3 {
+        V3::new(self.n[0][i], self.n[1][i], self.n[2][i])
     }
 
     /// How many elements.
@@ -63,8 +78,10 @@ impl Elements {
 
     #[inline]
     fn push(&mut self, x: V3, n: V3, area: f64, surface: f64) {
-        self.x.push([x.x, x.y, x.z]);
-        self.n.push([n.x, n.y, n.z]);
+        for k in 0..3 {
+            self.x[k].push(x[k]);
+            self.n[k].push(n[k]);
+        }
         self.area.push(area);
         self.depth.push((surface - x.z).max(0.0));
     }
