@@ -9,7 +9,9 @@ Each input is one bad or good value put into one field of one public way in:
 - ``element``: a field of a ``granrs.bodies`` ``Link``, ``Joint``, ``Contact`` (rod, box and
   arc) or ``Root`` of a small linkage;
 - ``sweep``: a value of a ``granrs.sweep`` axis;
-- ``toml``: a value in a TOML scene file's text.
+- ``toml``: a value in a TOML scene file's text;
+- ``space``: a field of a ``granrs.space.Scene``, of its body, of its shape (each shape in
+  space) or of its terms (``rft3d``, ``rft3d_inertial``, ``poncelet``).
 
 The values: NaN, infinities, -0, huge floats and ints (``10**400``), strings, None, bools,
 numpy bools, numpy scalars and arrays, nested lists, mappings, unknown names, and good
@@ -44,7 +46,7 @@ from typing import Any
 import numpy as np
 
 import granrs
-from granrs import Scene, cases, forces, scenefile
+from granrs import Scene, cases, forces, scenefile, space
 from granrs.bodies import Contact, Joint, Link, Linkage, Root
 from granrs.errors import GranrsError, SimulationError, StepSizeWarning
 
@@ -311,6 +313,76 @@ def toml_case(pick: Pick) -> Case:
     return Case("toml", field, value, lambda: run(granrs.scenefile.loads(text)))
 
 
+#: Each shape in space from one parameter value (the others good).
+SPACE_SHAPES: dict[str, Callable[[Any], Any]] = {
+    "sphere.radius": lambda v: space.Sphere(radius=v),
+    "capsule.radius": lambda v: space.Capsule(radius=v, length=0.05),
+    "capsule.length": lambda v: space.Capsule(radius=0.01, length=v),
+    "cylinder.length": lambda v: space.Cylinder(radius=0.01, length=v),
+    "cuboid.size": lambda v: space.Cuboid(size=v),
+    "cuboid.size[1]": lambda v: space.Cuboid(size=(0.02, v, 0.03)),
+    "mesh.vertices": lambda v: space.Mesh(vertices=v, triangles=np.zeros((4, 3), dtype=int)),
+    "mesh.triangles": lambda v: space.Mesh(vertices=np.eye(4, 3), triangles=v),
+}
+
+
+@dataclasses.dataclass
+class _Terms:
+    """A term to build inside the case's call (so that its own errors are the case's)."""
+
+    name: str
+    params: dict[str, Any]
+
+
+def space_case(pick: Pick) -> Case:
+    where = pick(("scene", "body", "shape", "term"), "where")
+    value = pick([*BAD, 0.5, 0.02, 1e6, (0.0, 0.0, -1.0), (1.0, 0.0, 0.0, 0.0)], "value")
+    kw: dict[str, Any] = {
+        "body": space.Body(space.Sphere(0.02), density=7800.0),
+        "forces": [forces.rft3d(zeta=2e5), forces.gravity()],
+        "velocity": (0.3, 0.0, -1.0),
+        "omega": (0.0, 2.0, 0.0),
+        "t_end": 0.01,
+    }
+    if where == "scene":
+        field = pick([f.name for f in dataclasses.fields(space.Scene) if f.init], "field")
+        kw[field] = value
+        names: tuple[str, ...] = (field,)
+    elif where == "body":
+        field = pick(("density", "mass", "inertia"), "field")
+        body = (
+            {"density": None, "mass": 0.1, field: value}
+            if field != "density"
+            else {"density": value}
+        )
+        kw["body"] = space.Body(space.Capsule(0.01, 0.04), **body)
+        names = ("body", field)
+    elif where == "shape":
+        field = pick(list(SPACE_SHAPES), "field")
+        make = SPACE_SHAPES[field]
+        kw["body"] = lambda: space.Body(make(value), density=2000.0)  # built in build()
+        names = ("body.shape", field.split(".")[-1].split("[")[0], "vertices", "triangles")
+    else:
+        name = pick(("rft3d", "rft3d_inertial", "poncelet"), "term")
+        info = forces.info(name)
+        field = pick([p.name for p in info.params], "parameter")
+        params = {p.name: (2e5 if p.name == "zeta" else 1.0) for p in info.params if p.required}
+        params[field] = value
+        kw["forces"] = _Terms(name, params)
+        names = (name, field, "forces")
+
+    def build() -> Any:
+        args = dict(kw)
+        if callable(args["body"]):
+            args["body"] = args["body"]()
+        if isinstance(args["forces"], _Terms):
+            t = args["forces"]
+            args["forces"] = [forces.term(t.name, **t.params), forces.gravity()]
+        return run(space.Scene(**args))
+
+    return Case("space", field, value, build, names=names)
+
+
 GENERATORS: dict[str, Callable[[Pick], Case]] = {
     "scene": scene_case,
     "case": case_case,
@@ -318,6 +390,7 @@ GENERATORS: dict[str, Callable[[Pick], Case]] = {
     "element": element_case,
     "sweep": sweep_case,
     "toml": toml_case,
+    "space": space_case,
 }
 
 

@@ -290,3 +290,12 @@ def test_the_bench_prints_its_figures(capsys: pytest.CaptureFixture[str]) -> Non
     out = capsys.readouterr().out
     for line in ("inputs tried: 30", "typed errors:", "runs ok:", "anything else: 0"):
         assert line in out
+
+
+def test_a_leg_size_so_small_its_segments_vanish_is_refused_naming_it() -> None:
+    """A TOML or Python leg with tibia_length = 1e-300: its shank's inertia underflows to 0,
+    which used to be refused naming ``links.shank.inertia``, a field the user never wrote;
+    now the smallest size is named (as the largest is when one overflows)."""
+    with pytest.raises(GranrsError) as info:
+        Scene(body="leg", tibia_length=1e-300)
+    assert info.value.field == "tibia_length", str(info.value)

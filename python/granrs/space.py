@@ -113,7 +113,7 @@ class Cuboid:
     size: tuple[float, float, float]
 
     def _dict(self) -> dict[str, Any]:
-        return {"kind": "cuboid", "size": tuple(self.size)}
+        return {"kind": "cuboid", "size": self.size}
 
 
 @dataclass(frozen=True, eq=False)
@@ -131,8 +131,19 @@ class Mesh:
     triangles: np.ndarray
 
     def __post_init__(self) -> None:
-        v = np.asarray(self.vertices, dtype=float)
-        t = np.asarray(self.triangles)
+        try:
+            v = np.asarray(self.vertices, dtype=float)
+        except (TypeError, ValueError, OverflowError) as e:
+            raise InvalidParameterError(
+                f"a mesh's vertices are an n x 3 array of numbers: {e}", field="body.shape.vertices"
+            ) from e
+        try:
+            t = np.asarray(self.triangles)
+        except (TypeError, ValueError, OverflowError) as e:
+            raise InvalidParameterError(
+                f"a mesh's triangles are an m x 3 array of vertex indices: {e}",
+                field="body.shape.triangles",
+            ) from e
         if v.ndim != 2 or v.shape[1] != 3:
             raise InvalidParameterError(
                 f"a mesh's vertices are an n x 3 array, got shape {v.shape}",
@@ -242,8 +253,12 @@ class Body:
                 f"Mesh), got {type(self.shape).__name__}",
                 field="body.shape",
             )
-        inertia = None if self.inertia is None else np.asarray(self.inertia, dtype=float).tolist()
-        return {"shape": shape(), "density": self.density, "mass": self.mass, "inertia": inertia}
+        return {
+            "shape": shape(),
+            "density": self.density,
+            "mass": self.mass,
+            "inertia": self.inertia,
+        }
 
 
 def _terms(forces: Any) -> list[tuple[str, dict[str, Any]]]:

@@ -251,26 +251,37 @@ impl Leg {
         }
         self.start.check()?;
         // Sizes so large that a segment's derived length, mass or inertia overflows are
-        // refused naming the largest of them (the one that overflows it).
-        let derived = self.segments().iter().all(|s| {
+        // refused naming the largest of them (the one that overflows it); so small that one
+        // underflows to zero, naming the smallest.
+        let segments = self.segments();
+        let overflows = segments.iter().any(|s| {
             [s.mass, s.length, s.com, s.inertia]
                 .iter()
-                .all(|x| x.is_finite())
+                .any(|x| !x.is_finite())
         });
-        if !derived {
+        let underflows = segments
+            .iter()
+            .any(|s| [s.mass, s.length, s.inertia].iter().any(|x| *x <= 0.0));
+        if overflows || underflows {
             let sizes = [
                 ("body_mass", self.body_mass),
                 ("height", self.height),
                 ("foot_length", self.foot_length),
                 ("tibia_length", self.tibia_length),
             ];
-            let (field, value) = sizes
-                .into_iter()
-                .fold(sizes[0], |a, b| if b.1 > a.1 { b } else { a });
+            let (field, value) = sizes.into_iter().fold(sizes[0], |a, b| {
+                if (overflows && b.1 > a.1) || (!overflows && b.1 < a.1) {
+                    b
+                } else {
+                    a
+                }
+            });
             return Err(GranrsError::InvalidParameter {
                 field: field.into(),
                 value,
-                allowed: "a size whose segments' lengths, masses and inertias are finite".into(),
+                allowed: "a size whose segments' lengths, masses and inertias are finite and \
+                          positive"
+                    .into(),
             });
         }
         Ok(())

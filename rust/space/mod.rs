@@ -93,7 +93,8 @@ impl Scene3 {
     /// The checked scene: the body, its state at t = 0 and the run's options. Every field
     /// is checked before any work; an error names the first bad one.
     pub fn build(&self) -> Result<(Body, State, Options)> {
-        let c = vector("position", self.position, 1e6, "[m]")?;
+        // Wide enough for the default placement (the surface plus a size) of any shape.
+        let c = vector("position", self.position, 1e7, "[m]")?;
         let mut q = [0.0; 4];
         for (k, x) in self.orientation.iter().enumerate() {
             q[k] = finite(
@@ -156,7 +157,18 @@ impl Scene3 {
         let inertia = match &self.mass {
             MassSpec::Density(rho) => {
                 let rho = finite("body.density", *rho, 1e-6, 1e6, "[kg/m^3]")?;
-                Inertia::new("body", rho * volume, unit * rho)?
+                let mass = rho * volume;
+                if !(1e-12..=1e12).contains(&mass) {
+                    return Err(GranrsError::InvalidParameter {
+                        field: "body.density".into(),
+                        value: rho,
+                        allowed: format!(
+                            "a density that gives the shape of {volume:.3e} m^3 a mass in \
+                             [1e-12, 1e12] kg (this one gives {mass:.3e} kg)"
+                        ),
+                    });
+                }
+                Inertia::new("body", mass, unit * rho)?
             }
             MassSpec::Mass(m) => {
                 let m = finite("body.mass", *m, 1e-12, 1e12, "[kg]")?;

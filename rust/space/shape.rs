@@ -165,26 +165,32 @@ pub enum Shape {
     Mesh(Box<Mesh>),
 }
 
+/// The smallest size of a shape [m] (a micrometre: below it the body's mass and inertia
+/// leave what a double holds well).
+pub const MIN_SIZE: f64 = 1e-6;
+/// The largest size of a shape [m].
+pub const MAX_SIZE: f64 = 1e6;
+
 fn positive(field: &str, v: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v > 0.0 && v < 1e6 {
+    if (MIN_SIZE..MAX_SIZE).contains(&v) {
         Ok(v)
     } else {
         Err(GranrsError::InvalidParameter {
             field: field.into(),
             value: v,
-            allowed: format!("finite, > 0, < 1e6 ({what} [m])"),
+            allowed: format!("finite, >= {MIN_SIZE:e}, < {MAX_SIZE:e} ({what} [m])"),
         })
     }
 }
 
 fn nonneg(field: &str, v: f64, what: &str) -> Result<f64> {
-    if (0.0..1e6).contains(&v) {
+    if (0.0..MAX_SIZE).contains(&v) {
         Ok(v)
     } else {
         Err(GranrsError::InvalidParameter {
             field: field.into(),
             value: v,
-            allowed: format!("finite, >= 0, < 1e6 ({what} [m])"),
+            allowed: format!("finite, >= 0, < {MAX_SIZE:e} ({what} [m])"),
         })
     }
 }
@@ -264,6 +270,19 @@ impl Shape {
         let mut scale: f64 = 0.0;
         for v in &verts {
             scale = scale.max(v.norm());
+        }
+        let (lo, hi) = verts.iter().fold(
+            (V3::repeat(f64::INFINITY), V3::repeat(f64::NEG_INFINITY)),
+            |(lo, hi), v| (lo.inf(v), hi.sup(v)),
+        );
+        if (hi - lo).max() < MIN_SIZE {
+            return Err(bad(
+                "vertices",
+                format!(
+                    "the mesh spans {:.3e} m; at least {MIN_SIZE:e} m",
+                    (hi - lo).max()
+                ),
+            ));
         }
         for (i, t) in triangles.iter().enumerate() {
             let mut idx = [0usize; 3];
