@@ -11,7 +11,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use super::shape::{Elements, Quadrature, Shape};
 use crate::error::{GranrsError, Result};
 use crate::forces::poncelet::Poncelet;
-use crate::forces::rft3d::{stress, stress_capped, Rft3d, Rft3dInertial, Rft3dLanes};
+use crate::forces::rft3d::{stress_capped, Rft3d, Rft3dInertial, Rft3dLanes};
 use crate::forces::{Acts, Medium, TermSpec};
 
 type V3 = Vector3<f64>;
@@ -379,6 +379,7 @@ pub fn load_with_error(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::forces::rft3d::stress;
     use std::f64::consts::PI;
 
     fn sand(shape: Shape, nodes: usize) -> Sand {
