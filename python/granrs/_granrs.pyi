@@ -244,7 +244,12 @@ class SpaceScene:
 def space_scene(scene: dict[str, Any]) -> SpaceScene: ...
 def space_run(scene: SpaceScene) -> dict[str, Any]: ...
 def space_load(
-    scene: SpaceScene, position: Any, orientation: Any, velocity: Any, omega: Any
+    scene: SpaceScene,
+    position: Any,
+    orientation: Any,
+    velocity: Any,
+    omega: Any,
+    error: bool = True,
 ) -> dict[str, Any]: ...
 def xi_n(rho_c: float, mu: float) -> float: ...
 def rft3d_alpha(

@@ -441,7 +441,7 @@ class Load:
             [m^2].
         elements: how many surface elements were evaluated.
         force_error: the surface rule's error estimate of the force [N] (how much the force
-            moves when the nodes per panel are doubled).
+            moves when the nodes per panel are doubled; NaN if not asked for).
         moment_error: the same for the moment [N m].
     """
 
@@ -461,9 +461,13 @@ def load(
     orientation: Sequence[float] | None = None,
     velocity: Sequence[float] | None = None,
     omega: Sequence[float] | None = None,
+    error: bool = True,
 ) -> Load:
     """The sand's load on ``scene``'s body under its terms, at its initial state or at the
-    pose and motion given (each checked as the scene's field of that name).
+    pose and motion given (each checked as the scene's field of that name). With ``error``
+    (default) the surface rule's error is estimated by evaluating again with twice the
+    nodes per panel (the cost of several evaluations); without, ``force_error`` and
+    ``moment_error`` are NaN.
 
     Example: the stress on a sphere dragged sideways under the surface has lift::
 
@@ -485,6 +489,7 @@ def load(
         scene.orientation if orientation is None else orientation,
         scene.velocity if velocity is None else velocity,
         scene.omega if omega is None else omega,
+        bool(error),
     )
     listed = {t.name for t in scene.forces}
     return Load(

@@ -13,7 +13,7 @@ use crate::forces::{Medium, TermSpec};
 use crate::space::load::load_with_error;
 use crate::space::outputs::{SERIES, SUMMARY};
 use crate::space::shape::{Quadrature, Shape};
-use crate::space::{MassSpec, Scene3};
+use crate::space::{state_of, MassSpec, Scene3};
 
 type Res<T> = std::result::Result<T, GranrsError>;
 
@@ -283,10 +283,12 @@ fn scene_of(d: &Bound<'_, PyDict>) -> Res<Scene3> {
     })
 }
 
-/// A scene of a body in space, converted and checked.
+/// A scene of a body in space, converted and checked, with its body built once (for
+/// `space_load`'s evaluations).
 #[pyclass(frozen, module = "granrs._granrs")]
 pub(super) struct SpaceScene {
     scene: Scene3,
+    body: std::sync::Mutex<crate::space::solve::Body>,
 }
 
 #[pymethods]
@@ -325,8 +327,12 @@ impl SpaceScene {
 #[pyfunction]
 pub(super) fn space_scene(py: Python<'_>, scene: &Bound<'_, PyDict>) -> PyResult<SpaceScene> {
     let scene = scene_of(scene).map_err(|e| to_pyerr(py, e))?;
-    scene.build().map_err(|e| to_pyerr(py, e))?;
-    Ok(SpaceScene { scene })
+    let (mut body, _, _) = scene.build().map_err(|e| to_pyerr(py, e))?;
+    body.sand.report_areas = true;
+    Ok(SpaceScene {
+        scene,
+        body: std::sync::Mutex::new(body),
+    })
 }
 
 /// Run a checked scene with the GIL released: a dict with `status`, `summary` (the fields of
@@ -365,9 +371,10 @@ pub(super) fn space_run<'py>(
 
 /// The sand's load on the scene's body at a pose and motion: a dict with `force` and
 /// `moment` (about the centre of mass) [N, N m], each term's share, the wetted and projected
-/// areas, the element count and the quadrature's error estimate (the change when its nodes
-/// are doubled) of the force and the moment.
+/// areas, the element count and, with `error`, the quadrature's error estimate (the change
+/// when its nodes are doubled) of the force and the moment (NaN without).
 #[pyfunction]
+#[pyo3(signature = (scene, position, orientation, velocity, omega, error=true))]
 pub(super) fn space_load<'py>(
     py: Python<'py>,
     scene: &Bound<'py, SpaceScene>,
@@ -375,22 +382,32 @@ pub(super) fn space_load<'py>(
     orientation: &Bound<'py, PyAny>,
     velocity: &Bound<'py, PyAny>,
     omega: &Bound<'py, PyAny>,
+    error: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let s = &scene.get().scene;
-    let mut probe = s.clone();
-    let read = || -> Res<()> {
-        probe.position = numbers::<3>(position, "position")?;
-        probe.orientation = numbers::<4>(orientation, "orientation")?;
-        probe.velocity = numbers::<3>(velocity, "velocity")?;
-        probe.omega = numbers::<3>(omega, "omega")?;
-        Ok(())
-    };
-    let mut read = read;
-    read().map_err(|e| to_pyerr(py, e))?;
-    let (mut body, y, _) = probe.build().map_err(|e| to_pyerr(py, e))?;
-    let r = y.rotation();
-    let w = r * y.w;
-    let (load, ef, em) = py.detach(|| load_with_error(&mut body.sand, &y.c, &r, &y.v, &w));
+    let scene = scene.get();
+    let state = (|| -> Res<crate::space::solve::State> {
+        state_of(
+            numbers::<3>(position, "position")?,
+            numbers::<4>(orientation, "orientation")?,
+            numbers::<3>(velocity, "velocity")?,
+            numbers::<3>(omega, "omega")?,
+        )
+    })()
+    .map_err(|e| to_pyerr(py, e))?;
+    let r = state.rotation();
+    let w = r * state.w;
+    let (load, ef, em) = py.detach(|| {
+        let mut body = scene.body.lock().unwrap_or_else(|p| p.into_inner());
+        if error {
+            load_with_error(&mut body.sand, &state.c, &r, &state.v, &w)
+        } else {
+            (
+                body.sand.load(&state.c, &r, &state.v, &w),
+                f64::NAN,
+                f64::NAN,
+            )
+        }
+    });
     let v3 = |v: nalgebra::Vector3<f64>| (v.x, v.y, v.z);
     Ok(py_dict!(py, {
         "force": v3(load.force),

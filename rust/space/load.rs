@@ -135,6 +135,9 @@ pub struct Sand {
     pub surface: f64,
     /// The surface rule.
     pub rule: Quadrature,
+    /// Whether [`Load::wetted_area`] and [`Load::projected_area`] are computed where no term
+    /// needs them (a caller that reports them; a run does not).
+    pub report_areas: bool,
     elements: Elements,
 }
 
@@ -153,6 +156,7 @@ impl Sand {
             medium,
             surface,
             rule,
+            report_areas: false,
             elements: Elements::default(),
         }
     }
@@ -205,8 +209,13 @@ impl Sand {
             }
             out.inertial = f;
         }
-        out.wetted_area = e.area.iter().sum();
         let speed = v.norm();
+        if !(self.report_areas || self.terms.poncelet.is_some()) {
+            out.force = out.rft3d + out.inertial;
+            out.moment = moment;
+            return out;
+        }
+        out.wetted_area = e.area.iter().sum();
         if speed > 0.0 {
             let vh = v / speed;
             let (mut a, mut centre) = (0.0, V3::zeros());

@@ -93,30 +93,7 @@ impl Scene3 {
     /// The checked scene: the body, its state at t = 0 and the run's options. Every field
     /// is checked before any work; an error names the first bad one.
     pub fn build(&self) -> Result<(Body, State, Options)> {
-        // Wide enough for the default placement (the surface plus a size) of any shape.
-        let c = vector("position", self.position, 1e7, "[m]")?;
-        let mut q = [0.0; 4];
-        for (k, x) in self.orientation.iter().enumerate() {
-            q[k] = finite(
-                &format!("orientation[{k}]"),
-                *x,
-                -2.0,
-                2.0,
-                "a unit quaternion (w, x, y, z)",
-            )?;
-        }
-        let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if (norm - 1.0).abs() > 1e-6 {
-            return Err(GranrsError::InvalidScene {
-                field: "orientation".into(),
-                message: format!(
-                    "a unit quaternion (w, x, y, z) is needed; this one has norm {norm:.9} \
-                     (normalise it first)"
-                ),
-            });
-        }
-        let v = vector("velocity", self.velocity, 1e4, "[m/s]")?;
-        let w = vector("omega", self.omega, 1e5, "[rad/s]")?;
+        let state = self.state()?;
         let rho_g = finite(
             "rho_g",
             self.medium.rho_g,
@@ -179,14 +156,6 @@ impl Scene3 {
                 Inertia::new("body", m, Matrix3::from_fn(|i, j| t[i][j]))?
             }
         };
-        let qn = Quaternion::new(q[0], q[1], q[2], q[3]).normalize();
-        let rot = nalgebra::UnitQuaternion::new_unchecked(qn);
-        let state = State {
-            c,
-            q: qn,
-            v,
-            w: rot.inverse() * w,
-        };
         let sand = Sand::new(
             self.shape.clone(),
             terms,
@@ -210,6 +179,57 @@ impl Scene3 {
             opts,
         ))
     }
+}
+
+impl Scene3 {
+    /// The body's state at t = 0 from the scene's `position`, `orientation`, `velocity` and
+    /// `omega`, each checked (an error names the first bad one).
+    pub fn state(&self) -> Result<State> {
+        state_of(self.position, self.orientation, self.velocity, self.omega)
+    }
+}
+
+/// A body's state from its `position` [m], `orientation` (a unit quaternion w, x, y, z),
+/// `velocity` [m/s] and `omega` (world frame) [rad/s], each checked and named as a scene's
+/// field.
+pub fn state_of(
+    position: [f64; 3],
+    orientation: [f64; 4],
+    velocity: [f64; 3],
+    omega: [f64; 3],
+) -> Result<State> {
+    // Wide enough for the default placement (the surface plus a size) of any shape.
+    let c = vector("position", position, 1e7, "[m]")?;
+    let mut q = [0.0; 4];
+    for (k, x) in orientation.iter().enumerate() {
+        q[k] = finite(
+            &format!("orientation[{k}]"),
+            *x,
+            -2.0,
+            2.0,
+            "a unit quaternion (w, x, y, z)",
+        )?;
+    }
+    let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (norm - 1.0).abs() > 1e-6 {
+        return Err(GranrsError::InvalidScene {
+            field: "orientation".into(),
+            message: format!(
+                "a unit quaternion (w, x, y, z) is needed; this one has norm {norm:.9} \
+                 (normalise it first)"
+            ),
+        });
+    }
+    let v = vector("velocity", velocity, 1e4, "[m/s]")?;
+    let w = vector("omega", omega, 1e5, "[rad/s]")?;
+    let qn = Quaternion::new(q[0], q[1], q[2], q[3]).normalize();
+    let rot = nalgebra::UnitQuaternion::new_unchecked(qn);
+    Ok(State {
+        c,
+        q: qn,
+        v,
+        w: rot.inverse() * w,
+    })
 }
 
 #[cfg(test)]

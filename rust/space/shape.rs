@@ -41,6 +41,8 @@ pub struct Elements {
     pub area: Vec<f64>,
     /// Depths below the surface [m] (>= 0).
     pub depth: Vec<f64>,
+    /// A mesh's vertices in the world frame (a buffer kept between evaluations).
+    scratch: Vec<V3>,
 }
 
 impl Elements {
@@ -645,13 +647,13 @@ impl Motion {
     /// Whether `n . v` over a set of points is zero within round-off (a grazing face).
     fn grazing(&self, n: &V3, points: &[V3]) -> bool {
         let mut most = 0.0f64;
-        let mut speed = 0.0f64;
+        let mut speed2 = 0.0f64;
         for p in points {
             let v = self.velocity_at(p);
             most = most.max(n.dot(&v).abs());
-            speed = speed.max(v.norm());
+            speed2 = speed2.max(v.norm_squared());
         }
-        most <= 1e-12 * speed
+        most * most <= 1e-24 * speed2
     }
 }
 
@@ -830,20 +832,47 @@ fn disk(m: &Motion, e: &V3, nu: &V3, r: f64, rule: &Quadrature, out: &mut Elemen
     });
 }
 
-/// Keep the part of a convex polygon where the linear function `f` is >= 0.
-fn clip_polygon(poly: &[V3], f: impl Fn(&V3) -> f64, out: &mut Vec<V3>) {
-    out.clear();
-    let k = poly.len();
-    for i in 0..k {
-        let (p, q) = (poly[i], poly[(i + 1) % k]);
-        let (fp, fq) = (f(&p), f(&q));
-        if fp >= 0.0 {
-            out.push(p);
+/// A convex polygon of at most 8 vertices (a quad cut by two lines has at most 6), on the
+/// stack.
+#[derive(Clone, Copy)]
+struct Poly {
+    p: [V3; 8],
+    len: usize,
+}
+
+impl Poly {
+    fn of(pts: &[V3]) -> Poly {
+        let mut p = [V3::zeros(); 8];
+        p[..pts.len()].copy_from_slice(pts);
+        Poly { p, len: pts.len() }
+    }
+
+    fn points(&self) -> &[V3] {
+        &self.p[..self.len]
+    }
+
+    /// The part where the linear function `f` is >= 0 (`f` at each vertex given).
+    fn clip(&self, f: &[f64]) -> Poly {
+        let mut out = Poly {
+            p: [V3::zeros(); 8],
+            len: 0,
+        };
+        let k = self.len;
+        for i in 0..k {
+            let j = (i + 1) % k;
+            let (p, q) = (self.p[i], self.p[j]);
+            let (fp, fq) = (f[i], f[j]);
+            if fp >= 0.0 {
+                out.p[out.len] = p;
+                out.len += 1;
+            }
+            if (fp >= 0.0) != (fq >= 0.0) {
+                let t = fp / (fp - fq);
+                out.p[out.len] = p + t * (q - p);
+                out.len += 1;
+            }
         }
-        if (fp >= 0.0) != (fq >= 0.0) {
-            let t = fp / (fp - fq);
-            out.push(p + t * (q - p));
-        }
+        out
     }
 }
 
@@ -851,24 +880,42 @@ fn clip_polygon(poly: &[V3], f: impl Fn(&V3) -> f64, out: &mut Vec<V3>) {
 fn polygon(m: &Motion, pts: &[V3], rule: &Quadrature, out: &mut Elements) {
     let n = (pts[1] - pts[0]).cross(&(pts[2] - pts[0]));
     let n = n / n.norm();
-    let mut wet = Vec::with_capacity(8);
-    clip_polygon(pts, |x| m.surface - x.z, &mut wet);
-    if wet.len() < 3 {
+    let face = Poly::of(pts);
+    let mut f = [0.0; 8];
+    let mut all_in = true;
+    for (fi, p) in f.iter_mut().zip(face.points()) {
+        *fi = m.surface - p.z;
+        all_in &= *fi >= 0.0;
+    }
+    let wet = if all_in {
+        face
+    } else {
+        face.clip(&f[..face.len])
+    };
+    if wet.len < 3 {
         return;
     }
-    let lead = if m.grazing(&n, &wet) {
+    let lead = if m.grazing(&n, wet.points()) {
         wet
     } else {
-        let mut lead = Vec::with_capacity(8);
-        clip_polygon(&wet, |x| n.dot(&m.velocity_at(x)), &mut lead);
-        lead
+        let mut all_lead = true;
+        for (fi, p) in f.iter_mut().zip(wet.points()) {
+            *fi = n.dot(&m.velocity_at(p));
+            all_lead &= *fi >= 0.0;
+        }
+        if all_lead {
+            wet
+        } else {
+            wet.clip(&f[..wet.len])
+        }
     };
-    if lead.len() < 3 {
+    if lead.len < 3 {
         return;
     }
     let k = rule.subdivisions();
-    for i in 1..lead.len() - 1 {
-        triangle(&lead[0], &lead[i], &lead[i + 1], &n, k, m.surface, out);
+    let p = lead.points();
+    for i in 1..p.len() - 1 {
+        triangle(&p[0], &p[i], &p[i + 1], &n, k, m.surface, out);
     }
 }
 

@@ -467,6 +467,11 @@ impl Body {
             }
         }
         let depth = -self.lowest(&y).0;
+        // The load at the end with its areas (a run does not compute them on the way).
+        let reported = self.sand.report_areas;
+        self.sand.report_areas = true;
+        let (_, load) = self.deriv(&y, false);
+        self.sand.report_areas = reported;
         Ok(Outcome {
             status,
             t_end: t,

@@ -1,0 +1,131 @@
+"""Speed of bodies in space, as ratios measured in one run.
+
+1. **A force evaluation on a 1280-facet mesh** (an icosphere of radius 50 mm, half sunk,
+   moving obliquely and spinning): ``granrs.space.load`` (each facet cut exactly at the
+   surface and at its leading edge, three points per facet) against a vectorized NumPy
+   implementation of the same law, written here as a user would (one point per facet, at
+   its centroid, no cut): what a user of the 3D-RFT public codes does today. One thread.
+   Their forces are printed side by side (they differ by the NumPy version's cruder rule).
+2. **A whole impact**: a steel ball (radius 20 mm) dropped straight down at 2 m/s on the
+   exact sphere (the default rule, and 3 nodes per panel), against the thesis's free link at
+   q = 45 deg (Table 3.5 row), each the core's own run time (``run_seconds``), minimum of
+   repeats.
+
+The element kernel's own rate (elements per second on one core) is measured by the
+criterion bench: ``cargo bench --bench space -- space_kernel``.
+
+    python benches/bench_space.py [--repeats 30]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import granrs
+from granrs import forces, space
+
+#: The 3D-RFT coefficient table (rows f1, f2, f3), written out for the NumPy version.
+C = np.array([
+    [0.00212, -0.02320, -0.20890, -0.43083, -0.00259, 0.48872, -0.00415, 0.07204, -0.02750,
+     -0.08772, 0.01992, -0.45961, 0.40799, -0.10107, -0.06576, 0.05664, -0.09269, 0.01892,
+     0.01033, 0.15120],
+    [-0.06796, -0.10941, 0.04725, -0.06914, -0.05835, -0.65880, -0.11985, -0.25739, -0.26834,
+     0.02692, -0.00736, 0.63758, 0.08997, 0.21069, 0.04748, 0.20406, 0.18519, 0.04934,
+     0.13527, -0.33207],
+    [-0.02634, -0.03436, 0.45256, 0.00835, 0.02553, -1.31290, -0.05532, 0.06790, -0.16404,
+     0.02287, 0.02927, 0.95406, -0.00131, -0.11028, 0.01487, -0.02730, 0.10911, -0.04097,
+     0.07881, -0.27519],
+])  # fmt: skip
+
+
+def numpy_rft3d(
+    vertices: np.ndarray,
+    triangles: np.ndarray,
+    centre: np.ndarray,
+    v: np.ndarray,
+    w: np.ndarray,
+    zeta: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """3D-RFT on a mesh at its facets' centroids, vectorized in NumPy (the vector form of
+    the law; a facet counts where its centroid is below z = 0 and it leads)."""
+    a, b, c = (vertices[triangles[:, k]] for k in range(3))
+    cross = np.cross(b - a, c - a)
+    area = 0.5 * np.linalg.norm(cross, axis=1)
+    n = cross / (2.0 * area[:, None])
+    x = (a + b + c) / 3.0
+    r = x - centre
+    vel = v + np.cross(w, r)
+    speed = np.linalg.norm(vel, axis=1)
+    vh = vel / speed[:, None]
+    depth = -x[:, 2]
+    keep = (depth > 0) & (np.einsum("ij,ij->i", n, vh) >= -1e-12)
+    m = np.where((n[:, 2] < -1e-12)[:, None], n, -n)
+    x1, x2, x3 = -vh[:, 2], np.abs(n[:, 2]), np.einsum("ij,ij->i", m, vh)
+    t = np.stack(
+        [np.ones_like(x1), x1, x2, x3, x1**2, x2**2, x3**2, x1 * x2, x2 * x3, x3 * x1,
+         x1**3, x2**3, x3**3, x1 * x2**2, x2 * x1**2, x2 * x3**2, x3 * x2**2, x3 * x1**2,
+         x1 * x3**2, x1 * x2 * x3]
+    )  # fmt: skip
+    f1, f2, f3 = C @ t
+    alpha = f1[:, None] * m + f2[:, None] * vh - f3[:, None] * np.array([0.0, 0.0, 1.0])
+    df = (zeta * depth * area * keep)[:, None] * alpha
+    return df.sum(axis=0), np.cross(r, df).sum(axis=0)
+
+
+def best(f, repeats: int) -> float:  # type: ignore[no-untyped-def]
+    """The minimum over ``repeats`` of the time of ``f()`` [s]."""
+    out = float("inf")
+    for _ in range(repeats):
+        t = time.perf_counter()
+        f()
+        out = min(out, time.perf_counter() - t)
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=int, default=30)
+    args = ap.parse_args(argv)
+    zeta = 1e6
+    mesh = space.Mesh.icosphere(0.05, 3)
+    assert len(mesh.triangles) == 1280
+    centre = np.array([0.0, 0.0, 0.0])
+    v, w = np.array([0.3, -0.2, -1.0]), np.array([1.0, 2.0, -0.5])
+    scene = space.Scene(
+        body=space.Body(mesh, density=1000.0), position=tuple(centre), velocity=tuple(v),
+        omega=tuple(w), forces=[forces.rft3d(zeta=zeta)],
+    )  # fmt: skip
+    ours = space.load(scene, error=False)
+    f_np, m_np = numpy_rft3d(mesh.vertices, mesh.triangles, centre, v, w, zeta)
+    t_ours = best(lambda: space.load(scene, error=False), args.repeats)
+    t_np = best(
+        lambda: numpy_rft3d(mesh.vertices, mesh.triangles, centre, v, w, zeta), args.repeats
+    )
+    print("1. rft3d on a 1280-facet icosphere, half sunk, oblique and spinning (one thread)")
+    print(f"   granrs.space.load: {t_ours * 1e6:8.1f} us  ({ours.elements} elements, cut exactly)")
+    print(f"   NumPy, vectorized: {t_np * 1e6:8.1f} us  (1280 facets at their centroids)")
+    print(f"   NumPy / granrs:    {t_np / t_ours:8.1f}x")
+    print(f"   force granrs {np.round(ours.force, 3)} N, NumPy {np.round(f_np, 3)} N")
+
+    ball = space.Body(space.Sphere(radius=0.02), density=7800.0)
+    law = [forces.rft3d(zeta=2e5), forces.gravity()]
+    free_link = granrs.cases.free_link(q_deg=45, v0=2.27)
+    t_free = min(granrs.simulate(free_link).run_seconds for _ in range(args.repeats))
+    print("2. whole impacts (the core's run time, minimum of repeats)")
+    print(f"   thesis free link q = 45 deg:        {t_free * 1e6:9.1f} us")
+    for nodes in (6, 3, 2):
+        drop = space.Scene(body=ball, velocity=(0, 0, -2.0), forces=law, quadrature=nodes)
+        runs = [granrs.simulate(drop) for _ in range(max(3, args.repeats // 5))]
+        t = min(r.run_seconds for r in runs)
+        r = runs[0]
+        print(
+            f"   steel ball, exact sphere, rule {nodes}: {t * 1e6:9.1f} us = {t / t_free:6.1f}x the "
+            f"free link (depth {r.depth * 1e3:.5f} mm, {r.summary['max_elements']:.0f} elements)"
+        )
+
+
+if __name__ == "__main__":
+    main()
