@@ -199,6 +199,34 @@ pub fn pieces(lo: f64, hi: f64, breaks: &mut [f64], max_len: f64, mut f: impl Fn
     }
 }
 
+/// Integrate over the angles `lo .. hi` cut at `breaks`: on a whole circle with no break,
+/// where the integrand is smooth and periodic, by the trapezoidal rule with `2 n` points
+/// (exact for trigonometric polynomials of degree below `2 n`, converging exponentially
+/// for a smooth periodic integrand); otherwise by `g` on panels of at most `max_len`
+/// between the breaks. Calls `f(angle, weight)`.
+pub fn around(
+    lo: f64,
+    hi: f64,
+    breaks: &mut [f64],
+    max_len: f64,
+    g: &Gauss,
+    mut f: impl FnMut(f64, f64),
+) {
+    let inside = breaks
+        .iter()
+        .filter(|&&t| t > lo + 1e-14 && t < hi - 1e-14)
+        .count();
+    if inside == 0 && hi - lo >= 2.0 * PI * (1.0 - 1e-15) {
+        let n = 2 * g.x.len();
+        let w = (hi - lo) / n as f64;
+        for k in 0..n {
+            f(lo + (k as f64 + 0.5) * w, w);
+        }
+        return;
+    }
+    pieces(lo, hi, breaks, max_len, |a, b| g.each(a, b, &mut f));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,6 +256,20 @@ mod tests {
             let inside = (phi - arc.start).rem_euclid(2.0 * PI) <= arc.len;
             assert_eq!(inside, a * phi.cos() + b * phi.sin() <= c, "phi {phi}");
         }
+    }
+
+    #[test]
+    fn a_whole_circle_takes_the_trapezoidal_rule_and_an_arc_gauss() {
+        let g = Gauss::new(6);
+        // cos(3 phi)^2 over the circle: pi, exactly with 12 points.
+        let mut s = 0.0;
+        around(0.0, 2.0 * PI, &mut [], PI / 4.0, &g, |p, w| {
+            s += w * (3.0 * p).cos().powi(2)
+        });
+        assert!((s - PI).abs() < 1e-14, "{s}");
+        let mut s = 0.0;
+        around(0.3, 1.3, &mut [0.5], PI / 4.0, &g, |p, w| s += w * p.cos());
+        assert!((s - (1.3f64.sin() - 0.3f64.sin())).abs() < 1e-14, "{s}");
     }
 
     #[test]

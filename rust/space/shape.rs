@@ -23,7 +23,7 @@ use std::f64::consts::PI;
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
-use super::quad::{arc_below, clip_linear, intersect, pieces, trig_roots, Gauss};
+use super::quad::{arc_below, around, clip_linear, intersect, pieces, trig_roots, Gauss};
 use crate::error::{GranrsError, Result};
 use crate::forces::ContactKind;
 
@@ -702,6 +702,9 @@ fn sphere_patch(
     let qz = e1.z.hypot(e2.z);
     trig_roots(r * p.z, r * qz, depth_ref, 0.0, theta_max, &mut breaks);
     trig_roots(r * p.z, -r * qz, depth_ref, 0.0, theta_max, &mut breaks);
+    // Where a circle about the pole touches the horizon n_z = 0 (the law's m flips there).
+    trig_roots(p.z, qz, 0.0, 0.0, theta_max, &mut breaks);
+    trig_roots(p.z, -qz, 0.0, 0.0, theta_max, &mut breaks);
     if let Some(a) = half {
         let ra = e1.dot(&a).hypot(e2.dot(&a));
         trig_roots(p.dot(&a), ra, 0.0, 0.0, theta_max, &mut breaks);
@@ -725,21 +728,16 @@ fn sphere_patch(
                 None => ([Some(wet), None], 1),
             };
             for arc in arcs[..k].iter().flatten() {
-                let mut none: [f64; 0] = [];
-                pieces(
-                    arc.start,
-                    arc.start + arc.len,
-                    &mut none,
-                    PANEL,
-                    |f0, f1| {
-                        g.each(f0, f1, |phi, wf| {
-                            let (sp, cp) = phi.sin_cos();
-                            let n = ct * p + st * (cp * e1 + sp * e2);
-                            let x = b + r * n;
-                            out.push(x, n, r * r * st * wt * wf, m.surface);
-                        });
-                    },
-                );
+                // Cut where the circle crosses the horizon n_z = 0 (the law jumps there).
+                let (lo, hi) = (arc.start, arc.start + arc.len);
+                let mut flips = Vec::with_capacity(4);
+                trig_roots(st * e1.z, st * e2.z, -ct * p.z, lo, hi, &mut flips);
+                around(lo, hi, &mut flips, PANEL, g, |phi, wf| {
+                    let (sp, cp) = phi.sin_cos();
+                    let n = ct * p + st * (cp * e1 + sp * e2);
+                    let x = b + r * n;
+                    out.push(x, n, r * r * st * wt * wf, m.surface);
+                });
             }
         });
     });
@@ -769,10 +767,12 @@ fn cylinder_side(m: &Motion, a: &V3, r: f64, h: f64, rule: &Quadrature, out: &mu
         let w = m.v + t * wa;
         trig_roots(u1.dot(&w), u2.dot(&w), 0.0, 0.0, 2.0 * PI, &mut breaks);
     }
+    // Where the side's normal is horizontal (the law's m flips there).
+    trig_roots(u1.z, u2.z, 0.0, 0.0, 2.0 * PI, &mut breaks);
     let g = &rule.gauss;
     let speed = m.v.norm() + m.omega.norm() * (r + h);
-    pieces(0.0, 2.0 * PI, &mut breaks, PANEL, |f0, f1| {
-        g.each(f0, f1, |phi, wf| {
+    around(0.0, 2.0 * PI, &mut breaks, PANEL, g, |phi, wf| {
+        {
             let (sp, cp) = phi.sin_cos();
             let n = cp * u1 + sp * u2;
             // Depth along the generator: (surface - c_z - r n_z) - t a_z >= 0.
@@ -793,7 +793,7 @@ fn cylinder_side(m: &Motion, a: &V3, r: f64, h: f64, rule: &Quadrature, out: &mu
                 let x = c + r * n + t * a;
                 out.push(x, n, r * wf * wt, m.surface);
             });
-        });
+        }
     });
 }
 
@@ -810,24 +810,22 @@ fn disk(m: &Motion, e: &V3, nu: &V3, r: f64, rule: &Quadrature, out: &mut Elemen
     let rim = [e + r * u1, e - r * u1, e + r * u2, e - r * u2, *e];
     let grazing = m.grazing(nu, &rim);
     let g = &rule.gauss;
-    pieces(0.0, 2.0 * PI, &mut breaks, PANEL, |f0, f1| {
-        g.each(f0, f1, |phi, wf| {
-            let (sp, cp) = phi.sin_cos();
-            let d = cp * u1 + sp * u2;
-            let Some((lo, hi)) = clip_linear(0.0, r, depth0, -d.z) else {
-                return;
-            };
-            let (lo, hi) = if grazing {
-                (lo, hi)
-            } else {
-                match clip_linear(lo, hi, nu.dot(&ve), cp * w1 + sp * w2) {
-                    Some(x) => x,
-                    None => return,
-                }
-            };
-            g.each(lo, hi, |rho, wr| {
-                out.push(e + rho * d, *nu, rho * wf * wr, m.surface);
-            });
+    around(0.0, 2.0 * PI, &mut breaks, PANEL, g, |phi, wf| {
+        let (sp, cp) = phi.sin_cos();
+        let d = cp * u1 + sp * u2;
+        let Some((lo, hi)) = clip_linear(0.0, r, depth0, -d.z) else {
+            return;
+        };
+        let (lo, hi) = if grazing {
+            (lo, hi)
+        } else {
+            match clip_linear(lo, hi, nu.dot(&ve), cp * w1 + sp * w2) {
+                Some(x) => x,
+                None => return,
+            }
+        };
+        g.each(lo, hi, |rho, wr| {
+            out.push(e + rho * d, *nu, rho * wf * wr, m.surface);
         });
     });
 }
