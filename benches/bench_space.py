@@ -11,6 +11,10 @@
    q = 45 deg (Table 3.5 row), each the core's own run time (``run_seconds``), minimum of
    repeats.
 
+3. **Where 3D-RFT does work on a body** (not a speed figure): the share of leading (normal,
+   velocity) pairs, uniform on the sphere, where the stress does positive work
+   (``alpha . v > 0``), its largest value, and where those pairs are.
+
 The element kernel's own rate (elements per second on one core) is measured by the
 criterion bench: ``cargo bench --bench space -- space_kernel``.
 
@@ -126,6 +130,29 @@ def main(argv: list[str] | None = None) -> None:
             f"   steel ball, exact sphere, rule {nodes}: {t * 1e6:9.1f} us = "
             f"{t / t_free:6.1f}x the free link (depth {r.depth * 1e3:.5f} mm, "
             f"{r.summary['max_elements']:.0f} elements)"
+        )
+    non_dissipative()
+
+
+def non_dissipative(pairs: int = 200_000, seed: int = 0) -> None:
+    """Part 3 (see the module's doc)."""
+    rng = np.random.default_rng(seed)
+    n = rng.normal(size=(pairs, 3))
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    v = rng.normal(size=(pairs, 3))
+    v /= np.linalg.norm(v, axis=1)[:, None]
+    lead = np.nonzero(np.einsum("ij,ij->i", n, v) >= 0)[0]
+    power = np.array([np.dot(space.rft3d_alpha(n[i], v[i]), v[i]) for i in lead])
+    bad = lead[power > 0]
+    print("3. where rft3d does positive work (alpha . v > 0), uniform random pairs")
+    print(
+        f"   {len(bad)} of {len(lead)} leading pairs ({100 * len(bad) / len(lead):.3f} %), "
+        f"largest alpha . v = {power.max():+.5f} (a plate pushed down: -0.87574)"
+    )
+    if len(bad):
+        print(
+            f"   all with n_z >= {n[bad, 2].min():.3f} (faces looking up) and v_z >= "
+            f"{v[bad, 2].min():.3f} (moving up)"
         )
 
 
