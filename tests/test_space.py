@@ -407,3 +407,32 @@ def test_a_mesh_file_loads_through_trimesh(tmp_path) -> None:  # type: ignore[no
         body=space.Body(space.Cuboid((0.1, 0.2, 0.3)), density=1000.0), forces=[forces.gravity()]
     )
     assert np.allclose(scene.inertia, cuboid.inertia, rtol=1e-6, atol=1e-12)
+
+
+def test_a_sweep_of_bodies_in_space_gives_each_run_as_simulate_does() -> None:
+    ball = space.Body(space.Sphere(0.02), density=7800.0)
+    base = space.Scene(body=ball, forces=[forces.rft3d(zeta=2e5), forces.gravity()])
+    speeds = [(0.0, 0.0, -v) for v in (0.5, 2.0)]
+    df = granrs.sweep(base, velocity=speeds, quadrature=[3, 6])
+    assert list(df.columns[:3]) == ["velocity", "quadrature", "status"]
+    assert len(df) == 4 and (df["status"] == "stopped").all()
+    for _, row in df.iterrows():
+        one = granrs.simulate(base.replace(velocity=row["velocity"], quadrature=row["quadrature"]))
+        assert row["depth"] == one.depth and row["t_s"] == one.t_s
+    listed = granrs.sweep([base.replace(velocity=v) for v in speeds], threads=1)
+    assert list(listed["depth"]) == list(df["depth"][df["quadrature"] == 6])
+    assert set(space.SUMMARY_FIELDS) <= set(df.columns)
+
+
+def test_a_bad_sweep_of_bodies_in_space_names_the_field() -> None:
+    ball = space.Body(space.Sphere(0.02), density=7800.0)
+    base = space.Scene(body=ball, forces=[forces.rft3d(zeta=2e5)])
+    with pytest.raises(granrs.GranrsError) as info:
+        granrs.sweep(base, velocity=[(0, 0, -1.0), (0, 0, math.nan)])
+    assert info.value.field == "velocity[2]" and "run 1" in str(info.value)
+    with pytest.raises(granrs.GranrsError) as info:
+        granrs.sweep(base, speed=[1.0])
+    assert info.value.field == "speed"
+    with pytest.raises(granrs.GranrsError) as info:
+        granrs.sweep(base, client=object())
+    assert info.value.field == "client"

@@ -12,8 +12,10 @@ Rust batch on a worker (``pip install 'granrs[dask]'``).
 
 from __future__ import annotations
 
+import concurrent.futures
 import difflib
 import functools
+import itertools
 import math
 import uuid
 import warnings
@@ -23,13 +25,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from . import _granrs
+from . import _granrs, space
 from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
 from .coefficients import Coefficients
 from .errors import (
     GranrsError,
     InvalidParameterError,
     InvalidSceneError,
+    SimulationError,
     StepSizeWarning,
     UnknownNameError,
 )
@@ -418,6 +421,96 @@ def _run_dask(
     }
 
 
+def _sweep_space(
+    scene: space.Scene | Sequence[space.Scene],
+    threads: int,
+    progress: bool | None,
+    client: Any,
+    axes: dict[str, Any],
+) -> pd.DataFrame:
+    """``sweep`` of bodies in space (see :func:`sweep`): each run on a worker thread, the
+    GIL released; one row per run of its status and :data:`granrs.space.SUMMARY_FIELDS`."""
+    if client is not None:
+        raise InvalidParameterError(
+            "a sweep of bodies in space runs on this machine's threads; Dask takes planar "
+            "scenes only",
+            field="client",
+        )
+    if isinstance(scene, space.Scene):
+        names = list(axes)
+        for name in names:
+            if name not in {f for f in space.Scene.__dataclass_fields__ if not f.startswith("_")}:
+                raise UnknownNameError(
+                    f"unknown axis {name!r}: a granrs.space.Scene field", field=name
+                )
+        values = [_axis_values(name, axes[name]) for name in names]
+        combos = list(itertools.product(*values))
+        scenes = []
+        for i, combo in enumerate(combos):
+            try:
+                scenes.append(scene.replace(**dict(zip(names, combo, strict=True))))
+            except GranrsError as e:
+                raise type(e)(f"run {i}: {e}", field=getattr(e, "field", None)) from e
+        columns: dict[str, list[Any]] = {
+            name: [c[k] for c in combos] for k, name in enumerate(names)
+        }
+    else:
+        if axes:
+            raise InvalidParameterError(
+                "sweep() over a list of scenes takes no axes; vary the scenes instead",
+                field=next(iter(axes)),
+            )
+        scenes = list(scene)
+        for i, s in enumerate(scenes):
+            if not isinstance(s, space.Scene):
+                raise InvalidParameterError(
+                    f"a sweep of bodies in space takes granrs.space.Scene items; item {i} is "
+                    f"{type(s).__name__}",
+                    field="scene",
+                )
+        columns = {}
+
+    def one(s: space.Scene) -> tuple[str, dict[str, float], str]:
+        try:
+            r = space.run(s)
+        except SimulationError as e:
+            return "failed", {}, str(e)
+        return r.status, dict(r.summary), ""
+
+    n = len(scenes)
+    rows: list[tuple[str, dict[str, float], str]] = []
+    bar = _progress_bar(n, progress)
+    try:
+        workers = threads or _granrs.max_threads()
+        with concurrent.futures.ThreadPoolExecutor(max_workers=workers) as pool:
+            for row in pool.map(one, scenes):
+                rows.append(row)
+                if bar is not None:
+                    bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    frame = pd.DataFrame(columns)
+    frame["status"] = pd.Categorical(
+        [r[0] for r in rows], categories=["stopped", "not_stopped", "failed"]
+    )
+    for name in space.SUMMARY_FIELDS:
+        frame[name] = np.array([r[1].get(name, np.nan) for r in rows], dtype=float)
+    if any(r[0] == "failed" for r in rows):
+        frame["error"] = [r[2] or None for r in rows]
+    stiff = int((frame["h_lambda"] > RK4_STABILITY_LIMIT).sum()) if n else 0
+    if stiff:
+        warnings.warn(
+            StepSizeWarning(
+                f"{stiff} of {n} runs were stiffer than their step resolves (h_lambda above "
+                f"{RK4_STABILITY_LIMIT}): their results are not the converged answer; use a "
+                "smaller dt there"
+            ),
+            stacklevel=3,
+        )
+    return frame
+
+
 def sweep(
     scene: Scene | Sequence[Scene],
     *,
@@ -432,7 +525,9 @@ def sweep(
 
     Args:
         scene: the base scene, whose fields the ``axes`` vary; or a list of scenes (then no
-            axes), all of one body.
+            axes), all of one body. A body in space (:class:`granrs.space.Scene`, or a list
+            of them) runs each scene on a worker thread and gives its status and the fields
+            of :data:`granrs.space.SUMMARY_FIELDS` (no Dask, no lanes).
         threads: worker threads (default: one per core). Results do not depend on it. Every
             sweep shares one pool of one thread per core: a larger count runs on every core,
             with a ``RuntimeWarning``.
@@ -476,6 +571,13 @@ def sweep(
         (6, ['q_deg', 'v0', 'status'])
     """
     n_threads = _threads(threads)
+    if isinstance(scene, space.Scene) or (
+        isinstance(scene, Sequence)
+        and not isinstance(scene, str)
+        and len(scene) > 0
+        and isinstance(scene[0], space.Scene)
+    ):
+        return _sweep_space(scene, n_threads, progress, client, axes)
     if isinstance(scene, Scene):
         kwargs, plain_axes = _axis_sweep(scene, axes)
         # A thesis-row scene swept over the field that selects its row (the free link's
