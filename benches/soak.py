@@ -1,7 +1,9 @@
 """Soak: a million random valid free-link scenes through ``granrs.sweep`` (issue 6), and
 beside them (``--table-share``, 2 % by default) two-link linkages whose knee is driven along a
 random table (issue 19), and (``--arc-share``, 2 %) random arc contacts, C-legs (issue 19,
-:func:`random_arc`; half of them with a box contact too), each kind swept separately.
+:func:`random_arc`; half of them with a box contact too), and (``--space-share``, 0.5 %)
+random bodies in space (:func:`random_space`: every shape, every term in space, random
+orientation, velocity and spin), each kind swept separately.
 
 Checks that a long batch never returns NaN or infinity in a run that did not fail, never
 hangs and keeps its memory flat. Scenes are drawn from the valid domain of
@@ -31,12 +33,13 @@ import collections
 import math
 import sys
 import time
+import warnings
 from typing import Any
 
 import numpy as np
 
 import granrs
-from granrs import Coefficients, Scene, forces
+from granrs import Coefficients, Scene, forces, space
 
 SCALE = {"eta_h": 6.5, "eta_d": 15.2, "eta_v": 248.0, "lam": 0.106}
 SIGN_MODELS = ("modes", "raw", "smooth")
@@ -239,7 +242,58 @@ def random_arc(rng: np.random.Generator, dt_range: bool, max_steps: int) -> Scen
                  sign_model=SIGN_MODELS[int(rng.integers(0, 3))])  # fmt: skip
 
 
-def describe(scene: Scene) -> str:
+def random_space(rng: np.random.Generator, dt_range: bool, max_steps: int) -> space.Scene:
+    """A random valid body in space: any shape of 2 to 60 mm, density 100 to 20000 kg/m^3,
+    a random orientation, velocity (up to 5 m/s, mostly down) and spin (up to 30 rad/s),
+    under rft3d (zeta 1e4 to 1e7) with, by chance, its inertial term, Poncelet, a friction
+    cap and gravity."""
+    size = lambda: float(rng.uniform(0.002, 0.06))  # noqa: E731
+    kind = int(rng.integers(5))
+    shape: Any
+    if kind == 0:
+        shape = space.Sphere(size())
+    elif kind == 1:
+        shape = space.Capsule(size(), size())
+    elif kind == 2:
+        shape = space.Cylinder(size(), size())
+    elif kind == 3:
+        shape = space.Cuboid((size(), size(), size()))
+    else:
+        shape = space.Mesh.icosphere(size(), int(rng.integers(0, 3)))
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    v = rng.normal(size=3) * rng.uniform(0.0, 2.0)
+    v[2] = -abs(v[2]) - rng.uniform(0.0, 3.0)
+    terms = [
+        forces.rft3d(
+            zeta=float(10 ** rng.uniform(4, 7)),
+            mu_surf=float(rng.uniform(0.1, 1.0)) if rng.random() < 0.3 else float("inf"),
+        )
+    ]
+    if rng.random() < 0.5:
+        terms.append(forces.rft3d_inertial(lam=float(rng.uniform(0.0, 2.0))))
+    if rng.random() < 0.3:
+        terms.append(
+            forces.poncelet(c=float(rng.uniform(0.0, 2.0)), k=float(rng.uniform(0.0, 500.0)))
+        )
+    if rng.random() < 0.8:
+        terms.append(forces.gravity())
+    dt = float(10 ** rng.uniform(-5, -3)) if dt_range else 1e-4
+    return space.Scene(
+        body=space.Body(shape, density=float(rng.uniform(100.0, 20000.0))),
+        orientation=tuple(q),
+        velocity=tuple(v),
+        omega=tuple(rng.normal(size=3) * rng.uniform(0.0, 30.0)),
+        forces=terms,
+        dt=dt,
+        t_end=min(0.5, max_steps * dt),
+        quadrature=int(rng.integers(2, 7)),
+    )
+
+
+def describe(scene: Any) -> str:
+    if isinstance(scene, space.Scene):
+        return repr(scene)
     if scene.kind == "linkage":
         return (
             f"Scene(body={scene.body!r}, dt={scene.dt!r}, t_end={scene.t_end!r}, "
@@ -270,29 +324,54 @@ def soak(args: argparse.Namespace) -> int:
         size = min(args.chunk, args.n - done)
         tables = int(rng.binomial(size, args.table_share))
         n_arcs = int(rng.binomial(size - tables, args.arc_share))
-        scenes = random_scenes(rng, size - tables - n_arcs, args.dt_range, args.max_steps)
+        n_space = int(rng.binomial(size - tables - n_arcs, args.space_share))
+        scenes = random_scenes(rng, size - tables - n_arcs - n_space, args.dt_range, args.max_steps)
         driven = random_table_scenes(rng, tables, args.dt_range, args.max_steps)
         arcs = [random_arc(rng, args.dt_range, args.max_steps) for _ in range(n_arcs)]
+        # A sweep's columns are its first body's contacts: arcs with a box swept apart.
+        arcs_alone = [a for a in arcs if len(a.body.contacts) == 1]
+        arcs_box = [a for a in arcs if len(a.body.contacts) != 1]
+        bodies = [random_space(rng, args.dt_range, args.max_steps) for _ in range(n_space)]
         t0 = time.perf_counter()
         counts: collections.Counter[str] = collections.Counter()
         for offset, batch in (
             (done, scenes),
             (done + len(scenes), driven),
-            (done + len(scenes) + len(driven), arcs),
+            (done + len(scenes) + len(driven), arcs_alone),
+            (done + len(scenes) + len(driven) + len(arcs_alone), arcs_box),
+            (done + len(scenes) + len(driven) + len(arcs), bodies),
         ):
             if not batch:
                 continue
-            df = granrs.sweep(batch, progress=False)
+            with warnings.catch_warnings():
+                # A stiff random body warns; the soak checks finiteness, not resolution.
+                warnings.simplefilter("ignore", granrs.StepSizeWarning)
+                df = granrs.sweep(batch, progress=False)
             counts.update({str(k): int(v) for k, v in df["status"].value_counts().items() if v})
             bad = (df["status"] == "failed").to_numpy()
             for i in np.flatnonzero(bad):
                 failed.append((offset + int(i), describe(batch[i]), str(df["error"].iloc[i])))
             ok = df[~bad]
-            numeric = ok.drop(columns=["status", "t_s", "t_entry", "error"], errors="ignore")
-            values = numeric.select_dtypes("number").to_numpy()
-            rows = np.flatnonzero(~np.isfinite(values).all(axis=1))
+            # t_s and t_entry are NaN where a contact did not stop or enter (one contact:
+            # "t_s"; several: "c0.t_s", ...).
+            times = [c for c in ok.columns if c.split(".")[-1] in ("t_s", "t_entry")]
+            numeric = ok.drop(columns=["status", "error", *times], errors="ignore")
+            numeric = numeric.select_dtypes("number")
+            values = numeric.to_numpy()
+            # A list of arcs with and without a box: a contact a run does not have is NaN in
+            # all its columns (not applicable); infinities, and NaN elsewhere, are failures.
+            extra = np.array(
+                [c.startswith("c") and c[1:2].isdigit() and c[1] != "0" for c in numeric.columns]
+            )
+            whole = np.zeros(len(values), bool)
+            if extra.any():
+                whole = np.isnan(values[:, extra]).all(axis=1)
+            bad_values = np.isinf(values) | (np.isnan(values) & ~(extra[None, :] & whole[:, None]))
+            rows = np.flatnonzero(bad_values.any(axis=1))
             stopped = (ok["status"] == "stopped").to_numpy()
-            rows = np.union1d(rows, np.flatnonzero(stopped & ok["t_s"].isna().to_numpy()))
+            t_s = [c for c in times if c.split(".")[-1] == "t_s"]
+            no_stop = ok[t_s].isna().all(axis=1).to_numpy() if t_s else np.zeros(len(ok), bool)
+            rows = np.union1d(rows, np.flatnonzero(stopped & no_stop))
             index = np.flatnonzero(~bad)
             for r in rows:
                 cols = [c for c in numeric.columns if not np.isfinite(numeric[c].iloc[r])]
@@ -300,7 +379,7 @@ def soak(args: argparse.Namespace) -> int:
             del df, ok, numeric, values
         seconds = time.perf_counter() - t0
         statuses.update(counts)
-        del scenes, driven, arcs
+        del scenes, driven, arcs, arcs_alone, arcs_box, bodies
         rss.append(rss_mb())
         short = ", ".join(f"{k} {int(v)}" for k, v in counts.items() if v)
         print(
@@ -350,6 +429,12 @@ def main(argv: list[str] | None = None) -> int:
         type=float,
         default=0.02,
         help="share of the scenes that are random arc contacts, C-legs (0.02)",
+    )
+    parser.add_argument(
+        "--space-share",
+        type=float,
+        default=0.005,
+        help="share of the scenes that are random bodies in space (0.005)",
     )
     parser.add_argument(
         "--max-growth",

@@ -4,6 +4,7 @@ progress, stops on Ctrl-C, and gives the same table on Dask."""
 
 from __future__ import annotations
 
+import importlib.util
 import itertools
 import math
 import multiprocessing
@@ -11,6 +12,7 @@ import os
 import signal
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -256,3 +258,21 @@ def test_docstring_examples() -> None:
     for module in (granrs.batch, granrs.forces):
         failures, tried = doctest.testmod(module, verbose=False, report=True)
         assert tried > 0 and failures == 0, module.__name__
+
+
+def test_a_sweep_of_linkages_with_several_links_names_their_joint_columns() -> None:
+    """A list of user linkages with two links (their joint columns are ``joint<i>.*``) used
+    to raise IndexError while naming the columns (found by the soak script)."""
+
+    import numpy as np
+
+    spec = importlib.util.spec_from_file_location(
+        "soak", Path(__file__).parent.parent / "benches" / "soak.py"
+    )
+    assert spec is not None and spec.loader is not None
+    soak = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(soak)
+    scenes = soak.random_table_scenes(np.random.default_rng(1), 3, False, 500)
+    df = granrs.sweep(scenes, progress=False)
+    assert len(df) == 3
+    assert any(c.startswith("joint") for c in df.columns), list(df.columns)

@@ -127,8 +127,9 @@ def _axis_sweep(
 
 
 def _names(columns: Sequence[str], body: str) -> list[str]:
-    """The DataFrame's names of the core's columns (a free link drops ``c0.``; joints by
-    name)."""
+    """The DataFrame's names of the core's columns (a free link drops ``c0.``; a built-in
+    body's joints by name; a linkage's keep the core's ``joint<i>``, i in the engine's
+    order of links, since the core names them by the link each carries)."""
     n_contacts = sum(1 for c in columns if c.endswith(".t_s"))
     joints = JOINT_NAMES.get(body, ())
     names = []
@@ -137,7 +138,8 @@ def _names(columns: Sequence[str], body: str) -> list[str]:
             c = c[3:]
         elif c.startswith("joint") and "." in c:
             idx, _, rest = c[5:].partition(".")
-            c = f"{joints[int(idx)]}.{rest}"
+            if int(idx) < len(joints):
+                c = f"{joints[int(idx)]}.{rest}"
         names.append(c)
     return names
 
