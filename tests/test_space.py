@@ -436,3 +436,38 @@ def test_a_bad_sweep_of_bodies_in_space_names_the_field() -> None:
     with pytest.raises(granrs.GranrsError) as info:
         granrs.sweep(base, client=object())
     assert info.value.field == "client"
+
+
+def test_an_animation_draws_the_body_at_its_recorded_pose(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """granrs.animate of a body in space: a cuboid's drawn corners are its corners at the
+    recorded pose (their mean is the recorded centre; the distance between two is an edge),
+    and a GIF is written whole."""
+    pytest.importorskip("matplotlib")
+    scene = space.Scene(
+        body=space.Body(space.Cuboid((0.04, 0.02, 0.01)), density=2000.0),
+        orientation=(math.cos(0.2), 0.0, math.sin(0.2), 0.0),
+        velocity=(0.4, 0.1, -1.5),
+        omega=(1.0, 4.0, 0.0),
+        forces=[forces.rft3d(zeta=3e5), forces.gravity()],
+        record=True,
+    )
+    res = granrs.simulate(scene)
+    anim = granrs.animate(res, out=tmp_path / "drop.gif", dpi=30)
+    assert (tmp_path / "drop.gif").read_bytes()[:6] == b"GIF89a"
+    s = res.series
+    checked = 0
+    for k in (0, anim.n_frames // 2, anim.n_frames - 1):
+        t = anim.frame_times[k]
+        i = int(np.argmin(np.abs(s["t"] - t)))
+        if abs(s["t"][i] - t) > 1e-12:
+            continue
+        checked += 1
+        corners = np.concatenate(anim.drawn(k))
+        assert np.allclose(corners.mean(axis=0), (s["x"][i], s["y"][i], s["z"][i]), atol=1e-12)
+        face = anim.drawn(k)[0]
+        # Its first face is x = -a; its first edge runs along z (the size 0.01).
+        assert np.linalg.norm(face[1] - face[0]) == pytest.approx(0.01, rel=1e-12)
+    assert checked >= 2
+    with pytest.raises(granrs.GranrsError) as info:
+        granrs.animate(granrs.simulate(scene.replace(record=False)))
+    assert info.value.field == "record"

@@ -26,6 +26,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Patch, Polygon
 from matplotlib.transforms import Bbox
 
+from . import _space_animation, space
 from . import forces as _forces
 from ._files import replacing
 from ._progress import progress_bar
@@ -863,7 +864,10 @@ def animate(
 
     Args:
         result: a :func:`granrs.simulate` result whose scene recorded ``"state"`` (and
-            ``"forces"`` for the force arrows): ``scene.replace(record=("state", "forces"))``.
+            ``"forces"`` for the force arrows): ``scene.replace(record=("state", "forces"))``;
+            or a body in space's (:class:`granrs.space.Result`) recorded with ``record=True``,
+            drawn in 3D: its surface at each pose over the sand's plane, with the sand's
+            force as an arrow from its centre of mass.
         frame_dt: simulated time per frame [s] (default: ``speed / fps``).
         speed: playback speed, simulated seconds per second of movie [-] (default 0.02:
             50x slow motion; faster for a run longer than
@@ -891,9 +895,15 @@ def animate(
         AnimationSizeWarning: writing ``out`` would hold more than
             :data:`granrs.animation.BIG_SAVE_BYTES` of frames; the message gives the estimate.
     """
+    if isinstance(result, space.Result):
+        return _space_animation.animate(  # type: ignore[return-value]
+            result, frame_dt, speed, fps, out=out, dpi=dpi, progress=progress
+        )
     if not isinstance(result, Result):
         raise InvalidParameterError(
-            f"animate() takes a granrs.Result, got {type(result).__name__}", field="result"
+            f"animate() takes a granrs.Result or a granrs.space.Result, got "
+            f"{type(result).__name__}",
+            field="result",
         )
     playback(frame_dt, speed, fps)  # the values checked before the series are read
     dpi_value = _positive(dpi, "dpi")

@@ -121,10 +121,11 @@ class Mesh:
     """A closed triangle mesh: ``vertices`` (n x 3) [m] and ``triangles`` (m x 3 vertex
     indices, counter-clockwise seen from outside, so that the normals point out).
 
-    The body's centre of mass is the mesh's (of a uniform solid): the body's position is
-    where that centre is, and ``Mesh.center`` says where it is in the vertices' frame. A
-    mesh that is not closed, not consistently oriented, turned inside out, or has a
-    triangle of zero area is refused naming the triangle.
+    The body's origin is the mesh's centre of mass (of a uniform solid): the body's
+    position is where that centre is (the vertices are moved so that it is their origin;
+    :meth:`Scene.body_vertices` gives them so). A mesh that is not closed, not consistently
+    oriented, turned inside out, or has a triangle of zero area is refused naming the
+    triangle.
     """
 
     vertices: np.ndarray
@@ -373,6 +374,12 @@ class Scene:
     def volume(self) -> float:
         """The body's volume [m^3]."""
         return float(self._compiled.mass_properties()[2])
+
+    def body_vertices(self) -> np.ndarray | None:
+        """A mesh body's vertices in the body frame, its centre of mass the origin [m]
+        (n x 3); None for another shape."""
+        v = self._compiled.body_vertices()
+        return None if v is None else np.array(v, dtype=float)
 
 
 @dataclass(frozen=True)

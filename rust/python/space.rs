@@ -307,6 +307,15 @@ impl SpaceScene {
         ))
     }
 
+    /// A mesh's vertices in the body frame (its centre of mass the origin) [m], or None for
+    /// another shape.
+    fn body_vertices(&self) -> Option<Vec<(f64, f64, f64)>> {
+        match &self.scene.shape {
+            Shape::Mesh(m) => Some(m.vertices.iter().map(|v| (v.x, v.y, v.z)).collect()),
+            _ => None,
+        }
+    }
+
     /// The lowest point's offset from the centre of mass at the initial orientation [m]
     /// (world axes).
     fn lowest_offset(&self) -> (f64, f64, f64) {
