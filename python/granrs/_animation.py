@@ -33,10 +33,9 @@ from ._progress import progress_bar
 from .animation import (
     BIG_SAVE_BYTES,
     DEFAULT_FRAMES,
-    MAX_FRAMES,
     _positive,
     check_output,
-    frame_count,
+    frame_times,
     playback,
     saved_bytes,
 )
@@ -919,16 +918,7 @@ def animate(
             field="record",
         )
     t = np.asarray(series["t"], dtype=float)
-    span = float(t[-1] - t[0])
-    frame_dt, speed, fps = playback(frame_dt, speed, fps, span=span)
-    n = frame_count(span, frame_dt)
-    if n > MAX_FRAMES:
-        raise InvalidParameterError(
-            f"frame_dt = {frame_dt:g} s gives {n} frames over {span:g} s; at most {MAX_FRAMES} "
-            f"(use frame_dt >= {span / (MAX_FRAMES - 1):.3g} s)",
-            field="frame_dt",
-        )
-    times = np.minimum(t[0] + frame_dt * np.arange(n), t[-1])
+    times, frame_dt, speed, fps = frame_times(t, frame_dt, speed, fps)
     anim = ImpactAnimation(result, times, frame_dt, speed, fps, dpi=dpi_value)
     if target is not None:
         anim.write(target, progress=progress)

@@ -15,6 +15,7 @@ __all__ = [
     "MAX_LINKS",
     "PRESETS",
     "RECORDS",
+    "RFT3D_COEFFICIENTS",
     "RFT_COEFFICIENTS",
     "RFT_GENERIC",
     "SCENE_FIELDS",
@@ -231,6 +232,7 @@ def rft_alpha(beta: Any, gamma: Any, coefficients: list[float]) -> tuple[Any, An
     """RFT (alpha_x, alpha_z) at equal-length float64 arrays of angles [rad]."""
 
 # Bodies in space (granrs.space).
+RFT3D_COEFFICIENTS: list[list[float]]
 SPACE_SUMMARY: list[tuple[str, str, str]]
 SPACE_SERIES: list[tuple[str, str, str]]
 SPACE_MAX_NODES: int

@@ -24,10 +24,9 @@ from ._progress import progress_bar
 from .animation import (
     BIG_SAVE_BYTES,
     DEFAULT_FRAMES,
-    MAX_FRAMES,
     _positive,
     check_output,
-    frame_count,
+    frame_times,
     playback,
     saved_bytes,
 )
@@ -193,12 +192,8 @@ class SpaceAnimation(mpl_animation.FuncAnimation):
                     writer = mpl_animation.PillowWriter(fps=fps)
                 else:
                     writer = mpl_animation.FFMpegWriter(fps=fps)
-                self.save(
-                    str(tmp),
-                    writer=writer,
-                    dpi=self.dpi,
-                    progress_callback=lambda i, n: bar.update(1),
-                )
+                tick = lambda _i, _n: bar.update(1)  # noqa: E731
+                self.save(str(tmp), writer=writer, dpi=self.dpi, progress_callback=tick)
         finally:
             bar.close()
         return out
@@ -228,16 +223,7 @@ def animate(
             "granrs.simulate(scene.replace(record=True))",
             field="record",
         )
-    t = np.asarray(series["t"], dtype=float)
-    span = float(t[-1] - t[0])
-    frame_dt, speed, fps = playback(frame_dt, speed, fps, span=span)
-    n = frame_count(span, frame_dt)
-    if n > MAX_FRAMES:
-        raise InvalidParameterError(
-            f"frame_dt = {frame_dt:g} s gives {n} frames over {span:g} s; at most {MAX_FRAMES}",
-            field="frame_dt",
-        )
-    times = np.minimum(t[0] + frame_dt * np.arange(n), t[-1])
+    times, _, _, fps = frame_times(np.asarray(series["t"], dtype=float), frame_dt, speed, fps)
     anim = SpaceAnimation(result, times, fps, dpi_value)
     if out is not None:
         anim.write(out, progress=progress)

@@ -149,6 +149,25 @@ def frame_count(t_end: float, frame_dt: float) -> int:
     return math.floor(t_end / frame_dt + _FRAME_ROUNDOFF) + 1
 
 
+def frame_times(
+    t: np.ndarray, frame_dt: float | None, speed: float | None, fps: float | None
+) -> tuple[np.ndarray, float, float, float]:
+    """The simulated time of each frame of series recorded at the times ``t`` [s], and the
+    playback (``frame_dt``, ``speed``, ``fps``) they come from (:func:`playback`); more than
+    :data:`MAX_FRAMES` frames raise an :class:`~granrs.errors.InvalidParameterError` naming
+    ``frame_dt``."""
+    span = float(t[-1] - t[0])
+    frame_dt, speed, fps = playback(frame_dt, speed, fps, span=span)
+    n = frame_count(span, frame_dt)
+    if n > MAX_FRAMES:
+        raise InvalidParameterError(
+            f"frame_dt = {frame_dt:g} s gives {n} frames over {span:g} s; at most {MAX_FRAMES} "
+            f"(use frame_dt >= {span / (MAX_FRAMES - 1):.3g} s)",
+            field="frame_dt",
+        )
+    return np.minimum(t[0] + frame_dt * np.arange(n), t[-1]), frame_dt, speed, fps
+
+
 def saved_bytes(n_frames: int, width_px: int, height_px: int) -> int:
     """Bytes of ``n_frames`` frames of ``width_px`` x ``height_px`` at one byte a pixel: what
     the GIF writer holds in memory before it writes the file (its frames reduced to one

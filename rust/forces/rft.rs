@@ -94,6 +94,19 @@ macro_rules! coefficient {
 }
 
 /// The element count parameter.
+/// The inertial terms' scale of the momentum flux (`rft_inertial`, and `rft3d_inertial` on
+/// a body in space).
+pub const LAM: Param = Param {
+    name: "lam",
+    unit: "-",
+    default: 1.0,
+    source: "the momentum-flux value (sand brought to the element's normal speed)",
+    min: 0.0,
+    description: "scale of the momentum flux rho_g v_n^2",
+    integer: false,
+    max: f64::INFINITY,
+};
+
 const ELEMENTS: Param = Param {
     name: "elements",
     unit: "-",
@@ -608,19 +621,7 @@ impl Term for RftInertial {
         equation: "dF = -lam rho_g |v_n| v_n n dA,  v_n = v . n, summed over the immersed elements",
         source: "Agarwal, Karsai, Goldman & Kamrin, Science Advances 7 (2021) eabe0631 \
                  (dynamic RFT)",
-        params: &[
-            Param {
-                name: "lam",
-                unit: "-",
-                default: 1.0,
-                source: "the momentum-flux value (sand brought to the element's normal speed)",
-                min: 0.0,
-                description: "scale of the momentum flux rho_g v_n^2",
-                integer: false,
-                max: f64::INFINITY,
-            },
-            ELEMENTS,
-        ],
+        params: &[LAM, ELEMENTS],
         acts: Acts::Contact,
         class: Class::Dynamic,
         velocity_dependent: true,

@@ -335,16 +335,7 @@ impl Term for Rft3dInertial {
         equation: "dF = -lam rho_g (n . v)^2 n dA on leading elements (n . v > 0)",
         source: "Agarwal, Karsai, Goldman & Kamrin, Science Advances 7 (2021) eabe0631 \
                  (dynamic RFT)",
-        params: &[Param {
-            name: "lam",
-            unit: "-",
-            default: 1.0,
-            source: "the momentum-flux value (sand brought to the element's normal speed)",
-            min: 0.0,
-            description: "scale of the momentum flux rho_g v_n^2",
-            integer: false,
-            max: f64::INFINITY,
-        }],
+        params: &[super::rft::LAM],
         acts: Acts::Contact,
         class: Class::Dynamic,
         velocity_dependent: true,

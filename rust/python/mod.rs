@@ -80,6 +80,13 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(space::space_load, m)?)?;
     m.add_function(wrap_pyfunction!(space::xi_n, m)?)?;
     m.add_function(wrap_pyfunction!(space::rft3d_alpha, m)?)?;
+    m.add(
+        "RFT3D_COEFFICIENTS",
+        crate::forces::rft3d::COEFFICIENTS
+            .iter()
+            .map(|row| row.to_vec())
+            .collect::<Vec<_>>(),
+    )?;
     m.add("SPACE_SUMMARY", space::summary_fields())?;
     m.add("SPACE_SERIES", space::series_columns())?;
     m.add(

@@ -389,7 +389,7 @@ pub fn load_with_error(
 mod tests {
     use super::*;
     use crate::forces::rft3d::stress;
-    use std::f64::consts::PI;
+    use crate::space::tests::sphere_fz;
 
     fn sand(shape: Shape, nodes: usize) -> Sand {
         let terms = Terms3 {
@@ -401,51 +401,6 @@ mod tests {
             ..Terms3::default()
         };
         Sand::new(shape, terms, Medium::default(), 0.0, Quadrature::new(nodes))
-    }
-
-    /// The vertical force on a sphere of radius r whose lowest point is `d` deep, moving
-    /// straight down, by a 1D integral over the polar angle written here (axisymmetric:
-    /// x1 = 1, x2 = x3 = cos(theta) on the lower hemisphere).
-    fn sphere_fz(r: f64, d: f64) -> f64 {
-        let c = &crate::forces::rft3d::COEFFICIENTS;
-        let tmax = (1.0 - d / r).clamp(-1.0, 1.0).acos().min(PI / 2.0);
-        let n = 4000;
-        let mut s = 0.0;
-        for k in 0..n {
-            let th = (k as f64 + 0.5) * tmax / n as f64;
-            let u = th.cos();
-            let t = [
-                1.0,
-                1.0,
-                u,
-                u,
-                1.0,
-                u * u,
-                u * u,
-                u,
-                u * u,
-                u,
-                1.0,
-                u * u * u,
-                u * u * u,
-                u * u,
-                u,
-                u * u * u,
-                u * u * u,
-                u,
-                u * u,
-                u * u,
-            ];
-            let f: Vec<f64> = c
-                .iter()
-                .map(|row| row.iter().zip(t).map(|(a, b)| a * b).sum())
-                .collect();
-            // alpha_z = -f1 cos(b) - f2 sin(g) - f3 with m = n: m_z = -u, v = -z.
-            let az = -(f[0] * u + f[1] + f[2]);
-            let depth = d - r * (1.0 - u);
-            s += az * depth * 2.0 * PI * r * r * th.sin() * tmax / n as f64;
-        }
-        s
     }
 
     #[test]

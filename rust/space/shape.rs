@@ -442,25 +442,13 @@ impl Shape {
             Shape::Capsule {
                 radius,
                 half_length,
-            } => {
-                let a = q * z;
-                let end = if a.z > 0.0 {
-                    c - *half_length * a
-                } else {
-                    c + *half_length * a
-                };
-                end - *radius * z
-            }
+            } => lower_end(c, &(q * z), *half_length) - *radius * z,
             Shape::Cylinder {
                 radius,
                 half_length,
             } => {
                 let a = q * z;
-                let end = if a.z > 0.0 {
-                    c - *half_length * a
-                } else {
-                    c + *half_length * a
-                };
+                let end = lower_end(c, &a, *half_length);
                 let down = z - a.z * a;
                 let norm = down.norm();
                 if norm > 1e-12 {
@@ -611,6 +599,15 @@ impl Shape {
                 }
             }
         }
+    }
+}
+
+/// The lower of the two ends `c +- h a` of an axis.
+fn lower_end(c: &V3, a: &V3, h: f64) -> V3 {
+    if a.z > 0.0 {
+        c - h * a
+    } else {
+        c + h * a
     }
 }
 

@@ -63,7 +63,7 @@ fn final_depth(m: f64, v0: f64, work: impl Fn(f64) -> f64) -> f64 {
 /// F_z of a sphere of radius r at depth d moving straight down, written from the table:
 /// on the lower hemisphere x1 = 1 and x2 = x3 = cos(theta); integrated over theta by
 /// Gauss-Legendre of high order on [0, theta_w] (independent of the code's surface rule).
-fn sphere_fz(r: f64, d: f64) -> f64 {
+pub(super) fn sphere_fz(r: f64, d: f64) -> f64 {
     let c = crate::forces::rft3d::COEFFICIENTS;
     let tw = (1.0 - d / r).clamp(-1.0, 1.0).acos().min(PI / 2.0);
     let g = super::quad::Gauss::new(40);
