@@ -175,7 +175,7 @@ def study(drawn: list[Scene], dts: tuple[float, ...] = (1e-3, 1e-4), mirrors: bo
             out.counts[dt][key] += 1
             info = {
                 k: (coarse.summary or {}).get(k, math.nan)
-                for k in ("h_lambda", "unresolved_stops", "t_s", "depth")
+                for k in ("h_lambda", "unresolved_stops", "step_error", "t_s", "depth")
             }
             info["t_s_fine"] = (finer.summary or {}).get("t_s", math.nan)
             info["depth_fine"] = (finer.summary or {}).get("depth", math.nan)
@@ -201,7 +201,7 @@ def report(s: Study, drawn: list[Scene]) -> str:
             sc = drawn[i]
             lines.append(
                 f"  scene {i} ({law}, at the {sc.fields['apply_at']}) dt {dt:g}: "
-                f"h_lambda {info['h_lambda']:.3g}, unresolved_stops {info['unresolved_stops']}, "
+                f"h_lambda {info['h_lambda']:.3g}, step_error {info['step_error']:.3g}, unresolved_stops {info['unresolved_stops']}, "
                 f"t_s {info['t_s']:.6g} against {info['t_s_fine']:.6g}, depth "
                 f"{info['depth']:.6g} against {info['depth_fine']:.6g}"
             )

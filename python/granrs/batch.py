@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from . import _granrs
-from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
+from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT, STEP_ERROR_LIMIT
 from .coefficients import Coefficients
 from .errors import (
     GranrsError,
@@ -591,7 +591,8 @@ def _run_by_row(
 
 def _warn_unresolved(table: _Table) -> None:
     """One :class:`~granrs.errors.StepSizeWarning` for the runs whose step did not resolve
-    their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, or steps the sign
+    their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, the steps' own
+    error estimate ``step_error`` above 1 %, a stop the step missed, or steps the sign
     modes chattered through, ``unresolved`` > 0, with a rise in energy: see
     :func:`granrs.api.energy_rose`)."""
     if "h_lambda" not in table.layout.rows_of:
@@ -603,16 +604,20 @@ def _warn_unresolved(table: _Table) -> None:
     end = table.column("energy_end")[maybe]
     with np.errstate(invalid="ignore"):
         rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
-    flagged = np.flatnonzero(
-        (h_lambda > RK4_STABILITY_LIMIT) | (table.column("unresolved_stops") > 0)
-    )
+    with np.errstate(invalid="ignore"):
+        flagged = np.flatnonzero(
+            (h_lambda > RK4_STABILITY_LIMIT)
+            | (table.column("unresolved_stops") > 0)
+            | (table.column("step_error") > STEP_ERROR_LIMIT)
+        )
     bad = np.union1d(flagged, maybe[rose])
     if bad.size:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
         warnings.warn(
             StepSizeWarning(
                 f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
-                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or "
+                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'step_error' above {STEP_ERROR_LIMIT}, "
+                "'unresolved_stops' the step missed, or "
                 "'unresolved' steps where the sign modes chattered and the energy rose); the "
                 "largest h_lambda is "
                 f"{np.nanmax(h_lambda[bad]):.3g}. "

@@ -171,6 +171,14 @@ pub struct Outcome {
     /// [`Model::centroid_inverse_mass`]: crate::dynamics::Model::centroid_inverse_mass
     /// [`RK4_STABILITY_LIMIT`]: super::observe::RK4_STABILITY_LIMIT
     pub h_lambda: f64,
+    /// The largest relative error of a contact's t_s or depth that the run's steps estimate
+    /// (RK4; NaN for Dopri5): each step's error estimate
+    /// ([`crate::integrate::stepper::companion`]), summed in magnitude over the run, carried
+    /// to the tip's height and vertical velocity at the stop (or at the end without one);
+    /// a stop's time error is that velocity's error and the residual left at the located
+    /// stop over the tip's vertical acceleration. Above
+    /// [`STOP_TIME_ERROR`](super::observe::STOP_TIME_ERROR) the result moves with the step.
+    pub step_error: f64,
     /// Time series, if any were asked for.
     pub series: Option<Series>,
     /// The terms that acted, in the scene's order.
@@ -290,6 +298,7 @@ pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
         real("energy_end", "J", |o| Real(o.energy_end)),
         real("dissipated", "J", |o| Real(o.dissipated)),
         real("h_lambda", "-", |o| Real(o.h_lambda)),
+        real("step_error", "-", |o| Real(o.step_error)),
     ],
     contact: &[
         Field {
