@@ -201,7 +201,8 @@ def report(s: Study, drawn: list[Scene]) -> str:
             sc = drawn[i]
             lines.append(
                 f"  scene {i} ({law}, at the {sc.fields['apply_at']}) dt {dt:g}: "
-                f"h_lambda {info['h_lambda']:.3g}, step_error {info['step_error']:.3g}, unresolved_stops {info['unresolved_stops']}, "
+                f"h_lambda {info['h_lambda']:.3g}, step_error {info['step_error']:.3g}, "
+                f"unresolved_stops {info['unresolved_stops']}, "
                 f"t_s {info['t_s']:.6g} against {info['t_s_fine']:.6g}, depth "
                 f"{info['depth']:.6g} against {info['depth_fine']:.6g}"
             )
