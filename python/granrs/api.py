@@ -29,16 +29,17 @@ def step_advice(
     step_error: float = 0.0,
 ) -> str:
     """What to tell a user whose run did not resolve its contact: ``h_lambda`` above
-    :data:`RK4_STABILITY_LIMIT`, ``step_error`` above :data:`STEP_ERROR_LIMIT`,
-    ``unresolved_stops`` stops the step missed, or ``unresolved`` steps the sign modes
-    chattered through."""
+    :data:`RK4_STABILITY_LIMIT`, ``unresolved_stops`` contacts the step did not resolve
+    (the steps' own error estimate ``step_error`` above :data:`STEP_ERROR_LIMIT`, or a stop
+    that fell between the steps), or ``unresolved`` steps the sign modes chattered
+    through."""
     if h_lambda > RK4_STABILITY_LIMIT:
         why = (
             f"dt times the contact's fastest rate reached {h_lambda:.3g} (RK4 is stable below "
             f"{RK4_STABILITY_LIMIT})"
         )
         advice = f"use dt <= {dt * 0.5 / h_lambda:.2g} s (dt * rate <= 0.5)"
-    elif step_error > STEP_ERROR_LIMIT:
+    elif unresolved_stops and step_error > STEP_ERROR_LIMIT:
         why = (
             f"the steps' own error estimates put t_s or the depth {100 * step_error:.3g} % off "
             f"(step_error {step_error:.3g}, above {STEP_ERROR_LIMIT})"
@@ -87,7 +88,6 @@ def simulate(scene: Scene) -> Result:
     result = Result(scene, outcome)
     if (
         outcome.h_lambda > RK4_STABILITY_LIMIT
-        or outcome.step_error > STEP_ERROR_LIMIT
         or outcome.unresolved_stops
         or (
             outcome.unresolved

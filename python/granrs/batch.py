@@ -604,12 +604,9 @@ def _warn_unresolved(table: _Table) -> None:
     end = table.column("energy_end")[maybe]
     with np.errstate(invalid="ignore"):
         rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
-    with np.errstate(invalid="ignore"):
-        flagged = np.flatnonzero(
-            (h_lambda > RK4_STABILITY_LIMIT)
-            | (table.column("unresolved_stops") > 0)
-            | (table.column("step_error") > STEP_ERROR_LIMIT)
-        )
+    flagged = np.flatnonzero(
+        (h_lambda > RK4_STABILITY_LIMIT) | (table.column("unresolved_stops") > 0)
+    )
     bad = np.union1d(flagged, maybe[rose])
     if bad.size:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"

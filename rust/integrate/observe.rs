@@ -138,6 +138,13 @@ pub(super) struct Observer<const N: usize> {
     /// the end without one) from `err_q`, `err_qd` and the stop's own residual
     /// (`Outcome::step_error`).
     step_error: f64,
+    /// Whether `step_error` counts in `unresolved_stops`: under a sign model that holds or
+    /// smooths the static terms' signs. Under the plain `sign()` they switch inside the
+    /// steps by construction, each step's estimate holds the switch's jump, and those jumps
+    /// cancel over a stick where the sum does not see it (measured on the property tests'
+    /// domain: half of its runs above 1 % moved by less than 1 % at dt / 10); its chatter
+    /// has its own rule (`Stats::unresolved` and the energy). Its `step_error` is reported.
+    estimates: bool,
     recorder: Recorder,
     /// Record every `stride`-th grid step.
     stride: u64,
@@ -196,6 +203,7 @@ impl<const N: usize> Observer<N> {
             err_q: SVector::zeros(),
             err_qd: SVector::zeros(),
             step_error: 0.0,
+            estimates: model.sign_model != SignModel::Raw,
             terms: {
                 let mut terms = TermStiffest {
                     damping: (0.0, y.q, 0),
@@ -402,7 +410,7 @@ impl<const N: usize> Observer<N> {
             ratio(e.contacts[ci].v_tip.y.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
         self.step_error = self.step_error.max(relative);
         if e.contacts[ci].v_tip.y.abs() > STOP_TIME_ERROR * t * accel.y.abs()
-            || relative > STOP_TIME_ERROR
+            || (self.estimates && relative > STOP_TIME_ERROR)
         {
             self.unresolved_stops += 1;
         }
@@ -463,6 +471,9 @@ impl<const N: usize> Observer<N> {
                     let depth = (-e_end.contacts[ci].tip.y).max(0.0);
                     if depth > 0.0 {
                         self.step_error = self.step_error.max(dy / depth);
+                        if self.estimates && dy > STOP_TIME_ERROR * depth {
+                            self.unresolved_stops += 1;
+                        }
                     }
                 }
             }
