@@ -405,7 +405,15 @@ impl<const N: usize> Observer<N> {
         // velocity, over its rate; the depth's: the run's error in the tip's height.
         let (dy, dv) = self.tip_errors(model, ci, &y.q, &y.qd);
         let depth = (-e.contacts[ci].tip.y).max(0.0);
-        let ratio = |err: f64, of: f64| if err > 0.0 { err / of } else { 0.0 };
+        // Finite however small the stop's rate (a blow-up's NaN counts as no estimate: the
+        // outcome check refuses that run).
+        let ratio = |err: f64, of: f64| {
+            if err > 0.0 {
+                (err / of).min(f64::MAX)
+            } else {
+                0.0
+            }
+        };
         let relative =
             ratio(e.contacts[ci].v_tip.y.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
         self.step_error = self.step_error.max(relative);
@@ -469,8 +477,8 @@ impl<const N: usize> Observer<N> {
                 if options.method == Method::Rk4 {
                     let (dy, _) = self.tip_errors(model, ci, &y.q, &y.qd);
                     let depth = (-e_end.contacts[ci].tip.y).max(0.0);
-                    if depth > 0.0 {
-                        self.step_error = self.step_error.max(dy / depth);
+                    if depth > 0.0 && dy > 0.0 {
+                        self.step_error = self.step_error.max((dy / depth).min(f64::MAX));
                         if self.estimates && dy > STOP_TIME_ERROR * depth {
                             self.unresolved_stops += 1;
                         }
