@@ -226,7 +226,8 @@ def test_a_sweep_over_a_frame_laws_numbers_runs_in_the_lanes() -> None:
 
 
 # The lanes against the scalar path; a drawn scene may warn (an rft rod with one element
-# reads step_error 1.0006e-2 at 1.0e-3 moved: the warning's own counts are benches/step_warning.py's).
+# reads step_error 1.0006e-2 where it moves 1.0e-3 at dt / 10: the warning's own counts
+# are benches/step_warning.py's).
 @pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(

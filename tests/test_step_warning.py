@@ -217,10 +217,10 @@ def test_the_random_set_in_small() -> None:
     assert counts["still&warned"] == 0, bench.report(study, drawn)
 
 
-#: The thesis's law (``forces.thesis()``: Table 3.4's 90 deg row) on a light rod at the tip (scene 182 of ``benches/step_warning.py --seed
-#: 7``): at dt = 1e-3 the impact is over in 3 steps and its depth is 3.7 % short of dt = 1e-4,
-#: at h_lambda 2.16, below the stability limit, with the stop resolved on its own step. It
-#: warned nothing before.
+#: The thesis's law (``forces.thesis()``, Table 3.4's 90 deg row) on a light rod at the tip
+#: (scene 182 of ``benches/step_warning.py --seed 7``): at dt = 1e-3 the impact is over in 3
+#: steps and its depth is 3.7 % short of dt = 1e-4, at h_lambda 2.16, below the stability
+#: limit, with the stop resolved on its own step. It warned nothing before.
 THESIS_FEW_STEPS = {
     "q_deg": -72.4589699820295,
     "v0": 3.318815411358659,
