@@ -7,7 +7,8 @@ scene *moved* at a dt when its ``t_s`` or its depth differs from the dt / 10 run
 than 1 % (or its status does); it *warned* when ``granrs.simulate`` warned
 :class:`granrs.StepSizeWarning` or refused the run as diverged. The script prints, per dt,
 the confusion counts (moved & warned, moved & silent, still & warned, still & silent), each
-miss and false alarm with its ``h_lambda`` and ``unresolved_stops``, and the mirror check:
+miss and false alarm with its ``h_lambda``, ``step_error`` and ``unresolved_stops``, and the
+mirror check:
 the largest relative difference of ``t_s`` and depth between a silent run and its mirror
 image (q, vx0, omega0 -> -q, -vx0, -omega0).
 
