@@ -260,7 +260,8 @@ impl<const N: usize> Observer<N> {
 
     /// The errors of contact `ci`'s tip height and vertical velocity [m, m/s] at `q, qd`
     /// that the run's estimate (`err_q`, `err_qd`) gives, through the tip's Jacobian J (its
-    /// height moves by J dq, its velocity by J dqd + (dJ/dq qd) dq).
+    /// height moves by J dq, its velocity J dqd + (dJ/dq qd) dq), each coordinate's part
+    /// in magnitude.
     fn tip_errors(
         &self,
         model: &Model<N>,
@@ -276,16 +277,16 @@ impl<const N: usize> Observer<N> {
         let (mut dy, mut dv) = (0.0, 0.0);
         for i in 0..N {
             let unit = SVector::<f64, N>::from_fn(|k, _| if k == i { 1.0 } else { 0.0 });
-            let j = m.point_velocity(&pose, link, tip, &unit).y;
+            let j = m.point_velocity(&pose, link, tip, &unit).y.abs();
             // dJ/dq_i qd, by a forward difference.
             let eps = 1e-7 * (1.0 + q[i].abs());
             let mut qe = *q;
             qe[i] += eps;
-            let dj = (m.point_velocity(&m.pose(&qe), link, tip, qd).y - v0) / eps;
-            dy += j * self.err_q[i];
-            dv += j * self.err_qd[i] + dj * self.err_q[i];
+            let dj = (m.point_velocity(&m.pose(&qe), link, tip, qd).y - v0).abs() / eps;
+            dy += j * self.err_q[i].abs();
+            dv += j * self.err_qd[i].abs() + dj * self.err_q[i].abs();
         }
-        (dy.abs(), dv.abs())
+        (dy, dv)
     }
 
     /// Show the drag's stiffness `s` at an RK4 stage with coordinates `q()` (read only when
