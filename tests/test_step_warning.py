@@ -293,3 +293,13 @@ def test_a_run_without_a_stop_warns_on_its_depth() -> None:
     assert coarse.status == "not_stopped" and fine.status == "stopped"
     assert coarse.summary["step_error"] > 0.01
     assert texts and "step_error" in texts[0], texts
+
+
+def test_step_error_falls_as_the_third_power_of_dt_where_the_run_is_smooth() -> None:
+    """Each step's estimate, h/6 (k4 - f(y_{n+1})), is of order h^4 on a smooth run, and the
+    run sums about 1/h of them: the thesis's free link at 45 deg reads h^3 (a tenth of dt, a
+    thousandth of step_error), far below 1 % at the thesis's 10 kHz."""
+    a, b = (granrs.simulate(cases.free_link(45.0, 2.27, dt=dt)) for dt in (1e-4, 1e-5))
+    ratio = a.summary["step_error"] / b.summary["step_error"]
+    assert 10.0**2.7 < ratio < 10.0**3.3, ratio
+    assert a.summary["step_error"] < 1e-4
