@@ -128,9 +128,9 @@ pub(super) struct Observer<const N: usize> {
     /// The terms' stiffest moments at the start, the step ends and the events so far.
     terms: TermStiffest<N>,
     /// The run's error so far, as its steps estimate it ([`super::stepper::companion`]):
-    /// each accepted step's estimate, in magnitude, summed per coordinate and rate. The
-    /// sand damps a perturbation rather than growing it, so the sum bounds the error it
-    /// estimates without propagating it.
+    /// each accepted step's estimate summed per coordinate and rate, signed (errors of
+    /// opposite sign in two steps cancel, as they do in the run). The sum does not carry an
+    /// error through the dynamics: the sand damps a perturbation rather than growing it.
     err_q: SVector<f64, N>,
     /// See `err_q`.
     err_qd: SVector<f64, N>,
