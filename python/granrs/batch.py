@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from . import _granrs
-from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT, STEP_ERROR_LIMIT
+from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
 from .coefficients import Coefficients
 from .errors import (
     GranrsError,
@@ -613,7 +613,7 @@ def _warn_unresolved(table: _Table) -> None:
         warnings.warn(
             StepSizeWarning(
                 f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
-                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'step_error' above {STEP_ERROR_LIMIT}, "
+                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'step_error' above 0.01, "
                 "'unresolved_stops' the step missed, or "
                 "'unresolved' steps where the sign modes chattered and the energy rose); the "
                 "largest h_lambda is "
