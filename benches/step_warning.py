@@ -7,7 +7,8 @@ scene *moved* at a dt when its ``t_s`` or its depth differs from the dt / 10 run
 than 1 % (or its status does); it *warned* when ``granrs.simulate`` warned
 :class:`granrs.StepSizeWarning` or refused the run as diverged. The script prints, per dt,
 the confusion counts (moved & warned, moved & silent, still & warned, still & silent), each
-miss and false alarm with its ``h_lambda`` and ``unresolved_stops``, and the mirror check:
+miss and false alarm with its ``h_lambda``, ``step_error`` and ``unresolved_stops``, and the
+mirror check:
 the largest relative difference of ``t_s`` and depth between a silent run and its mirror
 image (q, vx0, omega0 -> -q, -vx0, -omega0).
 
@@ -175,7 +176,7 @@ def study(drawn: list[Scene], dts: tuple[float, ...] = (1e-3, 1e-4), mirrors: bo
             out.counts[dt][key] += 1
             info = {
                 k: (coarse.summary or {}).get(k, math.nan)
-                for k in ("h_lambda", "unresolved_stops", "t_s", "depth")
+                for k in ("h_lambda", "unresolved_stops", "step_error", "t_s", "depth")
             }
             info["t_s_fine"] = (finer.summary or {}).get("t_s", math.nan)
             info["depth_fine"] = (finer.summary or {}).get("depth", math.nan)
@@ -201,7 +202,8 @@ def report(s: Study, drawn: list[Scene]) -> str:
             sc = drawn[i]
             lines.append(
                 f"  scene {i} ({law}, at the {sc.fields['apply_at']}) dt {dt:g}: "
-                f"h_lambda {info['h_lambda']:.3g}, unresolved_stops {info['unresolved_stops']}, "
+                f"h_lambda {info['h_lambda']:.3g}, step_error {info['step_error']:.3g}, "
+                f"unresolved_stops {info['unresolved_stops']}, "
                 f"t_s {info['t_s']:.6g} against {info['t_s_fine']:.6g}, depth "
                 f"{info['depth']:.6g} against {info['depth_fine']:.6g}"
             )

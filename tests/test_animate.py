@@ -422,6 +422,9 @@ def test_built_in_bodies_are_drawn_from_their_linkages(
     assert [ax.get_title() for ax in anim.figure.axes] == ["body", "contacts"]
 
 
+# The arrows, whether or not the step resolves the run: the poncelet rod (k = 2e5) warns
+# at dt = 1e-4, rightly (t_s 1.4523 ms against 1.4701 ms at dt = 1e-5).
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @pytest.mark.parametrize(
     "term", [forces.rft(zeta=1e6), forces.poncelet(c=0.5, k=2e5)], ids=lambda t: t.name
 )

@@ -69,6 +69,9 @@ def _table_3_5() -> list[granrs.Scene]:
     return [cases.free_link(q_deg=float(q), v0=float(v)) for q, v in rows]
 
 
+# The lanes against the scalar path, bit for bit (step_error included). Under `smooth`, Table 3.5's
+# vertical rows warn at dt = 1e-4 (their depth moves 5 % at dt = 1e-5): rightly.
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @pytest.mark.parametrize("sign_model", ["modes", "raw", "smooth"])
 def test_table_3_5_in_lanes_equals_the_scalar_path(sign_model: str) -> None:
     scenes = [s.replace(sign_model=sign_model) for s in _table_3_5()]
@@ -222,6 +225,10 @@ def test_a_sweep_over_a_frame_laws_numbers_runs_in_the_lanes() -> None:
     assert lanes["depth"].nunique() == len(scenes)
 
 
+# The lanes against the scalar path; a drawn scene may warn (an rft rod with one element
+# reads step_error 1.0006e-2 where it moves 1.0e-3 at dt / 10: the warning's own counts
+# are benches/step_warning.py's).
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     qs=st.lists(st.floats(-88.0, 88.0), min_size=1, max_size=4),

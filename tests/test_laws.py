@@ -173,6 +173,9 @@ def test_the_rft_element_count_converges_on_an_oblique_drop() -> None:
     assert min(orders) > 1.7, (errs, orders)
 
 
+# The energy, whether or not the step resolves the run: the poncelet rod at q = 0, v0 0.25
+# warns at dt = 1e-4 (t_s 0.235 s against 0.0740 s at 1e-5), rightly.
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 @settings(
     max_examples=60,
     derandomize=True,
@@ -292,6 +295,8 @@ def test_a_vanishing_zeta_lets_the_rod_sink_and_a_huge_one_is_resolved_or_named(
             assert math.isfinite(r.depth)
 
 
+# The chapter's tables; a run of its sweeps may warn (the steps' error estimate).
+@pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
 def test_the_force_laws_chapter_tables_each_law_on_the_three_bodies(tmp_path) -> None:
     from granrs.report import reproduce
 

@@ -12,6 +12,7 @@ import csv
 import math
 import re
 import statistics
+import warnings
 from importlib import metadata
 from pathlib import Path
 
@@ -55,12 +56,22 @@ def _float(cell: str) -> float:
     return float(match.group(0)) if match else math.nan
 
 
+#: The report's runs, without the step-size warning's one known false alarm among them: the
+#: chain (case 2) under ``poncelet`` to all stops at dt = 1e-4 reads step_error 0.19 (link 1's
+#: stop is grazing, its tip's vertical acceleration 0.4 m/s^2, and the steps' summed velocity
+#: error counts there whole) while its t_s moves by 1e-4 at dt / 10 (docs/hard_cases.md).
+def _reproduce_quietly(out: Path) -> Path:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", granrs.StepSizeWarning)
+        return report.reproduce(out, progress=False)
+
+
 @pytest.fixture(scope="module")
 def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     """The whole report (every chapter, the default), built once into a fresh directory:
     (README path, text)."""
     out = tmp_path_factory.mktemp("report") / "out"
-    path = report.reproduce(out, progress=False)
+    path = _reproduce_quietly(out)
     return path, path.read_text(encoding="utf-8")
 
 
@@ -229,7 +240,11 @@ def test_cli_reproduce_quiet_replaces_report(
     assert main(["reproduce", "--out", str(out), "--quiet"]) == 0
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert captured.err == ""
+    # No progress; the command's own warnings are part of its output (one line each): the
+    # step-size warning's known false alarm (see _reproduce_quietly) is the one line.
+    lines = captured.err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("granrs: warning: dt = 0.0001 s"), lines
+    assert "step_error 0.186" in lines[0]
     assert (out / "README.md").is_file()
     assert (out / "keep.txt").read_text() == "mine"
     assert not (out / "figures" / "stale.png").exists()

@@ -88,6 +88,7 @@ class RunOutcome:
     h_lambda: float
     unresolved: int
     unresolved_stops: int
+    step_error: float
     def to_dict(self) -> dict[str, Any]:
         """Everything, as a dict; once (the outcome moves out). ``impulses``: the
         table-driven joints' impulses, ``(link, t, impulse, energy)`` tuples in time order

@@ -16,18 +16,35 @@ __all__ = ["RK4_STABILITY_LIMIT", "simulate"]
 RK4_STABILITY_LIMIT = 2.785
 #: A rise of the mechanical energy beyond this fraction of its size counts as a rise.
 ENERGY_ROSE_RTOL = 1e-9
+#: The relative error of t_s or depth, as the run's steps estimate it (``step_error``),
+#: beyond which a run warns: 1 %, the change that counts as a result that moves with the step.
+STEP_ERROR_LIMIT = 0.01
 
 
-def step_advice(dt: float, h_lambda: float, unresolved: int = 0, unresolved_stops: int = 0) -> str:
+def step_advice(
+    dt: float,
+    h_lambda: float,
+    unresolved: int = 0,
+    unresolved_stops: int = 0,
+    step_error: float = 0.0,
+) -> str:
     """What to tell a user whose run did not resolve its contact: ``h_lambda`` above
-    :data:`RK4_STABILITY_LIMIT`, ``unresolved_stops`` stops the step missed, or
-    ``unresolved`` steps the sign modes chattered through."""
+    :data:`RK4_STABILITY_LIMIT`, ``unresolved_stops`` contacts the step did not resolve
+    (the steps' own error estimate ``step_error`` above :data:`STEP_ERROR_LIMIT`, or a stop
+    that fell between the steps), or ``unresolved`` steps the sign modes chattered
+    through."""
     if h_lambda > RK4_STABILITY_LIMIT:
         why = (
             f"dt times the contact's fastest rate reached {h_lambda:.3g} (RK4 is stable below "
             f"{RK4_STABILITY_LIMIT})"
         )
         advice = f"use dt <= {dt * 0.5 / h_lambda:.2g} s (dt * rate <= 0.5)"
+    elif unresolved_stops and step_error > STEP_ERROR_LIMIT:
+        why = (
+            f"the steps' own error estimates put t_s or the depth {100 * step_error:.3g} % off "
+            f"(step_error {step_error:.3g}, above {STEP_ERROR_LIMIT})"
+        )
+        advice = f"use dt <= {dt / 10:.2g} s (dt / 10)"
     elif unresolved_stops:
         why = (
             f"{unresolved_stops} stop{'s' if unresolved_stops != 1 else ''} fell between "
@@ -86,7 +103,11 @@ def simulate(scene: Scene | space.Scene) -> Result | space.Result:
         )
     ):
         advice = step_advice(
-            scene.dt, outcome.h_lambda, outcome.unresolved, outcome.unresolved_stops
+            scene.dt,
+            outcome.h_lambda,
+            outcome.unresolved,
+            outcome.unresolved_stops,
+            outcome.step_error,
         )
         warnings.warn(StepSizeWarning(advice), stacklevel=2)
     return result

@@ -695,7 +695,8 @@ def _run_by_row(
 
 def _warn_unresolved(table: _Table) -> None:
     """One :class:`~granrs.errors.StepSizeWarning` for the runs whose step did not resolve
-    their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, or steps the sign
+    their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, the steps' own
+    error estimate ``step_error`` above 1 %, a stop the step missed, or steps the sign
     modes chattered through, ``unresolved`` > 0, with a rise in energy: see
     :func:`granrs.api.energy_rose`)."""
     if "h_lambda" not in table.layout.rows_of:
@@ -716,7 +717,8 @@ def _warn_unresolved(table: _Table) -> None:
         warnings.warn(
             StepSizeWarning(
                 f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
-                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or "
+                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'step_error' above 0.01, "
+                "'unresolved_stops' the step missed, or "
                 "'unresolved' steps where the sign modes chattered and the energy rose); the "
                 "largest h_lambda is "
                 f"{np.nanmax(h_lambda[bad]):.3g}. "

@@ -40,6 +40,7 @@ SUMMARY_UNITS: dict[str, str] = {
     "unresolved": "-",
     "unresolved_stops": "-",
     "h_lambda": "-",
+    "step_error": "-",
 }
 
 # Friendly names of the generalized coordinates of each body.

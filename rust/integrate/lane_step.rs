@@ -8,7 +8,7 @@
 use nalgebra::{SVector, Vector2};
 
 use super::events::SwitchInputs;
-use super::stepper::State;
+use super::stepper::{Deriv, State};
 use crate::dynamics::rod_lanes::{pivot_ok, rod_eval_law, RodEval, RodModes, RodParams};
 use crate::dynamics::DragStiffness;
 use crate::forces::Real;
@@ -131,6 +131,11 @@ pub struct LaneEnd<F> {
     /// What the observer is shown of the end (read when the lanes accept the step,
     /// [`Run::accept_plain`]).
     pub last: LaneStage<F>,
+    /// The fourth stage's rates and q'' (the derivative `k4`, for the step's error
+    /// estimate, [`super::stepper::companion`]).
+    pub qd4: [F; 3],
+    /// See `qd4`.
+    pub qdd4: [F; 3],
 }
 
 /// What the observer is shown of an RK4 stage (see [`super::stepper::step_sampling`]),
@@ -228,6 +233,8 @@ pub fn lane_step<F: Real, const FRAME: bool>(
             LaneStage::of(q4, &e4),
         ],
         last: LaneStage::of(q, &eval),
+        qd4,
+        qdd4: e4.qdd,
     }
 }
 
@@ -249,6 +256,8 @@ impl LaneEnd<F64x4> {
                 self.stages[2].lane(i),
             ],
             last: self.last.lane(i),
+            qd4: l3(self.qd4),
+            qdd4: l3(self.qdd4),
         }
     }
 }
@@ -378,6 +387,18 @@ impl LaneEnd<f64> {
             qd: SVector::from_fn(|i, _| self.qd[i]),
             work: self.work,
             dissipated: self.dissipated,
+        }
+    }
+
+    /// The fourth stage's derivative (rates and q''; no power), for the step's error
+    /// estimate ([`super::stepper::companion`]).
+    #[inline]
+    pub fn k4<const N: usize>(&self) -> Deriv<N> {
+        Deriv {
+            q: SVector::from_fn(|i, _| self.qd4[i]),
+            qd: SVector::from_fn(|i, _| self.qdd4[i]),
+            work: 0.0,
+            dissipated: 0.0,
         }
     }
 

@@ -54,11 +54,13 @@ pub struct Stats {
     ///
     /// [`MAX_EVENTS_PER_STEP`]: super::events::MAX_EVENTS_PER_STEP
     pub unresolved: usize,
-    /// Stops the step did not resolve: at the located stop the tip's vertical velocity (the
-    /// stop's switching function, zero there when the step resolves it) over its vertical
-    /// acceleration, an estimate of the stop time's error, was above [`STOP_TIME_ERROR`] of
-    /// t_s. The stop is located on the step's interpolant; an impact over in a few steps
-    /// misses it, by up to several per cent in t_s.
+    /// Contacts whose result the step did not resolve: at the located stop the tip's
+    /// vertical velocity (the stop's switching function, zero there when the step resolves
+    /// it) over its vertical acceleration, an estimate of the stop time's error, was above
+    /// [`STOP_TIME_ERROR`] of t_s (the stop is located on the step's interpolant; an impact
+    /// over in a few steps misses it, by up to several per cent in t_s); or the steps' own
+    /// error estimate ([`Outcome::step_error`]) put its t_s or depth (at the stop, or at the
+    /// end without one) above [`STOP_TIME_ERROR`].
     ///
     /// [`STOP_TIME_ERROR`]: super::observe::STOP_TIME_ERROR
     pub unresolved_stops: usize,
@@ -171,6 +173,16 @@ pub struct Outcome {
     /// [`Model::centroid_inverse_mass`]: crate::dynamics::Model::centroid_inverse_mass
     /// [`RK4_STABILITY_LIMIT`]: super::observe::RK4_STABILITY_LIMIT
     pub h_lambda: f64,
+    /// The largest relative error of a contact's t_s or depth that the run's steps estimate
+    /// (RK4; NaN for Dopri5): each step's error estimate
+    /// ([`crate::integrate::stepper::companion`]), summed in magnitude over the run, carried
+    /// to the tip's height and vertical velocity at the stop (or at the end without one);
+    /// a stop's time error is that velocity's error and the residual left at the located
+    /// stop over the tip's vertical acceleration. Above
+    /// [`STOP_TIME_ERROR`](super::observe::STOP_TIME_ERROR) the result moves with the step,
+    /// and the contact counts in [`Stats::unresolved_stops`] (except under the plain
+    /// `sign()`, whose chatter the estimate overstates).
+    pub step_error: f64,
     /// Time series, if any were asked for.
     pub series: Option<Series>,
     /// The terms that acted, in the scene's order.
@@ -290,6 +302,7 @@ pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
         real("energy_end", "J", |o| Real(o.energy_end)),
         real("dissipated", "J", |o| Real(o.dissipated)),
         real("h_lambda", "-", |o| Real(o.h_lambda)),
+        real("step_error", "-", |o| Real(o.step_error)),
     ],
     contact: &[
         Field {

@@ -275,7 +275,7 @@ impl<const N: usize> Run<N> {
         let k1 = deriv_of(&self.y, e0);
         let obs = &mut self.obs;
         let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
-        let (y1, err) = full_step(
+        let (y1, err, k4) = full_step(
             model,
             self.options.method,
             &self.modes,
@@ -286,7 +286,7 @@ impl<const N: usize> Run<N> {
             &mut self.stats,
             sample,
         );
-        self.after_step(model, h, &k1, y1, err)
+        self.after_step(model, h, &k1, y1, err, k4.as_ref())
     }
 
     /// The start of a step of size `h` in one lane ([`super::lanes::lane_step`]): the state
@@ -331,12 +331,13 @@ impl<const N: usize> Run<N> {
         }
         end.eval.write(&self.layout, &mut self.evals[1 - self.cur]);
         self.stats.rhs_evals += 4;
-        Some(self.after_step(model, h, k1, end.state(), 0.0))
+        Some(self.after_step(model, h, k1, end.state(), 0.0, Some(&end.k4())))
     }
 
     /// The rest of a step of size `h` whose first stage is `k1`, whose end is `y1` (its
     /// evaluation in the end slot, `evals[1 - cur]`) and whose error estimate is `err` (0 for RK4):
     /// the step-size control, the events (located, and the step cut there), the observer.
+    /// `k4` is RK4's fourth stage (for the step's error estimate; `None` for Dopri5).
     #[inline(always)]
     pub fn after_step(
         &mut self,
@@ -345,6 +346,7 @@ impl<const N: usize> Run<N> {
         k1: &Deriv<N>,
         y1: State<N>,
         err: f64,
+        k4: Option<&Deriv<N>>,
     ) -> Result<()> {
         debug_assert!(!self.in_lanes, "resume the run first");
         let options = &self.options;
@@ -378,6 +380,7 @@ impl<const N: usize> Run<N> {
                 let h_star = earliest * h;
                 let y_star = if h_star > 0.0 {
                     let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
+                    // Dopri5 only (the adaptive step): no RK4 error estimate.
                     partial_step(model, options.method, modes, y, k1, h_star, stats, sample).0
                 } else {
                     *y
@@ -408,6 +411,9 @@ impl<const N: usize> Run<N> {
         };
         if events.none() {
             // Accept the whole step.
+            if let Some(k4) = k4 {
+                obs.step_error(h, k4, &deriv_of(&y1, e1));
+            }
             *y = y1;
             *cur = 1 - *cur;
             let evals = &mut self.evals;
@@ -436,19 +442,25 @@ impl<const N: usize> Run<N> {
             earliest = events.polish(model, modes, &span, earliest, stats);
         }
         let h_star = earliest * h;
-        let y_star = if let Some(y_star) = y_to_event {
-            y_star
+        // The step to the event, and its fourth stage (RK4).
+        let (y_star, k4_star) = if let Some(y_star) = y_to_event {
+            (y_star, None)
         } else if earliest >= 1.0 {
-            y1
+            (y1, k4.copied())
         } else if h_star > 0.0 {
             let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
-            partial_step(model, options.method, modes, y, k1, h_star, stats, sample).0
+            let (y_star, _, k4) =
+                partial_step(model, options.method, modes, y, k1, h_star, stats, sample);
+            (y_star, k4)
         } else {
-            *y
+            (*y, None)
         };
         let t_star = if earliest >= 1.0 { t_next } else { *t + h_star };
         let e_star = model.eval(&y_star.q, &y_star.qd, modes);
         stats.rhs_evals += 1;
+        if let (Some(k4), true) = (k4_star, h_star > 0.0) {
+            obs.step_error(h_star.min(h), &k4, &deriv_of(&y_star, &e_star));
+        }
         if h_star > 0.0 {
             stats.steps += 1;
             obs.step_end(model, &y_star, &e_star, modes);
@@ -536,6 +548,19 @@ impl<const N: usize> Run<N> {
             let (q, stiff) = st.seen_in_lane::<N>(i);
             self.obs.offer(q, &stiff);
         }
+        let k4 = Deriv {
+            q: SVector::from_fn(|k, _| lane(end.qd4[k])),
+            qd: SVector::from_fn(|k, _| lane(end.qdd4[k])),
+            work: 0.0,
+            dissipated: 0.0,
+        };
+        let k5 = Deriv {
+            q: y1.qd,
+            qd: SVector::from_fn(|k, _| lane(end.eval.qdd[k])),
+            work: 0.0,
+            dissipated: 0.0,
+        };
+        self.obs.step_error(self.t_next - self.t, &k4, &k5);
         self.stats.rhs_evals += 4;
         self.y = y1;
         self.t = self.t_next;

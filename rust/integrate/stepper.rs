@@ -101,12 +101,13 @@ pub fn step<const N: usize>(
     k1: &Deriv<N>,
     h: f64,
 ) -> State<N> {
-    step_sampling(model, modes, y, k1, h, |_, _| {})
+    step_sampling(model, modes, y, k1, h, |_, _| {}).0
 }
 
 /// [`step`], showing `sample` each stage's coordinates and the drag's stiffest contact
 /// there: a step that does not resolve the contact meets, at its stages, a stiffness its
-/// ends do not show.
+/// ends do not show. Returns the end and the fourth stage `k4`, whose difference from the
+/// derivative at the end is the step's error estimate ([`companion`]).
 #[inline]
 pub fn step_sampling<const N: usize>(
     model: &Model<N>,
@@ -115,7 +116,7 @@ pub fn step_sampling<const N: usize>(
     k1: &Deriv<N>,
     h: f64,
     mut sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
-) -> State<N> {
+) -> (State<N>, Deriv<N>) {
     let mut f = |s: &State<N>| {
         let (qdd, power, joint_power, stiff) = model.rates_sampled(&s.q, &s.qd, modes);
         sample(&s.q, &stiff);
@@ -134,7 +135,7 @@ pub fn step_sampling<const N: usize>(
     let k4 = f(&y4);
     let s6 = h / 6.0;
     // Component by component, in the same order of operations as the vector form.
-    State {
+    let y1 = State {
         q: SVector::from_fn(|i, _| {
             y.q[i] + s6 * (k1.q[i] + 2.0 * k2.q[i] + 2.0 * k3.q[i] + k4.q[i])
         }),
@@ -145,7 +146,30 @@ pub fn step_sampling<const N: usize>(
         dissipated: y.dissipated
             + (h / 6.0)
                 * (k1.dissipated + 2.0 * k2.dissipated + 2.0 * k3.dissipated + k4.dissipated),
-    }
+    };
+    (y1, k4)
+}
+
+/// The error estimate of an RK4 step of size `h` whose fourth stage is `k4` and whose end's
+/// derivative is `k5` (the next step's first stage, evaluated anyway): `h / 6 (k4 - k5)`,
+/// per coordinate and rate. It is the difference between RK4 and the third-order method
+/// that replaces its last stage by the end's derivative (weights 1/6, 1/3, 1/3, 0, 1/6; it
+/// meets the four order conditions up to order 3), so it is of order h^4 where the
+/// right-hand side is smooth through the step (a bound on RK4's own error, of order h^5),
+/// and of order h times the jump where the force changes abruptly between the fourth stage
+/// and the end (an element's or E's velocity through zero, a speed a step does not
+/// resolve). No evaluation: both stages exist.
+#[inline(always)]
+pub fn companion<const N: usize>(
+    h: f64,
+    k4: &Deriv<N>,
+    k5: &Deriv<N>,
+) -> (SVector<f64, N>, SVector<f64, N>) {
+    let s6 = h / 6.0;
+    (
+        SVector::from_fn(|i, _| s6 * (k4.q[i] - k5.q[i])),
+        SVector::from_fn(|i, _| s6 * (k4.qd[i] - k5.qd[i])),
+    )
 }
 
 /// The Dormand-Prince 5(4) pair (Dormand & Prince 1980, J. Comput. Appl. Math. 6:19-26;
@@ -253,9 +277,10 @@ pub fn dopri5_step<const N: usize>(
 }
 
 /// A whole step of `method` of size `h` from `y`, whose derivative `k1` is known: the new
-/// state, its evaluation written into `e1`, and the error estimate's weighted RMS norm (0 for
-/// RK4, which has none). RK4 shows `sample` each stage's coordinates and the drag's stiffest
-/// contact there (see [`step_sampling`]). Counts the evaluations in `stats`.
+/// state, its evaluation written into `e1`, the error estimate's weighted RMS norm (0 for
+/// RK4, whose step-size is fixed) and RK4's fourth stage (for [`companion`]; `None` for
+/// Dopri5). RK4 shows `sample` each stage's coordinates and the drag's stiffest contact
+/// there (see [`step_sampling`]). Counts the evaluations in `stats`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn full_step<const N: usize>(
@@ -268,26 +293,27 @@ pub fn full_step<const N: usize>(
     e1: &mut Eval<N>,
     stats: &mut Stats,
     sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
-) -> (State<N>, f64) {
+) -> (State<N>, f64, Option<Deriv<N>>) {
     match method {
         Method::Rk4 => {
-            let y1 = step_sampling(model, modes, y, k1, h, sample);
+            let (y1, k4) = step_sampling(model, modes, y, k1, h, sample);
             model.eval_into(&y1.q, &y1.qd, modes, e1);
             stats.rhs_evals += 4;
-            (y1, 0.0)
+            (y1, 0.0, Some(k4))
         }
         Method::Dopri5 { rtol, atol } => {
             let (y1, e, err) = dopri5_step(model, modes, y, k1, h, rtol, atol);
             stats.rhs_evals += 6;
             *e1 = e;
-            (y1, err)
+            (y1, err, None)
         }
     }
 }
 
 /// A step of `method` of size `h` from `y` to a located event, without the evaluation at
-/// its end (RK4: three evaluations; Dopri5 spends its six), and its error estimate's
-/// weighted RMS norm (0 for RK4). RK4 shows `sample` its stages.
+/// its end (RK4: three evaluations; Dopri5 spends its six), its error estimate's
+/// weighted RMS norm (0 for RK4) and RK4's fourth stage (`None` for Dopri5). RK4 shows
+/// `sample` its stages.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn partial_step<const N: usize>(
@@ -299,16 +325,17 @@ pub fn partial_step<const N: usize>(
     h: f64,
     stats: &mut Stats,
     sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
-) -> (State<N>, f64) {
+) -> (State<N>, f64, Option<Deriv<N>>) {
     match method {
         Method::Rk4 => {
             stats.rhs_evals += 3;
-            (step_sampling(model, modes, y, k1, h, sample), 0.0)
+            let (y1, k4) = step_sampling(model, modes, y, k1, h, sample);
+            (y1, 0.0, Some(k4))
         }
         Method::Dopri5 { rtol, atol } => {
             stats.rhs_evals += 6;
             let (y1, _, err) = dopri5_step(model, modes, y, k1, h, rtol, atol);
-            (y1, err)
+            (y1, err, None)
         }
     }
 }

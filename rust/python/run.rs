@@ -209,6 +209,10 @@ pub(super) struct RunOutcome {
     /// Stops the step did not resolve (see `Stats::unresolved_stops`).
     #[pyo3(get)]
     unresolved_stops: usize,
+    /// The steps' estimate of the largest relative error of t_s or depth (see
+    /// `Outcome::step_error`).
+    #[pyo3(get)]
+    step_error: f64,
     /// The rest, moved out (series included, without a copy) by the one `to_dict` call.
     out: Mutex<Option<Outcome>>,
 }
@@ -302,6 +306,7 @@ pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<Ru
         h_lambda: out.h_lambda,
         unresolved: out.stats.unresolved,
         unresolved_stops: out.stats.unresolved_stops,
+        step_error: out.step_error,
         out: Mutex::new(Some(out)),
     })
 }
