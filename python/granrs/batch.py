@@ -457,11 +457,6 @@ def _sweep_space(
             name: [c[k] for c in combos] for k, name in enumerate(names)
         }
     else:
-        if axes:
-            raise InvalidParameterError(
-                "sweep() over a list of scenes takes no axes; vary the scenes instead",
-                field=next(iter(axes)),
-            )
         scenes = list(scene)
         for i, s in enumerate(scenes):
             if not isinstance(s, space.Scene):
@@ -573,6 +568,11 @@ def sweep(
         (6, ['q_deg', 'v0', 'status'])
     """
     n_threads = _threads(threads)
+    if axes and not isinstance(scene, Scene | space.Scene):
+        raise InvalidParameterError(
+            "sweep() over a list of scenes takes no axes; vary the scenes instead",
+            field=next(iter(axes)),
+        )
     if isinstance(scene, space.Scene) or (
         isinstance(scene, Sequence)
         and not isinstance(scene, str)
@@ -588,11 +588,6 @@ def sweep(
         n = math.prod(len(v) for v in plain_axes.values())
         keep_axes = plain_axes
     else:
-        if axes:
-            raise InvalidParameterError(
-                "sweep() over a list of scenes takes no axes; vary the scenes instead",
-                field=next(iter(axes)),
-            )
         scenes = list(scene)
         for i, s in enumerate(scenes):
             if not isinstance(s, Scene):

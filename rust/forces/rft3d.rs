@@ -53,10 +53,7 @@
 //! planar `rft_inertial`; Agarwal, Karsai, Goldman & Kamrin, Science Advances 7 (2021)
 //! eabe0631).
 
-use super::{
-    Acts, Class, ContactKind, ContactState, Medium, Param, Rates, Real, Term, TermForce, TermInfo,
-    SPACE_SHAPES,
-};
+use super::{Acts, Class, ContactState, Medium, Param, Rates, Real, Term, TermInfo, SPACE_SHAPES};
 
 /// The fitted coefficients c_ik of the three functions f_1, f_2, f_3 (rows), in the order of
 /// the monomials T_k (columns; see the module's doc). Where public transcriptions of the SI
@@ -298,12 +295,8 @@ impl Term for Rft3d {
         vec![self.zeta, self.mu_surf, f64::from(u8::from(self.grazing))]
     }
 
-    /// Never evaluated on a planar contact (refused before any work).
-    fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        TermForce::force([F::splat(0.0); 2])
-    }
-
-    /// Never evaluated on a planar contact; a body in space estimates its own stiffness
+    /// Never evaluated on a planar contact (refused before any work; the trait's
+    /// `contact_force` gives it zero there); a body in space estimates its own stiffness
     /// (`crate::space::solve`).
     fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
         Rates::NONE
@@ -355,20 +348,10 @@ impl Term for Rft3dInertial {
         vec![self.lam]
     }
 
-    /// Never evaluated on a planar contact (refused before any work).
-    fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        TermForce::force([F::splat(0.0); 2])
-    }
-
-    /// Never evaluated on a planar contact.
+    /// Never evaluated on a planar contact (as `Rft3d::rates`).
     fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
         Rates::NONE
     }
-}
-
-/// Whether `kind` is a shape in space.
-pub fn in_space(kind: ContactKind) -> bool {
-    SPACE_SHAPES.contains(&kind)
 }
 
 #[cfg(test)]

@@ -507,7 +507,9 @@ impl Shape {
         rule: &Quadrature,
         out: &mut Elements,
     ) {
-        if self.lowest_point(c, q).z >= surface {
+        // Out of the sand: nothing (a mesh's triangles are each skipped when above, without
+        // a second pass over its vertices).
+        if !matches!(self, Shape::Mesh(_)) && self.lowest_point(c, q).z >= surface {
             return;
         }
         let motion = Motion {
