@@ -20,13 +20,16 @@ __all__ = [
     "RFT_GENERIC",
     "SCENE_FIELDS",
     "SPACE_DEFAULT_NODES",
+    "SPACE_GEOM_OUTPUTS",
     "SPACE_MAX_NODES",
+    "SPACE_REST_SPEED",
     "SPACE_SERIES",
     "SPACE_SUMMARY",
     "Compiled",
     "GeomCoupling",
     "RunOutcome",
     "SandGeoms",
+    "SpaceCoupling",
     "SpaceScene",
     "__version__",
     "body_linkage",
@@ -234,6 +237,57 @@ def rft_alpha(beta: Any, gamma: Any, coefficients: list[float]) -> tuple[Any, An
 
 # Bodies in space (granrs.space).
 RFT3D_COEFFICIENTS: list[list[float]]
+SPACE_GEOM_OUTPUTS: list[str]
+SPACE_REST_SPEED: float
+
+@final
+class SpaceCoupling:
+    """Geoms of a MuJoCo model as shapes in space under the terms in space
+    (granrs.mujoco.Sand in three dimensions)."""
+
+    def __new__(
+        cls,
+        names: list[str],
+        shapes: list[dict[str, Any]],
+        forces: list[tuple[str, dict[str, Any]]],
+        rho_g: float,
+        surface: float,
+        patch: list[float],
+        rest_speed: float,
+        quadrature: int,
+        geom: list[int],
+        body: list[int],
+        root: list[int],
+        dofs: list[list[int]],
+        nv: int,
+        implicit_damping: list[float],
+    ) -> SpaceCoupling: ...
+    def bind(
+        self,
+        geom_xpos: Any,
+        geom_xmat: Any,
+        subtree_com: Any,
+        cdof: Any,
+        qvel: Any,
+        qacc: Any,
+        qfrc_applied: Any,
+        qfrc_passive: Any,
+        mass: Any,
+        outputs: Any,
+        applied: Any,
+        h_lambda: Any,
+        generalized: Any,
+        before: Any,
+        after: Any,
+    ) -> None:
+        """Bind one mjData's arrays and the caller's buffers (checked once)."""
+    def step(
+        self, timestep: float, passive: bool, fresh: bool, hold: bool
+    ) -> tuple[float, int, int, float, bool]:
+        """One implicit evaluation at the bound arrays (GIL released). Returns the largest
+        h_lambda, its geom, the Newton iterations, the relative residual and whether the
+        step fell back to sticking or sliding."""
+
 SPACE_SUMMARY: list[tuple[str, str, str]]
 SPACE_SERIES: list[tuple[str, str, str]]
 SPACE_MAX_NODES: int

@@ -44,15 +44,22 @@ except ImportError as exc:  # pragma: no cover - exercised in a venv without muj
 from . import _granrs
 from .api import RK4_STABILITY_LIMIT
 from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
-from .forces import as_terms
+from .forces import Term, as_terms
+from .space import DEFAULT_QUADRATURE, Capsule, Cuboid, Cylinder, Mesh, Sphere
+from .space import Scene as SpaceScene
 
 __all__ = [
     "EULER_STABILITY_LIMIT",
     "GEOM_OUTPUTS",
     "INTEGRATORS",
+    "REST_SPEED",
+    "SPACE_GEOM_OUTPUTS",
+    "SPACE_TERMS",
     "STATICS",
     "WALKER_SAND_GEOMS",
     "Sand",
+    "body_drop",
+    "body_mjcf",
     "free_link_mjcf",
     "rod_drop",
     "walker_mjcf",
@@ -66,6 +73,21 @@ EULER_STABILITY_LIMIT = 2.0
 #: The columns of ``Sand.output``, one row per geom (the core's ``GEOM_OUTPUTS``).
 GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.GEOM_OUTPUTS)
 
+#: The columns of ``Sand.output`` in three dimensions, one row per geom: the depth of its
+#: lowest point [m], its surface elements below the sand, its centre's velocity and its
+#: angular velocity at the step's start, and its centre's velocity at the step's end as the
+#: implicit step solved it.
+SPACE_GEOM_OUTPUTS: tuple[str, ...] = tuple(_granrs.SPACE_GEOM_OUTPUTS)
+
+#: The speed [m/s] below which, in three dimensions, the sand's rate-independent terms fade
+#: to a viscous law (a foot at rest under its full resistance creeps at about this speed):
+#: :class:`Sand`'s default ``rest_speed``.
+REST_SPEED: float = float(_granrs.SPACE_REST_SPEED)
+
+#: The terms that make :class:`Sand` three-dimensional (any of them listed: every geom is a
+#: shape in space; ``poncelet`` acts in either, and with ``space=True`` in space).
+SPACE_TERMS = ("rft3d", "rft3d_inertial")
+
 #: How :class:`Sand` treats the static terms (those with a sticking bound: ``static_h``,
 #: ``static_v``): ``"stick"`` solves each step for the reaction that brings the immersed
 #: centroid's velocity to zero at the step's end, within the terms' bounds (the default);
@@ -78,6 +100,18 @@ _SUPPORTED = {
     int(mujoco.mjtGeom.mjGEOM_BOX): "box",
 }
 _PLANE_TOL = 1e-9
+#: MuJoCo's geom types that are shapes in space (an ellipsoid as a subdivided icosahedron
+#: scaled by its semi-axes, a mesh from the model's own vertices and faces).
+_SPACE_TYPES = {
+    int(mujoco.mjtGeom.mjGEOM_SPHERE): "sphere",
+    int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule",
+    int(mujoco.mjtGeom.mjGEOM_CYLINDER): "cylinder",
+    int(mujoco.mjtGeom.mjGEOM_BOX): "box",
+    int(mujoco.mjtGeom.mjGEOM_ELLIPSOID): "ellipsoid",
+    int(mujoco.mjtGeom.mjGEOM_MESH): "mesh",
+}
+#: Subdivisions of the icosahedron an ellipsoid geom is made of (1280 triangles).
+ELLIPSOID_SUBDIVISIONS = 3
 
 
 def _number(value: Any, name: str) -> float:
@@ -95,38 +129,66 @@ def _number(value: Any, name: str) -> float:
 
 
 class Sand:
-    """granrs's force terms on named rod geoms of a planar MuJoCo model.
+    """granrs's sand under named geoms of a MuJoCo model: in three dimensions under the
+    terms in space, or on a planar model under the planar terms.
+
+    **In three dimensions** (any of :data:`SPACE_TERMS` listed, or ``space=True``): every
+    sphere, capsule, cylinder, box, ellipsoid or mesh geom is the shape in space of
+    :mod:`granrs.space` (a mesh from the model's own vertices and faces; an ellipsoid a
+    subdivided icosahedron scaled by its semi-axes), its whole surface below ``surface``
+    cut exactly, under ``rft3d``, ``rft3d_inertial`` and ``poncelet``; the model may move in
+    any way. The sand is taken implicitly: the wrench each geom receives is the one at the
+    end of MuJoCo's step, solved with the law's exact derivatives, so that a foot at rest
+    holds still without chattering at the model's own timestep (see docs/mujoco.md).
+    ``applied`` holds each geom's force (x, y, z) [N] and moment (x, y, z) [N m] about its
+    shape's centre, world frame; ``output`` the columns :data:`SPACE_GEOM_OUTPUTS`.
+
+    **On a planar model** (the planar terms): the named capsule, cylinder and box geoms of a
+    model that moves in the x-z plane are the free link's rod and the leg's sole box, as
+    below; ``applied`` holds the force (x, z) [N] and moment about y [N m] at the tip,
+    ``output`` the columns :data:`GEOM_OUTPUTS`.
 
     Args:
-        model: a ``mujoco.MjModel`` that moves in the x-z plane (gravity along -z).
-        geoms: names of capsule, cylinder or box geoms. A capsule or cylinder is the free
-            link's rod: its tip T is the lower end of its axis, its diameter d_c twice its
-            radius, its length L (also L_ref) the cylinder's length; a capsule's caps count
-            (T is the bottom of the lower cap, L the capsule's whole length, as the thesis's
-            round-ended rod). A box is the leg's sole box: f_s its length along x (also
-            L_ref), w_s its width along y; use ``apply_at="centroid"`` with boxes (see
-            docs/mujoco.md).
-        forces: the medium's contact terms (``granrs.forces``: ``drag``, ``static_h``,
-            ``static_v``, ...). MuJoCo applies gravity and the joints: a ``gravity`` or
-            ``joint_springs`` term is an error naming it. A parameter is one value for every
-            geom or a tuple with one per geom.
+        model: a ``mujoco.MjModel`` (gravity along -z).
+        geoms: names of the geoms in the sand. Planar: capsule, cylinder or box geoms. A
+            capsule or cylinder is the free link's rod: its tip T is the lower end of its
+            axis, its diameter d_c twice its radius, its length L (also L_ref) the
+            cylinder's length; a capsule's caps count (T is the bottom of the lower cap, L
+            the capsule's whole length, as the thesis's round-ended rod). A box is the leg's
+            sole box: f_s its length along x (also L_ref), w_s its width along y; use
+            ``apply_at="centroid"`` with boxes (see docs/mujoco.md).
+        forces: the medium's contact terms (``granrs.forces``): ``rft3d``,
+            ``rft3d_inertial``, ``poncelet`` in three dimensions; ``drag``, ``static_h``,
+            ``static_v``, ``rft``, ... on a planar model. MuJoCo applies gravity and the
+            joints: a ``gravity`` or ``joint_springs`` term is an error naming it. Planar: a
+            parameter is one value for every geom or a tuple with one per geom.
         surface: height z of the sand's surface [m].
         rho_g: the sand's bulk density [kg/m^3] (the thesis's 1650). The static terms use
             g = |``model.opt.gravity``|.
-        apply_at: ``"tip"`` (as :func:`granrs.simulate`'s default; a box's sole middle) or
-            ``"centroid"``.
-        patch: the sand's extent in x, ``(x_min, x_max)`` [m]; a geom whose tip is outside
-            feels nothing from the sand. Geoms not listed keep MuJoCo's own contacts.
-        statics: ``"stick"`` (default) or ``"raw"``: see :data:`STATICS` and docs/mujoco.md.
-        sign_model: ``"raw"`` (the thesis's sign) or ``"smooth"`` (``tanh(v / smooth_eps)``).
-        smooth_eps: the smooth sign's velocity scale [m/s].
+        apply_at: planar only: ``"tip"`` (as :func:`granrs.simulate`'s default; a box's sole
+            middle) or ``"centroid"``.
+        patch: the sand's extent, ``(x_min, x_max)`` or ``(x_min, x_max, y_min, y_max)``
+            [m]; a geom whose tip (planar) or centre (in space) is outside feels nothing
+            from the sand. Geoms not listed keep MuJoCo's own contacts.
+        statics: planar only: ``"stick"`` (default) or ``"raw"``: see :data:`STATICS`.
+        sign_model: planar only: ``"raw"`` (the thesis's sign) or ``"smooth"``
+            (``tanh(v / smooth_eps)``).
+        smooth_eps: planar only: the smooth sign's velocity scale [m/s].
+        space: ``True`` for three dimensions whatever the terms, ``False`` for planar;
+            ``None`` (default): three dimensions where a term of :data:`SPACE_TERMS` is
+            listed.
+        rest_speed: in space: below this speed [m/s] the rate-independent terms fade to a
+            viscous law (:data:`REST_SPEED`).
+        quadrature: in space: Gauss-Legendre nodes per panel of a curved surface
+            (:data:`granrs.space.DEFAULT_QUADRATURE`).
 
     Every argument is checked here, before the first step; each error is a
     :class:`granrs.GranrsError` (a ``ValueError``) naming the geom or parameter.
 
-    After each step, ``output`` holds each geom's evaluation (columns
-    :data:`GEOM_OUTPUTS`), ``applied`` the force (x, z) [N] and moment about y [N m]
-    applied at its tip, and ``h_lambda`` each geom's timestep times the drag's rate.
+    After each step, ``output`` holds each geom's evaluation, ``applied`` what it
+    received, and ``h_lambda`` each geom's timestep times the sand's rate (planar: the
+    drag's; in space: the largest rate an explicit step would meet, which the implicit step
+    does not need).
     """
 
     def __init__(
@@ -141,6 +203,9 @@ class Sand:
         statics: str = "stick",
         sign_model: str = "raw",
         smooth_eps: float = 1e-3,
+        space: bool | None = None,
+        rest_speed: float = REST_SPEED,
+        quadrature: int = DEFAULT_QUADRATURE,
     ) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidParameterError(
@@ -168,17 +233,19 @@ class Sand:
         if eps <= 0.0:
             raise InvalidParameterError(f"`smooth_eps` must be > 0, got {eps}", field="smooth_eps")
         try:
-            lo, hi = (float(x) for x in patch)
+            bounds = [float(x) for x in patch]
         except (TypeError, ValueError):
+            bounds = []
+        pairs = list(zip(bounds[::2], bounds[1::2], strict=False))
+        if len(bounds) not in (2, 4) or not all(lo < hi for lo, hi in pairs):
             raise InvalidParameterError(
-                f"`patch` must be (x_min, x_max), got {patch!r}", field="patch"
-            ) from None
-        if math.isnan(lo) or math.isnan(hi) or not lo < hi:
-            raise InvalidParameterError(
-                f"`patch` must be (x_min, x_max) with x_min < x_max, got {patch!r}",
+                "`patch` must be (x_min, x_max) or (x_min, x_max, y_min, y_max), each "
+                f"min below its max, got {patch!r}",
                 field="patch",
             )
-        self.patch = (lo, hi)
+        if len(bounds) == 2:
+            bounds += [-math.inf, math.inf]
+        self.patch = tuple(bounds)
         gravity = np.asarray(model.opt.gravity, dtype=float)
         if not np.all(np.isfinite(gravity)) or abs(gravity[0]) > 0 or abs(gravity[1]) > 0:
             raise InvalidSceneError(
@@ -186,6 +253,36 @@ class Sand:
                 field="model.opt.gravity",
             )
         self.g = float(np.linalg.norm(gravity))
+        terms = list(as_terms(forces))
+        if space is None:
+            space = any(t.name in SPACE_TERMS for t in terms)
+        elif not isinstance(space, bool | np.bool_):
+            raise InvalidParameterError(
+                f"`space` must be True, False or None, got {space!r}", field="space"
+            )
+        #: Whether the geoms are shapes in space (else the planar rod and box).
+        self.space = bool(space)
+        self._warned = False
+        self._stage = (0, math.nan)
+        # The model's options (a live view: the timestep is read at every step) and its
+        # integrator, read here as the implicit damping is.
+        self._opt = model.opt
+        self._rk4 = model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
+        self._data_ref: Any = None
+        self._mass = np.zeros((model.nv, model.nv))
+        self._generalized = np.zeros(model.nv)
+        self._before = np.zeros(model.nv)
+        self._after = np.zeros(model.nv)
+        #: The largest of ``h_lambda`` over every step so far.
+        self.max_h_lambda = 0.0
+        if self.space:
+            self._init_space(names, terms, rho, rest_speed, quadrature)
+            return
+        if len(self.patch) == 4 and math.isfinite(self.patch[2] - self.patch[3]):
+            raise InvalidParameterError(
+                "a planar model's patch is (x_min, x_max): it has no y extent", field="patch"
+            )
+        self.patch = self.patch[:2]
 
         ids, half, shapes = [], [], []
         for i, name in enumerate(names):
@@ -230,16 +327,8 @@ class Sand:
             eps,
         )
         self.apply_at = apply_at
-        dofs = []
-        for body in self._body:
-            chain, b = [], int(body)
-            while b > 0:
-                chain.extend(
-                    range(model.body_dofadr[b], model.body_dofadr[b] + model.body_dofnum[b])
-                )
-                b = int(model.body_parentid[b])
-            dofs.append(sorted(chain))
-        self._coupling = _granrs.GeomCoupling(
+        dofs = self._dofs(self._body)
+        self._coupling: Any = _granrs.GeomCoupling(
             self._core,
             [int(i) for i in self._ids],
             [int(b) for b in self._body],
@@ -259,19 +348,109 @@ class Sand:
         self.applied = np.zeros((n, 3))
         #: Each geom's timestep times the drag's rate at the last step (0 out of the sand).
         self.h_lambda = np.zeros(n)
-        #: The largest of ``h_lambda`` over every step so far.
-        self.max_h_lambda = 0.0
-        self._warned = False
-        self._mass = np.zeros((model.nv, model.nv))
-        self._stage = (0, math.nan)
-        # The model's options (a live view: the timestep is read at every step) and its
-        # integrator, read here as the implicit damping is.
-        self._opt = model.opt
-        self._rk4 = model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
-        self._generalized = np.zeros(model.nv)
-        self._data_ref: Any = None
-        self._before = np.zeros(model.nv)
-        self._after = np.zeros(model.nv)
+
+    def _dofs(self, bodies: Any) -> list[list[int]]:
+        """The dofs that move each body: its joints' and its ancestors'."""
+        m = self.model
+        out = []
+        for body in bodies:
+            chain, b = [], int(body)
+            while b > 0:
+                chain.extend(range(m.body_dofadr[b], m.body_dofadr[b] + m.body_dofnum[b]))
+                b = int(m.body_parentid[b])
+            out.append(sorted(chain))
+        return out
+
+    def _space_shape(self, i: int, name: str, gid: int) -> Any:
+        """Geom ``gid``'s shape in space (its frame the geom's)."""
+        m = self.model
+        kind = int(m.geom_type[gid])
+        if kind not in _SPACE_TYPES:
+            type_name = mujoco.mjtGeom(kind).name.removeprefix("mjGEOM_").lower()
+            raise InvalidSceneError(
+                f"geom `{name}` is a {type_name}; Sand in space takes "
+                f"{', '.join(_SPACE_TYPES.values())} geoms",
+                field=f"geoms[{i}]",
+            )
+        size = [float(x) for x in m.geom_size[gid]]
+        what = _SPACE_TYPES[kind]
+        if what == "sphere":
+            return Sphere(size[0])
+        if what == "capsule":
+            return Capsule(size[0], 2.0 * size[1])
+        if what == "cylinder":
+            return Cylinder(size[0], 2.0 * size[1])
+        if what == "box":
+            return Cuboid((2.0 * size[0], 2.0 * size[1], 2.0 * size[2]))
+        if what == "ellipsoid":
+            ball = Mesh.icosphere(1.0, ELLIPSOID_SUBDIVISIONS)
+            return Mesh(ball.vertices * np.asarray(size), ball.triangles)
+        mesh = int(m.geom_dataid[gid])
+        if mesh < 0 or m.mesh_vertnum[mesh] == 0 or m.mesh_facenum[mesh] == 0:
+            raise InvalidSceneError(
+                f"mesh geom `{name}` has no vertex or face data in the model",
+                field=f"geoms[{i}]",
+            )
+        v0, nvert = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
+        f0, nface = int(m.mesh_faceadr[mesh]), int(m.mesh_facenum[mesh])
+        return Mesh(
+            np.array(m.mesh_vert[v0 : v0 + nvert], dtype=float),
+            np.array(m.mesh_face[f0 : f0 + nface], dtype=np.int64),
+        )
+
+    def _init_space(
+        self, names: list[str], terms: list[Term], rho: float, rest_speed: Any, quadrature: Any
+    ) -> None:
+        m = self.model
+        speed = _number(rest_speed, "rest_speed")
+        if speed <= 0.0:
+            raise InvalidParameterError(
+                f"`rest_speed` must be > 0, got {speed}", field="rest_speed"
+            )
+        if isinstance(quadrature, bool | np.bool_) or not isinstance(quadrature, int | np.integer):
+            raise InvalidParameterError(
+                f"`quadrature` must be an integer, got {quadrature!r}", field="quadrature"
+            )
+        ids, shapes = [], []
+        for i, name in enumerate(names):
+            gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, name)
+            if gid < 0:
+                raise UnknownNameError(f"the model has no geom named `{name}`", field=f"geoms[{i}]")
+            ids.append(gid)
+            shapes.append(self._space_shape(i, name, gid)._dict())
+        self.geoms = tuple(names)
+        self._ids = np.asarray(ids, dtype=np.intp)
+        self._body = np.asarray(m.geom_bodyid[self._ids], dtype=np.intp)
+        self._root = np.asarray(m.body_rootid[self._body], dtype=np.intp)
+        self.rest_speed = speed
+        self.apply_at = "centre"
+        self._coupling = _granrs.SpaceCoupling(
+            list(names),
+            shapes,
+            [(t.name, dict(t.params)) for t in terms],
+            rho,
+            self.surface,
+            list(self.patch),
+            speed,
+            int(quadrature),
+            [int(g) for g in self._ids],
+            [int(b) for b in self._body],
+            [int(r) for r in self._root],
+            self._dofs(self._body),
+            m.nv,
+            self._implicit_damping(),
+        )
+        n = len(names)
+        self.output = np.zeros((n, len(SPACE_GEOM_OUTPUTS)))
+        self.applied = np.zeros((n, 6))
+        self.h_lambda = np.zeros(n)
+        #: Newton iterations of the last step's implicit solve, its residual (the twists'
+        #: largest error over their scale) and whether that is below 1e-10.
+        self.iterations, self.residual, self.converged = 0, 0.0, True
+        #: The largest residual over every step so far.
+        self.max_residual = 0.0
+        #: Steps whose implicit solve did not converge and stuck or slid instead.
+        self.fallbacks = 0
 
     def _implicit_damping(self) -> list[float]:
         """The dof damping that MuJoCo's step takes implicitly (its velocity update is
@@ -344,7 +523,8 @@ class Sand:
         # kinematics and the mass matrix to qpos and qvel.
         mujoco.mj_kinematics(m, data)
         mujoco.mj_comPos(m, data)
-        mujoco.mj_comVel(m, data)
+        if not self.space:
+            mujoco.mj_comVel(m, data)
         mujoco.mj_makeM(m, data)
         self._evaluate(data, passive=False)
 
@@ -400,6 +580,47 @@ class Sand:
         (``passive``) or ``qfrc_applied``, and the drag's h lambda."""
         m = self.model
         fresh = data is not self._data_ref
+        if self.space:
+            if fresh:
+                self._coupling.bind(
+                    data.geom_xpos,
+                    data.geom_xmat,
+                    data.subtree_com,
+                    data.cdof,
+                    data.qvel,
+                    data.qacc,
+                    data.qfrc_applied,
+                    data.qfrc_passive,
+                    self._mass,
+                    self.output,
+                    self.applied,
+                    self.h_lambda,
+                    self._generalized,
+                    self._before,
+                    self._after,
+                )
+                self._data_ref = data
+            mujoco.mj_fullM(m, data, self._mass)
+            worst, _, self.iterations, self.residual, fell = self._coupling.step(
+                self._opt.timestep, passive, fresh, hold
+            )
+            self.converged = self.residual <= 1e-10
+            self.max_residual = max(self.max_residual, self.residual)
+            self.max_h_lambda = max(self.max_h_lambda, worst)
+            self.fallbacks += int(fell)
+            if fell and not self._warned:
+                self._warned = True
+                warnings.warn(
+                    StepSizeWarning(
+                        f"the sand's implicit step did not converge at MuJoCo's timestep "
+                        f"{self._opt.timestep:g} s (its residual is {self.residual:.2g} of the "
+                        f"geoms' speeds after {self.iterations} Newton iterations): that step "
+                        "stuck or slid instead (see Sand.fallbacks); a smaller timestep "
+                        "resolves the sand"
+                    ),
+                    stacklevel=4,
+                )
+            return
         if fresh:
             # MuJoCo allocates an mjData's arrays once: the core binds their views once.
             self._coupling.bind(
@@ -608,6 +829,150 @@ def rod_drop(
         "tip": np.asarray(after_tip),
         "energy": np.asarray(after_e),
         "sand": sand,
+    }
+
+
+def body_mjcf(scene: Any, timestep: float = 1e-4, integrator: str = "Euler") -> str:
+    """The MJCF of a body in space (a :class:`granrs.space.Scene`): its shape as a geom
+    ``body`` (a mesh from :meth:`granrs.space.Scene.body_vertices`) on a body with a free
+    joint, the scene's mass and inertia tensor, gravity ``scene.g`` along -z, no
+    contacts."""
+    if not isinstance(scene, SpaceScene):
+        raise InvalidParameterError(
+            f"body_mjcf takes a granrs.space.Scene, got {type(scene).__name__}", field="scene"
+        )
+    if integrator not in INTEGRATORS:
+        raise UnknownNameError(
+            f"unknown integrator `{integrator}` (allowed: {', '.join(INTEGRATORS)})",
+            field="integrator",
+        )
+    shape = scene.body.shape
+    asset = ""
+    if isinstance(shape, Sphere):
+        geom = f'type="sphere" size="{shape.radius!r}"'
+    elif isinstance(shape, Capsule | Cylinder):
+        kind = "capsule" if isinstance(shape, Capsule) else "cylinder"
+        geom = f'type="{kind}" size="{shape.radius!r} {shape.length / 2!r}"'
+    elif isinstance(shape, Cuboid):
+        geom = 'type="box" size="{!r} {!r} {!r}"'.format(*(x / 2 for x in shape.size))
+    else:
+        v = scene.body_vertices()
+        t = np.asarray(shape.triangles)
+        asset = (
+            '<asset><mesh name="body" vertex="'
+            + " ".join(repr(float(x)) for x in np.ravel(v))
+            + '" face="'
+            + " ".join(str(int(x)) for x in np.ravel(t))
+            + '"/></asset>'
+        )
+        geom = 'type="mesh" mesh="body"'
+    i = np.asarray(scene.inertia, dtype=float)
+    full = " ".join(repr(float(x)) for x in (i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]))
+    return f"""<mujoco model="granrs body in space">
+  <option timestep="{_number(timestep, "timestep")!r}" integrator="{integrator}"
+          gravity="0 0 {-float(scene.g)!r}"/>
+  {asset}
+  <worldbody>
+    <body name="body">
+      <freejoint name="free"/>
+      <inertial pos="0 0 0" mass="{scene.mass!r}" fullinertia="{full}"/>
+      <geom name="body" {geom} contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def body_drop(
+    scene: Any,
+    timestep: float = 1e-4,
+    integrator: str = "Euler",
+    mode: str = "step",
+    t_after: float = 0.0,
+    stop_speed: float = 1e-3,
+    **sand: Any,
+) -> dict[str, Any]:
+    """Drop a body in space (a :class:`granrs.space.Scene`) in MuJoCo (:func:`body_mjcf`)
+    with :class:`Sand` under the scene's terms (less ``gravity``, which MuJoCo applies),
+    from the scene's initial state, until its stop and ``t_after`` seconds on; ``sand``:
+    more arguments of :class:`Sand`.
+
+    The implicit sand brings the body to rest at a creep, not to an upward velocity: the
+    stop is the first step over which the lowest point sinks slower than ``stop_speed``
+    [m/s], interpolated linearly inside the step. Returns ``t_s`` [s], ``depth`` [m] (the
+    lowest point's, at the stop), ``steps``; and per step after the stop ``t``, ``depth``,
+    ``force`` (the sand's, x, y, z [N]) and ``energy`` (KE + gravitational PE [J]).
+    ``mode`` is ``"step"`` (:meth:`Sand.step`) or ``"callback"`` (:meth:`Sand.install`).
+    """
+    if mode not in ("step", "callback"):
+        raise UnknownNameError(f"unknown mode `{mode}` (allowed: step, callback)", field="mode")
+    speed = _number(stop_speed, "stop_speed")
+    if speed <= 0.0:
+        raise InvalidParameterError(f"`stop_speed` must be > 0, got {speed}", field="stop_speed")
+    model = mujoco.MjModel.from_xml_string(body_mjcf(scene, timestep, integrator))
+    data = mujoco.MjData(model)
+    w, x, y, z = (float(c) for c in scene.orientation)
+    rot = np.zeros(9)
+    mujoco.mju_quat2Mat(rot, np.array([w, x, y, z]))
+    data.qpos[:3] = scene.position
+    data.qpos[3:7] = (w, x, y, z)
+    data.qvel[:3] = scene.velocity
+    # A free joint's angular velocity is in the body's frame.
+    data.qvel[3:6] = rot.reshape(3, 3).T @ np.asarray(scene.omega, dtype=float)
+    terms = [t for t in scene.forces if t.name != "gravity"]
+    sand_ = Sand(
+        model, ["body"], terms, surface=scene.surface, rho_g=scene.rho_g, space=True, **sand
+    )
+    mass, inertia, g = scene.mass, np.asarray(scene.inertia, dtype=float), float(scene.g)
+
+    def energy() -> float:
+        v, om = data.qvel[:3], data.qvel[3:6]
+        return float(0.5 * mass * v @ v + 0.5 * om @ inertia @ om + mass * g * data.qpos[2])
+
+    def advance() -> float:
+        if mode == "step":
+            sand_.step(data)
+        mujoco.mj_step(model, data)
+        return float(sand_.output[0, 0])
+
+    if mode == "callback":
+        sand_.install()
+    try:
+        mujoco.mj_forward(model, data)
+        limit = math.ceil(max(scene.t_end, 1.0) / timestep)
+        # The depth each step starts from (the sand's output at that step).
+        d_prev, t_s, depth, steps = math.nan, math.nan, math.nan, limit
+        rate_prev = math.inf
+        for k in range(limit):
+            d = advance()
+            if k > 0:
+                rate = (d - d_prev) / timestep
+                if rate < speed and d > 0.0:
+                    f = (rate_prev - speed) / (rate_prev - rate) if rate_prev > rate else 1.0
+                    f = min(max(f, 0.0), 1.0)
+                    t_s = (k - 1 + f) * timestep
+                    depth = d_prev + f * (d - d_prev)
+                    steps = k
+                    break
+                rate_prev = rate
+            d_prev = d
+        after_t, after_d, after_f, after_e = [], [], [], []
+        for _ in range(round(t_after / timestep)):
+            after_d.append(advance())
+            after_t.append(float(data.time))
+            after_f.append(sand_.applied[0, :3].copy())
+            after_e.append(energy())
+    finally:
+        if mode == "callback":
+            sand_.uninstall()
+    return {
+        "t_s": t_s,
+        "depth": depth,
+        "steps": steps,
+        "t": np.asarray(after_t),
+        "depth_after": np.asarray(after_d),
+        "force": np.asarray(after_f).reshape(-1, 3),
+        "energy": np.asarray(after_e),
+        "sand": sand_,
     }
 
 

@@ -194,6 +194,218 @@ pub fn stress_capped<F: Real, const CAP: bool>(
     ]
 }
 
+/// The three fitted functions and their gradients: `(f, g)` with `g[i][k] = d f_i / d x_k`.
+pub fn fitted_with_gradient(x1: f64, x2: f64, x3: f64) -> ([f64; 3], [[f64; 3]; 3]) {
+    let f = fitted(x1, x2, x3);
+    // d T_k / d x1, d x2, d x3 for the monomials of `fitted`, in its order.
+    let d1 = [
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        2.0 * x1,
+        0.0,
+        0.0,
+        x2,
+        0.0,
+        x3,
+        3.0 * x1 * x1,
+        0.0,
+        0.0,
+        x2 * x2,
+        2.0 * x1 * x2,
+        0.0,
+        0.0,
+        2.0 * x1 * x3,
+        x3 * x3,
+        x2 * x3,
+    ];
+    let d2 = [
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        2.0 * x2,
+        0.0,
+        x1,
+        x3,
+        0.0,
+        0.0,
+        3.0 * x2 * x2,
+        0.0,
+        2.0 * x1 * x2,
+        x1 * x1,
+        x3 * x3,
+        2.0 * x2 * x3,
+        0.0,
+        0.0,
+        x1 * x3,
+    ];
+    let d3 = [
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        2.0 * x3,
+        0.0,
+        x2,
+        x1,
+        0.0,
+        0.0,
+        3.0 * x3 * x3,
+        0.0,
+        0.0,
+        2.0 * x2 * x3,
+        x2 * x2,
+        x1 * x1,
+        2.0 * x1 * x3,
+        x1 * x2,
+    ];
+    let mut g = [[0.0; 3]; 3];
+    for (gi, c) in g.iter_mut().zip(COEFFICIENTS.iter()) {
+        for (k, d) in [d1, d2, d3].iter().enumerate() {
+            gi[k] = c.iter().zip(d.iter()).map(|(a, b)| a * b).sum();
+        }
+    }
+    (f, g)
+}
+
+/// The stress per unit depth [N/m^3] of `rft3d` on an element (normal `n`, velocity `u`)
+/// made continuous in the velocity over the speed `eps` [m/s], and its derivative with
+/// respect to `u`: `(sigma, d sigma / d u)` with
+/// `sigma = lead(n . u) phi(|u|) stress(n, u)`, `phi(s) = s / sqrt(s^2 + eps^2)`, and the
+/// leading test a ramp over `eps`: `lead = clamp(n . u / eps + 1, 0, 1)` (grazing elements
+/// counted; `clamp(n . u / eps, 0, 1)` where they are not). With `eps = 0` it is
+/// [`stress`] exactly (phi = 1, the law's step).
+///
+/// The law gives no unique force at rest (it reads only the direction of the velocity)
+/// and jumps where an element turns from leading to trailing; `phi` makes it a stiff
+/// viscous law below `eps` and the ramp makes it continuous, so that an implicit step can
+/// hold a body at rest (`crate::space::engine`). At speed `|u|` the ramp changes the law
+/// only on elements within `eps / |u|` of grazing. The derivative is exact away from the
+/// law's own jump where a face turns through vertical (a change of position, not of
+/// velocity), the cap's switch and the ramp's ends; it is zero at `u = 0`.
+pub fn stress_with_rate(
+    law: &Rft3d,
+    n: [f64; 3],
+    u: [f64; 3],
+    eps: f64,
+) -> ([f64; 3], [[f64; 3]; 3]) {
+    let zero = ([0.0; 3], [[0.0; 3]; 3]);
+    let s2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    if s2 <= 0.0 {
+        return zero;
+    }
+    let s = s2.sqrt();
+    let vh = [u[0] / s, u[1] / s, u[2] / s];
+    let threshold = if law.grazing {
+        GRAZING_TOL
+    } else {
+        -GRAZING_TOL
+    };
+    // Leading: with eps, a ramp from n . u = -eps (nothing) to 0 (all; grazing counted),
+    // or from 0 to eps where grazing elements are left out; else the law's step.
+    let nu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+    let (lead, dlead) = if eps > 0.0 {
+        let x = if law.grazing {
+            nu / eps + 1.0
+        } else {
+            nu / eps
+        };
+        if x >= 1.0 {
+            (1.0, 0.0)
+        } else if x > 0.0 {
+            (x, 1.0 / eps)
+        } else {
+            return zero;
+        }
+    } else if nu / s + threshold > 0.0 {
+        (1.0, 0.0)
+    } else {
+        return zero;
+    };
+    // alpha and d alpha / d v^ (uncapped), as `generic_stress`.
+    let sign = if -n[2] - GRAZING_TOL > 0.0 { 1.0 } else { -1.0 };
+    let m = [sign * n[0], sign * n[1], sign * n[2]];
+    let x1 = -vh[2];
+    let x2 = n[2].abs();
+    let x3 = m[0] * vh[0] + m[1] * vh[1] + m[2] * vh[2];
+    let (f, g) = fitted_with_gradient(x1, x2, x3);
+    let mut a = [
+        f[0] * m[0] + f[1] * vh[0],
+        f[0] * m[1] + f[1] * vh[1],
+        f[0] * m[2] + f[1] * vh[2] - f[2],
+    ];
+    // d f_i / d v^ = -g_i1 z^ + g_i3 m
+    let df = |i: usize| [g[i][2] * m[0], g[i][2] * m[1], g[i][2] * m[2] - g[i][0]];
+    let (df1, df2, df3) = (df(0), df(1), df(2));
+    let mut ja = [[0.0; 3]; 3];
+    for r in 0..3 {
+        for c in 0..3 {
+            let z = if r == 2 { 1.0 } else { 0.0 };
+            let delta = if r == c { f[1] } else { 0.0 };
+            ja[r][c] = m[r] * df1[c] + delta + vh[r] * df2[c] - z * df3[c];
+        }
+    }
+    if law.mu_surf != f64::INFINITY {
+        // The cap: alpha_c = an n + (cap / |at|) at where |at| > cap = mu |an|.
+        let an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+        let at = [a[0] - an * n[0], a[1] - an * n[1], a[2] - an * n[2]];
+        let at_norm = (at[0] * at[0] + at[1] * at[1] + at[2] * at[2]).sqrt();
+        let cap = law.mu_surf * an.abs();
+        if at_norm > cap {
+            let k = cap / at_norm;
+            let sg = if an >= 0.0 { 1.0 } else { -1.0 };
+            // d alpha_c / d alpha = n n^T + at (mu sg n / |at| - cap at / |at|^3)^T + k P
+            let mut jc = [[0.0; 3]; 3];
+            for r in 0..3 {
+                for c in 0..3 {
+                    let p = if r == c { 1.0 } else { 0.0 } - n[r] * n[c];
+                    jc[r][c] = n[r] * n[c]
+                        + at[r]
+                            * (law.mu_surf * sg * n[c] / at_norm
+                                - cap * at[c] / (at_norm * at_norm * at_norm))
+                        + k * p;
+                }
+            }
+            let mut prod = [[0.0; 3]; 3];
+            for r in 0..3 {
+                for c in 0..3 {
+                    prod[r][c] = (0..3).map(|j| jc[r][j] * ja[j][c]).sum();
+                }
+            }
+            ja = prod;
+            a = [
+                an * n[0] + k * at[0],
+                an * n[1] + k * at[1],
+                an * n[2] + k * at[2],
+            ];
+        }
+    }
+    // sigma = zeta lead(n . u) phi(s) alpha(u / s):
+    // d sigma / d u = zeta (lead (phi'(s) alpha v^T + (phi(s) / s) J_alpha (I - v^ v^T))
+    //                       + lead' phi(s) alpha n^T).
+    let root = (s2 + eps * eps).sqrt();
+    let phi = s / root;
+    let dphi = eps * eps / (root * root * root);
+    let over_s = 1.0 / root;
+    let mut sigma = [0.0; 3];
+    let mut jac = [[0.0; 3]; 3];
+    for r in 0..3 {
+        sigma[r] = law.zeta * lead * phi * a[r];
+        let jv: f64 = (0..3).map(|j| ja[r][j] * vh[j]).sum();
+        for c in 0..3 {
+            jac[r][c] = law.zeta
+                * (lead * (dphi * a[r] * vh[c] + over_s * (ja[r][c] - jv * vh[c]))
+                    + dlead * phi * a[r] * n[c]);
+        }
+    }
+    (sigma, jac)
+}
+
 /// `rft3d`'s numbers as the element kernel reads them (one value, or one per lane).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rft3dLanes<F> {
@@ -468,6 +680,75 @@ mod tests {
             "the case must be capped"
         );
         assert!((tang(capped) - 0.1 * dot(capped).abs()).abs() < 1e-14);
+    }
+
+    /// The derivative of `stress_with_rate` against central differences, with and without
+    /// the cap and the rest speed, on random leading pairs away from the law's jumps.
+    #[test]
+    fn the_rate_is_the_derivative_of_the_stress() {
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let (mut checked, mut ramped) = (0, 0);
+        for trial in 0..2000 {
+            let unit = |v: [f64; 3]| {
+                let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                [v[0] / l, v[1] / l, v[2] / l]
+            };
+            let n = unit([rnd(), rnd(), rnd()]);
+            let scale = [1e-6, 1e-3, 1.0][trial % 3];
+            let u = [scale * rnd(), scale * rnd(), scale * rnd()];
+            let law = Rft3d {
+                zeta: 2.0e5,
+                mu_surf: if trial % 2 == 0 { f64::INFINITY } else { 0.2 },
+                grazing: true,
+            };
+            let eps = if trial % 4 < 2 { 1e-5 } else { 0.0 };
+            let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let nu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+            // Leading, or (with eps) inside the leading test's ramp, away from its ends.
+            let ramp = eps > 0.0 && (0.05..0.95).contains(&(nu / eps + 1.0));
+            if (nu / speed < 0.05 && !ramp) || n[2].abs() < 0.05 {
+                continue;
+            }
+            ramped += usize::from(ramp);
+            let (sig, jac) = stress_with_rate(&law, n, u, eps);
+            if eps == 0.0 {
+                let plain = stress(&law.lanes(), n, u);
+                for k in 0..3 {
+                    assert!(
+                        (sig[k] - plain[k]).abs() <= 1e-12 * law.zeta,
+                        "{sig:?} {plain:?}"
+                    );
+                }
+            }
+            let h = 1e-6 * speed;
+            for c in 0..3 {
+                let (mut up, mut dn) = (u, u);
+                up[c] += h;
+                dn[c] -= h;
+                let (a, _) = stress_with_rate(&law, n, up, eps);
+                let (b, _) = stress_with_rate(&law, n, dn, eps);
+                for r in 0..3 {
+                    let fd = (a[r] - b[r]) / (2.0 * h);
+                    let size = jac[r]
+                        .iter()
+                        .map(|x| x.abs())
+                        .fold(law.zeta / speed * 1e-3, f64::max);
+                    assert!(
+                        (fd - jac[r][c]).abs() <= 1e-5 * size,
+                        "n {n:?} u {u:?} eps {eps}: d{r}/d{c} {} vs {fd}",
+                        jac[r][c]
+                    );
+                }
+            }
+            checked += 1;
+        }
+        assert!(checked > 300 && ramped > 20, "{checked} {ramped}");
     }
 
     #[test]

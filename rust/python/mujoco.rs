@@ -17,6 +17,9 @@ use crate::evaluate::geoms::{
     self, Coupling, EngineOut, EnginePlace, EngineState, GeomShape, Work, MAX_COUPLED, STATE,
 };
 use crate::forces::{ForceSet, Medium};
+use crate::space::engine as space_engine;
+use crate::space::load::{Sand, Terms3};
+use crate::space::shape::{Quadrature, Shape};
 use crate::spec::Value;
 
 /// N geoms (rods and sole boxes) under a list of contact terms in one sand, checked once;
@@ -425,3 +428,286 @@ unsafe fn rw<'a, D: numpy::ndarray::Dimension>(
 
 type Bound1<'py> = Bound<'py, PyArray1<f64>>;
 type Bound2<'py> = Bound<'py, PyArray2<f64>>;
+
+/// The arrays one `SpaceCoupling` reads and writes at every step, bound once per `mjData`.
+struct SpaceArrays {
+    geom_xpos: Py<PyArray2<f64>>,
+    geom_xmat: Py<PyArray2<f64>>,
+    subtree_com: Py<PyArray2<f64>>,
+    cdof: Py<PyArray2<f64>>,
+    mass: Py<PyArray2<f64>>,
+    qvel: Py<PyArray1<f64>>,
+    qacc: Py<PyArray1<f64>>,
+    outputs: Py<PyArray2<f64>>,
+    applied: Py<PyArray2<f64>>,
+    h_lambda: Py<PyArray1<f64>>,
+    generalized: Py<PyArray1<f64>>,
+    qfrc_applied: Py<PyArray1<f64>>,
+    qfrc_passive: Py<PyArray1<f64>>,
+    before: Py<PyArray1<f64>>,
+    after: Py<PyArray1<f64>>,
+}
+
+/// Geoms of a MuJoCo model as shapes in space under the terms in space
+/// (`granrs.mujoco.Sand` in three dimensions; see `crate::space::engine`).
+#[pyclass(module = "granrs._granrs", unsendable)]
+pub struct SpaceCoupling {
+    inner: space_engine::SpaceCoupling,
+    bound: Option<SpaceArrays>,
+}
+
+#[pymethods]
+impl SpaceCoupling {
+    /// `names` and `shapes` per geom (a `granrs.space` shape's dict), `forces` the terms
+    /// in space (`(name, params)` pairs; no `gravity`: the engine applies it), the sand's
+    /// `rho_g`, `surface`, `patch` (x_min, x_max, y_min, y_max) and `rest_speed`, the
+    /// surface rule's `quadrature` nodes; each geom's place (`geom`, `body`, `root`,
+    /// `dofs`) in a model of `nv` dofs, and the dof damping its integrator takes
+    /// implicitly. Every error names the geom, term or parameter.
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        names: Vec<String>,
+        shapes: &Bound<'_, PyList>,
+        forces: &Bound<'_, PyAny>,
+        rho_g: f64,
+        surface: f64,
+        patch: [f64; 4],
+        rest_speed: f64,
+        quadrature: usize,
+        geom: Vec<usize>,
+        body: Vec<usize>,
+        root: Vec<usize>,
+        dofs: Vec<Vec<usize>>,
+        nv: usize,
+        implicit_damping: Vec<f64>,
+    ) -> PyResult<Self> {
+        let err = |e: GranrsError| to_pyerr(py, e);
+        let n = names.len();
+        if [shapes.len(), geom.len(), body.len(), root.len(), dofs.len()]
+            .iter()
+            .any(|&l| l != n)
+            || dofs.iter().flatten().any(|&j| j >= nv)
+            || implicit_damping.len() != nv
+        {
+            return Err(PyValueError::new_err(
+                "one shape and place per geom, dofs below nv",
+            ));
+        }
+        crate::error::check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
+        crate::error::check_finite("surface", surface).map_err(err)?;
+        crate::error::check_range("rest_speed", rest_speed, 0.0, true).map_err(err)?;
+        if !(1..=Quadrature::MAX_NODES).contains(&quadrature) {
+            return Err(err(GranrsError::InvalidParameter {
+                field: "quadrature".into(),
+                value: quadrature as f64,
+                allowed: format!("an integer in 1..={}", Quadrature::MAX_NODES),
+            }));
+        }
+        let specs = super::space::forces_of(forces).map_err(err)?;
+        let mut geoms = Vec::with_capacity(n);
+        for i in 0..n {
+            let field = format!("geoms[{i}]");
+            let shape = super::space::shape_at(&shapes.get_item(i)?, &field).map_err(err)?;
+            let terms = Terms3::from_specs(&specs, &shape).map_err(err)?;
+            if terms.gravity {
+                return Err(err(GranrsError::InvalidScene {
+                    field: "forces.gravity".into(),
+                    message: "MuJoCo applies the model's own gravity; list only the sand's \
+                              terms (rft3d, rft3d_inertial, poncelet)"
+                        .into(),
+                }));
+            }
+            if !terms.any_sand() {
+                return Err(err(GranrsError::InvalidScene {
+                    field: "forces".into(),
+                    message: "no term of the sand in space (rft3d, rft3d_inertial, poncelet)"
+                        .into(),
+                }));
+            }
+            let centre = match &shape {
+                Shape::Mesh(m) => -m.offset,
+                _ => nalgebra::Vector3::zeros(),
+            };
+            let sand = Sand::new(
+                shape,
+                terms,
+                Medium { rho_g, g: 9.81 },
+                surface,
+                Quadrature::new(quadrature),
+            );
+            geoms.push(space_engine::SpaceGeom {
+                sand,
+                centre,
+                place: space_engine::Place {
+                    geom: geom[i],
+                    body: body[i],
+                    root: root[i],
+                    dofs: dofs[i].clone(),
+                },
+            });
+        }
+        Ok(SpaceCoupling {
+            inner: space_engine::SpaceCoupling {
+                geoms,
+                nv,
+                patch,
+                rest_speed,
+                implicit_damping,
+                previous: vec![0.0; nv],
+                held: vec![None; n],
+                solved: vec![None; n],
+            },
+            bound: None,
+        })
+    }
+
+    /// Bind the arrays of one `mjData` (`geom_xpos`, `geom_xmat`, `subtree_com`, `cdof`,
+    /// `qvel`, `qacc`, `qfrc_applied`, `qfrc_passive`) and the caller's buffers (the dense
+    /// mass matrix it fills, `outputs` per geom in SPACE_GEOM_OUTPUTS order, the `applied`
+    /// wrench per geom (n x 6), `h_lambda`, the generalized force, and `before` and
+    /// `after`, the bookkeeping of `qfrc_applied`), each checked for its shape once.
+    #[allow(clippy::too_many_arguments)]
+    fn bind(
+        &mut self,
+        geom_xpos: Bound2<'_>,
+        geom_xmat: Bound2<'_>,
+        subtree_com: Bound2<'_>,
+        cdof: Bound2<'_>,
+        qvel: Bound1<'_>,
+        qacc: Bound1<'_>,
+        qfrc_applied: Bound1<'_>,
+        qfrc_passive: Bound1<'_>,
+        mass: Bound2<'_>,
+        outputs: Bound2<'_>,
+        applied: Bound2<'_>,
+        h_lambda: Bound1<'_>,
+        generalized: Bound1<'_>,
+        before: Bound1<'_>,
+        after: Bound1<'_>,
+    ) -> PyResult<()> {
+        let c = &self.inner;
+        let (n, nv) = (c.geoms.len(), c.nv);
+        let max_geom = c.geoms.iter().map(|g| g.place.geom + 1).max().unwrap_or(0);
+        let max_body = c
+            .geoms
+            .iter()
+            .map(|g| g.place.body.max(g.place.root) + 1)
+            .max()
+            .unwrap_or(0);
+        let width = space_engine::OUTPUTS.len();
+        let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
+            let [r, k] = [a.shape()[0], a.shape()[1]];
+            let ok = k == cols && if exact { r == rows } else { r >= rows };
+            if ok && a.is_c_contiguous() {
+                Ok(a.clone().unbind())
+            } else {
+                Err(PyValueError::new_err(format!("SpaceCoupling.bind: {name}")))
+            }
+        };
+        let one = |a: &Bound1<'_>, name: &str, len: usize| {
+            if a.len() == len && a.is_c_contiguous() {
+                Ok(a.clone().unbind())
+            } else {
+                Err(PyValueError::new_err(format!("SpaceCoupling.bind: {name}")))
+            }
+        };
+        self.bound = Some(SpaceArrays {
+            geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
+            geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
+            subtree_com: two(&subtree_com, "subtree_com", max_body, 3, false)?,
+            cdof: two(&cdof, "cdof", nv, 6, true)?,
+            mass: two(&mass, "mass", nv, nv, true)?,
+            qvel: one(&qvel, "qvel", nv)?,
+            qacc: one(&qacc, "qacc", nv)?,
+            outputs: two(&outputs, "outputs", n, width, true)?,
+            applied: two(&applied, "applied", n, 6, true)?,
+            h_lambda: one(&h_lambda, "h_lambda", n)?,
+            generalized: one(&generalized, "generalized", nv)?,
+            qfrc_applied: one(&qfrc_applied, "qfrc_applied", nv)?,
+            qfrc_passive: one(&qfrc_passive, "qfrc_passive", nv)?,
+            before: one(&before, "before", nv)?,
+            after: one(&after, "after", nv)?,
+        });
+        Ok(())
+    }
+
+    /// One evaluation at the bound arrays (the mass matrix filled by the caller), with the
+    /// GIL released: writes each geom's outputs, applied wrench and `h_lambda` and the
+    /// generalized force, and puts it into MuJoCo's as `GeomCoupling.step` does
+    /// (`passive`: added to `qfrc_passive`; else into `qfrc_applied`, keeping the user's
+    /// entries; `hold`: a later stage of RK4's step). Returns the largest `h_lambda`, its
+    /// geom, the Newton iterations, the solve's relative residual and whether the step
+    /// fell back to sticking or sliding.
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        timestep: f64,
+        passive: bool,
+        fresh: bool,
+        hold: bool,
+    ) -> PyResult<(f64, usize, usize, f64, bool)> {
+        let Some(b) = &self.bound else {
+            return Err(PyValueError::new_err("SpaceCoupling.step before bind"));
+        };
+        let inner = &mut self.inner;
+        let nv = inner.nv;
+        // SAFETY: as `GeomCoupling.step`: each array was checked contiguous with its shape
+        // at `bind`, MuJoCo never reallocates an mjData's arrays, the buffers are this
+        // Sand's own, and no two slices alias (distinct arrays). The caller holds the
+        // mjData while this call runs (a `Sand` method), and nothing of granrs's touches
+        // these arrays from another thread.
+        unsafe {
+            let state = EngineState {
+                geom_xpos: ro(py, &b.geom_xpos),
+                geom_xmat: ro(py, &b.geom_xmat),
+                cvel: &[],
+                subtree_com: ro(py, &b.subtree_com),
+                cdof: ro(py, &b.cdof),
+                mass: ro(py, &b.mass),
+                qvel: ro(py, &b.qvel),
+                qacc: ro(py, &b.qacc),
+            };
+            let (outputs, applied) = (rw(py, &b.outputs), rw(py, &b.applied));
+            let (h_lambda, gen) = (rw(py, &b.h_lambda), rw(py, &b.generalized));
+            let target = if passive {
+                rw(py, &b.qfrc_passive)
+            } else {
+                rw(py, &b.qfrc_applied)
+            };
+            let (before, after) = (rw(py, &b.before), rw(py, &b.after));
+            let report = py.detach(|| {
+                let out = EngineOut {
+                    outputs,
+                    applied,
+                    h_lambda,
+                    generalized: &mut *gen,
+                };
+                let report = inner.step(&state, timestep, hold, out);
+                if passive {
+                    target.iter_mut().zip(gen.iter()).for_each(|(t, g)| *t += g);
+                } else {
+                    for j in 0..nv {
+                        let user = if !fresh && target[j] == after[j] {
+                            before[j]
+                        } else {
+                            target[j]
+                        };
+                        before[j] = user;
+                        target[j] = user + gen[j];
+                        after[j] = target[j];
+                    }
+                }
+                report
+            });
+            Ok((
+                report.h_lambda,
+                report.geom,
+                report.iterations,
+                report.residual,
+                report.fallback,
+            ))
+        }
+    }
+}

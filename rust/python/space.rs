@@ -98,7 +98,11 @@ fn rows<const N: usize>(v: &Bound<'_, PyAny>, field: &str, most: usize) -> Res<V
 }
 
 fn shape_of(d: &Bound<'_, PyAny>) -> Res<Shape> {
-    let field = "body.shape";
+    shape_at(d, "body.shape")
+}
+
+/// A shape from its dict, errors naming `field` (`body.shape`, or a MuJoCo geom).
+pub(super) fn shape_at(d: &Bound<'_, PyAny>, field: &str) -> Res<Shape> {
     let d = d.cast::<PyDict>().map_err(|_| wrong(field, "a shape", d))?;
     let kind: String = item(d, "kind", &format!("{field}.kind"))?
         .extract()
@@ -189,7 +193,7 @@ fn mass_of(d: &Bound<'_, PyDict>) -> Res<MassSpec> {
     }
 }
 
-fn forces_of(v: &Bound<'_, PyAny>) -> Res<Vec<TermSpec>> {
+pub(super) fn forces_of(v: &Bound<'_, PyAny>) -> Res<Vec<TermSpec>> {
     let mut out = Vec::new();
     for (i, t) in v
         .try_iter()

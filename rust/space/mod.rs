@@ -12,6 +12,7 @@
 //! - [`solve`]: the rigid body, RK4 and the events;
 //! - [`Scene3`]: what a run is, checked field by field before any work.
 
+pub mod engine;
 pub mod load;
 pub mod outputs;
 pub mod quad;

@@ -1,0 +1,196 @@
+"""granrs.mujoco.Sand in three dimensions: geoms as shapes in space under rft3d, the
+implicit step, rest, and the momentum it hands MuJoCo."""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+import granrs
+from granrs import forces, space
+
+mujoco = pytest.importorskip("mujoco")
+from granrs.mujoco import Sand, body_drop, body_mjcf  # noqa: E402
+
+ZETA = 1e6
+
+# A step whose implicit solve falls back to sticking or sliding warns once; the tests
+# below check the outcome itself.
+pytestmark = pytest.mark.filterwarnings("ignore::granrs.StepSizeWarning")
+
+
+def q_about_y(deg: float) -> tuple[float, float, float, float]:
+    a = math.radians(deg) / 2
+    return (math.cos(a), 0.0, math.sin(a), 0.0)
+
+
+def scene(shape, **kw):
+    return space.Scene(
+        body=space.Body(shape, density=2500.0),
+        forces=[forces.rft3d(zeta=ZETA), forces.gravity()],
+        velocity=kw.pop("velocity", (0.0, 0.0, -1.0)),
+        **kw,
+    )
+
+
+CASES = {
+    "sphere": scene(space.Sphere(0.02)),
+    "sphere at 30 degrees": scene(space.Sphere(0.02), velocity=(0.5, 0.0, -0.866)),
+    "capsule vertical": scene(space.Capsule(0.01, 0.06)),
+    "capsule at 30 degrees": scene(space.Capsule(0.01, 0.06), orientation=q_about_y(30)),
+    "capsule at 60 degrees": scene(space.Capsule(0.01, 0.06), orientation=q_about_y(60)),
+    "capsule side-on": scene(space.Capsule(0.01, 0.06), orientation=q_about_y(90)),
+}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_a_drop_in_mujoco_matches_granrs_own_engine(name):
+    # granrs.simulate (RK4, located stop) against MuJoCo's Euler at 1e-4 s with the
+    # implicit sand: depth within 2 %, t_s within 5 %.
+    s = CASES[name]
+    ref = granrs.simulate(s)
+    d = body_drop(s, timestep=1e-4)
+    assert abs(d["depth"] / ref.depth - 1) < 0.02, (d["depth"], ref.depth)
+    assert abs(d["t_s"] / ref.t_s - 1) < 0.05, (d["t_s"], ref.t_s)
+
+
+@pytest.mark.parametrize("integrator", ["Euler", "implicitfast", "RK4"])
+@pytest.mark.parametrize("timestep", [1e-3, 1e-2])
+def test_a_sphere_at_rest_holds_still_without_chattering_or_gaining_energy(integrator, timestep):
+    s = CASES["sphere"]
+    d = body_drop(s, timestep=timestep, integrator=integrator, t_after=3.0)
+    weight = s.mass * s.g
+    last = slice(-round(1.0 / timestep), None)
+    # Less than 0.1 mm over the last second, force within 5 % of the weight step to step.
+    assert np.ptp(d["depth_after"][last]) < 1e-4
+    fz = d["force"][last, 2]
+    assert np.all(np.abs(fz - weight) < 0.05 * weight), (fz.min(), fz.max(), weight)
+    # The energy never rises beyond 1e-6 J/s after the stop.
+    e = d["energy"]
+    assert np.max(np.diff(e)) <= 1e-6 * timestep, np.max(np.diff(e))
+
+
+def test_the_force_handed_to_mujoco_is_the_momentum_the_body_receives():
+    s = CASES["capsule at 30 degrees"]
+    h = 1e-3
+    m = mujoco.MjModel.from_xml_string(body_mjcf(s, h))
+    d = mujoco.MjData(m)
+    d.qpos[:3] = s.position
+    d.qpos[3:7] = s.orientation
+    d.qvel[:3] = s.velocity
+    sand = Sand(m, ["body"], [forces.rft3d(zeta=ZETA)], space=True)
+    impulse = np.zeros(3)
+    p0 = s.mass * d.qvel[:3].copy()
+    for _ in range(60):
+        sand.step(d)
+        mujoco.mj_step(m, d)
+        impulse += h * (sand.applied[0, :3] + np.array([0.0, 0.0, -s.mass * s.g]))
+    p1 = s.mass * d.qvel[:3]
+    assert np.all(np.abs(p1 - p0 - impulse) < 1e-9 * (1 + np.abs(impulse).max()))
+    assert impulse[2] > 0.5 * s.mass  # the sand did stop it
+
+
+def test_step_and_callback_agree():
+    s = CASES["capsule at 60 degrees"]
+    a = body_drop(s, timestep=1e-4, mode="step")
+    b = body_drop(s, timestep=1e-4, mode="callback")
+    assert abs(a["depth"] - b["depth"]) < 1e-9 and abs(a["t_s"] - b["t_s"]) < 1e-9
+
+
+def test_every_geom_type_is_a_shape_in_space_and_feels_the_sand():
+    xml = """<mujoco><option timestep="0.001"/>
+      <asset><mesh name="tet" vertex="0 0 0  0.04 0 0  0 0.04 0  0 0 0.04"/></asset>
+      <worldbody>
+      <body pos="0 0 0"><freejoint/><geom name="sphere" type="sphere" size="0.02"/></body>
+      <body pos="1 0 0"><freejoint/><geom name="capsule" type="capsule" size="0.01 0.03"/></body>
+      <body pos="2 0 0"><freejoint/><geom name="cylinder" type="cylinder" size="0.01 0.03"/></body>
+      <body pos="3 0 0"><freejoint/><geom name="box" type="box" size="0.02 0.02 0.02"/></body>
+      <body pos="4 0 0"><freejoint/>
+        <geom name="ellipsoid" type="ellipsoid" size="0.02 0.03 0.01"/></body>
+      <body pos="5 0 0"><freejoint/><geom name="mesh" type="mesh" mesh="tet"/></body>
+      </worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    names = ["sphere", "capsule", "cylinder", "box", "ellipsoid", "mesh"]
+    sand = Sand(m, names, [forces.rft3d(zeta=ZETA)])
+    assert sand.space
+    for k in range(6):
+        d.qvel[6 * k + 2] = -1.0
+    sand.step(d)
+    depth = sand.output[:, 0]
+    # Every geom's centre is at the surface: each is half sunk (the mesh by its own
+    # lowest point), and each is pushed up.
+    assert np.all(depth > 0.0) and np.all(sand.output[:, 1] > 0)
+    assert np.all(sand.applied[:, 2] > 0.0), sand.applied
+
+
+def test_bad_input_is_a_typed_error_naming_it():
+    xml = """<mujoco><worldbody><geom name="floor" type="plane" size="1 1 1"/>
+      <body><freejoint/><geom name="ball" type="sphere" size="0.02"/></body>
+      </worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    rft = forces.rft3d(zeta=ZETA)
+    cases = [
+        (dict(geoms=["nope"], forces=[rft]), "geoms[0]"),
+        (dict(geoms=["floor"], forces=[rft]), "geoms[0]"),
+        (dict(geoms=["ball"], forces=[rft, forces.gravity()]), "gravity"),
+        (dict(geoms=["ball"], forces=[rft], rest_speed=0.0), "rest_speed"),
+        (dict(geoms=["ball"], forces=[rft], rest_speed=math.nan), "rest_speed"),
+        (dict(geoms=["ball"], forces=[rft], quadrature=True), "quadrature"),
+        (dict(geoms=["ball"], forces=[rft], quadrature=0), "quadrature"),
+        (dict(geoms=["ball"], forces=[rft], patch=(1, 0)), "patch"),
+        (dict(geoms=["ball"], forces=[rft], surface=math.inf), "surface"),
+        (dict(geoms=["ball"], forces=[forces.drag()], space=True), "forces[0]"),
+    ]
+    for kw, field in cases:
+        with pytest.raises(granrs.GranrsError) as e:
+            Sand(m, **kw)
+        assert field in (e.value.field or "") + str(e.value), (kw, e.value)
+
+
+def test_a_geom_outside_the_patch_feels_nothing():
+    s = CASES["sphere"]
+    m = mujoco.MjModel.from_xml_string(body_mjcf(s, 1e-3))
+    d = mujoco.MjData(m)
+    d.qpos[2] = 0.0
+    d.qvel[2] = -1.0
+    sand = Sand(m, ["body"], [forces.rft3d(zeta=ZETA)], patch=(-1, 1, 0.5, 1.0))
+    sand.step(d)
+    assert np.all(sand.applied == 0.0)
+    inside = Sand(m, ["body"], [forces.rft3d(zeta=ZETA)], patch=(-1, 1, -1, 1))
+    inside.step(d)
+    assert inside.applied[0, 2] > 0.0
+
+
+def test_gymnasiums_ant_stands_on_sand_at_its_own_timestep():
+    gymnasium = pytest.importorskip("gymnasium")
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/ant.xml")
+    m = mujoco.MjModel.from_xml_path(path)
+    feet = ["left_ankle_geom", "right_ankle_geom", "third_ankle_geom", "fourth_ankle_geom"]
+    for g in feet:
+        gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, g)
+        m.geom_contype[gid] = 0
+        m.geom_conaffinity[gid] = 0
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    sand = Sand(m, feet, [forces.rft3d(zeta=space.xi_n(1520.0, 0.4))], quadrature=3)
+    h = m.opt.timestep
+    tilt, z = [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", granrs.StepSizeWarning)
+        for _ in range(round(4.0 / h)):
+            sand.step(d)
+            mujoco.mj_step(m, d)
+            r = d.xmat[1].reshape(3, 3)
+            tilt.append(math.degrees(math.acos(min(1.0, max(-1.0, r[2, 2])))))
+            z.append(d.qpos[2])
+    assert np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))
+    assert max(tilt) < 30.0
+    # Standing on the sand: the feet in it, the weight carried by them.
+    assert np.all(sand.output[:, 0] > 0.0)
+    weight = m.body_subtreemass[1] * np.linalg.norm(m.opt.gravity)
+    assert abs(sand.applied[:, 2].sum() / weight - 1) < 0.1
