@@ -194,80 +194,77 @@ pub fn stress_capped<F: Real, const CAP: bool>(
     ]
 }
 
+/// Where each monomial's derivatives fall in the quadratic monomials
+/// `Q = (1, x1, x2, x3, x1^2, x2^2, x3^2, x1 x2, x2 x3, x3 x1)`: for T_k, per variable
+/// (x1, x2, x3), the factor and the index into Q (factor 0: no term).
+const MONOMIAL_DERIVATIVES: [[(f64, usize); 3]; 20] = [
+    [(0.0, 0), (0.0, 0), (0.0, 0)], // 1
+    [(1.0, 0), (0.0, 0), (0.0, 0)], // x1
+    [(0.0, 0), (1.0, 0), (0.0, 0)], // x2
+    [(0.0, 0), (0.0, 0), (1.0, 0)], // x3
+    [(2.0, 1), (0.0, 0), (0.0, 0)], // x1^2
+    [(0.0, 0), (2.0, 2), (0.0, 0)], // x2^2
+    [(0.0, 0), (0.0, 0), (2.0, 3)], // x3^2
+    [(1.0, 2), (1.0, 1), (0.0, 0)], // x1 x2
+    [(0.0, 0), (1.0, 3), (1.0, 2)], // x2 x3
+    [(1.0, 3), (0.0, 0), (1.0, 1)], // x3 x1
+    [(3.0, 4), (0.0, 0), (0.0, 0)], // x1^3
+    [(0.0, 0), (3.0, 5), (0.0, 0)], // x2^3
+    [(0.0, 0), (0.0, 0), (3.0, 6)], // x3^3
+    [(1.0, 5), (2.0, 7), (0.0, 0)], // x1 x2^2
+    [(2.0, 7), (1.0, 4), (0.0, 0)], // x2 x1^2
+    [(0.0, 0), (1.0, 6), (2.0, 8)], // x2 x3^2
+    [(0.0, 0), (2.0, 8), (1.0, 5)], // x3 x2^2
+    [(2.0, 9), (0.0, 0), (1.0, 4)], // x3 x1^2
+    [(1.0, 6), (0.0, 0), (2.0, 9)], // x1 x3^2
+    [(1.0, 8), (1.0, 9), (1.0, 7)], // x1 x2 x3
+];
+
+/// The gradients' coefficients on the quadratic monomials: `G[i][k][j]` multiplies `Q_j`
+/// in `d f_i / d x_k` (derived from [`COEFFICIENTS`] at compile time).
+const GRADIENT: [[[f64; 10]; 3]; 3] = {
+    let mut g = [[[0.0; 10]; 3]; 3];
+    let mut i = 0;
+    while i < 3 {
+        let mut t = 0;
+        while t < 20 {
+            let mut k = 0;
+            while k < 3 {
+                let (factor, j) = MONOMIAL_DERIVATIVES[t][k];
+                g[i][k][j] += factor * COEFFICIENTS[i][t];
+                k += 1;
+            }
+            t += 1;
+        }
+        i += 1;
+    }
+    g
+};
+
 /// The three fitted functions and their gradients: `(f, g)` with `g[i][k] = d f_i / d x_k`.
 pub fn fitted_with_gradient(x1: f64, x2: f64, x3: f64) -> ([f64; 3], [[f64; 3]; 3]) {
     let f = fitted(x1, x2, x3);
-    // d T_k / d x1, d x2, d x3 for the monomials of `fitted`, in its order.
-    let d1 = [
-        0.0,
+    let q = [
         1.0,
-        0.0,
-        0.0,
-        2.0 * x1,
-        0.0,
-        0.0,
-        x2,
-        0.0,
-        x3,
-        3.0 * x1 * x1,
-        0.0,
-        0.0,
-        x2 * x2,
-        2.0 * x1 * x2,
-        0.0,
-        0.0,
-        2.0 * x1 * x3,
-        x3 * x3,
-        x2 * x3,
-    ];
-    let d2 = [
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        2.0 * x2,
-        0.0,
         x1,
-        x3,
-        0.0,
-        0.0,
-        3.0 * x2 * x2,
-        0.0,
-        2.0 * x1 * x2,
-        x1 * x1,
-        x3 * x3,
-        2.0 * x2 * x3,
-        0.0,
-        0.0,
-        x1 * x3,
-    ];
-    let d3 = [
-        0.0,
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        2.0 * x3,
-        0.0,
         x2,
-        x1,
-        0.0,
-        0.0,
-        3.0 * x3 * x3,
-        0.0,
-        0.0,
-        2.0 * x2 * x3,
-        x2 * x2,
+        x3,
         x1 * x1,
-        2.0 * x1 * x3,
+        x2 * x2,
+        x3 * x3,
         x1 * x2,
+        x2 * x3,
+        x3 * x1,
     ];
     let mut g = [[0.0; 3]; 3];
-    for (gi, c) in g.iter_mut().zip(COEFFICIENTS.iter()) {
-        for (k, d) in [d1, d2, d3].iter().enumerate() {
-            gi[k] = c.iter().zip(d.iter()).map(|(a, b)| a * b).sum();
+    for i in 0..3 {
+        for k in 0..3 {
+            let c = &GRADIENT[i][k];
+            let mut acc = 0.0;
+            for j in 0..10 {
+                acc += c[j] * q[j];
+            }
+            g[i][k] = acc;
         }
     }
     (f, g)

@@ -259,40 +259,47 @@ pub struct Wrench {
     pub kz: [f64; 6],
 }
 
-/// `R a = r x a`.
-fn skew(r: &V3) -> [[f64; 3]; 3] {
-    [[0.0, -r.z, r.y], [r.z, 0.0, -r.x], [-r.y, r.x, 0.0]]
-}
-
 impl Wrench {
     /// Add a force `f` at arm `r` from the centre with its rate `g = d f / d u` (u the
     /// point's velocity, `v + omega x r`) and its height rate `fz`.
+    #[inline]
     fn add(&mut self, r: &V3, f: [f64; 3], g: &[[f64; 3]; 3], fz: [f64; 3]) {
-        let rx = skew(r);
-        let rf = r.cross(&V3::from(f));
-        let rz = r.cross(&V3::from(fz));
+        let (rx, ry, rz) = (r.x, r.y, r.z);
+        // r x a
+        let cross = |a: [f64; 3]| {
+            [
+                ry * a[2] - rz * a[1],
+                rz * a[0] - rx * a[2],
+                rx * a[1] - ry * a[0],
+            ]
+        };
+        let rf = cross(f);
+        let rzf = cross(fz);
         for i in 0..3 {
             self.w[i] += f[i];
             self.w[3 + i] += rf[i];
             self.kz[i] += fz[i];
-            self.kz[3 + i] += rz[i];
+            self.kz[3 + i] += rzf[i];
         }
-        // u = v - R omega: K_vv = G, K_vw = -G R, K_wv = R G, K_ww = -R G R.
-        let mut gr = [[0.0; 3]; 3];
-        let mut rg = [[0.0; 3]; 3];
+        // u = v - R omega, R a = r x a: the force's rate in the twist is G [I, -R]; the
+        // moment's, R G [I, -R]. Row i of -G R is -(r x^T)... written out: (G R)_ij =
+        // sum_k G_ik R_kj, with R = [[0, -rz, ry], [rz, 0, -rx], [-ry, rx, 0]].
+        let mut gt = [[0.0; 6]; 3];
         for i in 0..3 {
-            for j in 0..3 {
-                gr[i][j] = (0..3).map(|k| g[i][k] * rx[k][j]).sum();
-                rg[i][j] = (0..3).map(|k| rx[i][k] * g[k][j]).sum();
-            }
+            let gi = g[i];
+            gt[i][0] = gi[0];
+            gt[i][1] = gi[1];
+            gt[i][2] = gi[2];
+            gt[i][3] = -(gi[1] * rz - gi[2] * ry);
+            gt[i][4] = -(-gi[0] * rz + gi[2] * rx);
+            gt[i][5] = -(gi[0] * ry - gi[1] * rx);
         }
-        for i in 0..3 {
-            for j in 0..3 {
-                let rgr: f64 = (0..3).map(|k| rg[i][k] * rx[k][j]).sum();
-                self.k[i][j] += g[i][j];
-                self.k[i][3 + j] -= gr[i][j];
-                self.k[3 + i][j] += rg[i][j];
-                self.k[3 + i][3 + j] -= rgr;
+        for c in 0..6 {
+            let col = [gt[0][c], gt[1][c], gt[2][c]];
+            let m = cross(col);
+            for i in 0..3 {
+                self.k[i][c] += col[i];
+                self.k[3 + i][c] += m[i];
             }
         }
     }
