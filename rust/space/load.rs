@@ -294,12 +294,13 @@ impl Wrench {
             gt[i][4] = -(-gi[0] * rz + gi[2] * rx);
             gt[i][5] = -(gi[0] * ry - gi[1] * rx);
         }
-        for c in 0..6 {
-            let col = [gt[0][c], gt[1][c], gt[2][c]];
+        let [g0, g1, g2] = gt;
+        for (c, ((a, b), d)) in g0.into_iter().zip(g1).zip(g2).enumerate() {
+            let col = [a, b, d];
             let m = cross(col);
-            for i in 0..3 {
-                self.k[i][c] += col[i];
-                self.k[3 + i][c] += m[i];
+            for (i, (x, y)) in col.iter().zip(m).enumerate() {
+                self.k[i][c] += x;
+                self.k[3 + i][c] += y;
             }
         }
     }
