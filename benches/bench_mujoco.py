@@ -22,9 +22,20 @@ the median (and range) of the ratios within each repeat (two times of the same s
 the extension with ``maturin develop --release`` first (the dev build is several times
 slower); the machines are shared and noisy: read the ratios.
 
+**In three dimensions (``--part space-table``, ``--part space-cost``).** A sphere (r 20 mm)
+and a capsule (r 10 mm, 60 mm) of density 2500 kg/m^3 dropped at 1 m/s into sand under
+``rft3d(zeta=1e6)`` (vertical, the capsule also tilted 30 and 60 degrees and side-on, the
+sphere also on a path 30 degrees from vertical) with :func:`granrs.mujoco.body_drop`, against
+:func:`granrs.simulate` of the same :class:`granrs.space.Scene`, at MuJoCo timesteps 1e-4,
+1e-3, 2e-3, 5e-3 and 1e-2 s and the Euler, implicitfast and RK4 integrators; and the cost of
+``Sand`` on gymnasium's Ant (its four ankle capsules as sand geoms, standing in the sand under
+``rft3d``, RK4 at its own 0.01 s), at 3 and 6 Gauss nodes per panel, as ratios to ``mj_step``
+measured in the same repeats.
+
 Usage::
 
-    python benches/bench_mujoco.py [--part all|table|cost] [--repeats 15] [--steps 1000]
+    python benches/bench_mujoco.py [--part all|table|cost|space-table|space-cost]
+                                   [--repeats 15] [--steps 1000]
 """
 
 from __future__ import annotations
@@ -37,8 +48,8 @@ import mujoco
 import numpy as np
 
 import granrs
-from granrs import forces
-from granrs.mujoco import WALKER_SAND_GEOMS, Sand, rod_drop, walker_mjcf
+from granrs import forces, space
+from granrs.mujoco import WALKER_SAND_GEOMS, Sand, body_drop, rod_drop, walker_mjcf
 
 TIMESTEPS = (1e-4, 1e-3, 2e-3)
 RUNS = (("Euler", "step"), ("RK4", "step"), ("RK4", "callback"), ("implicitfast", "step"))
@@ -169,9 +180,136 @@ def cost(repeats: int, steps: int) -> dict[str, float]:
     return best
 
 
+def _q_about_y(deg: float) -> tuple[float, float, float, float]:
+    a = np.radians(deg) / 2
+    return (float(np.cos(a)), 0.0, float(np.sin(a)), 0.0)
+
+
+def space_table() -> list[dict[str, object]]:
+    """Bodies in space dropped in MuJoCo against granrs.simulate."""
+
+    def drop(shape: object, **kw: object) -> space.Scene:
+        return space.Scene(
+            body=space.Body(shape, density=2500.0),
+            forces=[forces.rft3d(zeta=1e6), forces.gravity()],
+            **{"velocity": (0.0, 0.0, -1.0), **kw},
+        )
+
+    cases = {
+        "sphere": drop(space.Sphere(0.02)),
+        "sphere, path at 30 deg": drop(space.Sphere(0.02), velocity=(0.5, 0.0, -0.866)),
+        "capsule vertical": drop(space.Capsule(0.01, 0.06)),
+        "capsule at 30 deg": drop(space.Capsule(0.01, 0.06), orientation=_q_about_y(30)),
+        "capsule at 60 deg": drop(space.Capsule(0.01, 0.06), orientation=_q_about_y(60)),
+        "capsule side-on": drop(space.Capsule(0.01, 0.06), orientation=_q_about_y(90)),
+    }
+    rows = []
+    print(
+        "| body | integrator | timestep [s] | depth / simulate - 1 | t_s / simulate - 1 | "
+        "fallback steps | pass (2 %, 5 %) |"
+    )
+    print("|---|---|---|---|---|---|---|")
+    for name, scene in cases.items():
+        ref = granrs.simulate(scene)
+        for integrator in ("Euler", "implicitfast", "RK4"):
+            for h in (1e-4, 1e-3, 2e-3, 5e-3, 1e-2):
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", granrs.StepSizeWarning)
+                    d = body_drop(scene, timestep=h, integrator=integrator)
+                dd = d["depth"] / ref.depth - 1
+                dt = d["t_s"] / ref.t_s - 1
+                ok = abs(dd) < 0.02 and abs(dt) < 0.05
+                rows.append(
+                    {
+                        "body": name,
+                        "integrator": integrator,
+                        "timestep": h,
+                        "depth": dd,
+                        "t_s": dt,
+                        "pass": ok,
+                    }
+                )
+                print(
+                    f"| {name} | {integrator} | {h:g} | {dd:+.4f} | {dt:+.4f} | "
+                    f"{d['sand'].fallbacks} | {'yes' if ok else 'no'} |"
+                )
+    return rows
+
+
+def space_cost(repeats: int, steps: int) -> None:
+    """Sand on gymnasium's Ant standing in the sand, against mj_step."""
+    import gymnasium
+
+    path = f"{gymnasium.__path__[0]}/envs/mujoco/assets/ant.xml"
+    feet = ["left_ankle_geom", "right_ankle_geom", "third_ankle_geom", "fourth_ankle_geom"]
+    print(f"Ant standing in sand under rft3d, {steps} steps, {repeats} repeats:")
+    print(
+        "| nodes | elements per foot | mj_step [us, min] | Sand.step [us, min] | "
+        "Sand.step / mj_step (median of repeats, range) | callback's extra / mj_step |"
+    )
+    print("|---|---|---|---|---|---|")
+    for nodes in (3, 6):
+        model = mujoco.MjModel.from_xml_path(path)
+        for g in feet:
+            i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g)
+            model.geom_contype[i] = model.geom_conaffinity[i] = 0
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        sand = Sand(model, feet, [forces.rft3d(zeta=space.xi_n(1520.0, 0.4))], quadrature=nodes)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", granrs.StepSizeWarning)
+            for _ in range(300):  # stand
+                sand.step(data)
+                mujoco.mj_step(model, data)
+        start = (data.qpos.copy(), data.qvel.copy(), data.qacc.copy(), data.time)
+        elements = int(sand.output[0, 1])
+
+        def restore(data: mujoco.MjData = data, start: tuple = start) -> None:
+            data.qpos[:], data.qvel[:], data.qacc[:], data.time = start
+
+        best = {"mj_step": np.inf, "Sand.step": np.inf, "callback": np.inf}
+        ratio, extra = [], []
+        for _ in range(repeats):
+            this = {}
+            restore()
+            t = time.perf_counter()
+            for _ in range(steps):
+                mujoco.mj_step(model, data)
+            this["mj_step"] = (time.perf_counter() - t) / steps
+            restore()
+            t = time.perf_counter()
+            for _ in range(steps):
+                sand.step(data)
+            this["Sand.step"] = (time.perf_counter() - t) / steps
+            restore()
+            sand.install()
+            warnings.simplefilter("ignore", granrs.StepSizeWarning)
+            try:
+                t = time.perf_counter()
+                for _ in range(steps):
+                    mujoco.mj_step(model, data)
+                this["callback"] = (time.perf_counter() - t) / steps
+            finally:
+                sand.uninstall()
+            for k, v in this.items():
+                best[k] = min(best[k], v)
+            ratio.append(this["Sand.step"] / this["mj_step"])
+            extra.append(this["callback"] / this["mj_step"] - 1.0)
+        r, e = np.array(ratio), np.array(extra)
+        print(
+            f"| {nodes} | {elements} | {best['mj_step'] * 1e6:.1f} | "
+            f"{best['Sand.step'] * 1e6:.1f} | {np.median(r):.2f} ({r.min():.2f} to "
+            f"{r.max():.2f}) | {np.median(e):.2f} ({e.min():.2f} to {e.max():.2f}) |"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--part", choices=("all", "table", "cost"), default="all")
+    parser.add_argument(
+        "--part",
+        choices=("all", "table", "cost", "space-table", "space-cost"),
+        default="all",
+    )
     parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--steps", type=int, default=1000)
     args = parser.parse_args()
@@ -179,6 +317,10 @@ def main() -> None:
         cost(args.repeats, args.steps)
     if args.part in ("all", "table"):
         table()
+    if args.part in ("all", "space-table"):
+        space_table()
+    if args.part in ("all", "space-cost"):
+        space_cost(args.repeats, args.steps)
 
 
 if __name__ == "__main__":
