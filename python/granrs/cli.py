@@ -49,6 +49,7 @@ from .errors import (
     SimulationError,
     StepSizeWarning,
 )
+from .space import Result as SpaceResult
 
 __all__ = ["main"]
 
@@ -743,12 +744,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     suffix = _series_format(args.series) if args.series else None
     scene = _read_scene(args.scene, overrides)
     if suffix and not scene.record:
-        scene = scene.replace(record=SERIES_RECORD)
-        print(
-            f"{PROG}: note: the scene records nothing; --series records {', '.join(SERIES_RECORD)}",
-            file=sys.stderr,
-        )
+        in_space = isinstance(scene.record, bool)
+        scene = scene.replace(record=True if in_space else SERIES_RECORD)
+        what = "every series column" if in_space else ", ".join(SERIES_RECORD)
+        print(f"{PROG}: note: the scene records nothing; --series records {what}", file=sys.stderr)
     result = simulate(scene)
+    if isinstance(result, SpaceResult):
+        return _finish_space_run(args, result)
     if args.series:
         frame = result.to_frame()
         units = series_units(result)
@@ -768,6 +770,68 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print(json.dumps(summary_dict(result, args.scene), indent=2, allow_nan=False))
     else:
         print(summary_text(result, args.scene))
+    return 0
+
+
+def space_summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
+    """A body in space's summary as plain data (``granrs run --json``): the scene file, the
+    status, every summary field (NaN is None) and their units."""
+    from .space import SUMMARY_FIELDS
+
+    return {
+        "scene": source,
+        "body": "space",
+        "status": result.status,
+        "summary": {
+            k: (None if isinstance(v, float) and math.isnan(v) else v)
+            for k, v in result.summary.items()
+        },
+        "units": {k: unit for k, (unit, _) in SUMMARY_FIELDS.items()},
+    }
+
+
+def space_summary_text(result: Any, source: str | None = None) -> str:
+    """A body in space's summary as a readable table (``granrs run``): the status, then
+    every summary field with its unit and description."""
+    from .space import SUMMARY_FIELDS
+
+    title = f"{source}: " if source else ""
+    shape = type(result.scene.body.shape).__name__.lower()
+    lines = [f"{title}a {shape} in space, status {result.status}", ""]
+    rows = [
+        [name, _number(result.summary[name]), unit, text]
+        for name, (unit, text) in SUMMARY_FIELDS.items()
+        if name in result.summary
+    ]
+    lines += _table(["field", "value", "unit", ""], rows)
+    return "\n".join(lines)
+
+
+def _finish_space_run(args: argparse.Namespace, result: Any) -> int:
+    """Write a body in space's series (``--series``) and print its summary."""
+    from .space import SERIES_COLUMNS
+
+    if args.series:
+        import pandas as pd
+
+        series = result.series or {}
+        frame = pd.DataFrame({k: v for k, v in series.items() if k != "t"})
+        frame.index = pd.Index(series.get("t", []), name="t [s]")
+        frame = frame.rename(columns=lambda n: f"{n} [{SERIES_COLUMNS.get(n, ('', ''))[0]}]")
+        with replacing(args.series) as tmp:
+            if _series_format(args.series) == ".parquet":
+                frame.to_parquet(tmp)
+            else:
+                frame.to_csv(tmp)
+        print(
+            f"{PROG}: series written to {args.series} ({len(frame)} rows, "
+            f"{len(frame.columns) + 1} columns)",
+            file=sys.stderr,
+        )
+    if args.json:
+        print(json.dumps(space_summary_dict(result, args.scene), indent=2, allow_nan=False))
+    else:
+        print(space_summary_text(result, args.scene))
     return 0
 
 

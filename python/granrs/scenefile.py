@@ -52,7 +52,7 @@ import sys
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from . import _granrs, forces
+from . import _granrs, forces, space
 from ._files import write_text
 from .bodies import ELEMENT_FIELDS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
@@ -187,16 +187,19 @@ def _applies(name: str, body: str) -> bool:
     return name not in BODY_FIELDS or body in BODY_FIELDS[name]
 
 
-def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> str:
+def dumps(scene: Scene | space.Scene, *, comments: bool = True, header: str | None = None) -> str:
     """The scene as TOML text: every field that applies to its body, floats exact.
 
     Fields whose value is ``None`` (their default) are written as comments only.
     ``comments=False`` leaves out the per-field notes; ``header`` adds lines (each prefixed
     with ``"# "``) after the version line.
     """
+    if isinstance(scene, space.Scene):
+        return _dumps_space(scene, header)
     if not isinstance(scene, Scene):
         raise InvalidParameterError(
-            f"dumps() takes a granrs.Scene, got {type(scene).__name__}", field="scene"
+            f"dumps() takes a granrs.Scene or a granrs.space.Scene, got {type(scene).__name__}",
+            field="scene",
         )
     lines = [f"# granrs {_granrs.__version__} scene file: one reproducible run."]
     if header:
@@ -232,6 +235,130 @@ def dumps(scene: Scene, *, comments: bool = True, header: str | None = None) -> 
             continue
         lines.append(_line(name, _format_value(value), note))
     return "\n".join(lines + tables) + "\n"
+
+
+#: The fields of a body in space's scene file (``space = true``), in the order written.
+_SPACE_FIELDS: tuple[str, ...] = tuple(
+    f.name for f in dataclasses.fields(space.Scene) if f.init and f.name != "body"
+)
+#: Each shape's keys in its ``[body.shape]`` table (besides ``kind``).
+_SPACE_SHAPES: dict[str, tuple[type, tuple[str, ...]]] = {
+    "sphere": (space.Sphere, ("radius",)),
+    "capsule": (space.Capsule, ("radius", "length")),
+    "cylinder": (space.Cylinder, ("radius", "length")),
+    "cuboid": (space.Cuboid, ("size",)),
+    "mesh": (space.Mesh, ("vertices", "triangles")),
+}
+
+
+def _dumps_space(scene: Any, header: str | None) -> str:
+    """A body in space as TOML: ``space = true``, its fields, ``[body]`` with its mass and
+    ``[body.shape]``, and its ``[[forces]]``; floats exact."""
+    lines = [f"# granrs {_granrs.__version__} scene file: a body in space, one reproducible run."]
+    if header:
+        lines.extend(f"# {h}".rstrip() for h in header.splitlines())
+    lines.append("# Units are SI (m, kg, s); z is up. Run it: granrs run FILE")
+    lines.append(f"format = {FORMAT_VERSION}")
+    lines.append("space = true")
+    tables: list[str] = []
+    for name in _SPACE_FIELDS:
+        value = getattr(scene, name)
+        if name == "forces":
+            for t in value:
+                tables += ["", "[[forces]]", f"term = {_format_value(t.name)}"]
+                tables += [f"{_format_key(k)} = {_format_value(v)}" for k, v in t.params.items()]
+            continue
+        if isinstance(value, tuple):
+            value = list(value)
+        lines.append(f"{name} = {_format_value(value)}")
+    body = scene.body
+    lines += ["", "[body]"]
+    for name in ("density", "mass"):
+        if getattr(body, name) is not None:
+            lines.append(f"{name} = {_format_value(getattr(body, name))}")
+    if body.inertia is not None:
+        rows = [[float(x) for x in row] for row in body.inertia]
+        lines.append(f"inertia = {_format_value(rows)}")
+    shape = body.shape
+    kind = next(k for k, (cls, _) in _SPACE_SHAPES.items() if isinstance(shape, cls))
+    lines += ["", "[body.shape]", f"kind = {_format_value(kind)}"]
+    for key in _SPACE_SHAPES[kind][1]:
+        value = getattr(shape, key)
+        if kind == "mesh":
+            value = value.tolist()
+        lines.append(f"{key} = {_format_value(list(value) if isinstance(value, tuple) else value)}")
+    return "\n".join(lines + tables) + "\n"
+
+
+def _build_space(data: dict[str, Any], locate: Callable[[tuple[str, ...]], str]) -> Any:
+    """A body in space's scene (:class:`granrs.space.Scene`) from parsed TOML data."""
+    known = ("format", "space", "body", *_SPACE_FIELDS)
+    for name in data:
+        if name not in known:
+            raise UnknownNameError(
+                f"{locate((name,))}: unknown key {name!r}: not a field of a body in space"
+                f"{_suggest(name, known)}",
+                field=name,
+            )
+    body = data.get("body")
+    if not isinstance(body, dict):
+        raise InvalidSceneError(
+            f"{locate(('body',))}: a body in space needs a [body] table with its mass "
+            "(density = ..., or mass = ...) and a [body.shape] table",
+            field="body",
+        )
+    for name in body:
+        if name not in ("shape", "density", "mass", "inertia"):
+            raise UnknownNameError(
+                f"{locate(('body', name))}: unknown key {name!r} of [body] (shape, density, "
+                "mass, inertia)",
+                field=f"body.{name}",
+            )
+    shape = body.get("shape")
+    if not isinstance(shape, dict) or shape.get("kind") not in _SPACE_SHAPES:
+        raise InvalidSceneError(
+            f"{locate(('body', 'shape'))}: [body.shape] needs kind = one of "
+            f"{', '.join(repr(k) for k in _SPACE_SHAPES)}",
+            field="body.shape.kind",
+        )
+    cls, keys = _SPACE_SHAPES[shape["kind"]]
+    for name in shape:
+        if name != "kind" and name not in keys:
+            raise UnknownNameError(
+                f"{locate(('body', 'shape', name))}: a {shape['kind']} has no key {name!r} "
+                f"({', '.join(keys)})",
+                field=f"body.shape.{name}",
+            )
+    missing = [k for k in keys if k not in shape]
+    if missing:
+        raise InvalidSceneError(
+            f"{locate(('body', 'shape'))}: a {shape['kind']} needs {', '.join(missing)}",
+            field=f"body.shape.{missing[0]}",
+        )
+    fields: dict[str, Any] = {}
+    for name in _SPACE_FIELDS:
+        if name not in data:
+            continue
+        value = data[name]
+        if name == "forces":
+            fields[name] = _forces(value, locate)
+        elif isinstance(value, list):
+            fields[name] = tuple(value)
+        else:
+            fields[name] = value
+    try:
+        args = [tuple(shape[k]) if k == "size" else shape[k] for k in keys]
+        made = cls(*args)
+        mass = {k: body[k] for k in ("density", "mass", "inertia") if k in body}
+        return space.Scene(body=space.Body(made, **mass), **fields)
+    except (InvalidSceneError, InvalidParameterError) as exc:
+        path = tuple((exc.field or "").split(".")) if exc.field else ()
+        term = re.match(r"forces\[(\d+)\]", exc.field or "")
+        if term:
+            path = ("forces", f"#{term.group(1)}")
+        raise _reraise(exc, locate(path)) from None
+    except TypeError as exc:
+        raise InvalidSceneError(f"{locate(('body',))}: {exc}", field="body") from None
 
 
 def _body_tables(body: Mapping[str, Any]) -> list[str]:
@@ -276,7 +403,7 @@ def _body_path(field: str, body: Any) -> tuple[str, ...]:
     return ("body", part, f"#{index}", *rest) if index is not None else ("body", part)
 
 
-def dump(scene: Scene, path: str | os.PathLike[str]) -> str:
+def dump(scene: Scene | space.Scene, path: str | os.PathLike[str]) -> str:
     """Write the scene to ``path`` (UTF-8; whole or not at all: an error leaves an existing
     file as it was) and return the text written."""
     text = dumps(scene)
@@ -437,11 +564,9 @@ def _forces(value: Any, locate: Callable[[tuple[str, ...]], str]) -> tuple[Any, 
     return tuple(out)
 
 
-def _build(
-    data: dict[str, Any],
-    locate: Callable[[tuple[str, ...]], str],
-) -> Scene:
-    """A validated Scene from parsed TOML data; ``locate`` says where a key path was set."""
+def _check_format(data: dict[str, Any], locate: Callable[[tuple[str, ...]], str]) -> None:
+    """Take the ``format`` key out of ``data``: a version this granrs reads, else a typed
+    error."""
     version = data.pop("format", FORMAT_VERSION)
     if isinstance(version, bool) or version not in SUPPORTED_FORMATS:
         raise InvalidSceneError(
@@ -450,6 +575,14 @@ def _build(
             f"{', '.join(str(v) for v in SUPPORTED_FORMATS)} (a newer granrs may read it)",
             field="format",
         )
+
+
+def _build(
+    data: dict[str, Any],
+    locate: Callable[[tuple[str, ...]], str],
+) -> Scene:
+    """A validated Scene from parsed TOML data; ``locate`` says where a key path was set."""
+    _check_format(data, locate)
     for name in data:
         if name in _TOML_REPLACED:
             raise UnknownNameError(
@@ -596,8 +729,9 @@ def _is_writable(value: Any) -> bool:
     return True
 
 
-def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | None = None) -> Scene:
-    """A validated :class:`~granrs.Scene` from TOML text; ``source`` names it in errors.
+def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | None = None) -> Any:
+    """A validated :class:`~granrs.Scene` from TOML text (a :class:`granrs.space.Scene`
+    where the file says ``space = true``); ``source`` names it in errors.
 
     ``overrides`` (``{"q_deg": 30.0, "static_v.eta_v": 300.0}``) replace values of the
     file before validation; an error in one points at ``--set field=value``.
@@ -607,6 +741,9 @@ def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | No
         data = _parse_toml(text, source)
     except tomllib.TOMLDecodeError as exc:
         raise _syntax_error(exc, text, source) from None
+    in_space = data.get("space") is True
+    if in_space and "forces" not in data:
+        data["forces"] = []
     origins = _apply_overrides(data, overrides)
     lines = key_lines(text)
 
@@ -618,10 +755,19 @@ def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | No
                 return _where(source, lines[path[:n]])
         return source
 
+    if "space" in data:
+        if data["space"] is not True:
+            raise InvalidSceneError(
+                f"{locate(('space',))}: `space` is true for a body in space (leave it out for "
+                "a planar scene)",
+                field="space",
+            )
+        _check_format(data, locate)
+        return _build_space(data, locate)
     return _build(data, locate)
 
 
-def load(path: str | os.PathLike[str], overrides: Mapping[str, Any] | None = None) -> Scene:
+def load(path: str | os.PathLike[str], overrides: Mapping[str, Any] | None = None) -> Any:
     """A validated :class:`~granrs.Scene` from the TOML file at ``path`` (see :func:`loads`).
 
     A file that is not a regular file, is larger than :data:`MAX_FILE_BYTES` or is not
