@@ -471,3 +471,19 @@ def test_an_animation_draws_the_body_at_its_recorded_pose(tmp_path) -> None:  # 
     with pytest.raises(granrs.GranrsError) as info:
         granrs.animate(granrs.simulate(scene.replace(record=False)))
     assert info.value.field == "record"
+
+
+def test_poncelet_depth_term_does_not_raise_a_false_step_warning():
+    # k d v/|v| does not grow with the speed: near the stop it must not count as a rate
+    # 1/|v| (it used to ask for dt <= 5e-16 s). The run is resolved: dt / 10 moves t_s and
+    # the depth by far less than 1 %, and no StepSizeWarning is raised (warnings are errors).
+    s = space.Scene(
+        body=space.Body(space.Cuboid((0.04, 0.03, 0.02)), mass=0.1),
+        forces=[granrs.forces.poncelet(c=1.0, k=200.0), granrs.forces.gravity()],
+        velocity=(0.0, 0.0, -2.0),
+        t_end=0.5,
+    )
+    a = granrs.simulate(s)
+    b = granrs.simulate(s.replace(dt=1e-5))
+    assert a.status == "stopped"
+    assert abs(a.t_s / b.t_s - 1) < 1e-2 and abs(a.depth / b.depth - 1) < 1e-2

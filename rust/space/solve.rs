@@ -22,8 +22,9 @@
 //! `h_lambda` is the step times the fastest rate the sand gives the body's centre: the
 //! spring rate `sqrt(K / m)` with `K = 2 |F_rft3d| / d` (exact for a force growing as the
 //! depth squared, an upper bound for one growing more slowly) and the damping rate
-//! `2 |F_inertial + F_poncelet| / (m |v|)`; the Python layer warns above RK4's stability
-//! limit.
+//! `2 (|F_inertial| + c rho_g A |v|^2) / (m |v|)` of the forces that grow as the velocity
+//! squared (poncelet's depth term `k d` does not grow with the speed: it has no rate along
+//! the motion); the Python layer warns above RK4's stability limit.
 
 use std::f64::consts::PI;
 
@@ -503,8 +504,14 @@ impl Body {
             0.0
         };
         let speed = y.v.norm();
+        // The velocity-squared forces' rate, 2 |F| / (m |v|): the inertial term's, and
+        // poncelet's drag c rho_g A |v|^2 (its depth term k d, which does not grow with
+        // the speed, has no rate along the motion).
+        let quadratic = self.sand.terms.poncelet.map_or(0.0, |p| {
+            p.c * self.sand.medium.rho_g * load.projected_area * speed * speed
+        });
         let damping = if speed > 0.0 {
-            2.0 * (load.inertial + load.poncelet).norm() / (m * speed)
+            2.0 * (load.inertial.norm() + quadratic) / (m * speed)
         } else {
             0.0
         };
