@@ -74,10 +74,13 @@ def test_a_sphere_at_rest_holds_still_without_chattering_or_gaining_energy(integ
     assert np.max(np.diff(e)) <= 1e-6 * timestep, np.max(np.diff(e))
 
 
-def test_the_force_handed_to_mujoco_is_the_momentum_the_body_receives():
+@pytest.mark.parametrize(
+    ("mode", "integrator"), [("step", "Euler"), ("callback", "Euler"), ("callback", "RK4")]
+)
+def test_the_force_handed_to_mujoco_is_the_momentum_the_body_receives(mode, integrator):
     s = CASES["capsule at 30 degrees"]
     h = 1e-3
-    m = mujoco.MjModel.from_xml_string(body_mjcf(s, h))
+    m = mujoco.MjModel.from_xml_string(body_mjcf(s, h, integrator))
     d = mujoco.MjData(m)
     d.qpos[:3] = s.position
     d.qpos[3:7] = s.orientation
@@ -85,10 +88,17 @@ def test_the_force_handed_to_mujoco_is_the_momentum_the_body_receives():
     sand = Sand(m, ["body"], [forces.rft3d(zeta=ZETA)], space=True)
     impulse = np.zeros(3)
     p0 = s.mass * d.qvel[:3].copy()
-    for _ in range(60):
-        sand.step(d)
-        mujoco.mj_step(m, d)
-        impulse += h * (sand.applied[0, :3] + np.array([0.0, 0.0, -s.mass * s.g]))
+    if mode == "callback":
+        sand.install()
+    try:
+        for _ in range(60):
+            if mode == "step":
+                sand.step(d)
+            mujoco.mj_step(m, d)
+            impulse += h * (sand.applied[0, :3] + np.array([0.0, 0.0, -s.mass * s.g]))
+    finally:
+        if mode == "callback":
+            sand.uninstall()
     p1 = s.mass * d.qvel[:3]
     assert np.all(np.abs(p1 - p0 - impulse) < 1e-9 * (1 + np.abs(impulse).max()))
     assert impulse[2] > 0.5 * s.mass  # the sand did stop it

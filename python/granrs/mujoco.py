@@ -443,6 +443,7 @@ class Sand:
         n = len(names)
         self.output = np.zeros((n, len(SPACE_GEOM_OUTPUTS)))
         self.applied = np.zeros((n, 6))
+        self._rk4_applied = np.zeros((n, 6))
         self.h_lambda = np.zeros(n)
         #: Newton iterations of the last step's implicit solve, its residual (the twists'
         #: largest error over their scale) and whether that is below 1e-10.
@@ -534,6 +535,18 @@ class Sand:
         if m is not self.model:
             return
         self._evaluate(data, passive=True, hold=self._later_stage(data))
+        if self.space and self._rk4:
+            # What the body receives over RK4's step is its stages' wrenches weighted 1, 2,
+            # 2, 1 (sixths): after the fourth, ``applied`` says so (a stage where a geom
+            # entered the sand solves its own).
+            stage = self._stage[0]
+            weight = (1.0, 2.0, 2.0, 1.0)[stage - 1] / 6.0
+            if stage == 1:
+                self._rk4_applied[:] = weight * self.applied
+            else:
+                self._rk4_applied += weight * self.applied
+            if stage == 4:
+                self.applied[:] = self._rk4_applied
 
     def install(self) -> None:
         """Run as MuJoCo's passive-force callback (``mujoco.set_mjcb_passive``), inside
