@@ -28,9 +28,10 @@
 //!
 //! Newton's method can fail where the law is far from smooth at a large step (a body
 //! toppling onto its side, a drop resolved in a few steps). Where its residual stays above
-//! [`FALLBACK`] the step sticks or slides instead: the wrench that brings every twist to
-//! zero at the step's end where the sand can supply it (its force no larger than the
-//! sand's resistance to the motion), else that resistance ([`Solve::fallback`]).
+//! [`FALLBACK`] the step sticks or slides instead, geom by geom: the wrench that brings
+//! every twist to zero at the step's end, each geom's scaled down to the sand's resistance
+//! to its motion where it asks for more ([`Solve::fallback`]); it never pushes a geom past
+//! rest.
 
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
@@ -96,8 +97,8 @@ pub struct Solve {
     /// The geom it belongs to.
     pub geom: usize,
     /// Whether Newton's residual stayed above [`FALLBACK`] and the step stuck or slid
-    /// instead (the wrench that stops every twist where the sand can supply it, else the
-    /// sand's resistance to the motion).
+    /// instead (the wrench that stops every twist, each geom's scaled down to the sand's
+    /// resistance to its motion where it asks for more).
     pub fallback: bool,
 }
 
@@ -344,16 +345,24 @@ impl SpaceCoupling {
             report.residual = r.amax() / scale;
             let mut w = effective(&ws);
             if report.residual > FALLBACK {
-                // Newton did not find the twists: stick or slide. The wrench that brings
-                // every twist to zero at the step's end, where its force is no larger than
-                // the sand's resistance to the motion without it; else that resistance.
-                let stop = (h * &resp).lu().solve(&(-&free));
+                // Newton did not find the twists: stick or slide, geom by geom. The wrench
+                // that brings every twist to zero at the step's end (the least one, where a
+                // geom's twist has fewer freedoms than six), each geom's scaled down where
+                // its force is more than the sand's resistance to its motion without it:
+                // it never pushes a geom past rest, nor harder than the sand resists.
                 let full = effective(&eval(&self.geoms, &free));
-                let force = |v: &DVector<f64>, a: usize| v.rows(6 * a, 3).norm();
-                w = match stop {
-                    Some(st) if (0..k).all(|a| force(&st, a) <= force(&full, a)) => st,
-                    _ => full,
-                };
+                let stop = (h * &resp)
+                    .svd(true, true)
+                    .solve(&(-&free), 1e-12 * (h * &resp).amax())
+                    .unwrap_or_else(|_| DVector::zeros(rows));
+                w = stop;
+                for a in 0..k {
+                    let (want, can) = (w.rows(6 * a, 3).norm(), full.rows(6 * a, 3).norm());
+                    if want > can {
+                        let scale = can / want;
+                        w.rows_mut(6 * a, 6).scale_mut(scale);
+                    }
+                }
                 xi = &free + h * (&resp * &w);
                 report.fallback = true;
             }
