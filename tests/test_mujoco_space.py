@@ -276,3 +276,26 @@ def test_gymnasiums_humanoid_dropped_on_sand_stays_finite():
         assert np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))
         assert np.all(np.isfinite(sand.applied))
     assert np.any(sand.output[:, 0] > 0.0)  # it is in the sand
+
+
+def test_the_gallery_ant_runs():
+    """The gallery's Ant-on-sand example (docs) runs: finite, standing on both grounds."""
+    import runpy
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    pytest.importorskip("gymnasium")
+    script = Path(__file__).resolve().parents[1] / "examples/gallery/plot_10_ant_on_sand.py"
+    namespace = runpy.run_path(str(script))
+    plt.close("all")
+    runs = namespace["runs"]
+    assert set(runs) == {"sand", "rigid floor"}
+    weight = namespace["weight"]
+    for r in runs.values():
+        assert np.all(np.isfinite(r["x"])) and np.all(np.isfinite(r["fz"]))
+    stand = runs["sand"]["t"] <= namespace["T_STAND"] + 1e-9
+    assert abs(runs["sand"]["fz"][stand][-1].sum() / weight - 1) < 0.05
