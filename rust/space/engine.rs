@@ -103,7 +103,7 @@ pub struct Solve {
 }
 
 /// The solve's relative residual above which the step falls back to sticking or sliding.
-pub const FALLBACK: f64 = 1e-3;
+pub const FALLBACK: f64 = 1e-2;
 
 /// The coupling: geoms in space on another engine's bodies.
 #[derive(Debug, Clone)]
