@@ -99,7 +99,7 @@ _BUILTINS = "|".join(sorted(n for n in dir(builtins) if not n.startswith("_")))
 _EXTERNAL = (
     rf"({_BUILTINS})",
     r"(collections\.abc|typing|types|os|io|pathlib|argparse|numbers|dataclasses|enum)\.\w+",
-    r"(numpy|np|pandas|pd|matplotlib|mpl|dask|distributed|scipy|tqdm)(\.\w+)*",
+    r"(numpy|np|pandas|pd|matplotlib|mpl|dask|distributed|scipy|tqdm|gymnasium)(\.\w+)*",
     r"(NDArray|ArrayLike|DataFrame|Series|Figure|Axes|FuncAnimation)",
     r"importlib\.(abc|resources)(\.\w+)*",
     # importlib's Traversable, named bare in granrs.data's annotations (imported for typing).
