@@ -290,21 +290,9 @@ impl GeomCoupling {
             .unwrap_or(0);
         let width = crate::evaluate::geoms::OUTPUTS.len();
         let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
-            let [r, k] = [a.shape()[0], a.shape()[1]];
-            let ok = k == cols && if exact { r == rows } else { r >= rows };
-            if ok && a.is_c_contiguous() {
-                Ok(a.clone().unbind())
-            } else {
-                Err(PyValueError::new_err(format!("GeomCoupling.bind: {name}")))
-            }
+            bind2(a, "GeomCoupling", name, rows, cols, exact)
         };
-        let one = |a: &Bound1<'_>, name: &str, len: usize| {
-            if a.len() == len && a.is_c_contiguous() {
-                Ok(a.clone().unbind())
-            } else {
-                Err(PyValueError::new_err(format!("GeomCoupling.bind: {name}")))
-            }
-        };
+        let one = |a: &Bound1<'_>, name: &str, len: usize| bind1(a, "GeomCoupling", name, len);
         self.bound = Some(Arrays {
             geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
             geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
@@ -346,7 +334,6 @@ impl GeomCoupling {
         let Some(b) = &self.bound else {
             return Err(PyValueError::new_err("GeomCoupling.step before bind"));
         };
-        let nv = self.inner.nv;
         // SAFETY: the arrays were checked contiguous with their shapes at `bind`; MuJoCo
         // never reallocates an mjData's arrays, the buffers are this Sand's own, and with
         // the GIL held nothing else touches them during the call. Each is read or written
@@ -377,16 +364,7 @@ impl GeomCoupling {
                 let target = rw(py, &b.qfrc_applied);
                 let before = rw(py, &b.before);
                 let after = rw(py, &b.after);
-                for j in 0..nv {
-                    let user = if !fresh && target[j] == after[j] {
-                        before[j]
-                    } else {
-                        target[j]
-                    };
-                    before[j] = user;
-                    target[j] = user + gen[j];
-                    after[j] = target[j];
-                }
+                keep_user_entries(target, before, after, gen, fresh);
             }
             let h = ro(py, &b.h_lambda);
             let (mut k, mut top) = (0, 0.0);
@@ -397,6 +375,57 @@ impl GeomCoupling {
             }
             Ok((top, k))
         }
+    }
+}
+
+/// A 2-d array checked for one `bind` of `class`: `cols` columns and `rows` rows (at least,
+/// unless `exact`), C-contiguous.
+fn bind2(
+    a: &Bound2<'_>,
+    class: &str,
+    name: &str,
+    rows: usize,
+    cols: usize,
+    exact: bool,
+) -> PyResult<Py<PyArray2<f64>>> {
+    let [r, k] = [a.shape()[0], a.shape()[1]];
+    let ok = k == cols && if exact { r == rows } else { r >= rows };
+    if ok && a.is_c_contiguous() {
+        Ok(a.clone().unbind())
+    } else {
+        Err(PyValueError::new_err(format!("{class}.bind: {name}")))
+    }
+}
+
+/// A 1-d array of `len` checked for one `bind` of `class`, C-contiguous.
+fn bind1(a: &Bound1<'_>, class: &str, name: &str, len: usize) -> PyResult<Py<PyArray1<f64>>> {
+    if a.len() == len && a.is_c_contiguous() {
+        Ok(a.clone().unbind())
+    } else {
+        Err(PyValueError::new_err(format!("{class}.bind: {name}")))
+    }
+}
+
+/// Put the generalized force `gen` into `qfrc_applied` (`target`): an entry still equal to
+/// `after` (what the last step left there) is restored to `before` (what it held before),
+/// any other entry is the user's (every entry, when `fresh`); the new contribution is added
+/// and `before` and `after` kept.
+fn keep_user_entries(
+    target: &mut [f64],
+    before: &mut [f64],
+    after: &mut [f64],
+    gen: &[f64],
+    fresh: bool,
+) {
+    for j in 0..target.len() {
+        let user = if !fresh && target[j] == after[j] {
+            before[j]
+        } else {
+            target[j]
+        };
+        before[j] = user;
+        target[j] = user + gen[j];
+        after[j] = target[j];
     }
 }
 
@@ -598,21 +627,9 @@ impl SpaceCoupling {
             .unwrap_or(0);
         let width = space_engine::OUTPUTS.len();
         let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
-            let [r, k] = [a.shape()[0], a.shape()[1]];
-            let ok = k == cols && if exact { r == rows } else { r >= rows };
-            if ok && a.is_c_contiguous() {
-                Ok(a.clone().unbind())
-            } else {
-                Err(PyValueError::new_err(format!("SpaceCoupling.bind: {name}")))
-            }
+            bind2(a, "SpaceCoupling", name, rows, cols, exact)
         };
-        let one = |a: &Bound1<'_>, name: &str, len: usize| {
-            if a.len() == len && a.is_c_contiguous() {
-                Ok(a.clone().unbind())
-            } else {
-                Err(PyValueError::new_err(format!("SpaceCoupling.bind: {name}")))
-            }
-        };
+        let one = |a: &Bound1<'_>, name: &str, len: usize| bind1(a, "SpaceCoupling", name, len);
         self.bound = Some(SpaceArrays {
             geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
             geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
@@ -652,7 +669,6 @@ impl SpaceCoupling {
             return Err(PyValueError::new_err("SpaceCoupling.step before bind"));
         };
         let inner = &mut self.inner;
-        let nv = inner.nv;
         // SAFETY: as `GeomCoupling.step`: each array was checked contiguous with its shape
         // at `bind`, MuJoCo never reallocates an mjData's arrays, the buffers are this
         // Sand's own, and no two slices alias (distinct arrays). The caller holds the
@@ -688,16 +704,7 @@ impl SpaceCoupling {
                 if passive {
                     target.iter_mut().zip(gen.iter()).for_each(|(t, g)| *t += g);
                 } else {
-                    for j in 0..nv {
-                        let user = if !fresh && target[j] == after[j] {
-                            before[j]
-                        } else {
-                            target[j]
-                        };
-                        before[j] = user;
-                        target[j] = user + gen[j];
-                        after[j] = target[j];
-                    }
+                    keep_user_entries(target, before, after, gen, fresh);
                 }
                 report
             });
