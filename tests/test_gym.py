@@ -201,15 +201,13 @@ def test_ant_settles_on_its_feet_and_the_sand_carries_its_weight():
     assert data.xmat[1][8] > math.cos(math.radians(5.0))
 
 
-@pytest.mark.xfail(
-    reason="a known limitation (docs/mujoco.md): the implicit step's prediction of the rest "
-    "of the robot's forces lags a 10 ms step, and from Gymnasium's default reset noise the "
-    "Ant's torso is thrown up (seed 0: from 0.66 m to 1.07 m)",
-    strict=False,
-)
-def test_ant_from_a_noisy_reset_is_not_thrown_up():
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4])
+def test_ant_from_a_noisy_reset_is_not_thrown_up(seed):
+    # From Gymnasium's default reset noise the Ant lands unevenly; the sand must not throw
+    # it up (a fallback that capped one foot and left the others' wrenches as solved for it
+    # once threw seed 0's torso from 0.66 m to 1.07 m).
     env = make("Ant-v5")
-    env.reset(seed=0)
+    env.reset(seed=seed)
     start = env.unwrapped.data.qpos[2]
     top = start
     for _ in range(40):

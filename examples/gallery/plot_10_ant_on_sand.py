@@ -88,9 +88,9 @@ def gait(model):
 # 0.01 s step; on sand ``sand.step(data)`` before each ``mujoco.mj_step``. The sand is taken
 # implicitly: each step solves, by Newton's method, for the feet's motion at the step's end
 # under the sand's force at that motion. A step where Newton's method does not converge
-# sticks or slides instead: the feet are brought to rest, each foot's wrench scaled down to
-# the sand's resistance where it asks for more. ``sand.fallbacks`` counts those steps, and
-# the first one warns (:class:`granrs.StepSizeWarning`). The runs catch that warning and
+# sticks or slides instead: the feet are brought to rest, a foot that would need more than
+# the sand's resistance held at it and the others solved again. ``sand.fallbacks`` counts
+# those steps, and the first one warns (:class:`granrs.StepSizeWarning`). The runs catch that warning and
 # print the count and the times of those steps instead.
 
 
@@ -231,8 +231,8 @@ for label, r in runs.items():
 # each foot's reaction is a train of spikes (cut off by the axis). Over a gait period (the
 # thick line) both grounds carry the weight. The Ant's own 0.01 s step holds it standing on
 # the sand, but it does not resolve the stride: the same gait on sand walks about 1.2 m at a
-# 1 ms step against 1.7 m at 0.01 s (the implicit step damps the feet's motion more at the
-# larger step); take the distance on sand at 0.01 s as the coarse step's, not the sand's.
+# 1 ms step against 1.4 m at 0.01 s; take the distance on sand at 0.01 s as the coarse
+# step's, not the sand's.
 
 fig = plt.figure(figsize=(9.0, 8.5))
 grid = fig.add_gridspec(3, 2)

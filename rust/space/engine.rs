@@ -29,9 +29,9 @@
 //! Newton's method can fail where the law is far from smooth at a large step (a body
 //! toppling onto its side, a drop resolved in a few steps). Where its residual stays above
 //! [`FALLBACK`] the step sticks or slides instead, geom by geom: the wrench that brings
-//! every twist to zero at the step's end, each geom's scaled down to the sand's resistance
-//! to its motion where it asks for more ([`Solve::fallback`]); it never pushes a geom past
-//! rest.
+//! every twist to zero at the step's end, a geom that would need more than the sand's
+//! resistance to its motion held at that resistance and the others solved again with it
+//! held ([`Solve::fallback`]).
 
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
@@ -142,6 +142,65 @@ fn jacobian(place: &Place, s: &EngineState, nv: usize, p: &V3, rows: &mut [f64])
         rows[4 * nv + j] = d[1];
         rows[5 * nv + j] = d[2];
     }
+}
+
+/// The fallback's wrenches (6 per geom, `k` geoms): those that bring every twist
+/// `free + ha w` to zero (the least, where the twists have fewer freedoms than `6 k`), with
+/// each geom's force at most the sand's resistance `full` to its motion: geom by geom, the
+/// one furthest past its resistance is held there (its wrench scaled down) and the others
+/// are solved again with it held (an active set), so that no geom is pushed past rest by
+/// another's cap.
+fn stick_or_slide(
+    ha: &DMatrix<f64>,
+    free: &DVector<f64>,
+    full: &DVector<f64>,
+    k: usize,
+) -> DVector<f64> {
+    let rows = 6 * k;
+    let mut w = DVector::zeros(rows);
+    let mut held = vec![false; k];
+    for _ in 0..k {
+        let open: Vec<usize> = (0..rows).filter(|&p| !held[p / 6]).collect();
+        if open.is_empty() {
+            break;
+        }
+        let sub = DMatrix::from_fn(open.len(), open.len(), |p, q| ha[(open[p], open[q])]);
+        let rhs = DVector::from_fn(open.len(), |p, _| {
+            let row = open[p];
+            -free[row]
+                - (0..rows)
+                    .filter(|&q| held[q / 6])
+                    .map(|q| ha[(row, q)] * w[q])
+                    .sum::<f64>()
+        });
+        let tol = 1e-12 * sub.amax();
+        let Ok(x) = sub.svd(true, true).solve(&rhs, tol) else {
+            break;
+        };
+        for (p, &row) in open.iter().enumerate() {
+            w[row] = x[p];
+        }
+        // The open geom furthest past the sand's resistance, if any.
+        let mut worst: Option<(usize, f64)> = None;
+        for a in (0..k).filter(|&a| !held[a]) {
+            let (want, can) = (w.rows(6 * a, 3).norm(), full.rows(6 * a, 3).norm());
+            if want > can {
+                let past = if can > 0.0 { want / can } else { f64::INFINITY };
+                if worst.is_none_or(|(_, x)| past > x) {
+                    worst = Some((a, past));
+                }
+            }
+        }
+        match worst {
+            None => return w,
+            Some((a, _)) => {
+                let (want, can) = (w.rows(6 * a, 3).norm(), full.rows(6 * a, 3).norm());
+                w.rows_mut(6 * a, 6).scale_mut(can / want);
+                held[a] = true;
+            }
+        }
+    }
+    w
 }
 
 /// Whether every active geom has a solved twist from the last step.
@@ -345,24 +404,8 @@ impl SpaceCoupling {
             report.residual = r.amax() / scale;
             let mut w = effective(&ws);
             if report.residual > FALLBACK {
-                // Newton did not find the twists: stick or slide, geom by geom. The wrench
-                // that brings every twist to zero at the step's end (the least one, where a
-                // geom's twist has fewer freedoms than six), each geom's scaled down where
-                // its force is more than the sand's resistance to its motion without it:
-                // it never pushes a geom past rest, nor harder than the sand resists.
                 let full = effective(&eval(&self.geoms, &free));
-                let stop = (h * &resp)
-                    .svd(true, true)
-                    .solve(&(-&free), 1e-12 * (h * &resp).amax())
-                    .unwrap_or_else(|_| DVector::zeros(rows));
-                w = stop;
-                for a in 0..k {
-                    let (want, can) = (w.rows(6 * a, 3).norm(), full.rows(6 * a, 3).norm());
-                    if want > can {
-                        let scale = can / want;
-                        w.rows_mut(6 * a, 6).scale_mut(scale);
-                    }
-                }
+                w = stick_or_slide(&(h * &resp), &free, &full, k);
                 xi = &free + h * (&resp * &w);
                 report.fallback = true;
             }
