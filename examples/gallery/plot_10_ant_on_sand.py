@@ -90,8 +90,8 @@ def gait(model):
 # under the sand's force at that motion. A step where Newton's method does not converge
 # sticks or slides instead: the feet are brought to rest, a foot that would need more than
 # the sand's resistance held at it and the others solved again. ``sand.fallbacks`` counts
-# those steps, and the first one warns (:class:`granrs.StepSizeWarning`). The runs catch that warning and
-# print the count and the times of those steps instead.
+# those steps, and the first one warns (:class:`granrs.StepSizeWarning`). The runs catch
+# that warning and print the count and the times of those steps instead.
 
 
 def run(on_sand):
