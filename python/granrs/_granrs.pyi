@@ -283,10 +283,10 @@ class SpaceCoupling:
         """Bind one mjData's arrays and the caller's buffers (checked once)."""
     def step(
         self, timestep: float, passive: bool, fresh: bool, hold: bool
-    ) -> tuple[float, int, int, float, bool]:
+    ) -> tuple[float, int, int, float, bool, bool]:
         """One implicit evaluation at the bound arrays (GIL released). Returns the largest
-        h_lambda, its geom, the Newton iterations, the relative residual and whether the
-        step fell back to sticking or sliding."""
+        h_lambda, its geom, the Newton iterations, the relative residual, whether the solve
+        converged and whether the step fell back to sticking or sliding."""
 
 SPACE_SUMMARY: list[tuple[str, str, str]]
 SPACE_SERIES: list[tuple[str, str, str]]

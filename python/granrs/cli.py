@@ -749,13 +749,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         what = "every series column" if in_space else ", ".join(SERIES_RECORD)
         print(f"{PROG}: note: the scene records nothing; --series records {what}", file=sys.stderr)
     result = simulate(scene)
-    if isinstance(result, SpaceResult):
-        return _finish_space_run(args, result)
+    in_space = isinstance(result, SpaceResult)
     if args.series:
-        frame = result.to_frame()
-        units = series_units(result)
-        frame = frame.rename(columns=lambda name: f"{name} [{units[name]}]")
-        frame.index.name = f"t [{units['t']}]"
+        frame = _space_frame(result) if in_space else _planar_frame(result)
         with replacing(args.series) as tmp:
             if suffix == ".parquet":
                 frame.to_parquet(tmp)
@@ -767,10 +763,32 @@ def _cmd_run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     if args.json:
-        print(json.dumps(summary_dict(result, args.scene), indent=2, allow_nan=False))
+        as_dict = space_summary_dict if in_space else summary_dict
+        print(json.dumps(as_dict(result, args.scene), indent=2, allow_nan=False))
     else:
-        print(summary_text(result, args.scene))
+        print((space_summary_text if in_space else summary_text)(result, args.scene))
     return 0
+
+
+def _planar_frame(result: Any) -> Any:
+    """A planar run's recorded series as a table, each column's unit in its name."""
+    frame = result.to_frame()
+    units = series_units(result)
+    frame = frame.rename(columns=lambda name: f"{name} [{units[name]}]")
+    frame.index.name = f"t [{units['t']}]"
+    return frame
+
+
+def _space_frame(result: Any) -> Any:
+    """A body in space's recorded series as a table, each column's unit in its name."""
+    import pandas as pd
+
+    from .space import SERIES_COLUMNS
+
+    series = result.series or {}
+    frame = pd.DataFrame({k: v for k, v in series.items() if k != "t"})
+    frame.index = pd.Index(series.get("t", []), name="t [s]")
+    return frame.rename(columns=lambda n: f"{n} [{SERIES_COLUMNS.get(n, ('', ''))[0]}]")
 
 
 def space_summary_dict(result: Any, source: str | None = None) -> dict[str, Any]:
@@ -805,34 +823,6 @@ def space_summary_text(result: Any, source: str | None = None) -> str:
     ]
     lines += _table(["field", "value", "unit", ""], rows)
     return "\n".join(lines)
-
-
-def _finish_space_run(args: argparse.Namespace, result: Any) -> int:
-    """Write a body in space's series (``--series``) and print its summary."""
-    from .space import SERIES_COLUMNS
-
-    if args.series:
-        import pandas as pd
-
-        series = result.series or {}
-        frame = pd.DataFrame({k: v for k, v in series.items() if k != "t"})
-        frame.index = pd.Index(series.get("t", []), name="t [s]")
-        frame = frame.rename(columns=lambda n: f"{n} [{SERIES_COLUMNS.get(n, ('', ''))[0]}]")
-        with replacing(args.series) as tmp:
-            if _series_format(args.series) == ".parquet":
-                frame.to_parquet(tmp)
-            else:
-                frame.to_csv(tmp)
-        print(
-            f"{PROG}: series written to {args.series} ({len(frame)} rows, "
-            f"{len(frame.columns) + 1} columns)",
-            file=sys.stderr,
-        )
-    if args.json:
-        print(json.dumps(space_summary_dict(result, args.scene), indent=2, allow_nan=False))
-    else:
-        print(space_summary_text(result, args.scene))
-    return 0
 
 
 #: What ``granrs animate`` records (besides what the scene records already).

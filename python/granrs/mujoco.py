@@ -446,7 +446,7 @@ class Sand:
         self._rk4_applied = np.zeros((n, 6))
         self.h_lambda = np.zeros(n)
         #: Newton iterations of the last step's implicit solve, its residual (the twists'
-        #: largest error over their scale) and whether that is below 1e-10.
+        #: largest error over their scale) and whether it converged (below 1e-10).
         self.iterations, self.residual, self.converged = 0, 0.0, True
         #: The largest residual over every step so far.
         self.max_residual = 0.0
@@ -593,53 +593,14 @@ class Sand:
         (``passive``) or ``qfrc_applied``, and the drag's h lambda."""
         m = self.model
         fresh = data is not self._data_ref
-        if self.space:
-            if fresh:
-                self._coupling.bind(
-                    data.geom_xpos,
-                    data.geom_xmat,
-                    data.subtree_com,
-                    data.cdof,
-                    data.qvel,
-                    data.qacc,
-                    data.qfrc_applied,
-                    data.qfrc_passive,
-                    self._mass,
-                    self.output,
-                    self.applied,
-                    self.h_lambda,
-                    self._generalized,
-                    self._before,
-                    self._after,
-                )
-                self._data_ref = data
-            mujoco.mj_fullM(m, data, self._mass)
-            worst, _, self.iterations, self.residual, fell = self._coupling.step(
-                self._opt.timestep, passive, fresh, hold
-            )
-            self.converged = self.residual <= 1e-10
-            self.max_residual = max(self.max_residual, self.residual)
-            self.max_h_lambda = max(self.max_h_lambda, worst)
-            self.fallbacks += int(fell)
-            if fell and not self._warned:
-                self._warned = True
-                warnings.warn(
-                    StepSizeWarning(
-                        f"the sand's implicit step did not converge at MuJoCo's timestep "
-                        f"{self._opt.timestep:g} s (its residual is {self.residual:.2g} of the "
-                        f"geoms' speeds after {self.iterations} Newton iterations): that step "
-                        "stuck or slid instead (see Sand.fallbacks); a smaller timestep "
-                        "resolves the sand"
-                    ),
-                    stacklevel=4,
-                )
-            return
         if fresh:
-            # MuJoCo allocates an mjData's arrays once: the core binds their views once.
+            # MuJoCo allocates an mjData's arrays once: the core binds their views once (the
+            # planar coupling reads each body's velocity, cvel; in space the Jacobian's).
+            velocity = () if self.space else (data.cvel,)
             self._coupling.bind(
                 data.geom_xpos,
                 data.geom_xmat,
-                data.cvel,
+                *velocity,
                 data.subtree_com,
                 data.cdof,
                 data.qvel,
@@ -656,6 +617,26 @@ class Sand:
             )
             self._data_ref = data
         mujoco.mj_fullM(m, data, self._mass)
+        if self.space:
+            worst, _, self.iterations, self.residual, self.converged, fell = self._coupling.step(
+                self._opt.timestep, passive, fresh, hold
+            )
+            self.max_residual = max(self.max_residual, self.residual)
+            self.max_h_lambda = max(self.max_h_lambda, worst)
+            self.fallbacks += int(fell)
+            if fell and not self._warned:
+                self._warned = True
+                warnings.warn(
+                    StepSizeWarning(
+                        f"the sand's implicit step did not converge at MuJoCo's timestep "
+                        f"{self._opt.timestep:g} s (its residual is {self.residual:.2g} of the "
+                        f"geoms' speeds after {self.iterations} Newton iterations): that step "
+                        "stuck or slid instead (see Sand.fallbacks); a smaller timestep "
+                        "resolves the sand"
+                    ),
+                    stacklevel=4,
+                )
+            return
         worst, geom = self._coupling.step(self._opt.timestep, passive, fresh, hold)
         if worst > self.max_h_lambda:
             self.max_h_lambda = worst

@@ -655,8 +655,8 @@ impl SpaceCoupling {
     /// generalized force, and puts it into MuJoCo's as `GeomCoupling.step` does
     /// (`passive`: added to `qfrc_passive`; else into `qfrc_applied`, keeping the user's
     /// entries; `hold`: a later stage of RK4's step). Returns the largest `h_lambda`, its
-    /// geom, the Newton iterations, the solve's relative residual and whether the step
-    /// fell back to sticking or sliding.
+    /// geom, the Newton iterations, the solve's relative residual, whether it converged
+    /// and whether the step fell back to sticking or sliding.
     fn step(
         &mut self,
         py: Python<'_>,
@@ -664,7 +664,7 @@ impl SpaceCoupling {
         passive: bool,
         fresh: bool,
         hold: bool,
-    ) -> PyResult<(f64, usize, usize, f64, bool)> {
+    ) -> PyResult<(f64, usize, usize, f64, bool, bool)> {
         let Some(b) = &self.bound else {
             return Err(PyValueError::new_err("SpaceCoupling.step before bind"));
         };
@@ -713,6 +713,7 @@ impl SpaceCoupling {
                 report.geom,
                 report.iterations,
                 report.residual,
+                report.converged,
                 report.fallback,
             ))
         }
