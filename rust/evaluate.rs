@@ -262,8 +262,8 @@ pub mod geoms {
     impl SandGeoms {
         /// Geoms named `names` of `shapes`, under `forces` (built for `names.len()`
         /// contacts: a parameter is one value for every geom or one per geom). Contact terms
-        /// only: `gravity` and `joint_springs` act through the other engine, and are an
-        /// error naming them.
+        /// only: a body term (`gravity`, `joint_springs`) acts through the other engine, and
+        /// is an error naming it.
         pub fn new(
             names: &[String],
             shapes: &[GeomShape],
@@ -278,16 +278,15 @@ pub mod geoms {
                     message: "one shape and one set of terms per geom".into(),
                 });
             }
-            for body in ["gravity", "joint_springs"] {
-                if forces.names.contains(&body) {
-                    return Err(GranrsError::InvalidScene {
-                        field: format!("forces.{body}"),
-                        message: format!(
-                            "`{body}` acts through the engine's own model (its gravity, its \
-                             joints); list only the medium's contact terms"
-                        ),
-                    });
-                }
+            if let Some(t) = forces.body.first() {
+                let body = t.info().name;
+                return Err(GranrsError::InvalidScene {
+                    field: format!("forces.{body}"),
+                    message: format!(
+                        "`{body}` acts through the engine's own model (its gravity, its \
+                         joints); list only the medium's contact terms"
+                    ),
+                });
             }
             check_range("rho_g", medium.rho_g, 0.0, true)?;
             check_range("g", medium.g, 0.0, false)?;
@@ -1057,8 +1056,11 @@ pub mod geoms {
             let r = Vector2::new(out[5], out[6] + 0.02);
             let by_hand = r.y * out[0] - r.x * out[1];
             assert!((out[2] - by_hand).abs() < 1e-12 * by_hand.abs(), "{out:?}");
-            let mut with_gravity = thesis_contact_terms();
-            with_gravity.names.push("gravity");
+            let with_gravity = ForceSet::build(
+                &[TermSpec::new("gravity", &[]), TermSpec::new("drag", &[])],
+                1,
+            )
+            .unwrap();
             let err = SandGeoms::new(
                 &["foot".into()],
                 &[ROD],

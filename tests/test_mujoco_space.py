@@ -162,6 +162,44 @@ def test_bad_input_is_a_typed_error_naming_it():
         assert field in (e.value.field or "") + str(e.value), (kw, e.value)
 
 
+@pytest.mark.parametrize("space", [True, False])
+def test_the_cores_binding_of_mujocos_arrays_names_the_array_it_refuses(space):
+    # Both couplings bind one mjData's arrays through one checked table (the planar one
+    # with cvel as well): a wrong count or a wrong shape is refused naming the array.
+    xml = """<mujoco><worldbody><body name="rod" pos="0 0 0.05">
+      <joint type="slide" axis="1 0 0"/><joint type="slide" axis="0 0 1"/>
+      <joint type="hinge" axis="0 1 0"/>
+      <geom name="rod" type="capsule" size="0.006 0.09" mass="0.18"/>
+      </body></worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    terms = [forces.rft3d(zeta=ZETA)] if space else [forces.drag(), forces.static_v()]
+    sand = Sand(m, ["rod"], terms, space=space)
+    sand.step(d)
+    core = sand._coupling
+    name = "SpaceCoupling" if space else "GeomCoupling"
+    velocity = () if space else (d.cvel,)
+    arrays = [d.geom_xpos, d.geom_xmat, *velocity, d.subtree_com, d.cdof, d.qvel, d.qacc]
+    arrays += [d.qfrc_applied, d.qfrc_passive, sand._mass, sand.output, sand.applied]
+    arrays += [sand.h_lambda, sand._generalized, sand._before, sand._after]
+    core.bind(*arrays)
+    with pytest.raises(ValueError, match=f"{name}.bind: {len(arrays)} arrays, got"):
+        core.bind(*arrays[:-1])
+    k = 3 if space else 4
+    bad = list(arrays)
+    bad[k] = np.zeros((m.nv, 5))
+    with pytest.raises(ValueError, match=f"{name}.bind: cdof"):
+        core.bind(*bad)
+    bad = list(arrays)
+    bad[-3] = np.zeros(m.nv + 1)
+    with pytest.raises(ValueError, match=f"{name}.bind: generalized"):
+        core.bind(*bad)
+    bad = list(arrays)
+    bad[0] = [[0.0] * 3]
+    with pytest.raises(ValueError, match=f"{name}.bind: geom_xpos"):
+        core.bind(*bad)
+
+
 def test_a_geom_outside_the_patch_feels_nothing():
     s = CASES["sphere"]
     m = mujoco.MjModel.from_xml_string(body_mjcf(s, 1e-3))

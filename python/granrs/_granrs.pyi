@@ -192,25 +192,7 @@ class GeomCoupling:
         stick: bool,
         implicit_damping: list[float],
     ) -> GeomCoupling: ...
-    def bind(
-        self,
-        geom_xpos: Any,
-        geom_xmat: Any,
-        cvel: Any,
-        subtree_com: Any,
-        cdof: Any,
-        qvel: Any,
-        qacc: Any,
-        qfrc_applied: Any,
-        qfrc_passive: Any,
-        mass: Any,
-        outputs: Any,
-        applied: Any,
-        h_lambda: Any,
-        generalized: Any,
-        before: Any,
-        after: Any,
-    ) -> None:
+    def bind(self, *arrays: Any) -> None:
         """Bind one mjData's arrays and the caller's buffers (checked once)."""
     def step(self, timestep: float, passive: bool, fresh: bool, hold: bool) -> tuple[float, int]:
         """One evaluation at the bound arrays; the generalized force into qfrc_passive
@@ -262,24 +244,7 @@ class SpaceCoupling:
         nv: int,
         implicit_damping: list[float],
     ) -> SpaceCoupling: ...
-    def bind(
-        self,
-        geom_xpos: Any,
-        geom_xmat: Any,
-        subtree_com: Any,
-        cdof: Any,
-        qvel: Any,
-        qacc: Any,
-        qfrc_applied: Any,
-        qfrc_passive: Any,
-        mass: Any,
-        outputs: Any,
-        applied: Any,
-        h_lambda: Any,
-        generalized: Any,
-        before: Any,
-        after: Any,
-    ) -> None:
+    def bind(self, *arrays: Any) -> None:
         """Bind one mjData's arrays and the caller's buffers (checked once)."""
     def step(
         self, timestep: float, passive: bool, fresh: bool, hold: bool

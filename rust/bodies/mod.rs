@@ -8,7 +8,6 @@
 
 use nalgebra::SVector;
 
-use crate::body::Joint;
 use crate::dynamics::{Model, SignModel};
 use crate::error::{check_range, fmt_num, GranrsError, Result};
 use crate::fields::{MAX_SAMPLES, MAX_STEPS};
@@ -95,17 +94,23 @@ pub(crate) fn validate_joint_stiffness<const N: usize>(
     options: &SolveOptions,
     names: &[&str],
 ) -> Result<()> {
-    if options.method != Method::Rk4 || !model.forces.joint_springs {
+    if options.method != Method::Rk4 || model.forces.body.is_empty() {
         return Ok(());
     }
     let pose = model.mechanism.pose(q0);
     let Some(chol) = model.mechanism.mass_matrix(&pose).cholesky() else {
         return Ok(());
     };
-    for (i, link) in model.mechanism.links.iter().enumerate() {
-        let (Some(p), Joint::Spring { k, c, .. }) = (link.parent, link.joint) else {
-            continue;
-        };
+    let joints = model
+        .mechanism
+        .links
+        .iter()
+        .enumerate()
+        .flat_map(|(i, link)| {
+            let rates = model.forces.body.iter().filter_map(|t| t.joint_rates(link));
+            link.parent.map(|p| rates.map(move |kc| (i, p, kc)))
+        });
+    for (i, p, (k, c)) in joints.flatten() {
         let mut a = SVector::<f64, N>::zeros();
         a[2 + i] = 1.0;
         a[2 + p] = -1.0;

@@ -254,45 +254,6 @@ impl<const N: usize> Mechanism<N> {
             || self.locked_rows().next().is_some()
     }
 
-    /// Add the spring-damper torques of the joints to the generalized forces `out`; return
-    /// the power they dissipate, `sum c thetadot^2` [W] (non-negative).
-    pub fn add_joint_torques(
-        &self,
-        q: &SVector<f64, N>,
-        qd: &SVector<f64, N>,
-        out: &mut SVector<f64, N>,
-        torques: &mut [f64; N],
-    ) -> f64 {
-        let mut dissipated = 0.0;
-        for (i, l) in self.links.iter().enumerate() {
-            if let (Some(p), Joint::Spring { k, c, rest }) = (l.parent, l.joint) {
-                let theta = q[2 + i] - q[2 + p];
-                let rate = qd[2 + i] - qd[2 + p];
-                let tau = -k * (theta - rest) - c * rate;
-                out[2 + i] += tau;
-                out[2 + p] -= tau;
-                torques[i] = tau;
-                dissipated += c * rate * rate;
-            }
-        }
-        dissipated
-    }
-
-    /// Elastic energy stored in the joints' springs [J].
-    pub fn spring_energy(&self, q: &SVector<f64, N>) -> f64 {
-        self.links
-            .iter()
-            .enumerate()
-            .map(|(i, l)| match (l.parent, l.joint) {
-                (Some(p), Joint::Spring { k, rest, .. }) => {
-                    let x = q[2 + i] - q[2 + p] - rest;
-                    0.5 * k * x * x
-                }
-                _ => 0.0,
-            })
-            .sum()
-    }
-
     /// Force the parent (or the root) exerts on each link at its joint [N], from Newton's
     /// law on the subtree the joint carries: `sum_subtree m (a_c - g) - F_external`.
     /// `external[i]` is the external force (the sand's) on link `i`.

@@ -260,15 +260,12 @@ impl<const N: usize> Model<N> {
         }
     }
 
-    /// The acceleration of gravity on the body [m/s^2]: the medium's g while the `gravity`
-    /// term acts, else zero (the body then has no potential energy from gravity either).
+    /// The acceleration of gravity on the body [m/s^2]: the field its body terms put on
+    /// every mass (the medium's g under `gravity`, zero without it: the body then has no
+    /// potential energy from gravity either).
     #[inline(always)]
     pub fn gravity(&self) -> f64 {
-        if self.forces.gravity {
-            self.medium.g
-        } else {
-            0.0
-        }
+        self.forces.field * self.medium.g
     }
 
     /// The signs of v_Ex and v_Ey that the static terms take in `mode`, by the sign model.
@@ -514,12 +511,10 @@ impl<const N: usize> Model<N> {
         let g = self.gravity();
         let mut rhs = self.mechanism.bias_forces(&pose, qd, g);
         let mut joint_torque = [0.0; N];
-        let joint_power = if self.forces.joint_springs {
-            self.mechanism
-                .add_joint_torques(q, qd, &mut rhs, &mut joint_torque)
-        } else {
-            0.0
-        };
+        let mut joint_power = 0.0;
+        for t in self.forces.body.iter() {
+            joint_power += t.add_joint_torques(&self.mechanism, q, qd, &mut rhs, &mut joint_torque);
+        }
         let contacts = &mut out_eval.contacts;
         for c in contacts.iter_mut().take(self.contacts.len()) {
             *c = ContactEval::default();
@@ -663,16 +658,16 @@ impl<const N: usize> Model<N> {
         self.mechanism.joint_forces(&pose, qd, &e.qdd, g, &external)
     }
 
-    /// Kinetic and potential energy at `(q, qd)` [J]; the potential energy is gravity's
-    /// (while the `gravity` term acts) plus the joints' springs' (while `joint_springs`
-    /// acts).
+    /// Kinetic and potential energy at `(q, qd)` [J]; the potential energy is the body
+    /// terms' field's (gravity's) plus what they store in the joints (the springs').
     pub fn energies(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>) -> (f64, f64) {
         let pose = self.mechanism.pose(q);
-        let springs = if self.forces.joint_springs {
-            self.mechanism.spring_energy(q)
-        } else {
-            0.0
-        };
+        let springs: f64 = self
+            .forces
+            .body
+            .iter()
+            .map(|t| t.joint_energy(&self.mechanism, q))
+            .sum();
         (
             self.mechanism.kinetic_energy(&pose, qd),
             self.mechanism.potential_energy(&pose, self.gravity()) + springs,

@@ -31,7 +31,7 @@ impl Term for Gravity {
         reads: "each link's mass and centre of mass; g of the medium",
         reads_area_speed: false,
         reads_frame: false,
-        shapes: super::EVERY_SHAPE,
+        shapes: super::ANY_SHAPE,
         switches: &[],
         columns: &[],
     };
@@ -47,5 +47,10 @@ impl Term for Gravity {
     /// None at a contact: a constant force on each link.
     fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
         Rates::NONE
+    }
+
+    /// The medium's g, downward, on every mass.
+    fn field(&self) -> f64 {
+        1.0
     }
 }

@@ -15,7 +15,10 @@
 //! - **Switches:** none.
 //! - **Energy:** the springs' energy is potential energy; the dampers' loss is `joint_loss`.
 
+use nalgebra::SVector;
+
 use super::{Acts, Class, ContactState, Medium, Rates, Term, TermInfo};
+use crate::body::{Joint, Link, Mechanism};
 
 /// The joints' spring-dampers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,8 +50,56 @@ impl Term for JointSprings {
         Vec::new()
     }
 
-    /// None at a contact: it acts through the mechanism, at the joints (a body term).
+    /// None at a contact: it acts at the joints (a body term; [`Term::joint_rates`]).
     fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
         Rates::NONE
+    }
+
+    /// Each spring-damper joint's torque on its child link, and its reaction on the parent.
+    #[inline(always)]
+    fn add_joint_torques<const N: usize>(
+        &self,
+        body: &Mechanism<N>,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+        out: &mut SVector<f64, N>,
+        torques: &mut [f64; N],
+    ) -> f64 {
+        let mut dissipated = 0.0;
+        for (i, l) in body.links.iter().enumerate() {
+            if let (Some(p), Joint::Spring { k, c, rest }) = (l.parent, l.joint) {
+                let theta = q[2 + i] - q[2 + p];
+                let rate = qd[2 + i] - qd[2 + p];
+                let tau = -k * (theta - rest) - c * rate;
+                out[2 + i] += tau;
+                out[2 + p] -= tau;
+                torques[i] = tau;
+                dissipated += c * rate * rate;
+            }
+        }
+        dissipated
+    }
+
+    /// The springs' elastic energy, `sum 1/2 k (theta - theta_rest)^2`.
+    fn joint_energy<const N: usize>(&self, body: &Mechanism<N>, q: &SVector<f64, N>) -> f64 {
+        body.links
+            .iter()
+            .enumerate()
+            .map(|(i, l)| match (l.parent, l.joint) {
+                (Some(p), Joint::Spring { k, rest, .. }) => {
+                    let x = q[2 + i] - q[2 + p] - rest;
+                    0.5 * k * x * x
+                }
+                _ => 0.0,
+            })
+            .sum()
+    }
+
+    /// A spring-damper joint's own k and c.
+    fn joint_rates(&self, link: &Link) -> Option<(f64, f64)> {
+        match link.joint {
+            Joint::Spring { k, c, .. } => Some((k, c)),
+            _ => None,
+        }
     }
 }

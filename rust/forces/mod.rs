@@ -13,8 +13,11 @@
 //!   contact's geometry and kinematics ([`ContactState`]) and return the force on it
 //!   ([`TermForce`]), applied at the scene's point of application; their parameters may
 //!   differ per contact;
-//! - **body terms** ([`Acts::Body`]: `gravity`, `joint_springs`) act through the mechanism
-//!   (the weight of every link, the joints' spring-dampers) and have no per-contact force.
+//! - **body terms** ([`Acts::Body`]: `gravity`, `joint_springs`) act on the body as a whole,
+//!   through the same trait's body methods: a uniform field on every mass
+//!   ([`Term::field`], gravity's), torques at the joints ([`Term::add_joint_torques`],
+//!   the spring-dampers'), with their energy and rates. They have no per-contact force, and
+//!   the engine reads them only through those methods.
 //!
 //! A term's arithmetic is generic over [`Real`], so that the same code can later run on
 //! several scenes at once in SIMD lanes (a lane type implementing [`Real`]) without a second
@@ -29,11 +32,17 @@
 
 use std::fmt::Debug;
 
+use nalgebra::SVector;
+
+use crate::body::{Link, Mechanism};
+
 #[cfg(test)]
 pub mod constant;
 pub mod drag;
 pub mod gravity;
 pub mod joint_springs;
+#[cfg(test)]
+pub mod lift;
 pub mod outline;
 pub mod poncelet;
 pub mod registry;
@@ -337,6 +346,19 @@ pub const SOLID_AND_SPACE_SHAPES: &[ContactKind] = &[
     ContactKind::Cuboid,
     ContactKind::Mesh,
 ];
+
+/// Every shape, planar and in space (`gravity`).
+pub const ANY_SHAPE: &[ContactKind] = &[
+    ContactKind::Rod,
+    ContactKind::Box,
+    ContactKind::Arc,
+    ContactKind::Sphere,
+    ContactKind::Capsule,
+    ContactKind::Cylinder,
+    ContactKind::Cuboid,
+    ContactKind::Mesh,
+];
+
 /// Everything known about a term, for validation, docs, TOML and errors.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TermInfo {
@@ -428,4 +450,37 @@ pub trait Term: Copy + Debug + PartialEq {
     /// contact's velocity and position, or why it does not ([`Rates::NONE`]), so that a new
     /// term cannot leave the check blind to it.
     fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates;
+
+    // What a body term ([`Acts::Body`]) does to the body as a whole; a contact term does
+    // none of it (the defaults).
+
+    /// The uniform field this term puts on every mass, as a multiple of the medium's g,
+    /// pointing down (gravity: 1). The mechanism turns the scene's field into generalized
+    /// forces, joint loads and the potential energy `m g y`.
+    #[inline(always)]
+    fn field(&self) -> f64 {
+        0.0
+    }
+    /// Add the torques this term puts at the joints to the generalized forces `out` and to
+    /// `torques` (by child link); return the power it dissipates [W].
+    #[inline(always)]
+    fn add_joint_torques<const N: usize>(
+        &self,
+        _body: &Mechanism<N>,
+        _q: &SVector<f64, N>,
+        _qd: &SVector<f64, N>,
+        _out: &mut SVector<f64, N>,
+        _torques: &mut [f64; N],
+    ) -> f64 {
+        0.0
+    }
+    /// The energy this term stores in the joints at `q` [J] (potential energy).
+    fn joint_energy<const N: usize>(&self, _body: &Mechanism<N>, _q: &SVector<f64, N>) -> f64 {
+        0.0
+    }
+    /// The stiffness [N m/rad] and damping [N m s/rad] this term puts on `link`'s joint, for
+    /// the step-size check (`None`: none).
+    fn joint_rates(&self, _link: &Link) -> Option<(f64, f64)> {
+        None
+    }
 }

@@ -8,7 +8,9 @@ use super::{
     drag, gravity, joint_springs, poncelet, rft, rft3d, static_h, static_v, Acts, Class,
     ContactState, Medium, Rates, Real, Switch, Term, TermForce, TermInfo,
 };
+use crate::body::{Link, Mechanism};
 use crate::error::{suggest, GranrsError, Result};
+use nalgebra::SVector;
 
 /// Most contact terms a scene may list: every contact term of the registry (each at most
 /// once). The per-term forces of an evaluation are a fixed-size array of this length (an
@@ -57,7 +59,7 @@ macro_rules! registry {
             }
 
             /// The term `name` from checked parameter values (`None`: no such term).
-            fn from_name(name: &str, values: &[f64]) -> Option<AnyTerm> {
+            pub(crate) fn from_name(name: &str, values: &[f64]) -> Option<AnyTerm> {
                 $($(#[$m])* if name == <$ty as Term>::INFO.name {
                     return Some(AnyTerm::$variant(<$ty as Term>::from_params(values)));
                 })*
@@ -76,6 +78,43 @@ macro_rules! registry {
             pub fn rates(&self, c: &ContactState<f64>, m: &Medium<f64>) -> Rates {
                 match self {
                     $($(#[$m])* AnyTerm::$variant(t) => t.rates(c, m),)*
+                }
+            }
+
+            /// The field it puts on every mass, in units of the medium's g ([`Term::field`]).
+            pub fn field(&self) -> f64 {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => t.field(),)*
+                }
+            }
+
+            /// Its torques at the joints ([`Term::add_joint_torques`]); the power it
+            /// dissipates [W].
+            #[inline(always)]
+            pub fn add_joint_torques<const N: usize>(
+                &self,
+                body: &Mechanism<N>,
+                q: &SVector<f64, N>,
+                qd: &SVector<f64, N>,
+                out: &mut SVector<f64, N>,
+                torques: &mut [f64; N],
+            ) -> f64 {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => t.add_joint_torques(body, q, qd, out, torques),)*
+                }
+            }
+
+            /// The energy it stores in the joints ([`Term::joint_energy`]) [J].
+            pub fn joint_energy<const N: usize>(&self, body: &Mechanism<N>, q: &SVector<f64, N>) -> f64 {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => t.joint_energy(body, q),)*
+                }
+            }
+
+            /// Its stiffness and damping at `link`'s joint ([`Term::joint_rates`]).
+            pub fn joint_rates(&self, link: &Link) -> Option<(f64, f64)> {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => t.joint_rates(link),)*
                 }
             }
 
@@ -118,6 +157,9 @@ registry! {
     // The worked example of docs/forces.md, a fixture of the crate's own tests.
     #[cfg(test)]
     Constant(super::constant::Constant),
+    // The worked example of a body term, a fixture of the crate's own tests.
+    #[cfg(test)]
+    Lift(super::lift::Lift),
 }
 
 /// The description of the term `name`, or a typed error naming it (with a near miss).
@@ -333,10 +375,11 @@ impl std::ops::DerefMut for TermList {
 pub struct ForceSet {
     /// Every listed term's name, in the scene's order.
     pub names: Vec<&'static str>,
-    /// Whether `gravity` acts.
-    pub gravity: bool,
-    /// Whether `joint_springs` acts.
-    pub joint_springs: bool,
+    /// The body terms ([`Acts::Body`]), in the scene's order.
+    pub body: TermList,
+    /// The field the body terms put on every mass, in units of the medium's g (the sum of
+    /// their [`Term::field`]: 1 under `gravity`, 0 without it).
+    pub field: f64,
     /// The contact terms per contact, in the scene's order: `per_contact[c][k]`.
     pub per_contact: Vec<TermList>,
     /// The contact terms' descriptions, in the same order.
@@ -361,8 +404,8 @@ impl ForceSet {
     pub fn build(specs: &[TermSpec], n_contacts: usize) -> Result<ForceSet> {
         let mut set = ForceSet {
             names: Vec::with_capacity(specs.len()),
-            gravity: false,
-            joint_springs: false,
+            body: TermList::default(),
+            field: 0.0,
             per_contact: vec![TermList::default(); n_contacts],
             contact_info: Vec::new(),
             owns: [false; 3],
@@ -382,8 +425,10 @@ impl ForceSet {
             set.names.push(info.name);
             match info.acts {
                 Acts::Body => {
-                    set.gravity |= info.name == gravity::Gravity::INFO.name;
-                    set.joint_springs |= info.name == joint_springs::JointSprings::INFO.name;
+                    let term =
+                        AnyTerm::from_name(info.name, &values[0]).expect("a registered term");
+                    set.field += term.field();
+                    set.body.push(term);
                 }
                 Acts::Contact => {
                     if set.contact_info.len() == MAX_TERMS {

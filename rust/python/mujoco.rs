@@ -6,7 +6,7 @@ use numpy::{
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyList, PyTuple};
 
 use super::errors::to_pyerr;
 use super::terms::terms_from_py;
@@ -162,26 +162,171 @@ impl SandGeoms {
     }
 }
 
-/// The arrays one `GeomCoupling` reads and writes at every step, bound once per `mjData`
-/// (MuJoCo allocates them once, so their views stay valid while held): reading them then
-/// costs no conversion per step.
+/// The arrays a coupling reads and writes at every step, bound once per `mjData` (MuJoCo
+/// allocates them once, so their views stay valid while held): reading them then costs no
+/// conversion per step. Both couplings bind the same arrays, in this order (`cvel` only for
+/// the planar one): `geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`, `cdof`, `qvel`, `qacc`,
+/// `qfrc_applied`, `qfrc_passive` of the `mjData`, and the caller's buffers: the dense mass
+/// matrix it fills, `outputs` per geom, the `applied` force and moment per geom,
+/// `h_lambda`, the generalized force, and `before` and `after`, the bookkeeping of
+/// `qfrc_applied`.
 struct Arrays {
     geom_xpos: Py<PyArray2<f64>>,
     geom_xmat: Py<PyArray2<f64>>,
-    cvel: Py<PyArray2<f64>>,
+    cvel: Option<Py<PyArray2<f64>>>,
     subtree_com: Py<PyArray2<f64>>,
     cdof: Py<PyArray2<f64>>,
-    mass: Py<PyArray2<f64>>,
     qvel: Py<PyArray1<f64>>,
     qacc: Py<PyArray1<f64>>,
+    qfrc_applied: Py<PyArray1<f64>>,
+    qfrc_passive: Py<PyArray1<f64>>,
+    mass: Py<PyArray2<f64>>,
     outputs: Py<PyArray2<f64>>,
     applied: Py<PyArray2<f64>>,
     h_lambda: Py<PyArray1<f64>>,
     generalized: Py<PyArray1<f64>>,
-    qfrc_applied: Py<PyArray1<f64>>,
-    qfrc_passive: Py<PyArray1<f64>>,
     before: Py<PyArray1<f64>>,
     after: Py<PyArray1<f64>>,
+}
+
+/// What a coupling's arrays must hold: `n` geoms on a model of `nv` dofs whose geoms and
+/// bodies reach `max_geom` and `max_body`, `width` outputs and an `applied` row of `wrench`
+/// values per geom, and whether the planar `cvel` is bound.
+struct Sizes {
+    n: usize,
+    nv: usize,
+    max_geom: usize,
+    max_body: usize,
+    width: usize,
+    wrench: usize,
+    cvel: bool,
+}
+
+/// One coupling's views of its bound arrays for one step.
+struct Views<'a> {
+    state: EngineState<'a>,
+    outputs: &'a mut [f64],
+    applied: &'a mut [f64],
+    h_lambda: &'a mut [f64],
+    generalized: &'a mut [f64],
+    /// `qfrc_passive` (the callback) or `qfrc_applied`.
+    target: &'a mut [f64],
+    before: &'a mut [f64],
+    after: &'a mut [f64],
+}
+
+impl Arrays {
+    /// The arrays of `a` (in the order of [`Arrays`]), each checked for its shape once; an
+    /// error names `class` and the array.
+    fn bind(class: &str, z: &Sizes, a: &Bound<'_, PyTuple>) -> PyResult<Arrays> {
+        let want = if z.cvel { 16 } else { 15 };
+        if a.len() != want {
+            return Err(PyValueError::new_err(format!(
+                "{class}.bind: {want} arrays, got {}",
+                a.len()
+            )));
+        }
+        let mut items = a.iter();
+        let mut two = |name: &str, rows: usize, cols: usize, exact: bool| {
+            let item = items.next().expect("counted");
+            let arr = item
+                .cast::<PyArray2<f64>>()
+                .map_err(|_| PyValueError::new_err(format!("{class}.bind: {name}")))?;
+            bind2(arr, class, name, rows, cols, exact)
+        };
+        let geom_xpos = two("geom_xpos", z.max_geom, 3, false)?;
+        let geom_xmat = two("geom_xmat", z.max_geom, 9, false)?;
+        let cvel = match z.cvel {
+            true => Some(two("cvel", z.max_body, 6, false)?),
+            false => None,
+        };
+        let subtree_com = two("subtree_com", z.max_body, 3, false)?;
+        let cdof = two("cdof", z.nv, 6, true)?;
+        let rest: Vec<_> = items.collect();
+        let one = |k: usize, name: &str, len: usize| {
+            let arr = rest[k]
+                .cast::<PyArray1<f64>>()
+                .map_err(|_| PyValueError::new_err(format!("{class}.bind: {name}")))?;
+            bind1(arr, class, name, len)
+        };
+        let two = |k: usize, name: &str, rows: usize, cols: usize| {
+            let arr = rest[k]
+                .cast::<PyArray2<f64>>()
+                .map_err(|_| PyValueError::new_err(format!("{class}.bind: {name}")))?;
+            bind2(arr, class, name, rows, cols, true)
+        };
+        Ok(Arrays {
+            geom_xpos,
+            geom_xmat,
+            cvel,
+            subtree_com,
+            cdof,
+            qvel: one(0, "qvel", z.nv)?,
+            qacc: one(1, "qacc", z.nv)?,
+            qfrc_applied: one(2, "qfrc_applied", z.nv)?,
+            qfrc_passive: one(3, "qfrc_passive", z.nv)?,
+            mass: two(4, "mass", z.nv, z.nv)?,
+            outputs: two(5, "outputs", z.n, z.width)?,
+            applied: two(6, "applied", z.n, z.wrench)?,
+            h_lambda: one(7, "h_lambda", z.n)?,
+            generalized: one(8, "generalized", z.nv)?,
+            before: one(9, "before", z.nv)?,
+            after: one(10, "after", z.nv)?,
+        })
+    }
+
+    /// The arrays as slices, with `qfrc_passive` (`passive`) or `qfrc_applied` as the
+    /// target of the generalized force.
+    ///
+    /// # Safety
+    /// Each array was checked contiguous with its shape at `bind`; MuJoCo never reallocates
+    /// an mjData's arrays, the buffers are the `Sand`'s own, and no two slices alias
+    /// (distinct arrays). The caller holds the mjData while the views live, and nothing
+    /// else reads or writes these arrays meanwhile.
+    unsafe fn views<'a>(&'a self, py: Python<'a>, passive: bool) -> Views<'a> {
+        Views {
+            state: EngineState {
+                geom_xpos: ro(py, &self.geom_xpos),
+                geom_xmat: ro(py, &self.geom_xmat),
+                cvel: self.cvel.as_ref().map_or(&[], |c| ro(py, c)),
+                subtree_com: ro(py, &self.subtree_com),
+                cdof: ro(py, &self.cdof),
+                mass: ro(py, &self.mass),
+                qvel: ro(py, &self.qvel),
+                qacc: ro(py, &self.qacc),
+            },
+            outputs: rw(py, &self.outputs),
+            applied: rw(py, &self.applied),
+            h_lambda: rw(py, &self.h_lambda),
+            generalized: rw(py, &self.generalized),
+            target: if passive {
+                rw(py, &self.qfrc_passive)
+            } else {
+                rw(py, &self.qfrc_applied)
+            },
+            before: rw(py, &self.before),
+            after: rw(py, &self.after),
+        }
+    }
+}
+
+impl Views<'_> {
+    /// Put the generalized force into MuJoCo's: added to `qfrc_passive` (`passive`, the
+    /// callback), or into `qfrc_applied` keeping the user's entries ([`keep_user_entries`]).
+    fn deliver(&mut self, passive: bool, fresh: bool) {
+        if passive {
+            let gen = &*self.generalized;
+            self.target.iter_mut().zip(gen).for_each(|(t, g)| *t += g);
+        } else {
+            keep_user_entries(
+                self.target,
+                self.before,
+                self.after,
+                self.generalized,
+                fresh,
+            );
+        }
+    }
 }
 
 /// [`SandGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
@@ -254,63 +399,27 @@ impl GeomCoupling {
         })
     }
 
-    /// Bind the arrays of one `mjData` (`geom_xpos`, `geom_xmat`, `cvel`, `subtree_com`,
-    /// `cdof`, `qvel`, `qacc`, `qfrc_applied`, `qfrc_passive`) and the caller's buffers (the
-    /// dense mass matrix it fills, `outputs` per geom in GEOM_OUTPUTS order, `applied`
-    /// force and moment, `h_lambda`, the generalized force, and `before` and `after`, the
-    /// bookkeeping of `qfrc_applied`), each checked for its shape once.
-    #[allow(clippy::too_many_arguments)]
-    fn bind(
-        &mut self,
-        geom_xpos: Bound2<'_>,
-        geom_xmat: Bound2<'_>,
-        cvel: Bound2<'_>,
-        subtree_com: Bound2<'_>,
-        cdof: Bound2<'_>,
-        qvel: Bound1<'_>,
-        qacc: Bound1<'_>,
-        qfrc_applied: Bound1<'_>,
-        qfrc_passive: Bound1<'_>,
-        mass: Bound2<'_>,
-        outputs: Bound2<'_>,
-        applied: Bound2<'_>,
-        h_lambda: Bound1<'_>,
-        generalized: Bound1<'_>,
-        before: Bound1<'_>,
-        after: Bound1<'_>,
-    ) -> PyResult<()> {
+    /// Bind the arrays of one `mjData` and the caller's buffers, in the order of the
+    /// bound arrays (`outputs` per geom in GEOM_OUTPUTS order, `applied` force and moment
+    /// n x 3), each checked for its shape once.
+    #[pyo3(signature = (*arrays))]
+    fn bind(&mut self, arrays: &Bound<'_, PyTuple>) -> PyResult<()> {
         let c = &self.inner;
-        let (n, nv) = (c.places.len(), c.nv);
-        let max_geom = c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0);
-        let max_body = c
-            .places
-            .iter()
-            .map(|p| p.body.max(p.root) + 1)
-            .max()
-            .unwrap_or(0);
-        let width = crate::evaluate::geoms::OUTPUTS.len();
-        let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
-            bind2(a, "GeomCoupling", name, rows, cols, exact)
+        let sizes = Sizes {
+            n: c.places.len(),
+            nv: c.nv,
+            max_geom: c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0),
+            max_body: c
+                .places
+                .iter()
+                .map(|p| p.body.max(p.root) + 1)
+                .max()
+                .unwrap_or(0),
+            width: crate::evaluate::geoms::OUTPUTS.len(),
+            wrench: 3,
+            cvel: true,
         };
-        let one = |a: &Bound1<'_>, name: &str, len: usize| bind1(a, "GeomCoupling", name, len);
-        self.bound = Some(Arrays {
-            geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
-            geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
-            cvel: two(&cvel, "cvel", max_body, 6, false)?,
-            subtree_com: two(&subtree_com, "subtree_com", max_body, 3, false)?,
-            cdof: two(&cdof, "cdof", nv, 6, true)?,
-            mass: two(&mass, "mass", nv, nv, true)?,
-            qvel: one(&qvel, "qvel", nv)?,
-            qacc: one(&qacc, "qacc", nv)?,
-            outputs: two(&outputs, "outputs", n, width, true)?,
-            applied: two(&applied, "applied", n, 3, true)?,
-            h_lambda: one(&h_lambda, "h_lambda", n)?,
-            generalized: one(&generalized, "generalized", nv)?,
-            qfrc_applied: one(&qfrc_applied, "qfrc_applied", nv)?,
-            qfrc_passive: one(&qfrc_passive, "qfrc_passive", nv)?,
-            before: one(&before, "before", nv)?,
-            after: one(&after, "after", nv)?,
-        });
+        self.bound = Some(Arrays::bind("GeomCoupling", &sizes, arrays)?);
         Ok(())
     }
 
@@ -334,41 +443,20 @@ impl GeomCoupling {
         let Some(b) = &self.bound else {
             return Err(PyValueError::new_err("GeomCoupling.step before bind"));
         };
-        // SAFETY: the arrays were checked contiguous with their shapes at `bind`; MuJoCo
-        // never reallocates an mjData's arrays, the buffers are this Sand's own, and with
-        // the GIL held nothing else touches them during the call. Each is read or written
-        // through one slice at a time (no two slices alias: distinct arrays).
+        // SAFETY: as `Arrays::views`; with the GIL held nothing else touches the arrays
+        // during the call.
         unsafe {
-            let state = EngineState {
-                geom_xpos: ro(py, &b.geom_xpos),
-                geom_xmat: ro(py, &b.geom_xmat),
-                cvel: ro(py, &b.cvel),
-                subtree_com: ro(py, &b.subtree_com),
-                cdof: ro(py, &b.cdof),
-                mass: ro(py, &b.mass),
-                qvel: ro(py, &b.qvel),
-                qacc: ro(py, &b.qacc),
-            };
+            let mut v = b.views(py, passive);
             let out = EngineOut {
-                outputs: rw(py, &b.outputs),
-                applied: rw(py, &b.applied),
-                h_lambda: rw(py, &b.h_lambda),
-                generalized: rw(py, &b.generalized),
+                outputs: &mut *v.outputs,
+                applied: &mut *v.applied,
+                h_lambda: &mut *v.h_lambda,
+                generalized: &mut *v.generalized,
             };
-            self.inner.step(&state, timestep, hold, out);
-            let gen = ro(py, &b.generalized);
-            if passive {
-                let target = rw(py, &b.qfrc_passive);
-                target.iter_mut().zip(gen).for_each(|(t, g)| *t += g);
-            } else {
-                let target = rw(py, &b.qfrc_applied);
-                let before = rw(py, &b.before);
-                let after = rw(py, &b.after);
-                keep_user_entries(target, before, after, gen, fresh);
-            }
-            let h = ro(py, &b.h_lambda);
+            self.inner.step(&v.state, timestep, hold, out);
+            v.deliver(passive, fresh);
             let (mut k, mut top) = (0, 0.0);
-            for (i, &x) in h.iter().enumerate() {
+            for (i, &x) in v.h_lambda.iter().enumerate() {
                 if x > top {
                     (k, top) = (i, x);
                 }
@@ -458,31 +546,12 @@ unsafe fn rw<'a, D: numpy::ndarray::Dimension>(
 type Bound1<'py> = Bound<'py, PyArray1<f64>>;
 type Bound2<'py> = Bound<'py, PyArray2<f64>>;
 
-/// The arrays one `SpaceCoupling` reads and writes at every step, bound once per `mjData`.
-struct SpaceArrays {
-    geom_xpos: Py<PyArray2<f64>>,
-    geom_xmat: Py<PyArray2<f64>>,
-    subtree_com: Py<PyArray2<f64>>,
-    cdof: Py<PyArray2<f64>>,
-    mass: Py<PyArray2<f64>>,
-    qvel: Py<PyArray1<f64>>,
-    qacc: Py<PyArray1<f64>>,
-    outputs: Py<PyArray2<f64>>,
-    applied: Py<PyArray2<f64>>,
-    h_lambda: Py<PyArray1<f64>>,
-    generalized: Py<PyArray1<f64>>,
-    qfrc_applied: Py<PyArray1<f64>>,
-    qfrc_passive: Py<PyArray1<f64>>,
-    before: Py<PyArray1<f64>>,
-    after: Py<PyArray1<f64>>,
-}
-
 /// Geoms of a MuJoCo model as shapes in space under the terms in space
 /// (`granrs.mujoco.Sand` in three dimensions; see `crate::space::engine`).
 #[pyclass(module = "granrs._granrs", unsendable)]
 pub struct SpaceCoupling {
     inner: space_engine::SpaceCoupling,
-    bound: Option<SpaceArrays>,
+    bound: Option<Arrays>,
 }
 
 #[pymethods]
@@ -540,7 +609,7 @@ impl SpaceCoupling {
             let field = format!("geoms[{i}]");
             let shape = super::space::shape_at(&shapes.get_item(i)?, &field).map_err(err)?;
             let terms = Terms3::from_specs(&specs, &shape).map_err(err)?;
-            if terms.gravity {
+            if terms.field != 0.0 {
                 return Err(err(GranrsError::InvalidScene {
                     field: "forces.gravity".into(),
                     message: "MuJoCo applies the model's own gravity; list only the sand's \
@@ -592,61 +661,27 @@ impl SpaceCoupling {
         })
     }
 
-    /// Bind the arrays of one `mjData` (`geom_xpos`, `geom_xmat`, `subtree_com`, `cdof`,
-    /// `qvel`, `qacc`, `qfrc_applied`, `qfrc_passive`) and the caller's buffers (the dense
-    /// mass matrix it fills, `outputs` per geom in SPACE_GEOM_OUTPUTS order, the `applied`
-    /// wrench per geom (n x 6), `h_lambda`, the generalized force, and `before` and
-    /// `after`, the bookkeeping of `qfrc_applied`), each checked for its shape once.
-    #[allow(clippy::too_many_arguments)]
-    fn bind(
-        &mut self,
-        geom_xpos: Bound2<'_>,
-        geom_xmat: Bound2<'_>,
-        subtree_com: Bound2<'_>,
-        cdof: Bound2<'_>,
-        qvel: Bound1<'_>,
-        qacc: Bound1<'_>,
-        qfrc_applied: Bound1<'_>,
-        qfrc_passive: Bound1<'_>,
-        mass: Bound2<'_>,
-        outputs: Bound2<'_>,
-        applied: Bound2<'_>,
-        h_lambda: Bound1<'_>,
-        generalized: Bound1<'_>,
-        before: Bound1<'_>,
-        after: Bound1<'_>,
-    ) -> PyResult<()> {
+    /// Bind the arrays of one `mjData` and the caller's buffers, in the order of the
+    /// bound arrays without `cvel` (`outputs` per geom in SPACE_GEOM_OUTPUTS order, the
+    /// `applied` wrench per geom n x 6), each checked for its shape once.
+    #[pyo3(signature = (*arrays))]
+    fn bind(&mut self, arrays: &Bound<'_, PyTuple>) -> PyResult<()> {
         let c = &self.inner;
-        let (n, nv) = (c.geoms.len(), c.nv);
-        let max_geom = c.geoms.iter().map(|g| g.place.geom + 1).max().unwrap_or(0);
-        let max_body = c
-            .geoms
-            .iter()
-            .map(|g| g.place.body.max(g.place.root) + 1)
-            .max()
-            .unwrap_or(0);
-        let width = space_engine::OUTPUTS.len();
-        let two = |a: &Bound2<'_>, name: &str, rows: usize, cols: usize, exact: bool| {
-            bind2(a, "SpaceCoupling", name, rows, cols, exact)
+        let sizes = Sizes {
+            n: c.geoms.len(),
+            nv: c.nv,
+            max_geom: c.geoms.iter().map(|g| g.place.geom + 1).max().unwrap_or(0),
+            max_body: c
+                .geoms
+                .iter()
+                .map(|g| g.place.body.max(g.place.root) + 1)
+                .max()
+                .unwrap_or(0),
+            width: space_engine::OUTPUTS.len(),
+            wrench: 6,
+            cvel: false,
         };
-        let one = |a: &Bound1<'_>, name: &str, len: usize| bind1(a, "SpaceCoupling", name, len);
-        self.bound = Some(SpaceArrays {
-            geom_xpos: two(&geom_xpos, "geom_xpos", max_geom, 3, false)?,
-            geom_xmat: two(&geom_xmat, "geom_xmat", max_geom, 9, false)?,
-            subtree_com: two(&subtree_com, "subtree_com", max_body, 3, false)?,
-            cdof: two(&cdof, "cdof", nv, 6, true)?,
-            mass: two(&mass, "mass", nv, nv, true)?,
-            qvel: one(&qvel, "qvel", nv)?,
-            qacc: one(&qacc, "qacc", nv)?,
-            outputs: two(&outputs, "outputs", n, width, true)?,
-            applied: two(&applied, "applied", n, 6, true)?,
-            h_lambda: one(&h_lambda, "h_lambda", n)?,
-            generalized: one(&generalized, "generalized", nv)?,
-            qfrc_applied: one(&qfrc_applied, "qfrc_applied", nv)?,
-            qfrc_passive: one(&qfrc_passive, "qfrc_passive", nv)?,
-            before: one(&before, "before", nv)?,
-            after: one(&after, "after", nv)?,
-        });
+        self.bound = Some(Arrays::bind("SpaceCoupling", &sizes, arrays)?);
         Ok(())
     }
 
@@ -669,43 +704,19 @@ impl SpaceCoupling {
             return Err(PyValueError::new_err("SpaceCoupling.step before bind"));
         };
         let inner = &mut self.inner;
-        // SAFETY: as `GeomCoupling.step`: each array was checked contiguous with its shape
-        // at `bind`, MuJoCo never reallocates an mjData's arrays, the buffers are this
-        // Sand's own, and no two slices alias (distinct arrays). The caller holds the
-        // mjData while this call runs (a `Sand` method), and nothing of granrs's touches
-        // these arrays from another thread.
+        // SAFETY: as `Arrays::views`; the caller holds the mjData while this call runs (a
+        // `Sand` method), and nothing of granrs's touches these arrays from another thread.
         unsafe {
-            let state = EngineState {
-                geom_xpos: ro(py, &b.geom_xpos),
-                geom_xmat: ro(py, &b.geom_xmat),
-                cvel: &[],
-                subtree_com: ro(py, &b.subtree_com),
-                cdof: ro(py, &b.cdof),
-                mass: ro(py, &b.mass),
-                qvel: ro(py, &b.qvel),
-                qacc: ro(py, &b.qacc),
-            };
-            let (outputs, applied) = (rw(py, &b.outputs), rw(py, &b.applied));
-            let (h_lambda, gen) = (rw(py, &b.h_lambda), rw(py, &b.generalized));
-            let target = if passive {
-                rw(py, &b.qfrc_passive)
-            } else {
-                rw(py, &b.qfrc_applied)
-            };
-            let (before, after) = (rw(py, &b.before), rw(py, &b.after));
+            let mut v = b.views(py, passive);
             let report = py.detach(|| {
                 let out = EngineOut {
-                    outputs,
-                    applied,
-                    h_lambda,
-                    generalized: &mut *gen,
+                    outputs: &mut *v.outputs,
+                    applied: &mut *v.applied,
+                    h_lambda: &mut *v.h_lambda,
+                    generalized: &mut *v.generalized,
                 };
-                let report = inner.step(&state, timestep, hold, out);
-                if passive {
-                    target.iter_mut().zip(gen.iter()).for_each(|(t, g)| *t += g);
-                } else {
-                    keep_user_entries(target, before, after, gen, fresh);
-                }
+                let report = inner.step(&v.state, timestep, hold, out);
+                v.deliver(passive, fresh);
                 report
             });
             Ok((

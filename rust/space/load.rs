@@ -12,7 +12,7 @@ use super::shape::{Elements, Quadrature, Shape};
 use crate::error::{GranrsError, Result};
 use crate::forces::poncelet::Poncelet;
 use crate::forces::rft3d::{stress_capped, stress_with_rate, Rft3d, Rft3dInertial, Rft3dLanes};
-use crate::forces::{Acts, Medium, TermSpec};
+use crate::forces::{Acts, AnyTerm, Medium, TermSpec, TERMS};
 
 type V3 = Vector3<f64>;
 
@@ -27,8 +27,9 @@ pub struct Terms3 {
     /// A the immersed leading area projected on the plane normal to the centre's velocity,
     /// E its centre and d the lowest point's depth (a sphere fully under: A = pi r^2).
     pub poncelet: Option<Poncelet>,
-    /// The body's weight.
-    pub gravity: bool,
+    /// The field the body terms put on the body's mass, in units of the medium's g,
+    /// downward (1 under `gravity`).
+    pub field: f64,
 }
 
 impl Terms3 {
@@ -47,40 +48,38 @@ impl Terms3 {
                 field: format!("forces[{i}]"),
                 message: format!("`{}` is listed twice", info.name),
             };
+            if specs[..i].iter().any(|s| s.name == info.name) {
+                return Err(twice());
+            }
             match info.name {
-                "gravity" => {
-                    if t.gravity {
-                        return Err(twice());
-                    }
-                    t.gravity = true;
-                }
-                _ if info.acts == Acts::Body || !info.shapes.contains(&kind) => {
+                _ if !info.shapes.contains(&kind) => {
+                    let here: Vec<&str> = TERMS
+                        .iter()
+                        .filter(|t| t.shapes.contains(&kind))
+                        .map(|t| t.name)
+                        .collect();
                     return Err(GranrsError::InvalidScene {
                         field: format!("forces[{i}]"),
                         message: format!(
-                            "`{}` does not act on a {} in space (terms in space: rft3d, \
-                             rft3d_inertial, poncelet, gravity)",
+                            "`{}` does not act on a {} in space (terms on it: {})",
                             info.name,
-                            kind.name()
+                            kind.name(),
+                            here.join(", ")
                         ),
-                    })
+                    });
+                }
+                _ if info.acts == Acts::Body => {
+                    t.field += AnyTerm::from_name(info.name, v)
+                        .expect("a registered term")
+                        .field();
                 }
                 "rft3d" => {
-                    if t.rft3d.is_some() {
-                        return Err(twice());
-                    }
                     t.rft3d = Some(<Rft3d as crate::forces::Term>::from_params(v));
                 }
                 "rft3d_inertial" => {
-                    if t.inertial.is_some() {
-                        return Err(twice());
-                    }
                     t.inertial = Some(<Rft3dInertial as crate::forces::Term>::from_params(v));
                 }
                 "poncelet" => {
-                    if t.poncelet.is_some() {
-                        return Err(twice());
-                    }
                     t.poncelet = Some(<Poncelet as crate::forces::Term>::from_params(v));
                 }
                 other => {
@@ -663,7 +662,7 @@ mod tests {
             }),
             inertial: Some(Rft3dInertial { lam: 1.0 }),
             poncelet: None,
-            gravity: false,
+            field: 0.0,
         };
         let shape = Shape::capsule("c", 0.01, 0.06).unwrap();
         let mut s = Sand::new(shape, terms, Medium::default(), 0.0, Quadrature::new(4));

@@ -272,8 +272,8 @@ impl Body {
             self.fastest_rate = self.fastest_rate.max(rate);
         }
         let mut f = load.force;
-        if self.sand.terms.gravity {
-            f.z -= self.inertia.mass * self.sand.medium.g;
+        if self.sand.terms.field != 0.0 {
+            f.z -= self.inertia.mass * (self.sand.terms.field * self.sand.medium.g);
         }
         let i = &self.inertia.tensor;
         let m_body = r.inverse() * load.moment;
@@ -291,11 +291,7 @@ impl Body {
     pub fn energy(&self, y: &State) -> f64 {
         let m = self.inertia.mass;
         let ke = 0.5 * m * y.v.norm_squared() + 0.5 * y.w.dot(&(self.inertia.tensor * y.w));
-        let pe = if self.sand.terms.gravity {
-            m * self.sand.medium.g * y.c.z
-        } else {
-            0.0
-        };
+        let pe = m * (self.sand.terms.field * self.sand.medium.g) * y.c.z;
         ke + pe
     }
 

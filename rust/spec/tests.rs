@@ -152,7 +152,8 @@ fn springs_are_free_without_the_effect() {
     // The joint keeps its spring-damper; without the `joint_springs` term it exerts
     // nothing (the engine reads the force set, not a rewritten joint).
     assert!(matches!(without.joints[0].joint, Joint::Spring { .. }));
-    assert!(!without.forces.joint_springs);
+    let body: Vec<_> = without.forces.body.iter().map(|t| t.info().name).collect();
+    assert_eq!(body, vec!["gravity"]);
     assert_eq!(without.forces.names, vec!["gravity", "static_v"]);
 }
 
