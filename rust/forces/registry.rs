@@ -17,6 +17,9 @@ use nalgebra::SVector;
 /// evaluation allocates nothing).
 pub const MAX_TERMS: usize = contact_terms(ALL_TERMS);
 
+/// Most body terms a scene may list: every body term of the registry (each at most once).
+pub const MAX_BODY_TERMS: usize = ALL_TERMS.len() - MAX_TERMS;
+
 /// How many of `terms` act at a contact.
 const fn contact_terms(terms: &[&TermInfo]) -> usize {
     let (mut n, mut i) = (0, 0);
@@ -329,32 +332,33 @@ fn unknown_param(info: &TermInfo, name: &str) -> GranrsError {
     }
 }
 
-/// One contact's terms in a fixed-size array (the hot path loops over it without a heap
-/// indirection); it reads as a slice of its `len` terms.
+/// One contact's terms (or the body's, `C` = [`MAX_BODY_TERMS`]) in a fixed-size array (the
+/// hot path loops over it without a heap indirection); it reads as a slice of its `len`
+/// terms.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TermList {
-    terms: [AnyTerm; MAX_TERMS],
+pub struct TermList<const C: usize = MAX_TERMS> {
+    terms: [AnyTerm; C],
     len: usize,
 }
 
-impl Default for TermList {
+impl<const C: usize> Default for TermList<C> {
     fn default() -> Self {
         TermList {
-            terms: [AnyTerm::Gravity(gravity::Gravity); MAX_TERMS],
+            terms: [AnyTerm::Gravity(gravity::Gravity); C],
             len: 0,
         }
     }
 }
 
-impl TermList {
-    /// Append `term` (the caller checks [`MAX_TERMS`]).
+impl<const C: usize> TermList<C> {
+    /// Append `term` (the caller checks the capacity `C`).
     pub fn push(&mut self, term: AnyTerm) {
         self.terms[self.len] = term;
         self.len += 1;
     }
 }
 
-impl std::ops::Deref for TermList {
+impl<const C: usize> std::ops::Deref for TermList<C> {
     type Target = [AnyTerm];
     #[inline(always)]
     fn deref(&self) -> &[AnyTerm] {
@@ -362,7 +366,7 @@ impl std::ops::Deref for TermList {
     }
 }
 
-impl std::ops::DerefMut for TermList {
+impl<const C: usize> std::ops::DerefMut for TermList<C> {
     #[inline(always)]
     fn deref_mut(&mut self) -> &mut [AnyTerm] {
         &mut self.terms[..self.len]
@@ -376,7 +380,7 @@ pub struct ForceSet {
     /// Every listed term's name, in the scene's order.
     pub names: Vec<&'static str>,
     /// The body terms ([`Acts::Body`]), in the scene's order.
-    pub body: TermList,
+    pub body: TermList<MAX_BODY_TERMS>,
     /// The field the body terms put on every mass, in units of the medium's g (the sum of
     /// their [`Term::field`]: 1 under `gravity`, 0 without it).
     pub field: f64,
