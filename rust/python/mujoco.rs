@@ -202,6 +202,34 @@ struct Sizes {
     cvel: bool,
 }
 
+impl Sizes {
+    /// The sizes for geoms at `places` (each geom's index and the highest body it reads:
+    /// its own or its tree's root), on a model of `nv` dofs.
+    fn of(
+        places: impl Iterator<Item = (usize, usize)>,
+        nv: usize,
+        width: usize,
+        wrench: usize,
+        cvel: bool,
+    ) -> Sizes {
+        let (mut n, mut max_geom, mut max_body) = (0, 0, 0);
+        for (geom, body) in places {
+            n += 1;
+            max_geom = max_geom.max(geom + 1);
+            max_body = max_body.max(body + 1);
+        }
+        Sizes {
+            n,
+            nv,
+            max_geom,
+            max_body,
+            width,
+            wrench,
+            cvel,
+        }
+    }
+}
+
 /// One coupling's views of its bound arrays for one step.
 struct Views<'a> {
     state: EngineState<'a>,
@@ -405,20 +433,8 @@ impl GeomCoupling {
     #[pyo3(signature = (*arrays))]
     fn bind(&mut self, arrays: &Bound<'_, PyTuple>) -> PyResult<()> {
         let c = &self.inner;
-        let sizes = Sizes {
-            n: c.places.len(),
-            nv: c.nv,
-            max_geom: c.places.iter().map(|p| p.geom + 1).max().unwrap_or(0),
-            max_body: c
-                .places
-                .iter()
-                .map(|p| p.body.max(p.root) + 1)
-                .max()
-                .unwrap_or(0),
-            width: crate::evaluate::geoms::OUTPUTS.len(),
-            wrench: 3,
-            cvel: true,
-        };
+        let places = c.places.iter().map(|p| (p.geom, p.body.max(p.root)));
+        let sizes = Sizes::of(places, c.nv, crate::evaluate::geoms::OUTPUTS.len(), 3, true);
         self.bound = Some(Arrays::bind("GeomCoupling", &sizes, arrays)?);
         Ok(())
     }
@@ -667,20 +683,11 @@ impl SpaceCoupling {
     #[pyo3(signature = (*arrays))]
     fn bind(&mut self, arrays: &Bound<'_, PyTuple>) -> PyResult<()> {
         let c = &self.inner;
-        let sizes = Sizes {
-            n: c.geoms.len(),
-            nv: c.nv,
-            max_geom: c.geoms.iter().map(|g| g.place.geom + 1).max().unwrap_or(0),
-            max_body: c
-                .geoms
-                .iter()
-                .map(|g| g.place.body.max(g.place.root) + 1)
-                .max()
-                .unwrap_or(0),
-            width: space_engine::OUTPUTS.len(),
-            wrench: 6,
-            cvel: false,
-        };
+        let places = c
+            .geoms
+            .iter()
+            .map(|g| (g.place.geom, g.place.body.max(g.place.root)));
+        let sizes = Sizes::of(places, c.nv, space_engine::OUTPUTS.len(), 6, false);
         self.bound = Some(Arrays::bind("SpaceCoupling", &sizes, arrays)?);
         Ok(())
     }
