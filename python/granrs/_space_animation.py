@@ -13,9 +13,10 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import animation as mpl_animation
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from . import space
@@ -107,14 +108,27 @@ class SpaceAnimation(mpl_animation.FuncAnimation):
 
     Attributes:
         frame_times: the simulated time of each frame [s].
+        frame_dt: simulated time per frame [s].
+        speed: simulated seconds per second of movie [-].
+        fps: frames per second of the movie [1/s].
         polygons: the body's surface in its body frame, as drawn.
     """
 
-    def __init__(self, result: space.Result, times: np.ndarray, fps: float, dpi: float) -> None:
+    def __init__(
+        self,
+        result: space.Result,
+        times: np.ndarray,
+        frame_dt: float,
+        speed: float,
+        fps: float,
+        dpi: float,
+    ) -> None:
         series = result.series
         assert series is not None
         t = np.asarray(series["t"])
         self.frame_times = times
+        self.frame_dt = frame_dt
+        self.speed = speed
         self.fps = fps
         self.dpi = dpi
         self.n_frames = len(times)
@@ -129,7 +143,9 @@ class SpaceAnimation(mpl_animation.FuncAnimation):
         hi = self.centres.max(axis=0) + reach
         span = float((hi - lo).max())
         mid = 0.5 * (lo + hi)
-        fig = plt.figure(figsize=(5.5, 5.0), dpi=dpi)
+        # No pyplot: no global figure left open, no window (as the planar animation).
+        fig = Figure(figsize=(5.5, 5.0), dpi=dpi)
+        FigureCanvasAgg(fig)
         ax = fig.add_subplot(projection="3d")
         ax.set_xlim(mid[0] - span / 2, mid[0] + span / 2)
         ax.set_ylim(mid[1] - span / 2, mid[1] + span / 2)
@@ -223,8 +239,9 @@ def animate(
             "granrs.simulate(scene.replace(record=True))",
             field="record",
         )
-    times, _, _, fps = frame_times(np.asarray(series["t"], dtype=float), frame_dt, speed, fps)
-    anim = SpaceAnimation(result, times, fps, dpi_value)
+    t = np.asarray(series["t"], dtype=float)
+    times, frame_dt, speed, fps = frame_times(t, frame_dt, speed, fps)
+    anim = SpaceAnimation(result, times, frame_dt, speed, fps, dpi_value)
     if out is not None:
         anim.write(out, progress=progress)
     return anim

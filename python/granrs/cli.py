@@ -5,7 +5,7 @@ Usage::
     granrs --version
     granrs run SCENE.toml [--set FIELD=VALUE ...] [--series OUT.csv|OUT.parquet] [--json]
     granrs animate SCENE.toml [--out OUT.gif|OUT.mp4|OUT.html] [--frame-dt S] [--speed X]
-                   [--fps N] [--set FIELD=VALUE ...]
+                   [--fps N] [--dpi DPI] [--quiet] [--set FIELD=VALUE ...]
     granrs scene new [--body BODY] [--out FILE]
     granrs reproduce [--out DIR] [--dt DT] [--chapter KEY ...] [--quiet]
     granrs bench accuracy [--out DIR] [--quick] [--repeats N] [--quiet]
@@ -50,6 +50,7 @@ from .errors import (
     StepSizeWarning,
 )
 from .space import Result as SpaceResult
+from .space import Scene as SpaceScene
 
 __all__ = ["main"]
 
@@ -838,10 +839,12 @@ def _add_animate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
         help="run one scene file and write an animation of the impact (GIF, MP4 or HTML)",
         description=(
             "Run the scene in a TOML scene file, recording its state and forces, and write an "
-            "animation of the impact: the body to scale, the sand, the immersed part, each "
-            "contact's force split by term, the clock and the depth. Frame k shows t = k * "
-            "frame_dt; speed = frame_dt * fps (give any two, or one). The output path is "
-            "checked before the run."
+            "animation of the impact. A planar scene: the body to scale, the sand, the "
+            "immersed part, each contact's force split by term, the clock and the depth. A "
+            "body in space (space = true): its surface in 3D at each recorded pose over the "
+            "sand's surface, the sand's force as an arrow from its centre of mass, and the "
+            "clock. Frame k shows t = k * frame_dt; speed = frame_dt * fps (give any two, or "
+            "one). The output path is checked before the run."
         ),
     )
     _add_scene_file(parser)
@@ -898,8 +901,12 @@ def _cmd_animate(args: argparse.Namespace) -> int:
     playback(args.frame_dt, args.speed, args.fps)
     out = check_output(args.out)
     scene = _read_scene(args.scene, overrides)
-    record = tuple(dict.fromkeys((*scene.record, *ANIMATE_RECORD)))
-    result = simulate(scene.replace(record=record))
+    if isinstance(scene, SpaceScene):
+        # A body in space records every series column (its pose and the sand's force) or none.
+        scene = scene.replace(record=True)
+    else:
+        scene = scene.replace(record=tuple(dict.fromkeys((*scene.record, *ANIMATE_RECORD))))
+    result = simulate(scene)
     # The defaults left out resolve against the run's length (at most DEFAULT_FRAMES frames).
     anim = animate(result, args.frame_dt, args.speed, args.fps, dpi=args.dpi)
     anim.write(out, progress=False if args.quiet else None)
