@@ -686,7 +686,9 @@ def test_cli_animate_writes_a_gif_per_example_scene(
     _, err = capsys.readouterr()
     assert code == 0, err
     assert f"animation written to {out}" in err
-    series = granrs.simulate(granrs.scenefile.load(path).replace(record=("state",))).series
+    scene = granrs.scenefile.load(path)
+    record = True if isinstance(scene, granrs.space.Scene) else ("state",)
+    series = granrs.simulate(scene.replace(record=record)).series  # type: ignore[arg-type]
     assert series is not None
     assert gif_frames(out) == math.floor(series["t"][-1] / 0.01) + 1
 
