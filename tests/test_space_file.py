@@ -4,13 +4,18 @@ from __future__ import annotations
 
 import json
 import math
+import sys
+import warnings
 
 import numpy as np
 import pytest
+from PIL import Image
 
 import granrs
+import granrs._space_animation
 from granrs import forces, scenefile, space
 from granrs.cli import main
+from granrs.errors import AnimationSizeWarning
 
 RFT = forces.rft3d(zeta=1e6)
 
@@ -137,3 +142,136 @@ def test_granrs_run_prints_a_body_in_space_and_writes_its_series(tmp_path, capsy
     assert rows[0].startswith("t [s],x [m]")
     recorded = granrs.simulate(scenes()["sphere"].replace(record=True)).series
     assert len(rows) - 1 == len(recorded["t"])
+
+
+# --- granrs animate of a body in space ------------------------------------------------------
+
+
+def _ball(tmp_path):
+    """The sphere's scene file, and its series as ``granrs animate`` records them."""
+    path = tmp_path / "ball.toml"
+    scenefile.dump(scenes()["sphere"], path)
+    return path, granrs.simulate(scenes()["sphere"].replace(record=True)).series
+
+
+def _gif(path):
+    """A GIF's frame count, size [px] and first frame's duration [ms]."""
+    with Image.open(path) as image:
+        assert image.format == "GIF"
+        return int(image.n_frames), image.size, image.info["duration"]
+
+
+def test_granrs_animate_writes_a_body_in_space_as_a_gif(tmp_path, capsys):
+    """`granrs animate FILE` on a space scene file (it failed with a TypeError traceback on
+    the scene's record = false): one frame per --frame-dt of the run, --fps the frame's
+    duration, --dpi its size (a 5.5 x 5 inch figure)."""
+    path, series = _ball(tmp_path)
+    out = tmp_path / "drop.gif"
+    argv = ["animate", str(path), "--out", str(out), "--frame-dt", "0.002", "--fps", "10"]
+    code = main([*argv, "--dpi", "40"])
+    err = capsys.readouterr().err
+    assert code == 0, err
+    n = math.floor(series["t"][-1] / 0.002) + 1
+    assert f"animation written to {out} ({n} frames, 2 ms per frame, 10 fps" in err
+    assert _gif(out) == (n, (220, 200), 100)
+
+
+def test_granrs_animate_of_a_body_in_space_takes_every_option(tmp_path, capsys, monkeypatch):
+    """Every option of `granrs animate` applies in 3D, none is ignored: --speed and --fps
+    give the frames, .html writes a player, --quiet turns the progress bar off, and a
+    write that would be big warns first."""
+    path, series = _ball(tmp_path)
+    html = tmp_path / "drop.html"
+    argv = ["animate", str(path), "--speed", "0.01", "--fps", "5", "--dpi", "30"]
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    assert main([*argv, "--out", str(html)]) == 0
+    err = capsys.readouterr().err
+    n = math.floor(series["t"][-1] / 0.002) + 1
+    assert "<script" in html.read_text() and f"({n} frames, 2 ms per frame, 5 fps" in err
+    assert "granrs animate: 100%|" in err and f"{n}/{n}" in err  # the progress bar
+    assert main([*argv, "--out", str(html), "--quiet"]) == 0
+    assert "granrs animate:" not in capsys.readouterr().err
+    monkeypatch.setattr(granrs._space_animation, "BIG_SAVE_BYTES", 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", AnimationSizeWarning)
+        assert main([*argv, "--out", str(tmp_path / "big.gif"), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert f"granrs: warning: writing {tmp_path / 'big.gif'}: {n} frames of 165 x 150 px" in err
+
+
+def test_granrs_animate_of_a_body_in_space_writes_whole_or_not_at_all(
+    tmp_path, capsys, monkeypatch
+):
+    """A bad --out is refused before the run (exit 2, one line naming it); a write that fails
+    part way leaves the old file as it was (exit 1)."""
+    path, _ = _ball(tmp_path)
+
+    def no_run(*_: object) -> None:
+        raise AssertionError("the scene ran")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(granrs.api, "simulate", no_run)
+        assert main(["animate", str(path), "--out", str(tmp_path / "drop.avi")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "unknown suffix" in err[0] and "drop.avi" in err[0]
+    out = tmp_path / "drop.gif"
+    out.write_bytes(b"the old file")
+
+    draw = granrs._space_animation.SpaceAnimation._draw
+
+    def full_disk(self, k):  # the third frame fails, as a full disk would
+        if k == 2:
+            raise OSError(28, "No space left on device")
+        return draw(self, k)
+
+    monkeypatch.setattr(granrs._space_animation.SpaceAnimation, "_draw", full_disk)
+    code = main(["animate", str(path), "--out", str(out), "--frame-dt", "0.002", "--quiet"])
+    assert code == 1 and "No space left on device" in capsys.readouterr().err
+    assert out.read_bytes() == b"the old file"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ball.toml", "drop.gif"]
+
+
+def test_granrs_animate_of_a_body_in_space_takes_set(tmp_path, capsys):
+    """--set changes the run that is animated: a faster drop into firmer sand stops sooner
+    (the frames are those of that scene run directly)."""
+    path, series = _ball(tmp_path)
+    out = tmp_path / "drop.gif"
+    sets = ["--set", "velocity=[0.0, 0.0, -2.0]", "--set", "rft3d.zeta=4e6"]
+    code = main(["animate", str(path), "--out", str(out), "--frame-dt", "0.001", *sets])
+    assert code == 0, capsys.readouterr().err
+    changed = scenes()["sphere"].replace(
+        velocity=(0.0, 0.0, -2.0), forces=[forces.rft3d(zeta=4e6), forces.gravity()], record=True
+    )
+    t_end = granrs.simulate(changed).series["t"][-1]
+    assert t_end != pytest.approx(series["t"][-1], rel=0.05)
+    assert _gif(out)[0] == math.floor(t_end / 0.001) + 1
+
+
+@pytest.mark.parametrize(
+    ("override", "named", "corrected"),
+    [
+        ("velocty=[0.0, 0.0, -2.0]", "did you mean 'velocity'", "velocity=[0.0, 0.0, -2.0]"),
+        ("rft3d.zetta=2e6", "did you mean `rft3d.zeta`", "rft3d.zeta=2e6"),
+        ("body.shape.radious=0.01", "no key 'radious'", "body.shape.radius=0.01"),
+        ("velocity=[0.0, -1.0]", "`velocity`: a sequence of 3", "velocity=[0.0, 0.0, -1.0]"),
+        ("q_deg=30", "'q_deg': not a field of a body in space", "orientation=[0.0, 1.0, 0.0, 0.0]"),
+    ],
+)
+def test_granrs_animate_of_a_body_in_space_names_a_bad_set(
+    tmp_path, capsys, override, named, corrected
+):
+    """A --set the body in space does not have (or a bad value; a planar scene's field) is
+    exit 2 with one line naming the key, before anything runs or is written; corrected, the
+    same command writes the movie."""
+    path, _ = _ball(tmp_path)
+    out = tmp_path / "drop.gif"
+    argv = ["animate", str(path), "--out", str(out), "--frame-dt", "0.005", "--dpi", "30"]
+    code = main([*argv, "--set", override])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1 and err[0].startswith("granrs: error: ") and named in err[0], err
+    assert f"--set {override.split('=')[0]}=" in err[0]
+    assert not out.exists()
+    code = main([*argv, "--set", corrected])
+    assert code == 0, capsys.readouterr().err
+    assert out.read_bytes()[:6] == b"GIF89a"

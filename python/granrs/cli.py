@@ -510,7 +510,8 @@ def _add_scene_file(parser: argparse.ArgumentParser) -> None:
         help=(
             "override a field, repeatable; VALUE is TOML (q_deg=30, 'record=[\"state\"]', "
             "'knee={k=300.0, c=5.0}'); TERM.PARAM sets a force term's parameter "
-            "(static_v.eta_v=300); a bare word is a string (body=chain)"
+            "(static_v.eta_v=300); a bare word is a string (body=chain); a body in space's "
+            "fields likewise ('velocity=[0, 0, -2]', rft3d.zeta=2e6, body.shape.radius=0.01)"
         ),
     )
 
