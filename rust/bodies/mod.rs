@@ -94,23 +94,25 @@ pub(crate) fn validate_joint_stiffness<const N: usize>(
     options: &SolveOptions,
     names: &[&str],
 ) -> Result<()> {
-    if options.method != Method::Rk4 || model.forces.body.is_empty() {
+    if options.method != Method::Rk4 {
+        return Ok(());
+    }
+    // Each jointed link's stiffness and damping as the body terms give them.
+    let mut joints = Vec::new();
+    for (i, link) in model.mechanism.links.iter().enumerate() {
+        if let Some(p) = link.parent {
+            let rates = model.forces.body.iter().filter_map(|t| t.joint_rates(link));
+            joints.extend(rates.map(|kc| (i, p, kc)));
+        }
+    }
+    if joints.is_empty() {
         return Ok(());
     }
     let pose = model.mechanism.pose(q0);
     let Some(chol) = model.mechanism.mass_matrix(&pose).cholesky() else {
         return Ok(());
     };
-    let joints = model
-        .mechanism
-        .links
-        .iter()
-        .enumerate()
-        .flat_map(|(i, link)| {
-            let rates = model.forces.body.iter().filter_map(|t| t.joint_rates(link));
-            link.parent.map(|p| rates.map(move |kc| (i, p, kc)))
-        });
-    for (i, p, (k, c)) in joints.flatten() {
+    for (i, p, (k, c)) in joints {
         let mut a = SVector::<f64, N>::zeros();
         a[2 + i] = 1.0;
         a[2 + p] = -1.0;

@@ -254,52 +254,42 @@ impl Arrays {
                 a.len()
             )));
         }
-        let mut items = a.iter();
-        let mut two = |name: &str, rows: usize, cols: usize, exact: bool| {
-            let item = items.next().expect("counted");
-            let arr = item
+        let items: Vec<_> = a.iter().collect();
+        let two = |k: usize, name: &str, rows: usize, cols: usize, exact: bool| {
+            let arr = items[k]
                 .cast::<PyArray2<f64>>()
                 .map_err(|_| PyValueError::new_err(format!("{class}.bind: {name}")))?;
             bind2(arr, class, name, rows, cols, exact)
         };
-        let geom_xpos = two("geom_xpos", z.max_geom, 3, false)?;
-        let geom_xmat = two("geom_xmat", z.max_geom, 9, false)?;
-        let cvel = match z.cvel {
-            true => Some(two("cvel", z.max_body, 6, false)?),
-            false => None,
-        };
-        let subtree_com = two("subtree_com", z.max_body, 3, false)?;
-        let cdof = two("cdof", z.nv, 6, true)?;
-        let rest: Vec<_> = items.collect();
         let one = |k: usize, name: &str, len: usize| {
-            let arr = rest[k]
+            let arr = items[k]
                 .cast::<PyArray1<f64>>()
                 .map_err(|_| PyValueError::new_err(format!("{class}.bind: {name}")))?;
             bind1(arr, class, name, len)
         };
-        let two = |k: usize, name: &str, rows: usize, cols: usize| {
-            let arr = rest[k]
-                .cast::<PyArray2<f64>>()
-                .map_err(|_| PyValueError::new_err(format!("{class}.bind: {name}")))?;
-            bind2(arr, class, name, rows, cols, true)
+        // The arrays after `cvel` sit one place later where it is bound.
+        let at = |k: usize| k + usize::from(z.cvel);
+        let cvel = match z.cvel {
+            true => Some(two(2, "cvel", z.max_body, 6, false)?),
+            false => None,
         };
         Ok(Arrays {
-            geom_xpos,
-            geom_xmat,
+            geom_xpos: two(0, "geom_xpos", z.max_geom, 3, false)?,
+            geom_xmat: two(1, "geom_xmat", z.max_geom, 9, false)?,
             cvel,
-            subtree_com,
-            cdof,
-            qvel: one(0, "qvel", z.nv)?,
-            qacc: one(1, "qacc", z.nv)?,
-            qfrc_applied: one(2, "qfrc_applied", z.nv)?,
-            qfrc_passive: one(3, "qfrc_passive", z.nv)?,
-            mass: two(4, "mass", z.nv, z.nv)?,
-            outputs: two(5, "outputs", z.n, z.width)?,
-            applied: two(6, "applied", z.n, z.wrench)?,
-            h_lambda: one(7, "h_lambda", z.n)?,
-            generalized: one(8, "generalized", z.nv)?,
-            before: one(9, "before", z.nv)?,
-            after: one(10, "after", z.nv)?,
+            subtree_com: two(at(2), "subtree_com", z.max_body, 3, false)?,
+            cdof: two(at(3), "cdof", z.nv, 6, true)?,
+            qvel: one(at(4), "qvel", z.nv)?,
+            qacc: one(at(5), "qacc", z.nv)?,
+            qfrc_applied: one(at(6), "qfrc_applied", z.nv)?,
+            qfrc_passive: one(at(7), "qfrc_passive", z.nv)?,
+            mass: two(at(8), "mass", z.nv, z.nv, true)?,
+            outputs: two(at(9), "outputs", z.n, z.width, true)?,
+            applied: two(at(10), "applied", z.n, z.wrench, true)?,
+            h_lambda: one(at(11), "h_lambda", z.n)?,
+            generalized: one(at(12), "generalized", z.nv)?,
+            before: one(at(13), "before", z.nv)?,
+            after: one(at(14), "after", z.nv)?,
         })
     }
 
