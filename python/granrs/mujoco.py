@@ -328,7 +328,7 @@ class Sand:
         )
         self.apply_at = apply_at
         dofs = self._dofs(self._body)
-        self._coupling: Any = _granrs.GeomCoupling(
+        self._coupling = _granrs.MujocoCoupling.planar(
             self._core,
             [int(i) for i in self._ids],
             [int(b) for b in self._body],
@@ -424,7 +424,7 @@ class Sand:
         self._root = np.asarray(m.body_rootid[self._body], dtype=np.intp)
         self.rest_speed = speed
         self.apply_at = "centre"
-        self._coupling = _granrs.SpaceCoupling(
+        self._coupling = _granrs.MujocoCoupling.space(
             list(names),
             shapes,
             [(t.name, dict(t.params)) for t in terms],
@@ -617,10 +617,11 @@ class Sand:
             )
             self._data_ref = data
         mujoco.mj_fullM(m, data, self._mass)
+        worst, geom, iterations, residual, converged, fell = self._coupling.step(
+            self._opt.timestep, passive, fresh, hold
+        )
         if self.space:
-            worst, _, self.iterations, self.residual, self.converged, fell = self._coupling.step(
-                self._opt.timestep, passive, fresh, hold
-            )
+            self.iterations, self.residual, self.converged = iterations, residual, converged
             self.max_residual = max(self.max_residual, self.residual)
             self.max_h_lambda = max(self.max_h_lambda, worst)
             self.fallbacks += int(fell)
@@ -637,7 +638,6 @@ class Sand:
                     stacklevel=4,
                 )
             return
-        worst, geom = self._coupling.step(self._opt.timestep, passive, fresh, hold)
         if worst > self.max_h_lambda:
             self.max_h_lambda = worst
             self._warn_step_size(worst, geom)
