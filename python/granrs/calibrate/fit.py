@@ -9,7 +9,7 @@ import difflib
 import math
 import os
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -267,12 +267,18 @@ def _check_law(law: Any) -> LawSpec | None:
 
 
 def _check_body(cases: Any) -> str:
-    """The body named by ``cases`` (one of :data:`BODIES`), with a did-you-mean if not."""
-    if not isinstance(cases, str) or cases not in BODIES:
+    """The body named by ``cases`` (one of :data:`BODIES`), with a did-you-mean if not; a
+    function of the row (that makes a body in space's scene) is ``"space"``."""
+    if callable(cases):
+        return "space"
+    if not isinstance(cases, str) or cases not in BODIES or cases == "space":
         hint = difflib.get_close_matches(str(cases), BODIES, n=1)
         more = f"; did you mean {hint[0]!r}?" if hint else ""
         raise UnknownNameError(
-            f"unknown cases {cases!r}{more}; calibrate fits {', '.join(BODIES)}", field="cases"
+            f"unknown cases {cases!r}{more}; calibrate fits "
+            f"{', '.join(b for b in BODIES if b != 'space')}, or bodies in space through a "
+            "function of the measurement row that returns a granrs.space.Scene",
+            field="cases",
         )
     return cases
 
@@ -335,6 +341,14 @@ def _check_quantities(quantities: Sequence[str] | str) -> list[str]:
 
 def _check_base(base: str | Coefficients | None, body: str) -> str | Coefficients:
     """The base coefficients' name (the body's default for None) or the Coefficients."""
+    if body == "space":
+        if base is not None:
+            raise InvalidParameterError(
+                "a body in space has no thesis coefficients: its law is its scene's forces "
+                "(or forces=)",
+                field="base",
+            )
+        return "none"
     if base is None:
         base = "table_3_4" if body == "free_link" else "thesis"
     if isinstance(base, str):
@@ -641,7 +655,7 @@ def _final_residuals(objective: _Objective, natural: np.ndarray, x0: np.ndarray)
 
 
 def calibrate(
-    cases: str,
+    cases: str | Callable[[dict[str, Any]], Any],
     measurements: Measurements | str | os.PathLike[str],
     params: Sequence[str] = ("eta_h", "eta_d", "eta_v", "lam"),
     *,
@@ -668,7 +682,10 @@ def calibrate(
         cases: the body, built per row by the :mod:`granrs.cases` function of that name:
             ``"free_link"`` (a row runs ``cases.free_link(q_deg, v0_mean)``), ``"chain"``
             (a case's two rows run ``cases.chain`` with both links' angles and the mean of
-            their speeds, ``end="all_stops"``) or ``"leg"`` (``cases.leg(v0_mean)``).
+            their speeds, ``end="all_stops"``) or ``"leg"`` (``cases.leg(v0_mean)``); or,
+            for bodies in space, a function of the measurement row (a dict of its columns)
+            returning that row's :class:`granrs.space.Scene`: its forces are the law (or
+            ``forces=``) and its step ``dt``; the measurements' body is then ``"space"``.
         measurements: a :class:`Measurements`, a thesis name (``"table_3_1"``,
             ``"table_4_chain"``, ``"table_5_1_means"``, ...; ``"thesis:"`` may prefix it) or
             the path of a CSV with the same columns.
@@ -745,7 +762,16 @@ def calibrate(
     fixed = _check_joints(joints, body)
     box = _bounds_for(parsed, bounds)
     law = _check_law(forces)
-    model = _Model(body, tuple(parsed), base, float(dt), dict(overrides), fixed, law)
+    model = _Model(
+        body,
+        tuple(parsed),
+        base,
+        float(dt),
+        dict(overrides),
+        fixed,
+        law,
+        scene_of=cases if body == "space" else None,
+    )
     x_start = _start_values(parsed, box, start, model, m, fixed)
     # Build every scene once up front: bad overrides or values fail here, before any run.
     model.scenes(m.rows, x_start)
