@@ -835,7 +835,7 @@ def _exp(u: float) -> float:
 
 
 def evaluate(
-    cases: str,
+    cases: str | Callable[[dict[str, Any]], Any],
     measurements: Measurements | str | os.PathLike[str],
     *,
     base: str | Coefficients | None = None,
@@ -848,15 +848,20 @@ def evaluate(
     """The residuals of ``measurements`` with the base coefficients, nothing fitted (e.g.
     the thesis's Table 3.4 rows): a frame as :attr:`CalibrationResult.residuals` without
     the start columns. Arguments as in :func:`calibrate`."""
-    if not isinstance(cases, str) or cases not in BODIES:
-        raise UnknownNameError(
-            f"unknown cases {cases!r}; calibrate fits {', '.join(BODIES)}", field="cases"
-        )
-    m = _check_measurements(measurements, cases)
-    if base is None:
-        base = "table_3_4" if cases == "free_link" else "thesis"
-    fixed = _check_joints(joints, cases)
-    model = _Model(cases, (), base, float(dt), dict(overrides), fixed, _check_law(forces))
+    body = _check_body(cases)
+    m = _check_measurements(measurements, body)
+    base = _check_base(base, body)
+    fixed = _check_joints(joints, body)
+    model = _Model(
+        body,
+        (),
+        base,
+        float(dt),
+        dict(overrides),
+        fixed,
+        _check_law(forces),
+        scene_of=cases if body == "space" else None,
+    )
     # Build every scene up front: a bad dt or override raises here (naming the field), not
     # as a failed run of every row.
     model.scenes(m.rows, [])
