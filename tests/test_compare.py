@@ -20,7 +20,7 @@ import granrs
 from granrs import cases, forces
 from granrs.calibrate import Measurements, calibrate
 from granrs.cli import main
-from granrs.compare import LAWS, Law, compare, synthetic, to_json
+from granrs.compare import LAWS, Law, compare, sums, synthetic, to_json
 from granrs.errors import InvalidParameterError, SimulationError, StepSizeWarning, UnknownNameError
 
 TABLE_3_1 = Measurements.thesis("table_3_1")
@@ -658,3 +658,49 @@ def test_compare_ranks_laws_on_bodies_in_space_out_of_sample():
     with pytest.raises(granrs.InvalidParameterError, match="bodies in space") as e:
         compare(laws[:1], {"balls": m}, folds="radius", progress=False)
     assert e.value.field == "cases"
+
+
+# --------------------------------------------------------------------------------------------
+# Sums of laws
+
+
+def test_laws_add_their_terms_and_fits_and_refuse_a_term_listed_twice():
+    a = Law("a", "A", terms=(("poncelet", {"k": 0.0}),), fit={"poncelet.c": (1.0, 1e-3, 1e3)})
+    b = Law("b", "B", terms=(("rft", {}),), fit={"rft.zeta": (1e6, 1e3, 1e9)}, body_unknowns=False)
+    s = LAWS["thesis_refit"] + a + b
+    assert s.name == "thesis_refit+a+b"
+    assert s.thesis
+    assert s.terms == (("poncelet", {"k": 0.0}), ("rft", {}))
+    assert set(s.params_for("free_link")) == {
+        *LAWS["thesis_refit"].fit,
+        "poncelet.c",
+        "rft.zeta",
+    }
+    assert not s.body_unknowns
+    # The leg's own setting of the thesis refit survives the sum.
+    assert s.params_for("leg") == (LAWS["thesis_refit"] + a).params_for("leg") | {
+        "rft.zeta": (1e6, 1e3, 1e9)
+    }
+    with pytest.raises(granrs.InvalidParameterError, match="both list the term 'poncelet'") as e:
+        _ = a + LAWS["poncelet"]
+    assert e.value.field == "laws"
+
+
+def test_sums_compares_every_small_sum_in_one_call():
+    # Pieces with nothing to fit (each evaluated once), on three rows of Table 3.1: every sum
+    # of at most two, and a sum whose pieces list the same term left out.
+    m = Measurements.thesis("table_3_1")
+    m = Measurements(m.body, m.rows.iloc[:3].reset_index(drop=True), m.source, m.resolution)
+    a = Law("a", "A", terms=(("poncelet", {"c": 0.5, "k": 20.0}),), body_unknowns=False)
+    b = Law("b", "B", terms=(("static_v", {}),), body_unknowns=False)
+    c = Law("c", "C", terms=(("poncelet", {"c": 1.0, "k": 0.0}),), body_unknowns=False)
+    frame = sums([a, b, c], m, max_terms=2, folds=None, progress=False)
+    assert list(frame["law"]) == ["a", "b", "c", "a+b", "b+c"]
+    alone = compare([a + b], m, folds=None, progress=False)
+    assert frame.set_index("law").loc["a+b", "oos_chi2"] == alone.loc[0, "oos_chi2"]
+    pairs = zip(frame["law"], frame["rows"], strict=True)
+    depth = {law: [r["depth_pred"] for r in rows] for law, rows in pairs}
+    assert depth["a+b"] != depth["a"] and depth["a+b"] != depth["b"]
+    with pytest.raises(granrs.InvalidParameterError) as e:
+        sums([a, b], m, max_terms=0)
+    assert e.value.field == "max_terms"

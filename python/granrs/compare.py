@@ -51,6 +51,7 @@ predictions are its in-sample ones.
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -78,6 +79,7 @@ __all__ = [
     "Law",
     "compare",
     "scenes",
+    "sums",
     "synthetic",
     "to_json",
 ]
@@ -120,6 +122,33 @@ class Law:
     fit_body: Mapping[str, Mapping[str, FitParam | None]] = field(default_factory=dict)
     fixed_body: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     body_unknowns: bool = True
+
+    def __add__(self, other: Law) -> Law:
+        """The sum of two laws: both laws' terms (a term that both list is refused), the
+        parameters either fits (``other``'s win on a name both fit), and the thesis's terms
+        if either starts from them; the body's unknowns fitted only if both fit them."""
+        if not isinstance(other, Law):
+            return NotImplemented
+        clash = sorted({t for t, _ in self.terms} & {t for t, _ in other.terms})
+        if clash:
+            raise InvalidParameterError(
+                f"laws {self.name!r} and {other.name!r} both list the term {clash[0]!r}",
+                field="laws",
+            )
+
+        def merged(a: Mapping[str, Mapping[str, Any]], b: Mapping[str, Mapping[str, Any]]) -> Any:
+            return {k: {**a.get(k, {}), **b.get(k, {})} for k in {*a, *b}}
+
+        return Law(
+            f"{self.name}+{other.name}",
+            f"{self.summary}; plus {other.summary}",
+            thesis=self.thesis or other.thesis,
+            terms=(*self.terms, *other.terms),
+            fit={**self.fit, **other.fit},
+            fit_body=merged(self.fit_body, other.fit_body),
+            fixed_body=merged(self.fixed_body, other.fixed_body),
+            body_unknowns=self.body_unknowns and other.body_unknowns,
+        )
 
     def params_for(self, body: str) -> dict[str, FitParam]:
         """The law's own parameters fitted on ``body`` (without the body's unknowns)."""
@@ -776,6 +805,38 @@ def compare(
     frame = pd.DataFrame.from_records(records)
     frame["rank"] = _rank(frame)
     return frame
+
+
+def sums(
+    pieces: Iterable[str | Law],
+    measurements: Any = None,
+    *,
+    base: str | Law | None = None,
+    max_terms: int = 2,
+    **options: Any,
+) -> pd.DataFrame:
+    """Search over small sums of laws in one call: every sum of 1 to ``max_terms`` of
+    ``pieces`` (law names or :class:`Law` objects, added with ``+``), each on top of
+    ``base`` when given (``base`` itself is compared too), fitted and cross-validated by
+    :func:`compare` (``options``: its keywords). A sum in which two pieces list the same term
+    is left out. Returns :func:`compare`'s frame, one row per dataset and sum, ranked."""
+    items = _law_list(pieces)
+    if isinstance(max_terms, bool) or not isinstance(max_terms, int) or max_terms < 1:
+        raise InvalidParameterError(
+            f"max_terms must be an integer >= 1; got {max_terms!r}", field="max_terms"
+        )
+    start = _law_list([base])[0] if base is not None else None
+    laws = [start] if start is not None else []
+    for k in range(1, min(max_terms, len(items)) + 1):
+        for combo in itertools.combinations(items, k):
+            try:
+                law = combo[0] if start is None else start + combo[0]
+                for piece in combo[1:]:
+                    law = law + piece
+            except InvalidParameterError:
+                continue  # two of them list the same term
+            laws.append(law)
+    return compare(laws, measurements, **options)
 
 
 def _check_dt(dt: Any) -> None:
