@@ -380,3 +380,52 @@ def test_calibrate_in_space_refuses_bad_cases_before_any_run():
     with pytest.raises(granrs.UnknownNameError, match="function of the measurement row") as e:
         calibrate("space", m, params=["rft3d.zeta"])
     assert e.value.field == "cases"
+
+
+# --------------------------------------------------------------------------------------------
+# Posterior samples
+
+
+def test_posterior_samples_agree_with_the_fit_and_give_predictive_intervals():
+    fit = calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"], posterior=40, walkers=4)
+    post = fit.posterior
+    assert post is not None and post.walkers == 4 and post.burn == 20
+    assert list(post.samples.columns) == ["scale.static_v.eta_v"]
+    assert len(post.samples) == 4 * 20 == len(post.log_prob)
+    assert 0.0 < post.acceptance < 1.0
+    # One parameter, a near-linear model: the posterior sits where the least-squares fit
+    # puts it, its median inside the fit's ~95 % interval and its 90 % interval about the
+    # fitted value.
+    value = fit.values["scale.static_v.eta_v"]
+    lo95, hi95 = fit.intervals["scale.static_v.eta_v"]
+    median = float(post.samples["scale.static_v.eta_v"].median())
+    assert lo95 < median < hi95
+    lo, hi = post.interval(0.9)["scale.static_v.eta_v"]
+    assert lo < value < hi
+    assert post.interval(0.5)["scale.static_v.eta_v"][1] < hi
+    # Seeded: the same call draws the same chains.
+    again = calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"], posterior=40, walkers=4)
+    pd.testing.assert_frame_equal(post.samples, again.posterior.samples)
+    pred = fit.predictive(draws=20)
+    assert len(pred) == 12
+    for q in ("depth", "t_s"):
+        assert np.all(pred[f"{q}_lo"] <= pred[f"{q}_median"])
+        assert np.all(pred[f"{q}_median"] <= pred[f"{q}_hi"])
+        assert np.all(pred[f"{q}_lo"] < pred[f"{q}_hi"])
+
+
+def test_posterior_options_are_refused_before_any_run():
+    for kwargs, name in (
+        ({"posterior": 5}, "posterior"),
+        ({"posterior": -1}, "posterior"),
+        ({"posterior": 40, "walkers": 3}, "walkers"),
+        ({"posterior": 40, "walkers": 1}, "walkers"),
+    ):
+        with pytest.raises(granrs.InvalidParameterError) as e:
+            calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"], **kwargs)
+        assert e.value.field == name
+    fit = calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"])
+    assert fit.posterior is None
+    with pytest.raises(granrs.InvalidParameterError) as e:
+        fit.predictive()
+    assert e.value.field == "posterior"
