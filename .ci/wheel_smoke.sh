@@ -35,7 +35,7 @@ expected_suffix="cp310-abi3-manylinux2014_${arch}.manylinux_2_17_${arch}.whl"
 # --- build tools, in their own venv ------------------------------------------------------------
 say "installing the build tools (maturin, ziglang, auditwheel) into $work/tools"
 python3 -m venv "$work/tools"
-"$work/tools/bin/pip" install -q "maturin>=1.7,<2" "ziglang>=0.11" "auditwheel>=6"
+"$work/tools/bin/pip" install -q "maturin>=1.9.4,<2" "ziglang>=0.11" "auditwheel>=6"
 tools_path="$work/tools/bin:$PATH"
 
 # --- 1. the wheel ------------------------------------------------------------------------------
