@@ -818,8 +818,8 @@ def sums(
     """Search over small sums of laws in one call: every sum of 1 to ``max_terms`` of
     ``pieces`` (law names or :class:`Law` objects, added with ``+``), each on top of
     ``base`` when given (``base`` itself is compared too), fitted and cross-validated by
-    :func:`compare` (``options``: its keywords). A sum in which two pieces list the same term
-    is left out. Returns :func:`compare`'s frame, one row per dataset and sum, ranked."""
+    :func:`granrs.compare` (``options``: its keywords). A sum in which two pieces list the same term
+    is left out. Returns :func:`granrs.compare`'s frame, one row per dataset and sum, ranked."""
     items = _law_list(pieces)
     if isinstance(max_terms, bool) or not isinstance(max_terms, int) or max_terms < 1:
         raise InvalidParameterError(
