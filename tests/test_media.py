@@ -277,3 +277,28 @@ def test_the_docs_table_lists_every_card_s_every_value() -> None:
         keys = [*card.medium, *card.params, *card.missing]
         listed = [r[1] for r in rows if r[0] == f"``{name}``"]
         assert listed == [f"``{k}``" for k in keys], name
+
+
+def test_mujoco_sand_takes_a_medium() -> None:
+    mujoco = pytest.importorskip("mujoco")
+    from granrs.mujoco import Sand
+
+    xml = (
+        '<mujoco><worldbody><body name="b" pos="0 0 0.1"><freejoint/>'
+        '<geom name="ball" type="sphere" size="0.02" density="7800"/></body></worldbody>'
+        "</mujoco>"
+    )
+    model = mujoco.MjModel.from_xml_string(xml)
+    sand = Sand(model, ["ball"], [f.rft3d(), f.poncelet()], medium="thesis_sand")
+    assert sand.medium is media.load("thesis_sand")
+    data = mujoco.MjData(model)
+    sand.install()
+    try:
+        for _ in range(200):
+            mujoco.mj_step(model, data)
+    finally:
+        sand.uninstall()
+    assert math.isfinite(float(data.qpos[2]))
+    with pytest.raises(granrs.InvalidSceneError) as caught:
+        Sand(model, ["ball"], [f.rft3d()], medium="thesis_fine_sand")
+    assert caught.value.field == "rft3d.zeta"
