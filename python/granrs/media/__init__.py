@@ -132,6 +132,17 @@ def _finite(key: str, what: str, value: Any) -> float:
     return number
 
 
+def _items(value: Any) -> list[Any] | None:
+    """``value`` as a list of its items, or None if it is not a sequence of them (a string,
+    a number, a 0-d array, a mapping)."""
+    if isinstance(value, str | bytes | Mapping) or not isinstance(value, Iterable):
+        return None
+    try:
+        return list(value)
+    except TypeError:  # iterable by type only (a 0-d numpy array)
+        return None
+
+
 @dataclass(frozen=True)
 class Value:
     """One number of a card, with its source and (optionally) its uncertainty.
@@ -166,10 +177,11 @@ class Value:
             raise MediumError(f"{key}.sd must be >= 0, got {sd!r}", field=f"{key}.sd")
         interval = None
         if self.interval is not None:
-            pair = self.interval
-            if isinstance(pair, str) or not isinstance(pair, Iterable) or len(list(pair)) != 2:
+            pair = _items(self.interval)
+            if pair is None or len(pair) != 2:
                 raise MediumError(
-                    f"{key}.interval must be [low, high], got {pair!r}", field=f"{key}.interval"
+                    f"{key}.interval must be [low, high], got {self.interval!r}",
+                    field=f"{key}.interval",
                 )
             low, high = (_finite(f"{key}.interval", "each end", x) for x in pair)
             if low > high:
@@ -183,10 +195,11 @@ class Value:
             raise MediumError(f"{key}.level must be in (0, 1), got {level!r}", field=f"{key}.level")
         if level is not None and interval is None:
             raise MediumError(f"{key}.level needs an interval", field=f"{key}.level")
-        samples = self.samples
-        if isinstance(samples, str) or not isinstance(samples, Iterable):
+        samples = _items(self.samples)
+        if samples is None:
             raise MediumError(
-                f"{key}.samples must be a list of numbers, got {samples!r}", field=f"{key}.samples"
+                f"{key}.samples must be a list of numbers, got {self.samples!r}",
+                field=f"{key}.samples",
             )
         out = tuple(_finite(f"{key}.samples", "each sample", x) for x in samples)
         return Value(value, self.source.strip(), sd, interval, level, out)
