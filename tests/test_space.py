@@ -383,8 +383,12 @@ def test_unknown_or_misspelled_term_parameters_are_named() -> None:
     with pytest.raises(granrs.GranrsError) as info:
         forces.rft3d(zeta=1e6, zetta=2.0)  # type: ignore[call-arg]
     assert "zetta" in str(info.value)
-    with pytest.raises(granrs.GranrsError, match="required"):
-        forces.term("rft3d")
+    # Left out, zeta is to come from a medium: a scene without one refuses it, naming it.
+    with pytest.raises(granrs.InvalidSceneError, match="required") as caught:
+        space.Scene(
+            body=space.Body(space.Sphere(0.02), density=2500.0), forces=[forces.term("rft3d")]
+        )
+    assert caught.value.field == "rft3d.zeta"
 
 
 def test_the_material_scale_is_the_cubic() -> None:
