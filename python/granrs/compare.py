@@ -63,6 +63,7 @@ import pandas as pd
 
 from . import forces as _forces
 from .batch import _threads as _check_threads
+from .bodies import CONTACT_SHAPES
 from .calibrate import Measurements, calibrate, evaluate
 from .calibrate.fit import _residual_frame
 from .calibrate.model import _parse_param, base_coefficients
@@ -187,14 +188,12 @@ class Law:
         return law
 
 
-#: The shapes of a body in space (a term acts on a body in space if it acts on one of them).
-_SPACE_SHAPES = frozenset(("sphere", "capsule", "cylinder", "cuboid", "mesh"))
-
-
 def _acts_on(term: str, body: str) -> bool:
-    """Whether ``term`` acts on ``body``: a body in space's shapes, or the planar ones."""
+    """Whether ``term`` acts on ``body``: on a planar contact's shape, or (a body in space)
+    on a shape that is not one."""
     shapes = set(_forces.info(term).shapes)
-    return bool(shapes & _SPACE_SHAPES) if body == "space" else bool(shapes - _SPACE_SHAPES)
+    planar = shapes & set(CONTACT_SHAPES)
+    return bool(shapes - planar) if body == "space" else bool(planar)
 
 
 def _body_terms() -> tuple[tuple[str, ...], tuple[str, ...]]:

@@ -313,9 +313,14 @@ class _Model:
             for t in _forces.as_terms(terms)
         )
 
-    def row_terms(self, row: Mapping[str, Any], values: Sequence[float]) -> tuple[Any, ...]:
-        """The terms of one row (one contact) at the natural parameter ``values``."""
-        terms = {t.name: dict(t.params) for t in self.base_terms(row)}
+    def row_terms(
+        self, row: Mapping[str, Any], values: Sequence[float], scene: Any = None
+    ) -> tuple[Any, ...]:
+        """The terms of one row (one contact) at the natural parameter ``values``; ``scene``:
+        a body in space's scene of the row, already made (its forces are the law's base)."""
+        given = scene.forces if scene is not None and self.law is None else None
+        base_terms = self.base_terms(row) if given is None else tuple(given)
+        terms = {t.name: dict(t.params) for t in base_terms}
         base = {name: dict(p) for name, p in terms.items()}
         nodes: dict[tuple[str, str], list[tuple[float, float, bool]]] = {}
         for p, v in zip(self.params, values, strict=True):
@@ -395,12 +400,13 @@ class _Model:
         """One scene per run: per row (free link, leg, space) or per chain case (two rows)."""
         records = rows.to_dict("records")
         if self.body == "space":
-            return [
-                dataclasses.replace(
-                    self.space_scene(r), forces=self.row_terms(r, values), dt=self.dt
-                )
-                for r in records
-            ]
+            out = []
+            for r in records:
+                # The caller's function runs once per row.
+                scene = self.space_scene(r)
+                terms = self.row_terms(r, values, scene)
+                out.append(dataclasses.replace(scene, forces=terms, dt=self.dt))
+            return out
         fields, joints = self.body_values(values)
         if self.body == "free_link":
             return [
