@@ -4,29 +4,31 @@
 //!
 //! `F64x4` is a plain `[f64; 4]` whose operations are written lane by lane with the same IEEE
 //! operation as `f64` (no fused multiply-add: Rust never contracts `a * b + c`), so a lane's
-//! result is bit for bit what the scalar path computes. The vector instructions come from
+//! arithmetic is bit for bit what the scalar path computes. The vector instructions come from
 //! the compiler: the lanes' step is compiled twice, once for the baseline target and once
 //! with AVX2 enabled (`#[target_feature]`), and the CPU picks one at run time ([`avx2`]).
 //! The scalar path's lean step (the same step in one lane, `f64`) is dispatched the same
 //! way: with AVX2's three-operand encodings it needs fewer register copies (a thesis-law
 //! impact about 8 % faster, bit for bit the same). One wheel thus runs on any x86-64 (SSE2,
 //! two lanes per instruction), uses 256-bit registers where the CPU has them, and builds
-//! unchanged for arm64 (NEON, two lanes per instruction). `sin_cos` and `powf` are libm's,
-//! lane by lane: glibc's vector versions (libmvec) do not give the scalar calls' bits
-//! (docs/sweeps.md, "What the speed targets leave"). Vectorized ones were written and measured: a
-//! `sin_cos` (range reduction and a series, within 1 ulp of glibc) made the lanes 8 % faster
-//! but the scalar path, which must call the same function for the lanes to stay bit for
-//! bit, 22 % slower; a `pow` within 1 ulp took 4x libm's time per call.
+//! unchanged for arm64 (NEON, two lanes per instruction).
+//!
+//! `sin_cos` and `powf` are libm's, lane by lane, by default: so a lane's result is the
+//! scalar path's bit for bit. With `GRANRS_FAST_LANES=1` the lanes call glibc's four-lane
+//! versions instead where the CPU has AVX2 ([`vector_calls`], which says what that gains
+//! and what it costs in agreement with the scalar path).
 //!
 //! Why no crate: `wide` picks its instructions when the crate is compiled
 //! (`cfg(target_feature)`), so a baseline x86-64 wheel would never use AVX2; `pulp` does
 //! dispatch at run time, but its vectors are values of an instruction-set token's
 //! associated types, with no arithmetic operators, so the terms' generic arithmetic
 //! (`a * b + c` over [`Real`]) could not run on them without wrapping every value with its
-//! token. Neither has a vector `pow` or `sin_cos` either.
+//! token. Neither has a vector `pow` or `sin_cos` either (glibc's are in [`vector_calls`]).
 
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
+
+pub mod vector_calls;
 
 /// The number type of a term's arithmetic: `f64` for one scene; [`F64x4`] for
 /// four scenes at once, one per SIMD lane (the sweep's lanes, `dynamics::rod_lanes`). Only
@@ -46,7 +48,7 @@ pub trait Real:
     const LANES: usize;
     /// The value `x` (in every lane).
     fn splat(x: f64) -> Self;
-    /// `self^e` (libm's, in each lane).
+    /// `self^e` (libm's; in the lanes, glibc's four-lane call with `GRANRS_FAST_LANES=1`).
     fn powf(self, e: Self) -> Self;
     /// `1 / self`.
     fn recip(self) -> Self;
@@ -62,7 +64,8 @@ pub trait Real:
     fn select_pos(self, a: Self, b: Self) -> Self;
     /// Whether it is zero (in every lane).
     fn all_zero(self) -> bool;
-    /// Sine and cosine (libm's, in each lane).
+    /// Sine and cosine (libm's; in the lanes, glibc's four-lane calls with
+    /// `GRANRS_FAST_LANES=1`).
     fn sin_cos(self) -> (Self, Self);
     /// Hyperbolic tangent (libm's, in each lane).
     fn tanh(self) -> Self;
@@ -177,7 +180,11 @@ impl Real for F64x4 {
     }
     #[inline(always)]
     fn powf(self, e: Self) -> Self {
-        self.zip(e, f64::powf)
+        // glibc's four-lane call where switched on (within 4 ulp of libm's), else libm's.
+        match vector_calls::pow(self.0, e.0) {
+            Some(p) => F64x4(p),
+            None => self.zip(e, f64::powf),
+        }
     }
     #[inline(always)]
     fn recip(self) -> Self {
@@ -211,9 +218,10 @@ impl Real for F64x4 {
     }
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
-        // libm's, lane by lane: a sin_cos of our own in vector instructions made the lanes
-        // 8 % faster but, called once per evaluation on the scalar path too (to keep the
-        // lanes bit for bit the scalar path), made `simulate` 22 % slower (measured).
+        // glibc's four-lane calls where switched on (within 4 ulp of libm's), else libm's.
+        if let Some((s, c)) = vector_calls::sin_cos(self.0) {
+            return (F64x4(s), F64x4(c));
+        }
         let r = self.0.map(f64::sin_cos);
         (F64x4(r.map(|x| x.0)), F64x4(r.map(|x| x.1)))
     }
@@ -255,13 +263,17 @@ mod tests {
         check(a * b, &|x, y| x * y);
         check(a / b, &|x, y| x / y);
         check(-a, &|x, _| -x);
-        check(a.abs().powf(b), &|x, y| x.abs().powf(y));
+        if !vector_calls::active() {
+            // Where glibc's four-lane calls are switched on, they are held to 4 ulp instead
+            // (`vector_calls`'s test).
+            check(a.abs().powf(b), &|x, y| x.abs().powf(y));
+            check(a.sin_cos().0, &|x, _| x.sin_cos().0);
+            check(a.sin_cos().1, &|x, _| x.sin_cos().1);
+        }
         check(a.max(b), &|x, y| x.max(y));
         check(a.min(b), &|x, y| x.min(y));
         check(a.recip(), &|x, _| 1.0 / x);
         check(a.abs().sqrt(), &|x, _| x.abs().sqrt());
-        check(a.sin_cos().0, &|x, _| x.sin_cos().0);
-        check(a.sin_cos().1, &|x, _| x.sin_cos().1);
         check(a.tanh(), &|x, _| x.tanh());
         assert!(F64x4::splat(0.0).all_zero());
         assert!(!b.all_zero());

@@ -10,6 +10,9 @@ failure says which of the two broke."""
 from __future__ import annotations
 
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pandas as pd
@@ -270,3 +273,41 @@ def test_lanes_must_be_a_bool() -> None:
         granrs.sweep(cases.free_link(0.0, 1.0), q_deg=[0.0], lanes=1)  # type: ignore[arg-type]
     scalar = granrs.sweep(cases.free_link(0.0, 1.0), q_deg=[0.0], lanes=False)
     assert math.isfinite(scalar["depth"][0])
+
+
+_FAST = """
+import numpy as np, granrs, warnings
+from granrs import cases
+from granrs.forces import gravity, rft
+warnings.simplefilter("ignore")
+t = granrs.data.load("table_3_5", as_="numpy")
+scenes = [cases.free_link(q_deg=float(q), v0=float(v)) for q, v in zip(t["q_deg"], t["v0"])]
+cols = ["t_s", "depth", "F_s_end", "work_sand"]
+fast = granrs.sweep(scenes, progress=False)[cols].to_numpy(float)
+alone = granrs.sweep(scenes, progress=False, lanes=False)[cols].to_numpy(float)
+rel = np.abs(fast - alone) / np.abs(alone)
+rods = [scenes[0].replace(forces=[gravity(), rft(zeta=1e6)], q_deg=float(q), v0=2.0)
+        for q in np.linspace(-80, 80, 24)]
+a = granrs.sweep(rods, progress=False)[cols].to_numpy(float)
+b = granrs.sweep(rods, progress=False, lanes=False)[cols].to_numpy(float)
+print(int(granrs.fast_lanes()), float(rel.max()),
+      int(not np.array_equal(a.view(np.uint64), b.view(np.uint64))))
+"""
+
+
+def test_fast_lanes_are_within_1e_12_on_table_3_5() -> None:
+    """With ``GRANRS_FAST_LANES=1`` (read once per process, so in a child process) the
+    lanes call glibc's four-lane ``sin``, ``cos`` and ``pow``: Table 3.5's rows under the
+    thesis's law stay within 1e-12 relative of the scalar path, and the switch does change
+    bits (an ``rft`` sweep is not the scalar path's bit for bit)."""
+    env = dict(os.environ, GRANRS_FAST_LANES="1")
+    done = subprocess.run(
+        [sys.executable, "-c", _FAST], env=env, capture_output=True, text=True, check=True
+    )
+    active, worst, changed = done.stdout.split()
+    if active == "0":
+        pytest.skip("no AVX2 or no libmvec here: the lanes call libm")
+    assert float(worst) <= 1e-12, done.stdout
+    assert changed == "1", done.stdout
+    # Off by default: this process's lanes give the scalar path's bits.
+    assert not granrs.fast_lanes()

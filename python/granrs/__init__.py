@@ -29,7 +29,7 @@ from . import (
     space,
 )
 from .api import RK4_STABILITY_LIMIT, simulate
-from .batch import sweep
+from .batch import fast_lanes, sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
 from .coefficients import Coefficients
 from .compare import compare
@@ -86,6 +86,7 @@ __all__ = [
     "coefficients",
     "compare",
     "data",
+    "fast_lanes",
     "forces",
     "media",
     "resistance_force",

@@ -37,6 +37,7 @@ __all__ = [
     "compile_fields",
     "compiled_scene",
     "element_fields",
+    "fast_lanes",
     "leg_segments",
     "max_threads",
     "resistance_force",
@@ -132,6 +133,11 @@ def validate_sweep(
 
 def max_threads() -> int:
     """The most threads a sweep runs on: the machine's cores (the shared pool's size)."""
+
+def fast_lanes() -> bool:
+    """Whether a sweep's lanes call glibc's four-lane ``sin``, ``cos`` and ``pow``
+    (``GRANRS_FAST_LANES=1``, read once per process, on a CPU with AVX2 where libmvec is
+    found): then a lane's row is near ``simulate``'s, not its bits."""
 
 FORCE_INPUTS: list[str]
 FORCE_OUTPUTS: list[str]

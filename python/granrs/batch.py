@@ -514,6 +514,22 @@ def _sweep_space(
     return frame
 
 
+def fast_lanes() -> bool:
+    """Whether this process's sweeps call glibc's four-lane ``sin``, ``cos`` and ``pow`` in
+    their SIMD lanes.
+
+    Off by default: a sweep's row is then :func:`granrs.simulate`'s bit for bit. On with
+    ``GRANRS_FAST_LANES=1`` in the environment before Python starts (read once per process),
+    on a CPU with AVX2 where glibc's vector math library is found; a row is then near
+    ``simulate``'s, not its bits (the sweeps guide, "The lanes and the scalar path", has
+    what it gains and how far rows move).
+
+    Returns:
+        True where the lanes call the four-lane functions.
+    """
+    return bool(_granrs.fast_lanes())
+
+
 def sweep(
     scene: Scene | Sequence[Scene],
     *,

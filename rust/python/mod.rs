@@ -47,6 +47,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::validate_sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::max_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::fast_lanes, m)?)?;
     m.add_function(wrap_pyfunction!(force::resistance_force, m)?)?;
     m.add("FORCE_INPUTS", crate::evaluate::INPUTS.to_vec())?;
     m.add("FORCE_OUTPUTS", crate::evaluate::OUTPUTS.to_vec())?;

@@ -158,6 +158,14 @@ pub(super) fn max_threads(py: Python<'_>) -> PyResult<usize> {
     Ok(pool_for(py, 0)?.1)
 }
 
+/// Whether a sweep's lanes call glibc's four-lane `sin`, `cos` and `pow`
+/// (`GRANRS_FAST_LANES=1`, read once per process, on a CPU with AVX2 where libmvec is found):
+/// then a lane's row is near `simulate`'s, not its bits.
+#[pyfunction]
+pub(super) fn fast_lanes() -> bool {
+    crate::num::vector_calls::active()
+}
+
 /// Validate every run of a batch (as `sweep` describes it) without running any, on
 /// `threads` threads (as `sweep`); raises the typed error of the first bad run, naming the
 /// field and the run. Ctrl-C stops it (within milliseconds) and raises.
