@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import re
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -17,6 +18,7 @@ from typing import Any
 import pandas as pd
 
 from ..calibrate import Measurements
+from ..cases import FREE_LINK, free_link
 from ..compare import DATASETS, LAWS, Law, _rank, compare, to_json
 from ..errors import InvalidParameterError
 from .format import _fmt, md_table
@@ -234,9 +236,13 @@ def _drag_evidence(laws: Sequence[Mapping[str, Any]]) -> str:
                 "the oblique drops do not ask for it, so the fold that predicts the vertical "
                 "drops has no axial drag."
             )
+        c = full["values"]["poncelet.c"]
+        # In kg/m at the density of the free link's scenes, which the fit ran.
+        axial = c * free_link(0.0, 1.0).rho_g * math.pi * FREE_LINK["diameter"] ** 2 / 4.0
         out.append(
             f"- **{law['law']}**: the vertical drops' depth/t_s z in sample {ins}; out of "
-            f"sample {oos}.{note} Fitted values ({folds})."
+            f"sample {oos}. Fitted to every row, the axial drag is c rho_g pi d_c^2 / 4 = "
+            f"{axial:.3g} kg/m.{note} Fitted values ({folds})."
         )
     return "\n".join(out)
 
