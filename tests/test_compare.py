@@ -497,16 +497,25 @@ def test_leg_published_is_locked_thesis() -> None:
 FAST_LAWS = ("thesis_published", "thesis_refit")
 
 
+#: The pieces of the fast chapter's sums: rft alone and on the axial drag (the sums rft
+#: and axial_drag+rft).
+def _fast_pieces():
+    return (LAWS["rft"],)
+
+
 def _build_chapter(tmp_path_factory, laws):
     import sys
 
     from granrs.report import laws as chapter_module
-    from granrs.report import reproduce
+    from granrs.report import laws_sums, reproduce
 
     subset = {k: v for k, v in LAWS.items() if k in laws}
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(sys.modules["granrs.compare"], "LAWS", subset)
         mp.setattr(chapter_module, "LAWS", subset)
+        if laws == FAST_LAWS:
+            mp.setattr(laws_sums, "SUM_PIECES", _fast_pieces())
+            mp.setattr(laws_sums, "SUM_MAX_TERMS", 1)
         out = tmp_path_factory.mktemp("laws") / "out"
         path = reproduce(out, chapters=["laws"], progress=False)
     return out, path.read_text(encoding="utf-8"), subset
@@ -556,6 +565,94 @@ def test_chapter_verdict_names_the_winner_of_laws_json(chapter) -> None:
             f"**{best}** ranks first by the held-out χ²" in text
         ), dataset
     assert "### Targets" in text
+
+
+def _md_rows(text: str, heading: str, header_start: str) -> tuple[list[str], list[list[str]]]:
+    """The header and body cells of the first Markdown table after ``heading`` whose
+    header starts with ``header_start``."""
+    part = text[text.index(heading) :]
+    lines = part.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(header_start))
+    header = [c.strip() for c in lines[start].strip("|").split("|")]
+    body = []
+    for line in lines[start + 2 :]:
+        if not line.startswith("|"):
+            break
+        body.append([c.strip() for c in line.strip("|").split("|")])
+    return header, body
+
+
+def test_chapter_ranks_sums_with_residuals_per_table_3_1_row(chapter) -> None:
+    """The sums of terms: every Table 3.1 row (from the shipped CSV) has a line with its
+    measured depth and t_s, and the out-of-sample z of the published law there are those of
+    independent runs of the thesis's cases; the sums are ranked with the laws."""
+    out, text, _ = chapter
+    assert "### Sums of terms (Table 3.1)" in text
+    data = json.loads((out / "laws_sums.json").read_text())
+    assert "axial_drag+rft" in data["free_link"]
+    header, ranking = _md_rows(text, "### Sums of terms", "| law | rank")
+    names = [r[0] for r in ranking]
+    assert "axial_drag+rft" in names and "thesis_published" in names
+    assert [int(r[1]) for r in ranking] == sorted(int(r[1]) for r in ranking)
+    header, body = _md_rows(text, "### Sums of terms", "| q [deg]")
+    assert len(body) == 12
+    rows = pd.read_csv(granrs.data.path("table_3_1_free_link_experiments"))
+    assert "thesis_published: depth z" in header
+    col = header.index("thesis_published: depth z")
+    for cells, r in zip(body, rows.itertuples(), strict=True):
+        assert float(cells[0]) == r.q_deg and float(cells[1]) == r.v0_mean
+        assert cells[2] == f"{r.depth_mean * 1e3:.0f} ± {r.depth_sd * 1e3:.0f}"
+        assert cells[3] == f"{r.t_s_mean * 1e3:.0f} ± {r.t_s_sd * 1e3:.0f}"
+        res = granrs.simulate(cases.free_link(r.q_deg, r.v0_mean))
+        assert float(cells[col]) == pytest.approx(
+            (res.depth - r.depth_mean) / r.depth_sd, abs=0.051
+        )
+        assert float(cells[col + 1]) == pytest.approx((res.t_s - r.t_s_mean) / r.t_s_sd, abs=0.051)
+    assert "**Target on Table 3.1**" in text
+    assert "#### The best fitted law on the chain and the leg" in text
+
+
+def test_chapter_writes_the_media_card_of_a_fit_and_a_drop_runs_in_it(chapter) -> None:
+    """The chapter writes the cards of its best fits (granrs.calibrate's card): each is a
+    file granrs.media loads, shown in the chapter, whose values are those of its law's fit
+    to every row (laws.json, laws_sums.json); a drop in a card's medium takes its values."""
+    import re
+
+    out, text, _ = chapter
+    entries = {}
+    for name in ("laws.json", "laws_sums.json"):
+        entries.update(json.loads((out / name).read_text())["free_link"])
+    written = re.findall(r"`(table_3_1_[^`]+\.toml)` \(([^,]+), rank", text)
+    assert written
+    with_values = 0
+    for name, law in written:
+        card = granrs.media.load(out / name)
+        assert f'name = "{card.name}"' in text
+        fitted = entries[law]["folds"][0]["values"]
+        for key, v in card.params.items():
+            assert v.value == pytest.approx(fitted.get(key, math.nan), rel=1e-12) or (
+                f"scale.{key}" in fitted
+            ), (law, key)
+        with_values += bool(card.params)
+        if "rft.zeta" in card.params and all(p in fitted for p in card.params):
+            r = TABLE_3_1.rows.iloc[0]
+            base = cases.free_link(r["q_deg"], r["v0_mean"])
+            terms = [forces.term(t) for t in {k.split(".")[0] for k in card.params}]
+            scene = base.replace(medium=str(out / name), forces=[forces.gravity(), *terms])
+            given = [
+                forces.term(
+                    t.name,
+                    **{
+                        p.split(".")[1]: fitted[p]
+                        for p in card.params
+                        if p.startswith(t.name + ".")
+                    },
+                )
+                for t in terms
+            ]
+            expected = granrs.simulate(base.replace(forces=[forces.gravity(), *given]))
+            assert granrs.simulate(scene).depth == expected.depth
+    assert with_values >= 1
 
 
 def test_chain_mass_and_force_scale_are_one_direction() -> None:

@@ -219,6 +219,15 @@ def _add_calibrate(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> 
         "--out", metavar="FILE.csv", default=None, help="write the residuals per row to CSV"
     )
     parser.add_argument(
+        "--card",
+        metavar="FILE.toml",
+        default=None,
+        help=(
+            "write the fit as a medium card (granrs.media), named after the file: each "
+            "fitted term's parameter with its source, sd and ~95%% interval"
+        ),
+    )
+    parser.add_argument(
         "--quiet", action="store_true", help="no progress bar (shown on a terminal)"
     )
     parser.set_defaults(handler=_cmd_calibrate)
@@ -247,6 +256,13 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
     if args.out:
         check_target(args.out, "out", "the residuals to")
+    if args.card:
+        from pathlib import Path
+
+        from .media import MediumCard
+
+        check_target(args.card, "card", "the medium card to")
+        MediumCard(Path(args.card).stem)  # the card's name: a bad one is refused here
     measurements = Measurements.load(args.measurements, args.cases)
     cases = args.cases or measurements.body
     fit_rows = measurements
@@ -277,6 +293,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     if args.out:
         with replacing(args.out) as tmp:
             frame.to_csv(tmp, index=False)
+    if args.card:
+        result.card(Path(args.card).stem).save(args.card)
     if args.json:
         out = result.to_dict()
         if predicted is not None:

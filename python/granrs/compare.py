@@ -42,7 +42,10 @@ The numbers, per dataset and law (columns of the frame, and keys of
   one failed out of sample, and a law with a row failed out of sample is ranked after
   every law whose rows all ran (by its number of failed rows), never as a better fit;
 * ``available``, ``reason``: whether the law could run, and why not;
-* ``simulations``, ``seconds``: what the comparison cost.
+* ``simulations``, ``seconds``: what the comparison cost;
+* ``result``: the :class:`~granrs.CalibrationResult` of the fit to every row (None when
+  the law fits nothing or did not run), e.g. to write it as a medium card
+  (:meth:`~granrs.CalibrationResult.card`); not in :func:`~granrs.compare.to_json`.
 
 A law with nothing to fit (``thesis_published``) is evaluated once: its out-of-sample
 predictions are its in-sample ones.
@@ -636,6 +639,7 @@ def _entry(
     n_res = 2 * len(m)
     sims = 0
     folds: list[dict[str, Any]] = []
+    full = None
     if k == 0:
         pred = _predict(job, m, dt, threads)
         sims += len(m)
@@ -705,6 +709,7 @@ def _entry(
         "folds": folds,
         "simulations": sims,
         "seconds": time.perf_counter() - t0,
+        "result": full,
     }
 
 
@@ -887,6 +892,7 @@ def _missing(name: str, law: Law, m: Measurements, reason: str) -> dict[str, Any
         "folds": [],
         "simulations": 0,
         "seconds": 0.0,
+        "result": None,
     }
 
 

@@ -11,7 +11,7 @@ import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -27,6 +27,9 @@ from . import posterior as _posterior
 from .measurements import _KEY_COLUMNS, BODIES, QUANTITIES, Measurements, _is_number
 from .model import _JOINT_START, _JOINTS, LawSpec, _Model, _Param, _parse_param
 from .posterior import Posterior
+
+if TYPE_CHECKING:
+    from ..media import MediumCard
 
 __all__ = ["CalibrationResult", "calibrate", "evaluate", "within"]
 
@@ -163,6 +166,43 @@ class CalibrationResult:
         """The fitted law's terms for one measurement row (one contact: the chain's rows
         need ``link`` and ``v0_case``)."""
         return self._model.row_terms(row, [self.values[p] for p in self.params])
+
+    def card(
+        self,
+        name: str,
+        *,
+        base: Any = None,
+        description: str | None = None,
+        source: str | None = None,
+    ) -> MediumCard:
+        """The fit as a medium card (:class:`granrs.media.MediumCard`; ``.save(path)``
+        writes its TOML file, which :func:`granrs.media.load` and a scene's ``medium=``
+        read).
+
+        Each fitted term's parameter becomes the card's value with its source (``source``,
+        default: "fitted here" with the measurements and the method), its standard error
+        as ``sd``, its ~95 % interval (level 0.95) and, when the fit sampled its posterior
+        (``posterior=``), the samples. A factor ``scale.TERM.PARAM`` is written as the
+        value it gives when every row's base value is the same; where they differ (the
+        thesis's Table 3.4 per angle), and for angle nodes, the parameter is listed under
+        the card's ``missing`` with the reason. The body's unknowns (``mass``, ``joints.k``,
+        ...) are not the medium's and are left out. The scenes' ``rho_g`` is written when
+        the card has none.
+
+        Args:
+            name: the card's name (a file stem).
+            base: a card (name, path or :class:`~granrs.media.MediumCard`) to start from:
+                its other values are kept; its ``rho_g`` must be the fit's.
+            description: the card's description (default: the base's, or what wrote it).
+            source: the source of every value written (default: "fitted here: ...").
+
+        Raises:
+            MediumError: ``base`` has another ``rho_g`` than the fit's scenes
+                (``field="rho_g"``), or a value out of its parameter's range.
+        """
+        from .card import card_of
+
+        return card_of(self, name, base=base, description=description, source=source)
 
     def within(self, quantity: str, k: float) -> int:
         """Rows with the fitted simulation within ``k`` measured sd (see :func:`within`)."""

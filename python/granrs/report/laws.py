@@ -29,6 +29,7 @@ import pandas as pd
 from .. import forces
 from ..calibrate import Measurements
 from ..compare import BODY_UNKNOWNS, DATASETS, LAWS, compare, scenes, to_json
+from . import laws_sums
 from .format import _fmt, md_table
 from .framework import ReportContext, register_chapter
 
@@ -696,6 +697,7 @@ def chapter_laws(ctx: ReportContext) -> str:
         fig_dt = _figure_depth_time(ctx, frame)
     verdict, headlines = _verdict(ctx, frame)
     acceptance = _acceptance(ctx, frame)
+    sums = laws_sums.section(ctx, frame, _STARTS)
     for h in headlines:
         ctx.add_headline(h)
     n_fit = int(frame["simulations"].sum())
@@ -732,6 +734,8 @@ The laws:
 {acceptance}
 
 {"".join(tables)}
+{sums}
+
 {fig_pred}
 
 {fig_res}
