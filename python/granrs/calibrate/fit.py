@@ -175,7 +175,7 @@ class CalibrationResult:
         description: str | None = None,
         source: str | None = None,
     ) -> MediumCard:
-        """The fit as a medium card (:class:`granrs.media.MediumCard`; ``.save(path)``
+        """The fit as a medium card (:class:`granrs.media.MediumCard`; its ``save`` method
         writes its TOML file, which :func:`granrs.media.load` and a scene's ``medium=``
         read).
 
