@@ -29,8 +29,8 @@ sphere also on a path 30 degrees from vertical) with :func:`granrs.mujoco.body_d
 :func:`granrs.simulate` of the same :class:`granrs.space.Scene`, at MuJoCo timesteps 1e-4,
 1e-3, 2e-3, 5e-3 and 1e-2 s and the Euler, implicitfast and RK4 integrators; and the cost of
 ``Sand`` on gymnasium's Ant (its four ankle capsules as sand geoms, standing in the sand under
-``rft3d``, RK4 at its own 0.01 s), at 3 and 6 Gauss nodes per panel, as ratios to ``mj_step``
-measured in the same repeats.
+``rft3d``, RK4 at its own 0.01 s), at 3, 5 and 6 Gauss nodes per panel (93, 265 and 396
+elements per foot), as ratios to ``mj_step`` measured in the same repeats.
 
 **At rest (``--part rest``).** Gymnasium's own hopper (``hopper.xml``, RK4 at 2 ms, no
 floor) held upright by a PD controller on its motors, its whole weight on its foot in the
@@ -259,7 +259,7 @@ def space_cost(repeats: int, steps: int) -> None:
         "Sand.step / mj_step (median of repeats, range) | callback's extra / mj_step |"
     )
     print("|---|---|---|---|---|---|")
-    for nodes in (3, 6):
+    for nodes in (3, 5, 6):
         model = mujoco.MjModel.from_xml_path(path)
         for g in feet:
             i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g)
