@@ -686,7 +686,11 @@ pub mod geoms {
             }
             let active = &active_buf[..n_active];
             if active.is_empty() {
+                // Nothing in the sand: no reaction is held into a later stage where a geom
+                // enters it (that stage solves its own).
                 self.previous.fill(0.0);
+                self.held.fill(None);
+                self.held_wrench.fill(None);
                 return;
             }
             let k = active.len();
