@@ -29,12 +29,23 @@ sphere also on a path 30 degrees from vertical) with :func:`granrs.mujoco.body_d
 :func:`granrs.simulate` of the same :class:`granrs.space.Scene`, at MuJoCo timesteps 1e-4,
 1e-3, 2e-3, 5e-3 and 1e-2 s and the Euler, implicitfast and RK4 integrators; and the cost of
 ``Sand`` on gymnasium's Ant (its four ankle capsules as sand geoms, standing in the sand under
-``rft3d``, RK4 at its own 0.01 s), at 3 and 6 Gauss nodes per panel, as ratios to ``mj_step``
-measured in the same repeats.
+``rft3d``, RK4 at its own 0.01 s), at 3, 5 and 6 Gauss nodes per panel (93, 265 and 396
+elements per foot), as ratios to ``mj_step`` measured in the same repeats.
+
+**At rest (``--part rest``).** Gymnasium's own hopper (``hopper.xml``, RK4 at 2 ms, no
+floor) held upright by a PD controller on its motors, its whole weight on its foot in the
+sand (the capsule foot, or a box of 0.39 x 0.1 x 0.06 m in its place), 10 s under each law
+(the thesis's, ``rft``, ``rft`` + ``rft_inertial`` and ``poncelet`` in the plane with
+``apply_at="centroid"``; ``rft3d``, ``rft3d`` + ``rft3d_inertial`` and ``poncelet`` in space),
+with ``Sand.step`` and as the callback. Over the last 5 s: how far the foot moves, the sand's
+vertical force's largest step-to-step change and its mean over the load, the largest power
+of the sand's generalized force (at the step's mean velocity) and the largest rise of its
+work over ``max(t, 1 s)`` from the window's start. A row passes below 0.1 mm, 5 % of the load
+and 1e-6 J/s.
 
 Usage::
 
-    python benches/bench_mujoco.py [--part all|table|cost|space-table|space-cost]
+    python benches/bench_mujoco.py [--part all|table|cost|space-table|space-cost|rest]
                                    [--repeats 15] [--steps 1000]
 """
 
@@ -248,7 +259,7 @@ def space_cost(repeats: int, steps: int) -> None:
         "Sand.step / mj_step (median of repeats, range) | callback's extra / mj_step |"
     )
     print("|---|---|---|---|---|---|")
-    for nodes in (3, 6):
+    for nodes in (3, 5, 6):
         model = mujoco.MjModel.from_xml_path(path)
         for g in feet:
             i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g)
@@ -303,11 +314,124 @@ def space_cost(repeats: int, steps: int) -> None:
         )
 
 
+#: The laws of ``--part rest``: the Sand's arguments (zeta as the docs' Ant and hopper).
+REST_ZETA = space.xi_n(1520.0, 0.4)
+REST_PONCELET = {"c": 1.0, "k": 2000.0}
+
+
+def rest_laws() -> dict[str, dict[str, object]]:
+    rft = forces.term("rft", zeta=REST_ZETA)
+    return {
+        "thesis": {"forces": [forces.drag(), forces.static_h(), forces.static_v()]},
+        "rft": {"forces": [rft]},
+        "rft + rft_inertial": {"forces": [rft, forces.term("rft_inertial")]},
+        "poncelet": {"forces": [forces.poncelet(**REST_PONCELET)]},
+        "rft3d": {"forces": [forces.rft3d(zeta=REST_ZETA)]},
+        "rft3d + rft3d_inertial": {
+            "forces": [forces.rft3d(zeta=REST_ZETA), forces.term("rft3d_inertial")]
+        },
+        "poncelet in space": {"forces": [forces.poncelet(**REST_PONCELET)], "space": True},
+    }
+
+
+def hopper_model(foot: str) -> mujoco.MjModel:
+    """Gymnasium's hopper, no contacts (no floor), its foot a capsule or a box."""
+    import os
+
+    import gymnasium
+
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/hopper.xml")
+    with open(path) as f:
+        xml = f.read()
+    if foot == "box":
+        capsule = 'quat="0.70710678118654757 0 -0.70710678118654746 0" name="foot_geom" '
+        xml = xml.replace(capsule, 'name="foot_geom" ').replace(
+            'name="foot_geom" size="0.06 0.195" type="capsule"',
+            'name="foot_geom" size="0.195 0.05 0.03" type="box"',
+        )
+    m = mujoco.MjModel.from_xml_string(xml)
+    m.geom_contype[:] = 0
+    m.geom_conaffinity[:] = 0
+    return m
+
+
+def hopper_rest(law: str, mode: str, foot: str, seconds: float = 10.0) -> dict[str, float]:
+    """One row of ``--part rest``."""
+    kw = dict(rest_laws()[law])
+    m = hopper_model(foot)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    fid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
+    planar = not kw.get("space") and not any(
+        t.name.startswith("rft3d")
+        for t in kw["forces"]  # type: ignore[attr-defined]
+    )
+    if planar:
+        kw["apply_at"] = "centroid"
+    sand = Sand(m, ["foot_geom"], **kw)  # type: ignore[arg-type]
+    q0 = d.qpos[3:6].copy()
+    h = m.opt.timestep
+    weight = m.body_subtreemass[1] * np.linalg.norm(m.opt.gravity)
+    pos, fz, power = [], [], []
+    if mode == "callback":
+        sand.install()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", granrs.StepSizeWarning)
+            for _ in range(round(seconds / h)):
+                pd = 200.0 * (q0 - d.qpos[3:6]) - 10.0 * d.qvel[3:6]
+                d.ctrl[:] = np.clip(pd, -200, 200) / 200
+                if mode == "step":
+                    sand.step(d)
+                v0 = d.qvel.copy()
+                mujoco.mj_step(m, d)
+                if not np.all(np.isfinite(d.qpos)):
+                    inf = float("inf")
+                    return {"moved": inf, "spread": inf, "load": inf, "power": inf, "rise": inf}
+                pos.append(d.geom_xpos[fid].copy())
+                fz.append(sand.applied[0, 1 if planar else 2])
+                power.append(sand._generalized @ (0.5 * (v0 + d.qvel)))
+    finally:
+        if mode == "callback":
+            sand.uninstall()
+    last = slice(-round(5.0 / h), None)
+    p, f, w = np.array(pos)[last], np.array(fz)[last], np.array(power)[last]
+    work = np.cumsum(w) * h
+    work -= work[0]
+    elapsed = np.arange(len(work)) * h
+    return {
+        "moved": float(np.max(np.ptp(p, axis=0))),
+        "spread": float(np.max(np.abs(np.diff(f))) / weight),
+        "load": float(f.mean() / weight),
+        "power": float(w.max()),
+        "rise": float(np.max(work / np.maximum(elapsed, 1.0))),
+    }
+
+
+def rest() -> None:
+    print(
+        "| law | foot | mode | moved [mm] | F_z spread / load | mean F_z / load | "
+        "largest power [W] | work's rise [J/s] | pass |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|")
+    for law in rest_laws():
+        for foot in ("capsule", "box"):
+            for mode in ("step", "callback"):
+                r = hopper_rest(law, mode, foot)
+                ok = r["moved"] < 1e-4 and r["spread"] < 0.05 and r["rise"] <= 1e-6
+                print(
+                    f"| {law} | {foot} | {mode} | {r['moved'] * 1e3:.3g} | {r['spread']:.2g} | "
+                    f"{r['load']:.4f} | {r['power']:.2g} | {r['rise']:.2g} | "
+                    f"{'yes' if ok else 'no'} |",
+                    flush=True,
+                )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument(
         "--part",
-        choices=("all", "table", "cost", "space-table", "space-cost"),
+        choices=("all", "table", "cost", "space-table", "space-cost", "rest"),
         default="all",
     )
     parser.add_argument("--repeats", type=int, default=15)
@@ -321,6 +445,8 @@ def main() -> None:
         space_table()
     if args.part in ("all", "space-cost"):
         space_cost(args.repeats, args.steps)
+    if args.part in ("all", "rest"):
+        rest()
 
 
 if __name__ == "__main__":

@@ -374,6 +374,13 @@ pub mod geoms {
             self.models.is_empty()
         }
 
+        /// Whether a term resists the geoms' turning about any point of their own: `rft`,
+        /// whose elements spread over the boundary (the thesis's terms and `poncelet` act at
+        /// one point, and give no moment about it).
+        pub fn resist_turning(&self) -> bool {
+            self.models.iter().any(|m| m.forces.names.contains(&"rft"))
+        }
+
         /// Whether geom `i` is a sole box (else a rod).
         pub fn is_sole(&self, i: usize) -> bool {
             matches!(self.models[i].contacts[0].shape, Shape::Sole(_))
@@ -593,6 +600,9 @@ pub mod geoms {
         /// Each geom's reactions as last solved (x, y) [N] and whether each was at its
         /// bound (sliding); `None` out of the sand.
         pub held: Vec<Option<([f64; 2], [bool; 2])>>,
+        /// Under a term that resists turning ([`SandGeoms::resist_turning`]), with `stick`:
+        /// each geom's whole wrench at R as last solved (force x, y [N], moment [N m]).
+        pub held_wrench: Vec<Option<[f64; 3]>>,
     }
 
     /// The x and z rows of the Jacobian of world point `p` on the tree of `place` into
@@ -629,6 +639,7 @@ pub mod geoms {
             let nv = self.nv;
             let width = OUTPUTS.len();
             let mut tips = [[0.0; 3]; MAX_COUPLED];
+            let mut states = [[0.0; 7]; MAX_COUPLED];
             let mut active_buf = [0usize; MAX_COUPLED];
             let mut n_active = 0;
             out.applied.fill(0.0);
@@ -667,6 +678,7 @@ pub mod geoms {
                 let row = &mut out.outputs[i * width..(i + 1) * width];
                 self.rods.evaluate(i, &state, row);
                 tips[i] = tip;
+                states[i] = state;
                 if row[3] > 0.0 && tip[0] >= self.patch.0 && tip[0] <= self.patch.1 {
                     active_buf[n_active] = i;
                     n_active += 1;
@@ -674,7 +686,11 @@ pub mod geoms {
             }
             let active = &active_buf[..n_active];
             if active.is_empty() {
+                // Nothing in the sand: no reaction is held into a later stage where a geom
+                // enters it (that stage solves its own).
                 self.previous.fill(0.0);
+                self.held.fill(None);
+                self.held_wrench.fill(None);
                 return;
             }
             let k = active.len();
@@ -779,6 +795,10 @@ pub mod geoms {
                     out.h_lambda[i] = timestep * 2.0 * row[c_k] * inv_mass;
                 }
             }
+            if self.stick && self.rods.resist_turning() {
+                self.stick_wrenches(s, timestep, hold, active, &states, out);
+                return;
+            }
             let mut reaction = [0.0; 2 * MAX_COUPLED];
             let mut bounds = [0.0; 2 * MAX_COUPLED];
             let mut soft = [false; 2 * MAX_COUPLED];
@@ -859,6 +879,92 @@ pub mod geoms {
             self.generalized(active, out.applied, out.generalized);
         }
 
+        /// The static reactions of a term that resists turning (`rft`), solved as the
+        /// implicit coupling in space does ([`stick_or_slide`]): each geom's whole wrench
+        /// at R (force x, z and moment about y) that brings R's velocity and the rotation
+        /// to zero at the end of the engine's step, where its force is no larger than the
+        /// sand's resistance to the motion without it (the law's wrench at that motion),
+        /// else the law's wrench at that motion (sliding). RFT's force does not shrink as
+        /// the contact slows, so its reactions along x and y alone left the rotation free:
+        /// a foot standing on one geom turned and chattered. The Jacobians and the factor
+        /// of `M + h B` are this evaluation's ([`Coupling::step`]); `states` the geoms'.
+        fn stick_wrenches(
+            &mut self,
+            s: &EngineState,
+            timestep: f64,
+            hold: bool,
+            active: &[usize],
+            states: &[[f64; 7]; MAX_COUPLED],
+            out: EngineOut,
+        ) {
+            use nalgebra::{DMatrix, DVector};
+            let (nv, k) = (self.nv, active.len());
+            let rows = 3 * k;
+            let w_ = &mut self.work;
+            // R's x and z and the rotation about y, per geom.
+            let j = DMatrix::from_fn(rows, nv, |r, c| {
+                let a = r / 3;
+                match r % 3 {
+                    2 => w_.j_rot[a * nv + c],
+                    axis => w_.j_tip[(2 * a + axis) * nv + c],
+                }
+            });
+            let held = hold && active.iter().all(|&i| self.held_wrench[i].is_some());
+            let mut w = DVector::zeros(rows);
+            if held {
+                for (a, &i) in active.iter().enumerate() {
+                    let h = self.held_wrench[i].expect("held");
+                    w.rows_mut(3 * a, 3).copy_from_slice(&h);
+                }
+            } else {
+                // The twists without the sand: the rest of the world's force (the last
+                // M qacc less the sand's last force) over the engine's step.
+                for r in 0..nv {
+                    w_.tmp[r] = dot(&s.mass[r * nv..(r + 1) * nv], s.qacc) - self.previous[r];
+                }
+                chol_solve(&w_.chol_h, nv, &mut w_.tmp);
+                let qvel = DVector::from_column_slice(s.qvel);
+                let free = &j * (qvel + timestep * DVector::from_column_slice(&w_.tmp));
+                // Their response to a unit wrench over the step: J H^-1 J^T.
+                let mut resp = DMatrix::zeros(rows, rows);
+                for c in 0..rows {
+                    for (d, x) in w_.tmp.iter_mut().enumerate() {
+                        *x = j[(c, d)];
+                    }
+                    chol_solve(&w_.chol_h, nv, &mut w_.tmp);
+                    for r in 0..rows {
+                        resp[(r, c)] = (0..nv).map(|d| j[(r, d)] * w_.tmp[d]).sum::<f64>();
+                    }
+                }
+                // The law's wrench at those twists (the step's start's pose).
+                let mut full = DVector::zeros(rows);
+                let mut row = [0.0; OUTPUTS.len()];
+                for (a, &i) in active.iter().enumerate() {
+                    let mut state = states[i];
+                    state[4..7].copy_from_slice(&free.as_slice()[3 * a..3 * a + 3]);
+                    self.rods.evaluate(i, &state, &mut row);
+                    full.rows_mut(3 * a, 3).copy_from_slice(&row[..3]);
+                }
+                w = stick_or_slide(
+                    &(timestep * resp),
+                    &free,
+                    &full,
+                    k,
+                    3,
+                    2,
+                    Slide::AsEvaluated,
+                );
+                self.held_wrench.fill(None);
+                for (a, &i) in active.iter().enumerate() {
+                    self.held_wrench[i] = Some([w[3 * a], w[3 * a + 1], w[3 * a + 2]]);
+                }
+            }
+            for (a, &i) in active.iter().enumerate() {
+                out.applied[3 * i..3 * i + 3].copy_from_slice(&w.as_slice()[3 * a..3 * a + 3]);
+            }
+            self.generalized(active, out.applied, out.generalized);
+        }
+
         /// The generalized force of the applied forces and moments (at the tip, through the
         /// Jacobians of the last evaluation), kept as `previous`.
         fn generalized(&mut self, active: &[usize], applied: &[f64], generalized: &mut [f64]) {
@@ -891,6 +997,91 @@ pub mod geoms {
         applied[3 * i] = row[0] + d[0];
         applied[3 * i + 1] = row[1] + d[1];
         applied[3 * i + 2] = row[2] + lever[1] * d[0] - lever[0] * d[1];
+    }
+
+    /// What a sliding geom receives in [`stick_or_slide`]: the stick's wrench scaled down
+    /// to the sand's resistance (in space), or the law's wrench at the motion (the plane).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Slide {
+        /// The wrench that would stop it, scaled to the resistance's size.
+        Scaled,
+        /// The law's own wrench at the motion without the sand.
+        AsEvaluated,
+    }
+
+    /// The wrenches (`block` values per geom, `k` geoms, its first `force` the force) that
+    /// bring every twist `free + ha w` to zero (the least, where the twists have fewer
+    /// freedoms than `block k`), with each geom's force at most the sand's resistance
+    /// `full` to its motion (the law's wrench at the twist without the sand): geom by geom,
+    /// the one furthest past its resistance is held there ([`Slide`]) and the others are
+    /// solved again with it held (an active set), so that no geom is pushed past rest by
+    /// another's. Shared by the planar coupling (rft's reactions) and the coupling in space
+    /// (the fallback of its implicit solve).
+    pub fn stick_or_slide(
+        ha: &nalgebra::DMatrix<f64>,
+        free: &nalgebra::DVector<f64>,
+        full: &nalgebra::DVector<f64>,
+        k: usize,
+        block: usize,
+        force: usize,
+        slide: Slide,
+    ) -> nalgebra::DVector<f64> {
+        use nalgebra::{DMatrix, DVector};
+        let rows = block * k;
+        let mut w = DVector::zeros(rows);
+        let mut held = vec![false; k];
+        for _ in 0..k {
+            let open: Vec<usize> = (0..rows).filter(|&p| !held[p / block]).collect();
+            if open.is_empty() {
+                break;
+            }
+            let sub = DMatrix::from_fn(open.len(), open.len(), |p, q| ha[(open[p], open[q])]);
+            let rhs = DVector::from_fn(open.len(), |p, _| {
+                let row = open[p];
+                -free[row]
+                    - (0..rows)
+                        .filter(|&q| held[q / block])
+                        .map(|q| ha[(row, q)] * w[q])
+                        .sum::<f64>()
+            });
+            let tol = 1e-12 * sub.amax();
+            let Ok(x) = sub.svd(true, true).solve(&rhs, tol) else {
+                break;
+            };
+            for (p, &row) in open.iter().enumerate() {
+                w[row] = x[p];
+            }
+            // The open geom furthest past the sand's resistance, if any.
+            let mut worst: Option<(usize, f64)> = None;
+            for a in (0..k).filter(|&a| !held[a]) {
+                let want = w.rows(block * a, force).norm();
+                let can = full.rows(block * a, force).norm();
+                if want > can {
+                    let past = if can > 0.0 { want / can } else { f64::INFINITY };
+                    if worst.is_none_or(|(_, x)| past > x) {
+                        worst = Some((a, past));
+                    }
+                }
+            }
+            match worst {
+                None => return w,
+                Some((a, _)) => {
+                    match slide {
+                        Slide::Scaled => {
+                            let want = w.rows(block * a, force).norm();
+                            let can = full.rows(block * a, force).norm();
+                            w.rows_mut(block * a, block).scale_mut(can / want);
+                        }
+                        Slide::AsEvaluated => {
+                            w.rows_mut(block * a, block)
+                                .copy_from(&full.rows(block * a, block));
+                        }
+                    }
+                    held[a] = true;
+                }
+            }
+        }
+        w
     }
 
     /// `a . b`.

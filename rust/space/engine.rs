@@ -36,7 +36,7 @@
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 use super::load::{Sand, Wrench};
-use crate::evaluate::geoms::{EngineOut, EngineState};
+use crate::evaluate::geoms::{stick_or_slide, EngineOut, EngineState, Slide};
 
 type V3 = Vector3<f64>;
 
@@ -123,6 +123,9 @@ pub struct SpaceCoupling {
     pub previous: Vec<f64>,
     /// Each geom's wrench as last solved (for the later stages of a multi-stage step).
     pub held: Vec<Option<[f64; 6]>>,
+    /// Each geom's element count at its last cut (the held stages of a multi-stage step
+    /// keep it).
+    pub cut: Vec<usize>,
     /// Each geom's twist at the end of the last step as solved (where the next solve
     /// starts, if it is closer than the twist without the sand).
     pub solved: Vec<Option<[f64; 6]>>,
@@ -142,65 +145,6 @@ fn jacobian(place: &Place, s: &EngineState, nv: usize, p: &V3, rows: &mut [f64])
         rows[4 * nv + j] = d[1];
         rows[5 * nv + j] = d[2];
     }
-}
-
-/// The fallback's wrenches (6 per geom, `k` geoms): those that bring every twist
-/// `free + ha w` to zero (the least, where the twists have fewer freedoms than `6 k`), with
-/// each geom's force at most the sand's resistance `full` to its motion: geom by geom, the
-/// one furthest past its resistance is held there (its wrench scaled down) and the others
-/// are solved again with it held (an active set), so that no geom is pushed past rest by
-/// another's cap.
-fn stick_or_slide(
-    ha: &DMatrix<f64>,
-    free: &DVector<f64>,
-    full: &DVector<f64>,
-    k: usize,
-) -> DVector<f64> {
-    let rows = 6 * k;
-    let mut w = DVector::zeros(rows);
-    let mut held = vec![false; k];
-    for _ in 0..k {
-        let open: Vec<usize> = (0..rows).filter(|&p| !held[p / 6]).collect();
-        if open.is_empty() {
-            break;
-        }
-        let sub = DMatrix::from_fn(open.len(), open.len(), |p, q| ha[(open[p], open[q])]);
-        let rhs = DVector::from_fn(open.len(), |p, _| {
-            let row = open[p];
-            -free[row]
-                - (0..rows)
-                    .filter(|&q| held[q / 6])
-                    .map(|q| ha[(row, q)] * w[q])
-                    .sum::<f64>()
-        });
-        let tol = 1e-12 * sub.amax();
-        let Ok(x) = sub.svd(true, true).solve(&rhs, tol) else {
-            break;
-        };
-        for (p, &row) in open.iter().enumerate() {
-            w[row] = x[p];
-        }
-        // The open geom furthest past the sand's resistance, if any.
-        let mut worst: Option<(usize, f64)> = None;
-        for a in (0..k).filter(|&a| !held[a]) {
-            let (want, can) = (w.rows(6 * a, 3).norm(), full.rows(6 * a, 3).norm());
-            if want > can {
-                let past = if can > 0.0 { want / can } else { f64::INFINITY };
-                if worst.is_none_or(|(_, x)| past > x) {
-                    worst = Some((a, past));
-                }
-            }
-        }
-        match worst {
-            None => return w,
-            Some((a, _)) => {
-                let (want, can) = (w.rows(6 * a, 3).norm(), full.rows(6 * a, 3).norm());
-                w.rows_mut(6 * a, 6).scale_mut(can / want);
-                held[a] = true;
-            }
-        }
-    }
-    w
 }
 
 /// Whether every active geom has a solved twist from the last step.
@@ -245,10 +189,10 @@ impl SpaceCoupling {
         };
         let n = self.geoms.len();
         let mut poses = Vec::with_capacity(n);
-        let mut active = Vec::with_capacity(n);
+        let mut candidates = Vec::with_capacity(n);
         for i in 0..n {
             let (c, q) = self.pose(i, s);
-            let g = &mut self.geoms[i];
+            let g = &self.geoms[i];
             let low = g.sand.shape.lowest_point(&c, &q);
             let depth = g.sand.surface - low.z;
             out.outputs[i * width] = depth.max(0.0);
@@ -257,13 +201,24 @@ impl SpaceCoupling {
                 && c.y >= self.patch[2]
                 && c.y <= self.patch[3];
             if depth > 0.0 && inside {
-                let k = g.sand.cut_at_rest(&c, &q);
-                out.outputs[i * width + 1] = k as f64;
-                if k > 0 {
-                    active.push(i);
-                }
+                candidates.push(i);
             }
             poses.push((c, q));
+        }
+        // A later stage of a multi-stage step (RK4's) whose geoms in the sand all hold the
+        // wrench of its first stage applies that wrench at this stage's pose: no cut (a
+        // geom that entered the sand since has none, and the stage solves anew).
+        let keep = hold && candidates.iter().all(|&i| self.held[i].is_some());
+        let mut active = Vec::with_capacity(n);
+        for &i in &candidates {
+            if !keep {
+                let (c, q) = &poses[i];
+                self.cut[i] = self.geoms[i].sand.cut_at_rest(c, q);
+            }
+            out.outputs[i * width + 1] = self.cut[i] as f64;
+            if self.cut[i] > 0 {
+                active.push(i);
+            }
         }
         if active.is_empty() {
             self.previous.fill(0.0);
@@ -405,7 +360,7 @@ impl SpaceCoupling {
             let mut w = effective(&ws);
             if report.residual > FALLBACK {
                 let full = effective(&eval(&self.geoms, &free));
-                w = stick_or_slide(&(h * &resp), &free, &full, k);
+                w = stick_or_slide(&(h * &resp), &free, &full, k, 6, 3, Slide::Scaled);
                 xi = &free + h * (&resp * &w);
                 report.fallback = true;
             }
