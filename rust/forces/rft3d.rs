@@ -87,38 +87,30 @@ pub fn xi_n(rho_c: f64, mu: f64) -> f64 {
     rho_c * 9.81 * (894.0 * mu * mu * mu - 386.0 * mu * mu + 89.0 * mu)
 }
 
-/// The three fitted functions (f1, f2, f3) at the invariants (x1, x2, x3).
+/// The three fitted functions (f1, f2, f3) at the invariants (x1, x2, x3), each the sum of
+/// [`COEFFICIENTS`] times the monomials T_k, evaluated in nested (Horner) form, in x1 over
+/// polynomials in x2 and x3:
+///
+/// ```text
+/// f = P0 + x1 (P1 + x1 (P2 + x1 c10))
+/// P0 = c0 + x3 (c3 + x3 (c6 + x3 c12)) + x2 (c2 + x3 (c8 + x3 c15) + x2 (c5 + x3 c16 + x2 c11))
+/// P1 = c1 + x3 (c9 + x3 c18) + x2 (c7 + x3 c19 + x2 c13)
+/// P2 = c4 + x2 c14 + x3 c17
+/// ```
+///
+/// (19 products per function instead of 16 monomials and 19 products each; the same sum to
+/// round-off).
 #[inline(always)]
 pub fn fitted<F: Real>(x1: F, x2: F, x3: F) -> [F; 3] {
-    let t = [
-        F::splat(1.0),
-        x1,
-        x2,
-        x3,
-        x1 * x1,
-        x2 * x2,
-        x3 * x3,
-        x1 * x2,
-        x2 * x3,
-        x3 * x1,
-        x1 * x1 * x1,
-        x2 * x2 * x2,
-        x3 * x3 * x3,
-        x1 * x2 * x2,
-        x2 * x1 * x1,
-        x2 * x3 * x3,
-        x3 * x2 * x2,
-        x3 * x1 * x1,
-        x1 * x3 * x3,
-        x1 * x2 * x3,
-    ];
     let mut f = [F::splat(0.0); 3];
     for (fi, c) in f.iter_mut().zip(COEFFICIENTS.iter()) {
-        let mut s = F::splat(0.0);
-        for (tk, &ck) in t.iter().zip(c.iter()) {
-            s = s + F::splat(ck) * *tk;
-        }
-        *fi = s;
+        let k = |i: usize| F::splat(c[i]);
+        let p0 = k(0)
+            + x3 * (k(3) + x3 * (k(6) + x3 * k(12)))
+            + x2 * (k(2) + x3 * (k(8) + x3 * k(15)) + x2 * (k(5) + x3 * k(16) + x2 * k(11)));
+        let p1 = k(1) + x3 * (k(9) + x3 * k(18)) + x2 * (k(7) + x3 * k(19) + x2 * k(13));
+        let p2 = k(4) + x2 * k(14) + x3 * k(17);
+        *fi = p0 + x1 * (p1 + x1 * (p2 + x1 * k(10)));
     }
     f
 }
@@ -128,20 +120,29 @@ pub fn fitted<F: Real>(x1: F, x2: F, x3: F) -> [F; 3] {
 /// friction cap.
 #[inline(always)]
 pub fn generic_stress<F: Real>(n: [F; 3], vh: [F; 3]) -> [F; 3] {
+    let nv = n[0] * vh[0] + n[1] * vh[1] + n[2] * vh[2];
+    generic_stress_nv(n, vh, nv)
+}
+
+/// [`generic_stress`] with `n . vh` given (as [`stress`] has it already). With `m = s n`,
+/// `s = +-1`: `x3 = m . v^ = s (n . v^)` and `f1 m = (s f1) n`, bit for bit (a product by
+/// +-1 is exact).
+#[inline(always)]
+fn generic_stress_nv<F: Real>(n: [F; 3], vh: [F; 3], nv: F) -> [F; 3] {
     // m: the plate's normal facing down (n where n_z < -tol, else -n). The law jumps where
     // a face turns through vertical (f1 m flips, and f1 is not zero there); the tie within
     // round-off goes one way, so that a vertical wall is one plate whatever the round-off
     // of its normal (else a wall tilted by 1e-26 rad pushes sideways).
     let s = (-n[2] - F::splat(GRAZING_TOL)).select_pos(F::splat(1.0), F::splat(-1.0));
-    let m = [s * n[0], s * n[1], s * n[2]];
     let x1 = -vh[2];
     let x2 = n[2].abs();
-    let x3 = m[0] * vh[0] + m[1] * vh[1] + m[2] * vh[2];
+    let x3 = s * nv;
     let [f1, f2, f3] = fitted(x1, x2, x3);
+    let f1 = s * f1;
     [
-        f1 * m[0] + f2 * vh[0],
-        f1 * m[1] + f2 * vh[1],
-        f1 * m[2] + f2 * vh[2] - f3,
+        f1 * n[0] + f2 * vh[0],
+        f1 * n[1] + f2 * vh[1],
+        f1 * n[2] + f2 * vh[2] - f3,
     ]
 }
 
@@ -170,7 +171,7 @@ pub fn stress_capped<F: Real, const CAP: bool>(
     let nv = n[0] * vh[0] + n[1] * vh[1] + n[2] * vh[2];
     // Leading: n . v^ > -tol (grazing counted) or > tol (grazing left out).
     let leading = (nv + law.threshold).select_pos(F::splat(1.0), zero) * moving;
-    let a = generic_stress(n, vh);
+    let a = generic_stress_nv(n, vh, nv);
     let k = law.zeta * leading;
     if !CAP {
         return [k * a[0], k * a[1], k * a[2]];
