@@ -295,6 +295,46 @@ def test_a_run_without_a_stop_warns_on_its_depth() -> None:
     assert texts and "step_error" in texts[0], texts
 
 
+#: An ``rft`` rod at the centroid whose E, sinking, comes to rest in y (scene 75 of
+#: ``benches/step_warning.py --seed 7``). At dt = 1e-5 and below E sticks there; at
+#: dt = 1e-4 the located switch leaves E rising at 8.7e-5 m/s, so it slides on upwards
+#: instead of taking the stick test, and the tip "stops" at 14.1 ms against 16.8 ms. It warned
+#: nothing before (step_error 0.0021, h_lambda 0.019).
+OVERSHOT_STICK = {
+    "q_deg": -61.53355902997765,
+    "v0": 0.9512349213150317,
+    "vx0": -0.43333718928349585,
+    "omega0": 9.234185497588847,
+    "mass": 0.011261145898437165,
+    "zeta": 432229.60001029103,
+}
+
+
+def overshot_stick(dt: float) -> granrs.Scene:
+    p = OVERSHOT_STICK
+    return cases.free_link(p["q_deg"], p["v0"], dt=dt).replace(
+        vx0=p["vx0"],
+        omega0=p["omega0"],
+        mass=p["mass"],
+        apply_at="centroid",
+        forces=[f.gravity(), f.rft(zeta=p["zeta"])],
+        t_end=0.3,
+    )
+
+
+def test_a_stick_the_step_decided_warns() -> None:
+    """OVERSHOT_STICK at dt = 1e-4 moves by 16 % in t_s at dt = 1e-6 and warned nothing: a
+    miss of the random set. The overshot stick now counts in ``unresolved_stops`` and the run
+    warns, saying so; at dt = 1e-6 (E sticks) it is silent."""
+    coarse, texts = simulate_caught(overshot_stick(1e-4))
+    fine, fine_texts = simulate_caught(overshot_stick(1e-6))
+    assert abs(coarse.t_s - fine.t_s) > 0.1 * fine.t_s  # the miss is real
+    assert coarse.summary["step_error"] < 0.01  # the steps' estimate does not see it
+    assert coarse.summary["unresolved_stops"] == 1
+    assert len(texts) == 1 and "decided a stick" in texts[0] and "dt = 0.0001 s" in texts[0]
+    assert fine.summary["unresolved_stops"] == 0 and not fine_texts
+
+
 def test_step_error_falls_as_the_third_power_of_dt_where_the_run_is_smooth() -> None:
     """Each step's estimate, h/6 (k4 - f(y_{n+1})), is of order h^4 on a smooth run, and the
     run sums about 1/h of them: the thesis's free link at 45 deg reads h^3 (a tenth of dt, a

@@ -122,9 +122,10 @@ pub(super) struct Observer<const N: usize> {
     /// term reads the contact's boundary (`rft`, `rft_inertial`, `poncelet`), whose rates the
     /// drag's |F_d| / |v_E| does not see. The thesis's terms keep the drag's estimate alone.
     rates_on: bool,
-    /// Stops whose estimated time error was past [`STOP_TIME_ERROR`]
-    /// (`Stats::unresolved_stops`).
-    unresolved_stops: usize,
+    /// Each contact: whether the step did not resolve it (`Stats::unresolved_stops` counts
+    /// them): its stop's estimated error past [`STOP_TIME_ERROR`] (or its depth's at the end
+    /// without a stop), or a stick decision the step made ([`Observer::overshot_stick`]).
+    unresolved: Vec<bool>,
     /// The terms' stiffest moments at the start, the step ends and the events so far.
     terms: TermStiffest<N>,
     /// The run's error so far, as its steps estimate it ([`super::stepper::companion`]):
@@ -199,7 +200,7 @@ impl<const N: usize> Observer<N> {
                 q: y.q,
             },
             rates_on: model.forces.reads_frame,
-            unresolved_stops: 0,
+            unresolved: vec![false; nc],
             err_q: SVector::zeros(),
             err_qd: SVector::zeros(),
             step_error: 0.0,
@@ -374,6 +375,15 @@ impl<const N: usize> Observer<N> {
         }
     }
 
+    /// Contact `ci` slid on where its static bound would have held it, because the located
+    /// sign switch overshot the zero (see `events::choose_slip`): the step, not the contact,
+    /// decided, and the contact counts in `unresolved_stops`.
+    pub(super) fn overshot_stick(&mut self, ci: usize) {
+        if self.estimates {
+            self.unresolved[ci] = true;
+        }
+    }
+
     /// Contact `ci` entered the sand at `t` (the first entry counts).
     pub(super) fn entered(&mut self, ci: usize, t: f64) {
         let s = &mut self.summaries[ci];
@@ -420,7 +430,7 @@ impl<const N: usize> Observer<N> {
         if e.contacts[ci].v_tip.y.abs() > STOP_TIME_ERROR * t * accel.y.abs()
             || (self.estimates && relative > STOP_TIME_ERROR)
         {
-            self.unresolved_stops += 1;
+            self.unresolved[ci] = true;
         }
         let s = &mut self.summaries[ci];
         s.stopped = true;
@@ -480,7 +490,7 @@ impl<const N: usize> Observer<N> {
                     if depth > 0.0 && dy > 0.0 {
                         self.step_error = self.step_error.max((dy / depth).min(f64::MAX));
                         if self.estimates && dy > STOP_TIME_ERROR * depth {
-                            self.unresolved_stops += 1;
+                            self.unresolved[ci] = true;
                         }
                     }
                 }
@@ -502,7 +512,7 @@ impl<const N: usize> Observer<N> {
             options.dt * drag.max(self.terms.rate(model))
         };
         let mut stats = stats;
-        stats.unresolved_stops = self.unresolved_stops;
+        stats.unresolved_stops = self.unresolved.iter().filter(|&&u| u).count();
         let step_error = if options.method == Method::Rk4 {
             self.step_error
         } else {
