@@ -686,7 +686,10 @@ impl Events {
                 }
                 Kind::SlipX | Kind::StickX | Kind::SlipY | Kind::StickY => {
                     let axis = usize::from(matches!(hit.kind, Kind::SlipY | Kind::StickY));
-                    if choose_slip(model, modes, ci, axis, at.y, at.lookahead, stats) {
+                    // A stopped contact's results are settled.
+                    if choose_slip(model, modes, ci, axis, at.y, at.lookahead, stats)
+                        && !modes[ci].stopped
+                    {
                         obs.overshot_stick(ci);
                     }
                 }
