@@ -26,6 +26,10 @@ pub const RK4_STABILITY_LIMIT: f64 = 2.785;
 /// stop): that velocity over the tip's vertical acceleration.
 pub const STOP_TIME_ERROR: f64 = 0.01;
 
+/// The tip's vertical velocity [m/s] below which a located stop that is still sinking counts
+/// as reached (round-off at a stop the step resolves is far below it).
+const STOP_SPEED: f64 = 1e-9;
+
 /// The fastest rate [1/s] of a quadratic drag `F = -c |v| v` on a point of inverse effective
 /// mass `w`, with `k = |F| / |v|` and `dir` the unit velocity: the largest eigenvalue of
 /// `w K`, `K = dF/dv = -k (I + dir dir^T)` (twice as stiff along the motion as across).
@@ -424,10 +428,18 @@ impl<const N: usize> Observer<N> {
                 0.0
             }
         };
-        let relative =
-            ratio(e.contacts[ci].v_tip.y.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
+        let v_res = e.contacts[ci].v_tip.y;
+        // Still sinking where the stop was located, and not slowing down: the interpolant's
+        // root is not one of the run's own map, whose velocity moves away from zero there;
+        // the stop may come much later or not at all. Its time error is of the order of t_s.
+        let spurious = v_res < -STOP_SPEED && accel.y <= 0.0;
+        let mut relative = ratio(v_res.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
+        if spurious {
+            relative = relative.max(1.0);
+        }
         self.step_error = self.step_error.max(relative);
-        if e.contacts[ci].v_tip.y.abs() > STOP_TIME_ERROR * t * accel.y.abs()
+        if spurious
+            || v_res.abs() > STOP_TIME_ERROR * t * accel.y.abs()
             || (self.estimates && relative > STOP_TIME_ERROR)
         {
             self.unresolved[ci] = true;
