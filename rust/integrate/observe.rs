@@ -432,7 +432,9 @@ impl<const N: usize> Observer<N> {
         // Still sinking where the stop was located, and not slowing down: the interpolant's
         // root is not one of the run's own map, whose velocity moves away from zero there;
         // the stop may come much later or not at all. Its time error is of the order of t_s.
-        let spurious = v_res < -STOP_SPEED && accel.y <= 0.0;
+        // Not under the plain `sign()`, whose static terms chatter through every stop by
+        // construction (see `estimates`).
+        let spurious = self.estimates && v_res < -STOP_SPEED && accel.y <= 0.0;
         let mut relative = ratio(v_res.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
         if spurious {
             relative = relative.max(1.0);
