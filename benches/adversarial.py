@@ -11,7 +11,11 @@ Each input is one bad or good value put into one field of one public way in:
 - ``sweep``: a value of a ``granrs.sweep`` axis;
 - ``toml``: a value in a TOML scene file's text;
 - ``space``: a field of a ``granrs.space.Scene``, of its body, of its shape (each shape in
-  space) or of its terms (``rft3d``, ``rft3d_inertial``, ``poncelet``).
+  space) or of its terms (``rft3d``, ``rft3d_inertial``, ``poncelet``);
+- ``medium``: an entry of a medium card (``granrs.media``: the medium's numbers, a term's
+  parameter, a value's source and uncertainty, the card's name), the card then a scene's
+  medium. (A scene's ``medium`` field is an input of ``scene``, ``sweep`` and ``space``, with
+  the shipped cards' names among the values.)
 
 The values: NaN, infinities, -0, huge floats and ints (``10**400``), strings, None, bools,
 numpy bools, numpy scalars and arrays, nested lists, mappings, unknown names, and good
@@ -46,7 +50,7 @@ from typing import Any
 import numpy as np
 
 import granrs
-from granrs import Scene, cases, forces, scenefile, space
+from granrs import Scene, cases, forces, media, scenefile, space
 from granrs.bodies import Contact, Joint, Link, Linkage, Root
 from granrs.errors import GranrsError, SimulationError, StepSizeWarning
 
@@ -127,13 +131,21 @@ TOML_VALUES: tuple[str, ...] = (
     '"free"',
     '"smooth"',
     '"dopri5"',
+    '"thesis_sand"',
     "2.0",
     "0.5",
 )
 
 
-def good_variants(default: Any) -> list[Any]:
-    """Values near a field's default that a scene may well take."""
+#: Values of a scene's ``medium``: the shipped cards, a near miss, a path to nothing.
+MEDIA: tuple[Any, ...] = (*media.names(), "thesis_snad", "/no/such/card.toml")
+
+
+def good_variants(default: Any, name: str = "") -> list[Any]:
+    """Values near a field's default that a scene may well take (the field ``name``'s own
+    good values: a medium's names)."""
+    if name == "medium":
+        return [default, *MEDIA]
     if isinstance(default, float) and math.isfinite(default):
         return [default, default * 0.5 + 1e-3, default * 2.0 + 1e-3]
     return [default]
@@ -183,7 +195,7 @@ def scene_case(pick: Pick) -> Case:
     names = [f.name for f in dataclasses.fields(Scene)]
     name = pick(names, "field")
     default = granrs.scene._DEFAULTS.get(name)
-    value = pick([*BAD, *good_variants(default)], "value")
+    value = pick([*BAD, *good_variants(default, name)], "value")
     kw = {"body": value} if name == "body" else {"body": body, name: value}
     return Case("scene", name, value, lambda: run(Scene(**kw)))
 
@@ -281,7 +293,7 @@ def sweep_case(pick: Pick) -> Case:
     names = [f.name for f in dataclasses.fields(Scene) if f.name != "body"]
     name = pick(names, "axis")
     default = granrs.scene._DEFAULTS.get(name)
-    value = pick([*BAD, *good_variants(default)], "value")
+    value = pick([*BAD, *good_variants(default, name)], "value")
     base = cases.free_link(q_deg=10.0, v0=1.5, t_end=0.01)
 
     def build() -> Any:
@@ -346,7 +358,7 @@ def space_case(pick: Pick) -> Case:
     }
     if where == "scene":
         field = pick([f.name for f in dataclasses.fields(space.Scene) if f.init], "field")
-        kw[field] = value
+        kw[field] = pick((value, *MEDIA), "medium") if field == "medium" else value
         names: tuple[str, ...] = (field,)
     elif where == "body":
         field = pick(("density", "mass", "inertia"), "field")
@@ -383,6 +395,56 @@ def space_case(pick: Pick) -> Case:
     return Case("space", field, value, build, names=names)
 
 
+#: The entries of a medium card an input may set: the medium's numbers, terms'
+#: parameters, a value's source and uncertainty, and the card's own keys.
+MEDIUM_ENTRIES: tuple[str, ...] = (
+    "name",
+    "description",
+    "rho_g",
+    "g",
+    "rho",
+    "rft.zeta",
+    "rft.elements",
+    "rft.A00",
+    "poncelet.c",
+    "poncelet.k",
+    "drag.eta_d",
+    "static_v.lam",
+    "rft3d.zeta",
+    "rfx.zeta",
+    "rft.zetta",
+    "rft.zeta.source",
+    "rft.zeta.sd",
+    "rft.zeta.interval",
+    "rft.zeta.level",
+    "rft.zeta.samples",
+)
+
+
+def medium_case(pick: Pick) -> Case:
+    entry = pick(MEDIUM_ENTRIES, "entry")
+    value = pick([*BAD, 0.5, 1e6, 1650.0, "a source", [1.0, 2.0]], "value")
+    data = media.load("thesis_sand").to_dict()
+    data["name"] = "adversary"
+    data["missing"] = {}
+    parts = entry.split(".")
+    if entry in ("name", "description"):
+        data[entry] = value
+    elif len(parts) == 1:
+        data["medium"][entry] = {"value": value, "source": "adversary"}
+    elif len(parts) == 2:
+        data["terms"].setdefault(parts[0], {})[parts[1]] = {"value": value, "source": "s"}
+    else:
+        data["terms"][parts[0]][parts[1]][parts[2]] = value
+
+    def build() -> Any:
+        card = media.MediumCard.from_dict(data)
+        scene = Scene(medium=card, forces=[forces.gravity(), forces.rft(elements=2)])
+        return run(scene)
+
+    return Case("medium", entry, value, build, names=(entry, *parts))
+
+
 GENERATORS: dict[str, Callable[[Pick], Case]] = {
     "scene": scene_case,
     "case": case_case,
@@ -391,6 +453,7 @@ GENERATORS: dict[str, Callable[[Pick], Case]] = {
     "sweep": sweep_case,
     "toml": toml_case,
     "space": space_case,
+    "medium": medium_case,
 }
 
 

@@ -7,10 +7,10 @@ Python around it); a law's cost is the sum over the angles. The ratios come from
 this script (absolute times on a shared machine are noisy). Use a release build.
 
 An impact's cost is its evaluations times their cost, and the evaluations follow how long
-the impact lasts: a stiffer sand stops the rod sooner. ``zeta = 1e6`` (the order of Li et
-al.'s media) makes this sand softer than the thesis's law does, so the ``rft`` rows are also
-run at ``zeta`` fitted to Table 3.1 (``granrs.calibrate``, fitted here at the start: the
-same sand as the thesis's row).
+the impact lasts: a stiffer sand stops the rod sooner. ``zeta = 1e6`` (the examples' scale)
+makes this sand softer than the thesis's law does, so the ``rft`` rows are also run at
+``zeta`` fitted to Table 3.1 (``granrs.calibrate``, fitted here at the start: the same sand
+as the thesis's row; the ``thesis_sand`` medium card of ``granrs.media`` keeps the value).
 
 Usage::
 

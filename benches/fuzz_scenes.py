@@ -58,7 +58,7 @@ NAMES = (
     "free_link chain leg tip centroid modes raw smooth rk4 dopri5 first_stop all_stops time "
     "state forces energy gravity drag static_h static_v joint_springs free locked box thesis "
     "rft rft_inertial poncelet zeta elements c k A00 Bm11 driven table arc radius start_deg "
-    "end_deg chords rate pinned moving"
+    "end_deg chords rate pinned moving medium thesis_sand thesis_fine_sand li2013_generic"
 ).split()
 
 

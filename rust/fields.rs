@@ -106,6 +106,8 @@ scene_fields! {
         "rod length L (thesis sec. 3.2.1: 0.190); each chain link's";
     "mass": "body", "kg", "> 0",
         "body mass m (thesis sec. 3.2.1: 0.184); each chain link's (not in the thesis: 0.0341, a solid steel link)";
+    "medium": "notes", "", "a medium's name, a card's path, or none",
+        "the granular medium (granrs.media): a shipped card's name, a card file's path or a granrs.media.MediumCard; its rho_g and g, and each listed term's parameters the scene does not give, come from the card (default: none, the fields and the terms' defaults as given)";
     "method": "solver", "", "rk4 or dopri5",
         "the integrator: \"rk4\" (default: classical RK4 on the grid n dt) or \"dopri5\" (adaptive Dormand-Prince 5(4) with rtol and atol)";
     "omega0": "start", "rad/s", "finite",

@@ -297,3 +297,135 @@ def test_cli_calibrate_bad_input(capsys, tmp_path) -> None:
     assert main(["calibrate", "--measurements", str(bad)]) == 2
     assert "t_s_mean" in capsys.readouterr().err
     assert main(["calibrate", "--fit", "q_deg"]) == 2
+
+
+# --------------------------------------------------------------------------------------------
+# Bodies in space: each row's scene from a function of the row
+
+
+def _ball_drops(zeta: float, speeds=(1.0, 2.0, 3.0)) -> Measurements:
+    """Drops of a steel ball under rft3d at ``zeta``, simulated, as measurements (sd 0.1 mm
+    and 0.1 ms)."""
+    rows = []
+    for v0 in speeds:
+        r = granrs.simulate(_ball(v0, zeta))
+        assert r.status == "stopped"
+        rows.append(dict(v0=v0, depth_mean=r.depth, depth_sd=1e-4, t_s_mean=r.t_s, t_s_sd=1e-4))
+    return Measurements(body="space", rows=pd.DataFrame(rows), source="ball drops")
+
+
+def _ball(v0: float, zeta: float = 1e6) -> granrs.space.Scene:
+    from granrs import space
+
+    body = space.Body(space.Sphere(radius=0.02), density=7800.0)
+    terms = [granrs.forces.rft3d(zeta=zeta), granrs.forces.gravity()]
+    return space.Scene(body=body, velocity=(0.0, 0.0, -v0), forces=terms)
+
+
+def test_calibrate_recovers_rft3d_zeta_from_drops_of_a_body_in_space():
+    # The truth is chosen here (2e5 N/m^3); the fit starts from the scene's 1e6.
+    truth = 2e5
+    fit = calibrate(
+        lambda row: _ball(row["v0"]),
+        _ball_drops(truth),
+        params=["rft3d.zeta"],
+        bounds={"rft3d.zeta": (1e4, 1e7)},
+    )
+    assert fit.body == "space"
+    assert fit.start["rft3d.zeta"] == pytest.approx(1e6)
+    assert fit.values["rft3d.zeta"] == pytest.approx(truth, rel=1e-6)
+    lo, hi = fit.intervals["rft3d.zeta"]
+    assert lo < truth < hi
+    assert fit.failed_runs == 0
+
+
+def test_calibrate_in_space_takes_forces_as_the_law_over_the_scenes_own():
+    # The scene's own law has rft3d only; forces= adds poncelet, whose c is fitted.
+    m = _ball_drops(2e5, speeds=(1.0, 3.0))
+    law = [
+        granrs.forces.rft3d(zeta=2e5),
+        granrs.forces.poncelet(c=0.5, k=1.0),
+        granrs.forces.gravity(),
+    ]
+    fit = calibrate(
+        lambda row: _ball(row["v0"]),
+        m,
+        params=["poncelet.c"],
+        forces=law,
+        bounds={"poncelet.c": (1e-4, 10.0)},
+        quantities=["depth"],
+    )
+    # The data hold no poncelet: its drag coefficient goes to the lower bound's side.
+    assert fit.values["poncelet.c"] < 1e-2
+    with pytest.raises(granrs.UnknownNameError, match="poncelet") as e:
+        calibrate(
+            lambda row: _ball(row["v0"]), m, params=["poncelet.c"], bounds={"poncelet.c": (0.1, 1)}
+        )
+    assert e.value.field == "poncelet.c"
+
+
+def test_calibrate_in_space_refuses_bad_cases_before_any_run():
+    m = _ball_drops(2e5, speeds=(1.0, 2.0))
+    with pytest.raises(granrs.InvalidParameterError, match=r"granrs\.space\.Scene") as e:
+        calibrate(
+            lambda row: granrs.Scene(), m, params=["rft3d.zeta"], bounds={"rft3d.zeta": (1e4, 1e7)}
+        )
+    assert e.value.field == "cases"
+    with pytest.raises(granrs.InvalidParameterError, match="measurements are of the") as e:
+        calibrate(lambda row: _ball(1.0), Measurements.thesis("table_3_1"), params=["rft3d.zeta"])
+    assert e.value.field == "cases"
+    with pytest.raises(granrs.InvalidParameterError, match="no thesis coefficients") as e:
+        calibrate(lambda row: _ball(row["v0"]), m, params=["rft3d.zeta"], base="table_3_4")
+    assert e.value.field == "base"
+    with pytest.raises(granrs.UnknownNameError, match="function of the measurement row") as e:
+        calibrate("space", m, params=["rft3d.zeta"])
+    assert e.value.field == "cases"
+
+
+# --------------------------------------------------------------------------------------------
+# Posterior samples
+
+
+def test_posterior_samples_agree_with_the_fit_and_give_predictive_intervals():
+    fit = calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"], posterior=40, walkers=4)
+    post = fit.posterior
+    assert post is not None and post.walkers == 4 and post.burn == 20
+    assert list(post.samples.columns) == ["scale.static_v.eta_v"]
+    assert len(post.samples) == 4 * 20 == len(post.log_prob)
+    assert 0.0 < post.acceptance < 1.0
+    # One parameter, a near-linear model: the posterior sits where the least-squares fit
+    # puts it, its median inside the fit's ~95 % interval and its 90 % interval about the
+    # fitted value.
+    value = fit.values["scale.static_v.eta_v"]
+    lo95, hi95 = fit.intervals["scale.static_v.eta_v"]
+    median = float(post.samples["scale.static_v.eta_v"].median())
+    assert lo95 < median < hi95
+    lo, hi = post.interval(0.9)["scale.static_v.eta_v"]
+    assert lo < value < hi
+    assert post.interval(0.5)["scale.static_v.eta_v"][1] < hi
+    # Seeded: the same call draws the same chains.
+    again = calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"], posterior=40, walkers=4)
+    pd.testing.assert_frame_equal(post.samples, again.posterior.samples)
+    pred = fit.predictive(draws=20)
+    assert len(pred) == 12
+    for q in ("depth", "t_s"):
+        assert np.all(pred[f"{q}_lo"] <= pred[f"{q}_median"])
+        assert np.all(pred[f"{q}_median"] <= pred[f"{q}_hi"])
+        assert np.all(pred[f"{q}_lo"] < pred[f"{q}_hi"])
+
+
+def test_posterior_options_are_refused_before_any_run():
+    for kwargs, name in (
+        ({"posterior": 5}, "posterior"),
+        ({"posterior": -1}, "posterior"),
+        ({"posterior": 40, "walkers": 3}, "walkers"),
+        ({"posterior": 40, "walkers": 1}, "walkers"),
+    ):
+        with pytest.raises(granrs.InvalidParameterError) as e:
+            calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"], **kwargs)
+        assert e.value.field == name
+    fit = calibrate("free_link", "table_3_1", ["scale.static_v.eta_v"])
+    assert fit.posterior is None
+    with pytest.raises(granrs.InvalidParameterError) as e:
+        fit.predictive()
+    assert e.value.field == "posterior"

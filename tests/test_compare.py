@@ -13,13 +13,14 @@ import math
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import granrs
 from granrs import cases, forces
 from granrs.calibrate import Measurements, calibrate
 from granrs.cli import main
-from granrs.compare import LAWS, Law, compare, synthetic, to_json
+from granrs.compare import LAWS, Law, compare, sums, synthetic, to_json
 from granrs.errors import InvalidParameterError, SimulationError, StepSizeWarning, UnknownNameError
 
 TABLE_3_1 = Measurements.thesis("table_3_1")
@@ -596,3 +597,110 @@ def test_synthetic_chain_recovers_the_link_mass() -> None:
         lo, hi = fold["intervals"]["mass"]
         assert lo <= 0.02 <= hi, fold
         assert hi / lo < 1.5, fold  # determined, not merely bounded
+
+
+# --------------------------------------------------------------------------------------------
+# Bodies in space
+
+
+def _ball(v0: float, radius: float) -> granrs.space.Scene:
+    body = granrs.space.Body(granrs.space.Sphere(radius=radius), density=7800.0)
+    terms = [granrs.forces.rft3d(zeta=2e5), granrs.forces.gravity()]
+    return granrs.space.Scene(body=body, velocity=(0.0, 0.0, -v0), forces=terms)
+
+
+def test_compare_ranks_laws_on_bodies_in_space_out_of_sample():
+    # Balls of two radii dropped under rft3d (zeta 2e5, chosen here), sd 0.2 % of each value;
+    # each radius is predicted by the law fitted to the other. rft3d made the data and must
+    # predict them; poncelet cannot follow the depth's growth with the speed under a
+    # rate-independent law; the planar laws do not act in space.
+    rows = []
+    for radius in (0.015, 0.025):
+        for v0 in (1.0, 3.0):
+            r = granrs.simulate(_ball(v0, radius))
+            rows.append(
+                dict(
+                    radius=radius,
+                    v0=v0,
+                    depth_mean=r.depth,
+                    depth_sd=2e-3 * r.depth,
+                    t_s_mean=r.t_s,
+                    t_s_sd=2e-3 * r.t_s,
+                )
+            )
+    m = granrs.Measurements(body="space", rows=pd.DataFrame(rows), source="balls")
+    laws = [
+        Law("rft3d", "3D-RFT", terms=(("rft3d", {}),), fit={"rft3d.zeta": (1e6, 1e4, 1e8)}),
+        Law(
+            "poncelet",
+            "Poncelet",
+            terms=(("poncelet", {}),),
+            fit={"poncelet.c": (1.0, 1e-3, 1e3), "poncelet.k": (300.0, 1.0, 1e7)},
+        ),
+        "rft",
+    ]
+    frame = compare(
+        laws,
+        {"balls": m},
+        cases=lambda row: _ball(row["v0"], row["radius"]),
+        folds="radius",
+        progress=False,
+    ).set_index("law")
+    assert frame.loc["rft3d", "rank"] == 1
+    assert frame.loc["rft3d", "depth_within_1sd"] == 4
+    assert frame.loc["rft3d", "ts_within_2sd"] == 4
+    fitted = frame.loc["rft3d", "folds"]
+    assert len(fitted) == 3  # every row, then each radius left out
+    assert all(f["values"]["rft3d.zeta"] == pytest.approx(2e5, rel=1e-6) for f in fitted)
+    assert frame.loc["poncelet", "oos_chi2"] > 1e3 * max(frame.loc["rft3d", "oos_chi2"], 1e-9)
+    assert not frame.loc["rft", "available"]
+    assert "does not act on a body in space" in frame.loc["rft", "reason"]
+    with pytest.raises(granrs.InvalidParameterError, match="bodies in space") as e:
+        compare(laws[:1], {"balls": m}, folds="radius", progress=False)
+    assert e.value.field == "cases"
+
+
+# --------------------------------------------------------------------------------------------
+# Sums of laws
+
+
+def test_laws_add_their_terms_and_fits_and_refuse_a_term_listed_twice():
+    a = Law("a", "A", terms=(("poncelet", {"k": 0.0}),), fit={"poncelet.c": (1.0, 1e-3, 1e3)})
+    b = Law("b", "B", terms=(("rft", {}),), fit={"rft.zeta": (1e6, 1e3, 1e9)}, body_unknowns=False)
+    s = LAWS["thesis_refit"] + a + b
+    assert s.name == "thesis_refit+a+b"
+    assert s.thesis
+    assert s.terms == (("poncelet", {"k": 0.0}), ("rft", {}))
+    assert set(s.params_for("free_link")) == {
+        *LAWS["thesis_refit"].fit,
+        "poncelet.c",
+        "rft.zeta",
+    }
+    assert not s.body_unknowns
+    # The leg's own setting of the thesis refit survives the sum.
+    assert s.params_for("leg") == (LAWS["thesis_refit"] + a).params_for("leg") | {
+        "rft.zeta": (1e6, 1e3, 1e9)
+    }
+    with pytest.raises(granrs.InvalidParameterError, match="both list the term 'poncelet'") as e:
+        _ = a + LAWS["poncelet"]
+    assert e.value.field == "laws"
+
+
+def test_sums_compares_every_small_sum_in_one_call():
+    # Pieces with nothing to fit (each evaluated once), on three rows of Table 3.1: every sum
+    # of at most two, and a sum whose pieces list the same term left out.
+    m = Measurements.thesis("table_3_1")
+    m = Measurements(m.body, m.rows.iloc[:3].reset_index(drop=True), m.source, m.resolution)
+    a = Law("a", "A", terms=(("poncelet", {"c": 0.5, "k": 20.0}),), body_unknowns=False)
+    b = Law("b", "B", terms=(("static_v", {}),), body_unknowns=False)
+    c = Law("c", "C", terms=(("poncelet", {"c": 1.0, "k": 0.0}),), body_unknowns=False)
+    frame = sums([a, b, c], m, max_terms=2, folds=None, progress=False)
+    assert list(frame["law"]) == ["a", "b", "c", "a+b", "b+c"]
+    alone = compare([a + b], m, folds=None, progress=False)
+    assert frame.set_index("law").loc["a+b", "oos_chi2"] == alone.loc[0, "oos_chi2"]
+    pairs = zip(frame["law"], frame["rows"], strict=True)
+    depth = {law: [r["depth_pred"] for r in rows] for law, rows in pairs}
+    assert depth["a+b"] != depth["a"] and depth["a+b"] != depth["b"]
+    with pytest.raises(granrs.InvalidParameterError) as e:
+        sums([a, b], m, max_terms=0)
+    assert e.value.field == "max_terms"

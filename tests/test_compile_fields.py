@@ -65,12 +65,13 @@ SCENES = [
 
 def test_the_core_keeps_every_field_name() -> None:
     """Every field a Scene sends has a slot of its own in the core's spec; the only fields
-    it does not send are the notes (provenance the run does not read)."""
+    it does not send are the notes (provenance the run does not read: the terms' source and
+    the medium, whose values the scene's rho_g, g and terms already hold)."""
     from granrs.scene import FIELD_INFO
 
     sent = set(itertools.chain.from_iterable(_CORE_FIELDS.values()))
     notes = {n for n, f in FIELD_INFO.items() if f["part"] == "notes"}
-    assert notes == {"coefficients_source"}
+    assert notes == {"coefficients_source", "medium"}
     assert sent == set(_granrs.SCENE_FIELDS) - notes
 
 

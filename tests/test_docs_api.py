@@ -46,6 +46,8 @@ gen = _generator()
 #: Python blocks of the pages that are not run, by (page, index among its python blocks).
 NOT_RUN = {
     ("sweeps.md", 3): "needs a Dask scheduler",
+    ("compare.md", 4): "a search of four sums on Table 3.1, about a minute of fits (sums are "
+    "tested on a cheap set in test_compare.py)",
 }
 #: Blocks that show an error: the exception they must raise.
 RAISES = {("getting_started.md", 1): "InvalidParameterError"}

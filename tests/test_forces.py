@@ -103,8 +103,14 @@ def test_every_term_describes_itself_from_the_core() -> None:
         expected = {p.name: required.get(p.name, p.default) for p in t.info.params}
         assert dict(built.params) == expected
         if required:
-            with pytest.raises(granrs.GranrsError, match="required"):
-                forces.term(name)
+            # Left out, a required parameter is to come from a scene's medium: the term
+            # says which are missing, and refuses to be used without them.
+            pending = forces.term(name)
+            assert pending.missing == tuple(required)
+            assert set(pending.params) == {p.name for p in info.params} - set(required)
+            with pytest.raises(granrs.GranrsError, match="required") as caught:
+                pending.require()
+            assert caught.value.field == f"{name}.{next(iter(required))}"
     sv = forces.static_v().info
     assert [p.name for p in sv.params] == ["eta_v", "lam"]
     assert sv.params[0].default == 248.0 and sv.params[0].unit == "-"

@@ -202,7 +202,9 @@ def test_constructor_arguments_keep_working() -> None:
         (lambda: forces.rft(1e6, A00=0.1, coefficients={"A00": 0.2}), "rft.A00"),
         (lambda: forces.rft(1e6, coefficients={"k": 1.0}), "rft.k"),
         (lambda: forces.static_v(eta=1.0), "static_v.eta"),
-        (lambda: forces.poncelet(c=1.0), "poncelet.k"),
+        # k left out is to come from a medium: refused where the term must have it.
+        (lambda: forces.poncelet(c=1.0).require(), "poncelet.k"),
+        (lambda: granrs.Scene(forces=[forces.poncelet(c=1.0)]), "poncelet.k"),
     ]:
         with pytest.raises(granrs.GranrsError) as info:
             call()

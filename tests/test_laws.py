@@ -232,7 +232,7 @@ def test_bad_parameters_are_named_before_any_work() -> None:
         (lambda: f.rft(zeta=1e6, coefficients={"E00": 1.0}), "rft.E00"),
         (lambda: f.poncelet(c=-1.0, k=1.0), "poncelet.c"),
         (lambda: f.poncelet(c=1.0, k=float("inf")), "poncelet.k"),
-        (lambda: f.term("poncelet", c=1.0), "poncelet.k"),
+        (lambda: granrs.Scene(forces=[f.term("poncelet", c=1.0)]), "poncelet.k"),
         (lambda: f.rft_inertial(lam=-2.0), "rft_inertial.lam"),
     ]:
         with pytest.raises(granrs.GranrsError, match=field.replace(".", r"\.")):

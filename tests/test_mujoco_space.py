@@ -177,7 +177,7 @@ def test_the_cores_binding_of_mujocos_arrays_names_the_array_it_refuses(space):
     sand = Sand(m, ["rod"], terms, space=space)
     sand.step(d)
     core = sand._coupling
-    name = "SpaceCoupling" if space else "GeomCoupling"
+    name = "MujocoCoupling." + ("space" if space else "planar")
     velocity = () if space else (d.cvel,)
     arrays = [d.geom_xpos, d.geom_xmat, *velocity, d.subtree_com, d.cdof, d.qvel, d.qacc]
     arrays += [d.qfrc_applied, d.qfrc_passive, sand._mass, sand.output, sand.applied]

@@ -62,7 +62,7 @@ def test_readme_starts_with_the_two_commands_that_ci_runs() -> None:
     first = _commands(_bash_blocks()[0])
     assert len(first) == 2, first
     assert first[0].endswith("pip install . && granrs reproduce --out granrs-report")
-    assert first[1].endswith("pip install -e '.[test]' && cargo test && pytest")
+    assert first[1].endswith("pip install -e '.[test]' && cargo test && pytest -n auto")
     ci = CI_RUN.read_text()
     assert first[1] in ci.splitlines()
     docs = [c for b in _bash_blocks() for c in _commands(b) if "sphinx-build" in c]

@@ -229,29 +229,6 @@ def test_figures_are_png(built: tuple[Path, str]) -> None:
     )
 
 
-def test_cli_reproduce_quiet_replaces_report(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """--quiet prints nothing; an existing report folder is updated in place."""
-    out = tmp_path / "existing"
-    (out / "figures").mkdir(parents=True)
-    (out / "figures" / "stale.png").write_bytes(b"old")
-    (out / "keep.txt").write_text("mine")
-    assert main(["reproduce", "--out", str(out), "--quiet"]) == 0
-    captured = capsys.readouterr()
-    assert captured.out == ""
-    # No progress; the command's own warnings are part of its output (one line each): the
-    # step-size warning's known false alarm (see _reproduce_quietly) is the one line.
-    lines = captured.err.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("granrs: warning: dt = 0.0001 s"), lines
-    assert "step_error 0.186" in lines[0]
-    assert (out / "README.md").is_file()
-    assert (out / "keep.txt").read_text() == "mine"
-    assert not (out / "figures" / "stale.png").exists()
-    assert any((out / "figures").glob("*.png"))
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["existing"]  # no temp leftovers
-
-
 @pytest.mark.parametrize("dt", ["-1", "0", "nan"])
 def test_cli_invalid_dt_writes_nothing(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], dt: str

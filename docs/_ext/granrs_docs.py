@@ -20,6 +20,9 @@ In Markdown pages these directives go inside an ``{eval-rst}`` block.
 ``.. granrs-terms-table::``
     Every registered force term: what it acts on, its equation, its parameters with units,
     defaults and their sources, and the switches it owns (``granrs.forces.info``).
+``.. granrs-media-table::``
+    Every shipped medium card (``granrs.media``): each value with its unit, uncertainty
+    and source, and what the card could not source.
 ``.. granrs-leg-segments::``
     The leg's segments (mass, length, centre of mass, inertia) of ``granrs.cases.leg()``.
 ``.. granrs-scene-template:: BODY``
@@ -74,6 +77,11 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
         ),
     ),
     (
+        "Media",
+        "Named granular media as data: each card's values for the force terms, with sources.",
+        ("media",),
+    ),
+    (
         "Calibration",
         "Fitting the coefficients to measurements, and comparing force laws.",
         ("calibrate", "compare", "Measurements", "CalibrationResult"),
@@ -93,6 +101,7 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
             "InvalidParameterError",
             "UnknownNameError",
             "CoefficientTableError",
+            "MediumError",
             "MeasurementError",
             "SimulationError",
             "StepSizeWarning",
@@ -524,6 +533,50 @@ def list_table(header: Sequence[str], rows: Iterable[Sequence[str]], widths: str
     return "\n".join(lines) + "\n"
 
 
+def _unit_of(key: str) -> str:
+    """The unit of a card's entry: the scene field's (``rho_g``) or the parameter's."""
+    if "." not in key:
+        return granrs.scene.FIELD_INFO[key]["unit"]
+    term, param = key.split(".")
+    return next(p.unit for p in forces.info(term).params if p.name == param)
+
+
+def _uncertainty(v: Any) -> str:
+    parts = []
+    if v.sd is not None:
+        parts.append(f"sd {v.sd:g}")
+    if v.interval is not None:
+        level = 0.95 if v.level is None else v.level
+        parts.append(f"{level:.0%} [{v.interval[0]:g}, {v.interval[1]:g}]")
+    if v.samples:
+        parts.append(f"{len(v.samples)} samples")
+    return "; ".join(parts)
+
+
+def media_table_rows() -> list[list[str]]:
+    """Rows of the media table: every shipped card's every value (medium, entry, value,
+    unit, uncertainty, source) and what it could not source, from the cards themselves."""
+    rows = []
+    for name in granrs.media.names():
+        card = granrs.media.load(name)
+        entries = [*card.medium.items(), *card.params.items()]
+        for key, v in entries:
+            unit = _unit_of(key)
+            rows.append(
+                [
+                    f"``{name}``",
+                    f"``{key}``",
+                    f"{v.value:g}",
+                    "dimensionless" if unit == "-" else rst_escape(unit),
+                    _uncertainty(v),
+                    rst_escape(v.source),
+                ]
+            )
+        for key, why in card.missing.items():
+            rows.append([f"``{name}``", f"``{key}``", "not given", "", "", rst_escape(why)])
+    return rows
+
+
 def element_fields_rows() -> list[list[str]]:
     """Rows of the linkage elements' table (the core's ``ELEMENT_FIELDS``): element, field,
     unit, allowed values and what it is."""
@@ -829,6 +882,13 @@ def setup(app: Any) -> dict[str, Any]:
             header = ["term", "acts on", "equation (granrs frame)", "parameters", "switches"]
             return list_table(header, terms_table_rows(), "12 8 30 35 15")
 
+    class MediaTable(_RstDirective):
+        """``.. granrs-media-table::``: every shipped medium card's values, with sources."""
+
+        def rst(self) -> str:
+            header = ["medium", "entry", "value", "unit", "uncertainty", "source"]
+            return list_table(header, media_table_rows(), "12 14 9 8 14 43")
+
     class LegSegments(_RstDirective):
         """``.. granrs-leg-segments::``."""
 
@@ -923,6 +983,7 @@ def setup(app: Any) -> dict[str, Any]:
     app.add_directive("granrs-body-fields", BodyFields)
     app.add_directive("granrs-leg-segments", LegSegments)
     app.add_directive("granrs-terms-table", TermsTable)
+    app.add_directive("granrs-media-table", MediaTable)
     app.add_directive("granrs-element-fields", ElementFields)
     app.add_directive("granrs-scene-template", SceneTemplate)
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}

@@ -16,7 +16,18 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from . import _granrs, animation, bodies, cases, coefficients, data, forces, scenefile, space
+from . import (
+    _granrs,
+    animation,
+    bodies,
+    cases,
+    coefficients,
+    data,
+    forces,
+    media,
+    scenefile,
+    space,
+)
 from .api import RK4_STABILITY_LIMIT, simulate
 from .batch import sweep
 from .calibrate import CalibrationResult, Measurements, calibrate
@@ -30,6 +41,7 @@ from .errors import (
     InvalidParameterError,
     InvalidSceneError,
     MeasurementError,
+    MediumError,
     SimulationError,
     StepSizeWarning,
     UnknownNameError,
@@ -58,6 +70,7 @@ __all__ = [
     "InvalidSceneError",
     "MeasurementError",
     "Measurements",
+    "MediumError",
     "ResistanceForce",
     "Result",
     "Scene",
@@ -74,6 +87,7 @@ __all__ = [
     "compare",
     "data",
     "forces",
+    "media",
     "resistance_force",
     "scenefile",
     "simulate",

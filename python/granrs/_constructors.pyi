@@ -154,9 +154,9 @@ def poncelet(
 
     Args:
         c: inertial drag coefficient [-]; required (no default; none: fitted per body and
-            medium (m / d1 = c rho_g A)).
+            medium (m / d1 = c rho_g A; granrs.media)).
         k: depth-friction coefficient [N/m]; required (no default; none: fitted per body and
-            medium).
+            medium (granrs.media)).
 
     Returns:
         The term, its parameters checked by the core.
@@ -195,8 +195,8 @@ def rft(
 
     Args:
         zeta: alpha_z of a horizontal plate pushed straight down, per unit depth [N/m^3];
-            required (no default; none: a property of the medium (Li et al. 2013 measured
-            ~1e6 for their media)).
+            required (no default; none: a property of the medium (granrs.media's cards give
+            values with sources; the docs tabulate them)).
         elements: elements per boundary plate [-], an integer from 1 to 1024; default 8
             (granrs (convergence study, docs/laws.md)).
         A00: Fourier coefficient A00 of alpha_z [-]; default 0.206 (Li, Zhang & Goldman
@@ -275,8 +275,8 @@ def rft3d(
 
     Args:
         zeta: material scale of the generic stress [N/m^3]; required (no default; none: the
-            medium's scale xi_n (granrs.space.xi_n from its density and internal friction,
-            or fitted)).
+            medium's scale xi_n (granrs.space.xi_n from its density and internal friction, a
+            granrs.media card, or fitted)).
         mu_surf: surface friction: cap on the stress's tangential part [-]; default inf (no
             cap unless given (the public codes take 0.15 to 0.4)).
         grazing: whether elements moving along their own surface count (1 or 0) [-], an

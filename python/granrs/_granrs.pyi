@@ -26,10 +26,9 @@ __all__ = [
     "SPACE_SERIES",
     "SPACE_SUMMARY",
     "Compiled",
-    "GeomCoupling",
+    "MujocoCoupling",
     "RunOutcome",
     "SandGeoms",
-    "SpaceCoupling",
     "SpaceScene",
     "__version__",
     "body_linkage",
@@ -174,30 +173,6 @@ class SandGeoms:
         """Every geom's force: states n x 7 (GEOM_STATE order) in, out n x 18
         (GEOM_OUTPUTS order) written."""
 
-@final
-class GeomCoupling:
-    """SandGeoms placed on the bodies of a MuJoCo model (granrs.mujoco.Sand)."""
-
-    def __new__(
-        cls,
-        rods: SandGeoms,
-        geom: list[int],
-        body: list[int],
-        root: list[int],
-        reach: list[float],
-        dofs: list[list[int]],
-        nv: int,
-        surface: float,
-        patch: tuple[float, float],
-        stick: bool,
-        implicit_damping: list[float],
-    ) -> GeomCoupling: ...
-    def bind(self, *arrays: Any) -> None:
-        """Bind one mjData's arrays and the caller's buffers (checked once)."""
-    def step(self, timestep: float, passive: bool, fresh: bool, hold: bool) -> tuple[float, int]:
-        """One evaluation at the bound arrays; the generalized force into qfrc_passive
-        (passive) or qfrc_applied. Returns the largest h_lambda and its geom."""
-
 def scene_fields() -> list[dict[str, Any]]:
     """The one table of a scene's fields (name, part, bodies, unit, note, doc)."""
 
@@ -223,12 +198,26 @@ SPACE_GEOM_OUTPUTS: list[str]
 SPACE_REST_SPEED: float
 
 @final
-class SpaceCoupling:
-    """Geoms of a MuJoCo model as shapes in space under the terms in space
-    (granrs.mujoco.Sand in three dimensions)."""
+class MujocoCoupling:
+    """The sand placed on the bodies of a MuJoCo model (granrs.mujoco.Sand): planar rod and
+    sole geoms, or geoms as shapes in space."""
 
-    def __new__(
-        cls,
+    @staticmethod
+    def planar(
+        rods: SandGeoms,
+        geom: list[int],
+        body: list[int],
+        root: list[int],
+        reach: list[float],
+        dofs: list[list[int]],
+        nv: int,
+        surface: float,
+        patch: tuple[float, float],
+        stick: bool,
+        implicit_damping: list[float],
+    ) -> MujocoCoupling: ...
+    @staticmethod
+    def space(
         names: list[str],
         shapes: list[dict[str, Any]],
         forces: list[tuple[str, dict[str, Any]]],
@@ -243,15 +232,16 @@ class SpaceCoupling:
         dofs: list[list[int]],
         nv: int,
         implicit_damping: list[float],
-    ) -> SpaceCoupling: ...
+    ) -> MujocoCoupling: ...
     def bind(self, *arrays: Any) -> None:
         """Bind one mjData's arrays and the caller's buffers (checked once)."""
     def step(
         self, timestep: float, passive: bool, fresh: bool, hold: bool
     ) -> tuple[float, int, int, float, bool, bool]:
-        """One implicit evaluation at the bound arrays (GIL released). Returns the largest
-        h_lambda, its geom, the Newton iterations, the relative residual, whether the solve
-        converged and whether the step fell back to sticking or sliding."""
+        """One evaluation at the bound arrays; the generalized force into qfrc_passive
+        (passive) or qfrc_applied. Returns the largest h_lambda, its geom, the Newton
+        iterations, the relative residual, whether the solve converged and whether the step
+        fell back to sticking or sliding (planar: 0, 0.0, True, False)."""
 
 SPACE_SUMMARY: list[tuple[str, str, str]]
 SPACE_SERIES: list[tuple[str, str, str]]

@@ -93,6 +93,12 @@ def _check_axes(scene: Scene, axes: dict[str, list[Any]]) -> None:
             raise InvalidSceneError(
                 "a sweep runs one body; sweep each body separately", field="body"
             )
+        if name == "medium":
+            raise InvalidSceneError(
+                "a sweep's axis cannot change the medium (it sets rho_g, g and the terms' "
+                "parameters); sweep a list of scenes: [scene.replace(medium=m) for m in ...]",
+                field="medium",
+            )
         if name not in known:
             hint = difflib.get_close_matches(name, known, n=1)
             more = f"; did you mean {hint[0]!r}?" if hint else ""

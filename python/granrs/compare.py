@@ -51,6 +51,7 @@ predictions are its in-sample ones.
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -62,6 +63,7 @@ import pandas as pd
 
 from . import forces as _forces
 from .batch import _threads as _check_threads
+from .bodies import CONTACT_SHAPES
 from .calibrate import Measurements, calibrate, evaluate
 from .calibrate.fit import _residual_frame
 from .calibrate.model import _parse_param, base_coefficients
@@ -78,6 +80,7 @@ __all__ = [
     "Law",
     "compare",
     "scenes",
+    "sums",
     "synthetic",
     "to_json",
 ]
@@ -121,6 +124,33 @@ class Law:
     fixed_body: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     body_unknowns: bool = True
 
+    def __add__(self, other: Law) -> Law:
+        """The sum of two laws: both laws' terms (a term that both list is refused), the
+        parameters either fits (``other``'s win on a name both fit), and the thesis's terms
+        if either starts from them; the body's unknowns fitted only if both fit them."""
+        if not isinstance(other, Law):
+            return NotImplemented
+        clash = sorted({t for t, _ in self.terms} & {t for t, _ in other.terms})
+        if clash:
+            raise InvalidParameterError(
+                f"laws {self.name!r} and {other.name!r} both list the term {clash[0]!r}",
+                field="laws",
+            )
+
+        def merged(a: Mapping[str, Mapping[str, Any]], b: Mapping[str, Mapping[str, Any]]) -> Any:
+            return {k: {**a.get(k, {}), **b.get(k, {})} for k in {*a, *b}}
+
+        return Law(
+            f"{self.name}+{other.name}",
+            f"{self.summary}; plus {other.summary}",
+            thesis=self.thesis or other.thesis,
+            terms=(*self.terms, *other.terms),
+            fit={**self.fit, **other.fit},
+            fit_body=merged(self.fit_body, other.fit_body),
+            fixed_body=merged(self.fixed_body, other.fixed_body),
+            body_unknowns=self.body_unknowns and other.body_unknowns,
+        )
+
     def params_for(self, body: str) -> dict[str, FitParam]:
         """The law's own parameters fitted on ``body`` (without the body's unknowns)."""
         out: dict[str, FitParam | None] = {**self.fit, **self.fit_body.get(body, {})}
@@ -144,7 +174,7 @@ class Law:
             held = {k.split(".", 1)[1]: v for k, v in fixed.items() if k.startswith(name + ".")}
             extra.append(_forces.term(name, **{**params, **held, **starts}))
         listed = {t.name for t in extra}
-        head, tail = _body_terms()
+        head, tail = (tuple(n for n in names if _acts_on(n, body)) for names in _body_terms())
 
         def law(row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
             if self.thesis:
@@ -156,6 +186,14 @@ class Law:
             return (*base, *extra, *after)
 
         return law
+
+
+def _acts_on(term: str, body: str) -> bool:
+    """Whether ``term`` acts on ``body``: on a planar contact's shape, or (a body in space)
+    on a shape that is not one."""
+    shapes = set(_forces.info(term).shapes)
+    planar = shapes & set(CONTACT_SHAPES)
+    return bool(shapes - planar) if body == "space" else bool(planar)
 
 
 def _body_terms() -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -250,6 +288,7 @@ BODY_UNKNOWNS: dict[str, dict[str, FitParam]] = {
     "free_link": {},
     "chain": {},
     "leg": {"joints.k": (300.0, 100.0, 1000.0)},
+    "space": {},
 }
 
 
@@ -382,7 +421,7 @@ def _group_column(name: str, m: Measurements, folds: Any) -> str | None:
             "free_link": "q_deg",
             "chain": "v0_case",
             "leg": "height_case" if "subject" not in m.rows.columns else "subject",
-        }[m.body]
+        }.get(m.body)
         return default if default in m.rows.columns else None
     if not isinstance(folds, str) or folds not in m.rows.columns:
         hint = difflib.get_close_matches(str(folds), list(m.rows.columns), n=1)
@@ -398,6 +437,9 @@ def _unavailable(law: Law, body: str) -> str:
     for name in law.needs():
         if name not in _forces.TERMS:
             return f"the term {name!r} is not in this build of granrs"
+        if not _acts_on(name, body):
+            where = "a body in space" if body == "space" else f"the planar {body}"
+            return f"the term {name!r} does not act on {where}"
     for name, _ in law.terms:
         given = {p.name for p in _forces.info(name).params}
         for k in dict(law.terms)[name]:
@@ -417,12 +459,31 @@ class _Job:
 
     law: Law
     body: str
+    #: What calibrate takes as its cases: the body's name, or (space) the function of
+    #: the row that makes its scene.
+    cases: Any
     params: dict[str, FitParam]
     overrides: dict[str, Any]
     joints: dict[str, float] | None
 
 
-def _job(law: Law, name: str, m: Measurements) -> _Job:
+def _scene_fn(cases: Any, name: str, m: Measurements) -> Any:
+    """The function that makes a row's scene for the dataset ``name`` if its measurements
+    are of bodies in space (``cases``: one function, or a mapping of dataset name to one);
+    None for the thesis's bodies."""
+    if m.body != "space":
+        return None
+    fn = cases.get(name) if isinstance(cases, Mapping) else cases
+    if not callable(fn):
+        raise InvalidParameterError(
+            f"the {name} measurements are of bodies in space: cases= must give the function "
+            "of a measurement row that returns its granrs.space.Scene",
+            field="cases",
+        )
+    return fn
+
+
+def _job(law: Law, name: str, m: Measurements, scene_of: Any = None) -> _Job:
     body = m.body
     params = dict(law.params_for(body))
     settings = DATASETS[name] if name in DATASETS else Dataset("", "")
@@ -436,13 +497,13 @@ def _job(law: Law, name: str, m: Measurements) -> _Job:
     if isinstance(joints, str):
         overrides.update({j: joints for j in ("ankle", "knee", "hip")})
         joints = None
-    return _Job(law, body, params, overrides, joints)
+    return _Job(law, body, scene_of if body == "space" else body, params, overrides, joints)
 
 
 def _fit(job: _Job, m: Measurements, dt: float, threads: int | None, starts: int) -> Any:
     names = list(job.params)
     return calibrate(
-        job.body,
+        job.cases,
         m,
         names,
         bounds={k: (v[1], v[2]) for k, v in job.params.items()},
@@ -462,7 +523,7 @@ def _predict(
     if fit is not None:
         return fit.predict(m)
     return evaluate(
-        job.body,
+        job.cases,
         m,
         forces=job.law.terms_for(job.body),
         joints=job.joints,
@@ -656,6 +717,7 @@ def compare(
     starts: int = 1,
     threads: int | None = None,
     progress: bool | None = None,
+    cases: Any = None,
 ) -> pd.DataFrame:
     """Fit every law to every dataset and cross-validate it; one row per dataset and law.
 
@@ -676,6 +738,10 @@ def compare(
         starts: starts of each fit (:func:`granrs.calibrate`).
         threads: the sweeps' worker threads (default: every core).
         progress: a tqdm bar over the fits (None: on a terminal).
+        cases: for measurements of bodies in space (body ``"space"``), the function of a
+            measurement row that returns its :class:`granrs.space.Scene` (as
+            :func:`granrs.calibrate` takes it), or a mapping of dataset name to one. Their
+            folds are not guessed: name the column (``folds="v0"``).
 
     Returns:
         A DataFrame with the columns of the module's notes, one row per (dataset, law), in
@@ -699,6 +765,7 @@ def compare(
     _check_dt(dt)
     _check_threads(threads)
     groups = {name: _group_column(name, m, folds) for name, m in data.items()}
+    scene_fns = {name: _scene_fn(cases, name, m) for name, m in data.items()}
     plans: list[tuple[str, Law, Measurements, str | None, _Job | None, str]] = []
     total = 0
     for name, m in data.items():
@@ -706,7 +773,7 @@ def compare(
             reason = _unavailable(law, m.body)
             job = None
             if not reason:
-                job = _job(law, name, m)
+                job = _job(law, name, m, scene_fns[name])
                 n_groups = len(pd.unique(m.rows[groups[name]])) if groups[name] else 0
                 total += 1 + (n_groups if job.params else 0)
             plans.append((name, law, m, groups[name], job, reason))
@@ -737,6 +804,38 @@ def compare(
     frame = pd.DataFrame.from_records(records)
     frame["rank"] = _rank(frame)
     return frame
+
+
+def sums(
+    pieces: Iterable[str | Law],
+    measurements: Any = None,
+    *,
+    base: str | Law | None = None,
+    max_terms: int = 2,
+    **options: Any,
+) -> pd.DataFrame:
+    """Search over small sums of laws in one call: every sum of 1 to ``max_terms`` of
+    ``pieces`` (law names or :class:`Law` objects, added with ``+``), each on top of
+    ``base`` when given (``base`` itself is compared too), fitted and cross-validated by
+    :func:`granrs.compare` (``options``: its keywords). A sum in which two pieces list the same term
+    is left out. Returns :func:`granrs.compare`'s frame, one row per dataset and sum, ranked."""
+    items = _law_list(pieces)
+    if isinstance(max_terms, bool) or not isinstance(max_terms, int) or max_terms < 1:
+        raise InvalidParameterError(
+            f"max_terms must be an integer >= 1; got {max_terms!r}", field="max_terms"
+        )
+    start = _law_list([base])[0] if base is not None else None
+    laws = [start] if start is not None else []
+    for k in range(1, min(max_terms, len(items)) + 1):
+        for combo in itertools.combinations(items, k):
+            try:
+                law = combo[0] if start is None else start + combo[0]
+                for piece in combo[1:]:
+                    law = law + piece
+            except InvalidParameterError:
+                continue  # two of them list the same term
+            laws.append(law)
+    return compare(laws, measurements, **options)
 
 
 def _check_dt(dt: Any) -> None:
@@ -870,6 +969,7 @@ def synthetic(
     seed: int = 0,
     dataset: str | None = None,
     dt: float = 1e-4,
+    cases: Any = None,
 ) -> Measurements:
     """Measurements made by granrs under ``law`` at the parameter ``values``, with noise:
     the rows of ``like`` (its angles, speeds, cases), each mean drawn from a normal
@@ -880,7 +980,9 @@ def synthetic(
 
     ``values`` gives every fitted parameter of the law on that body (its own and the
     body's unknowns, as :func:`granrs.compare` fits them; ``dataset`` names the settings of
-    :data:`~granrs.compare.DATASETS` to use, default the body's name)."""
+    :data:`~granrs.compare.DATASETS` to use, default the body's name; ``cases``: for
+    measurements of bodies in space, the function of a row that makes its scene, as
+    :func:`granrs.compare` takes it)."""
     (law_obj,) = _law_list([law])
     m = like if isinstance(like, Measurements) else Measurements.load(like)
     _check_dt(dt)
@@ -889,7 +991,8 @@ def synthetic(
     reason = _unavailable(law_obj, m.body)
     if reason:
         raise InvalidParameterError(f"law {law_obj.name}: {reason}", field="law")
-    job = _job(law_obj, dataset or m.body, m)
+    name = dataset or m.body
+    job = _job(law_obj, name, m, _scene_fn(cases, name, m))
     missing = [p for p in job.params if p not in values]
     extra = [p for p in values if p not in job.params]
     if missing or extra:
@@ -931,6 +1034,7 @@ def _model(job: _Job, dt: float) -> Any:
         dict(job.overrides),
         dict(job.joints or {}),
         _check_law(job.law.terms_for(job.body)),
+        scene_of=job.cases if job.body == "space" else None,
     )
 
 
@@ -947,13 +1051,16 @@ def scenes(
     *,
     dataset: str | None = None,
     dt: float = 1e-4,
+    cases: Any = None,
 ) -> list[Any]:
     """The scenes :func:`granrs.compare` runs for the rows of ``measurements`` under ``law`` at
     the parameter ``values`` (e.g. one fold's ``folds[i]["values"]``): one per row (one
-    per case for the chain), to rerun or record a prediction."""
+    per case for the chain), to rerun or record a prediction (``cases`` as
+    :func:`granrs.compare` takes it)."""
     (law_obj,) = _law_list([law])
     m = measurements if isinstance(measurements, Measurements) else Measurements.load(measurements)
-    job = _job(law_obj, dataset or m.body, m)
+    name = dataset or m.body
+    job = _job(law_obj, name, m, _scene_fn(cases, name, m))
     given = dict(values or {})
     if set(given) != set(job.params):
         raise InvalidParameterError(

@@ -18,6 +18,7 @@ __all__ = [
     "InvalidParameterError",
     "InvalidSceneError",
     "MeasurementError",
+    "MediumError",
     "SimulationError",
     "StepSizeWarning",
     "UnknownNameError",
@@ -51,6 +52,12 @@ class CoefficientTableError(InvalidSceneError):
 class MeasurementError(InvalidSceneError):
     """A measurements table (for :func:`granrs.calibrate`) could not be read or holds
     invalid values. ``field`` names the column (or ``"measurements"``)."""
+
+
+class MediumError(InvalidSceneError):
+    """A medium card (:mod:`granrs.media`) could not be read or holds an invalid entry: an
+    unknown term or parameter, a value out of the parameter's range, a value without its
+    source. ``field`` names the entry (``rft.zeta``, ``rho_g``, ``name``, ...)."""
 
 
 class SimulationError(GranrsError, RuntimeError):

@@ -164,20 +164,34 @@ def info(name: str) -> TermInfo:
     return _INFO[name]
 
 
+def _placeholder(p: Param) -> float:
+    """A value inside ``p``'s range, to check a term's other parameters while a required
+    one is still to come from a medium."""
+    low = p.min if math.isfinite(p.min) else 0.0
+    return max(low, min(1.0, p.max)) if not p.integer else math.ceil(low)
+
+
 @dataclass(frozen=True)
 class Term:
     """One force term with its parameters, checked by the core when built.
 
     Build terms with the constructors of this module (:func:`drag`, ...) or :func:`term`.
 
+    A required parameter (``rft.zeta``, ``poncelet.c``) may be left out: the term then
+    takes it from the scene's medium (:mod:`granrs.media`), and a scene without a medium
+    that gives it refuses the term, naming the parameter (:attr:`missing`).
+
     Attributes:
         name: the term's registered name.
         params: every parameter, defaults filled in: a float for every contact or a tuple
-            with one value per contact (read-only).
+            with one value per contact (read-only); a required one left out is absent.
+        given: the names of the parameters the caller gave (the others are defaults,
+            which a scene's medium replaces by its card's values); not compared.
     """
 
     name: str
     params: Mapping[str, ParamValue] = field(default_factory=dict)
+    given: frozenset[str] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -188,12 +202,33 @@ class Term:
             raise InvalidParameterError(
                 f"{self.name}: params must be a mapping, got {self.params!r}", field=self.name
             )
-        checked = dict(_granrs.check_term(self.name, dict(self.params)))
+        given = dict(self.params)
+        ti = _INFO.get(self.name)
+        later = [p for p in ti.params if p.required and p.name not in given] if ti else []
+        probe = {**given, **{p.name: _placeholder(p) for p in later}}
+        checked = dict(_granrs.check_term(self.name, probe))
+        for p in later:
+            del checked[p.name]
         for p in _INFO[self.name].params:
-            v = checked[p.name]
-            if p.integer:
+            v = checked.get(p.name)
+            if p.integer and v is not None:
                 checked[p.name] = tuple(int(x) for x in v) if isinstance(v, tuple) else int(v)
         object.__setattr__(self, "params", MappingProxyType(checked))
+        names = frozenset(str(k) for k in given) if self.given is None else frozenset(self.given)
+        object.__setattr__(self, "given", names & set(checked))
+
+    @property
+    def missing(self) -> tuple[str, ...]:
+        """The required parameters left out (to come from a medium), in the registry's
+        order."""
+        return tuple(p.name for p in self.info.params if p.name not in self.params)
+
+    def require(self) -> Term:
+        """This term if it has every required parameter; else the core's typed error naming
+        the first missing one (``rft.zeta``), as a term without it was refused before."""
+        if self.missing:
+            _granrs.check_term(self.name, dict(self.params))
+        return self
 
     @property
     def info(self) -> TermInfo:
@@ -210,7 +245,8 @@ class Term:
 
     def replace(self, **params: ParamValue) -> Term:
         """A copy with some parameters changed (checked like the constructor)."""
-        return Term(self.name, {**self.params, **params})
+        given = (self.given or frozenset()) | set(params)
+        return Term(self.name, {**self.params, **params}, given)
 
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.params.items())
@@ -226,7 +262,7 @@ class Term:
 
     def __reduce__(self) -> tuple[Any, ...]:
         # Pickle (Dask, multiprocessing) by name and plain parameters.
-        return (Term, (self.name, dict(self.params)))
+        return (Term, (self.name, dict(self.params), self.given))
 
 
 def term(name: str, **params: ParamValue) -> Term:

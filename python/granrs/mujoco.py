@@ -41,7 +41,7 @@ except ImportError as exc:  # pragma: no cover - exercised in a venv without muj
         "(or pip install 'mujoco>=3')"
     ) from exc
 
-from . import _granrs
+from . import _granrs, media
 from .api import RK4_STABILITY_LIMIT
 from .errors import InvalidParameterError, InvalidSceneError, StepSizeWarning, UnknownNameError
 from .forces import Term, as_terms
@@ -114,6 +114,14 @@ _SPACE_TYPES = {
 ELLIPSOID_SUBDIVISIONS = 3
 
 
+def _default(value: Any, default: float) -> bool:
+    """Whether an argument is its default (an array or another type is not)."""
+    try:
+        return bool(value == default)
+    except (TypeError, ValueError):
+        return False
+
+
 def _number(value: Any, name: str) -> float:
     if isinstance(value, bool | np.bool_):
         raise InvalidParameterError(f"`{name}` must be a number, got {value!r}", field=name)
@@ -181,6 +189,10 @@ class Sand:
             viscous law (:data:`REST_SPEED`).
         quadrature: in space: Gauss-Legendre nodes per panel of a curved surface
             (:data:`granrs.space.DEFAULT_QUADRATURE`).
+        medium: the granular medium (:mod:`granrs.media`): a shipped card's name, a card
+            file's path or a card. Its ``rho_g`` (where ``rho_g`` is left at its default)
+            and its values of the terms' parameters not given (``rft3d()`` without
+            ``zeta``) are the sand's; gravity stays the model's.
 
     Every argument is checked here, before the first step; each error is a
     :class:`granrs.GranrsError` (a ``ValueError``) naming the geom or parameter.
@@ -206,6 +218,7 @@ class Sand:
         space: bool | None = None,
         rest_speed: float = REST_SPEED,
         quadrature: int = DEFAULT_QUADRATURE,
+        medium: Any = None,
     ) -> None:
         if not isinstance(model, mujoco.MjModel):
             raise InvalidParameterError(
@@ -220,6 +233,10 @@ class Sand:
         if len(set(names)) != len(names):
             raise InvalidSceneError("`geoms` lists a geom twice", field="geoms")
         self.surface = _number(surface, "surface")
+        card = None if medium is None else media.load(medium)
+        self.medium = card
+        if card is not None and card.rho_g is not None and _default(rho_g, 1650.0):
+            rho_g = card.rho_g
         rho = _number(rho_g, "rho_g")
         if rho <= 0.0:
             raise InvalidParameterError(f"`rho_g` must be > 0, got {rho}", field="rho_g")
@@ -253,7 +270,16 @@ class Sand:
                 field="model.opt.gravity",
             )
         self.g = float(np.linalg.norm(gravity))
-        terms = list(as_terms(forces))
+        terms = (
+            list(media.resolve_terms(as_terms(forces), card)) if card else list(as_terms(forces))
+        )
+        for t in terms:
+            if t.missing:
+                try:
+                    t.require()
+                except InvalidSceneError as e:
+                    where = f"the medium {card.name!r}" if card else "a medium= whose card has it"
+                    raise type(e)(f"{e}; give it, or {where}", field=e.field) from None
         if space is None:
             space = any(t.name in SPACE_TERMS for t in terms)
         elif not isinstance(space, bool | np.bool_):
@@ -328,7 +354,7 @@ class Sand:
         )
         self.apply_at = apply_at
         dofs = self._dofs(self._body)
-        self._coupling: Any = _granrs.GeomCoupling(
+        self._coupling = _granrs.MujocoCoupling.planar(
             self._core,
             [int(i) for i in self._ids],
             [int(b) for b in self._body],
@@ -424,7 +450,7 @@ class Sand:
         self._root = np.asarray(m.body_rootid[self._body], dtype=np.intp)
         self.rest_speed = speed
         self.apply_at = "centre"
-        self._coupling = _granrs.SpaceCoupling(
+        self._coupling = _granrs.MujocoCoupling.space(
             list(names),
             shapes,
             [(t.name, dict(t.params)) for t in terms],
@@ -617,10 +643,11 @@ class Sand:
             )
             self._data_ref = data
         mujoco.mj_fullM(m, data, self._mass)
+        worst, geom, iterations, residual, converged, fell = self._coupling.step(
+            self._opt.timestep, passive, fresh, hold
+        )
         if self.space:
-            worst, _, self.iterations, self.residual, self.converged, fell = self._coupling.step(
-                self._opt.timestep, passive, fresh, hold
-            )
+            self.iterations, self.residual, self.converged = iterations, residual, converged
             self.max_residual = max(self.max_residual, self.residual)
             self.max_h_lambda = max(self.max_h_lambda, worst)
             self.fallbacks += int(fell)
@@ -637,7 +664,6 @@ class Sand:
                     stacklevel=4,
                 )
             return
-        worst, geom = self._coupling.step(self._opt.timestep, passive, fresh, hold)
         if worst > self.max_h_lambda:
             self.max_h_lambda = worst
             self._warn_step_size(worst, geom)

@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _granrs, data
+from . import _granrs, data, media
 from .bodies import Linkage
 from .coefficients import Coefficients, resolve
 from .errors import CoefficientsWarning, InvalidParameterError, InvalidSceneError, UnknownNameError
@@ -348,6 +348,7 @@ class Scene:
     inertia: float | None = None
     rho_g: float = 1650.0
     g: float = 9.81
+    medium: str | os.PathLike[str] | media.MediumCard | None = None
     coefficients_source: str = "Table 3.4, row q = 0 deg"
     q_deg: float = 0.0
     v0: float = 2.214
@@ -424,6 +425,7 @@ class Scene:
                     field=name,
                 )
         object.__setattr__(self, "forces", as_terms(self.forces))
+        media.apply(self)
         object.__setattr__(self, "record", _names(self.record, "record", RECORDS))
         rule = _ROW_RULES.get(kind)
         change = _row_change(self, getattr(self, rule.field)) if rule else None
@@ -459,6 +461,7 @@ class Scene:
         ):
             # Terms given by the caller are theirs: no table row is followed any more.
             changes["coefficients_source"] = OWN_FORCES
+        media.leave(self, changes, _DEFAULTS)
         return dataclasses.replace(self, **changes)
 
     @property
@@ -483,6 +486,9 @@ class Scene:
         d["body"] = self.body._core_value  # type: ignore[union-attr]
         d["forces"] = [t.to_dict() for t in self.forces]
         d["record"] = list(self.record)
+        if self.medium is not None:
+            card = self.medium
+            d["medium"] = media.reference(card) or card.to_dict()  # type: ignore[arg-type,union-attr]
         return d
 
     def _plain(self) -> dict[str, Any]:

@@ -52,7 +52,7 @@ import sys
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from . import _granrs, forces, space
+from . import _granrs, forces, media, space
 from ._files import write_text
 from .bodies import ELEMENT_FIELDS
 from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
@@ -221,6 +221,13 @@ def dumps(scene: Scene | space.Scene, *, comments: bool = True, header: str | No
             else:
                 tables.extend(_body_tables(value._core_value))
             continue
+        if name == "medium":
+            ref = media.reference(value)
+            if ref is None:
+                tables.extend(["", *value.toml_lines("medium")])
+            else:
+                lines.append(_line(name, _format_value(ref), note))
+            continue
         if name == "forces":
             if not value:
                 lines.append(_line(name, "[]", "nothing acts"))
@@ -267,6 +274,13 @@ def _dumps_space(scene: Any, header: str | None) -> str:
             for t in value:
                 tables += ["", "[[forces]]", f"term = {_format_value(t.name)}"]
                 tables += [f"{_format_key(k)} = {_format_value(v)}" for k, v in t.params.items()]
+            continue
+        if name == "medium":
+            ref = None if value is None else media.reference(value)
+            if value is not None and ref is None:
+                tables.extend(["", *value.toml_lines("medium")])
+            elif ref is not None:
+                lines.append(f"{name} = {_format_value(ref)}")
             continue
         if isinstance(value, tuple):
             value = list(value)
@@ -745,6 +759,7 @@ def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | No
     if in_space and "forces" not in data:
         data["forces"] = []
     origins = _apply_overrides(data, overrides)
+    _medium_path(data, source)
     lines = key_lines(text)
 
     def locate(path: tuple[str, ...]) -> str:
@@ -765,6 +780,21 @@ def loads(text: str, source: str = "<string>", overrides: Mapping[str, Any] | No
         _check_format(data, locate)
         return _build_space(data, locate)
     return _build(data, locate)
+
+
+def _medium_path(data: dict[str, Any], source: str) -> None:
+    """A scene file's ``medium`` given as a relative path is relative to the file's folder
+    (when the file is read from a path and the card is there)."""
+    value = data.get("medium")
+    if not isinstance(value, str) or value in media.names() or os.path.isabs(value):
+        return
+    try:
+        folder = os.path.dirname(source) if os.path.isfile(source) else ""
+        candidate = os.path.join(folder, value)
+        if folder and os.path.isfile(candidate):
+            data["medium"] = candidate
+    except (OSError, ValueError):
+        return
 
 
 def load(path: str | os.PathLike[str], overrides: Mapping[str, Any] | None = None) -> Any:

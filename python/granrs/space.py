@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _granrs
+from . import _granrs, media
 from .errors import InvalidParameterError
 from .forces import Term
 
@@ -297,8 +297,13 @@ class Scene:
         velocity: the centre's velocity at t = 0 [m/s].
         omega: the angular velocity at t = 0, world frame [rad/s].
         rho_g: the sand's bulk density [kg/m^3] (1650, the thesis's sand), read by
-            ``rft3d_inertial`` and ``poncelet``.
-        g: gravity [m/s^2] (9.81).
+            ``rft3d_inertial`` and ``poncelet``; the medium's where one is given (and
+            this is left at its default).
+        g: gravity [m/s^2] (9.81); the medium's, as ``rho_g``.
+        medium: the granular medium (:mod:`granrs.media`): a shipped card's name, a card
+            file's path or a :class:`granrs.media.MediumCard`. Its ``rho_g`` and ``g``, and
+            its values of the listed terms' parameters not given (``rft3d(...)`` without
+            ``zeta``), are the scene's. ``None`` (default): no medium.
         surface: the sand's surface z [m].
         dt: the step [s] (1e-4: 10 kHz, as the planar scenes).
         t_end: the end time [s].
@@ -316,6 +321,7 @@ class Scene:
     omega: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rho_g: float = 1650.0
     g: float = 9.81
+    medium: str | os.PathLike[str] | media.MediumCard | None = None
     surface: float = 0.0
     dt: float = 1e-4
     t_end: float = 1.0
@@ -349,6 +355,7 @@ class Scene:
     def __post_init__(self) -> None:
         if isinstance(self.forces, list | tuple):
             object.__setattr__(self, "forces", tuple(self.forces))
+        media.apply(self)
         if self.position is None:
             probe = _granrs.space_scene(self._dict((0.0, 0.0, 0.0)))
             low = probe.lowest_offset()
@@ -357,7 +364,10 @@ class Scene:
         object.__setattr__(self, "_compiled", _granrs.space_scene(self._dict(self.position)))
 
     def replace(self, **changes: Any) -> Scene:
-        """A copy with ``changes`` (checked as a new scene)."""
+        """A copy with ``changes`` (checked as a new scene). A new ``medium`` applies as to
+        a new scene: what the old one set goes back to its default first."""
+        defaults = {f.name: f.default for f in dataclasses.fields(self)}
+        media.leave(self, changes, defaults)
         return dataclasses.replace(self, **changes)
 
     @property

@@ -69,6 +69,48 @@ pub struct JointSpec {
     pub table: Option<DriveTable>,
 }
 
+/// Each joint kind's keys beyond `name`, `parent`, `child`, `at` and `kind`, as a user
+/// writes them: the one list that the scene file's keys, the linkage's checks and the
+/// joint's dict read (a driven joint's `table` is not a number; [`JointSpec::fields`]).
+pub const JOINT_FIELDS: &[(&str, &[&str])] = &[
+    ("free", &[]),
+    ("locked", &[]),
+    ("spring", &["k", "c", "rest_deg"]),
+    (
+        "driven",
+        &["rate", "amplitude_deg", "frequency", "phase_deg", "table"],
+    ),
+];
+
+impl JointSpec {
+    /// Its kind and its numbers as a user writes them (angles in degrees, the frequency in
+    /// Hz), named by [`JOINT_FIELDS`]; a table-driven joint has none.
+    pub fn fields(&self) -> (&'static str, impl Iterator<Item = (&'static str, f64)>) {
+        let (i, values) = match self.joint {
+            Joint::Free => (0, vec![]),
+            Joint::Locked => (1, vec![]),
+            Joint::Spring { k, c, rest } => (2, vec![k, c, rest.to_degrees()]),
+            Joint::Driven {
+                rate,
+                amplitude,
+                omega,
+                phase,
+            } => (
+                3,
+                vec![
+                    rate,
+                    amplitude.to_degrees(),
+                    omega / std::f64::consts::TAU,
+                    phase.to_degrees(),
+                ],
+            ),
+            Joint::Table => (3, vec![]),
+        };
+        let (kind, keys) = JOINT_FIELDS[i];
+        (kind, keys.iter().copied().zip(values))
+    }
+}
+
 /// A contact's shape and where it sits on its link.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactShape {
@@ -117,6 +159,18 @@ pub enum ContactShape {
     },
 }
 
+/// Each contact shape's name and the numbers it reads beyond `name`, `link` and `at`, as a
+/// user writes them (angles in degrees): the one list that the scene file's keys, the
+/// linkage's checks and the contact's dict read.
+pub const SHAPE_FIELDS: &[(&str, &[&str])] = &[
+    ("rod", &["length", "diameter"]),
+    ("box", &["length", "height", "width", "l_ref"]),
+    (
+        "arc",
+        &["radius", "start_deg", "end_deg", "width", "chords"],
+    ),
+];
+
 impl ContactShape {
     /// Its kind, as a term's list of shapes names it.
     pub fn kind(&self) -> ContactKind {
@@ -125,6 +179,45 @@ impl ContactShape {
             ContactShape::Box { .. } => ContactKind::Box,
             ContactShape::Arc { .. } => ContactKind::Arc,
         }
+    }
+
+    /// Its place on its link, local (s, n) [m]: a rod's tip, a box's corner, an arc's centre.
+    pub fn at(&self) -> Vector2<f64> {
+        match *self {
+            ContactShape::Rod { tip, .. } => tip,
+            ContactShape::Box { corner, .. } => corner,
+            ContactShape::Arc { centre, .. } => centre,
+        }
+    }
+
+    /// Its name and its numbers as a user writes them, named by [`SHAPE_FIELDS`].
+    pub fn fields(&self) -> (&'static str, impl Iterator<Item = (&'static str, f64)>) {
+        let (i, values) = match *self {
+            ContactShape::Rod {
+                length, diameter, ..
+            } => (0, vec![length, diameter]),
+            ContactShape::Box {
+                length,
+                height,
+                width,
+                l_ref,
+                ..
+            } => (1, vec![length, height, width, l_ref]),
+            ContactShape::Arc {
+                radius,
+                start,
+                end,
+                width,
+                chords,
+                ..
+            } => (
+                2,
+                vec![radius, start.to_degrees(), end.to_degrees(), width, chords],
+            ),
+        };
+        let (name, keys) = SHAPE_FIELDS[i];
+        debug_assert_eq!(keys.len(), values.len());
+        (name, keys.iter().copied().zip(values))
     }
 }
 
@@ -195,6 +288,26 @@ fn bad(field: String, message: String) -> GranrsError {
     GranrsError::InvalidScene { field, message }
 }
 
+/// Every element of a list (`links`, `joints`) has a name, and no two the same.
+fn check_names<'a>(list: &str, what: &str, names: impl Iterator<Item = &'a str>) -> Result<()> {
+    let names: Vec<&str> = names.collect();
+    for (i, name) in names.iter().enumerate() {
+        if name.is_empty() {
+            return Err(bad(
+                format!("{list}[{i}].name"),
+                format!("a {what} needs a name"),
+            ));
+        }
+        if names[..i].contains(name) {
+            return Err(bad(
+                format!("{list}.{name}.name"),
+                format!("two {list} are named {name:?}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn check_point(field: &str, p: Vector2<f64>) -> Result<()> {
     check_finite(&format!("{field}[0]"), p.x)?;
     check_finite(&format!("{field}[1]"), p.y)?;
@@ -235,17 +348,9 @@ impl LinkageScene {
                 allowed: format!("at most {MAX_CONTACTS} contacts"),
             });
         }
-        for (i, l) in self.links.iter().enumerate() {
+        check_names("links", "link", self.links.iter().map(|l| l.name.as_str()))?;
+        for l in &self.links {
             let f = |k: &str| format!("links.{}.{k}", l.name);
-            if l.name.is_empty() {
-                return Err(bad(
-                    format!("links[{i}].name"),
-                    "a link needs a name".into(),
-                ));
-            }
-            if self.links[..i].iter().any(|o| o.name == l.name) {
-                return Err(bad(f("name"), format!("two links are named {:?}", l.name)));
-            }
             check_range(&f("mass"), l.mass, 0.0, true)?;
             check_range(&f("inertia"), l.inertia, 0.0, true)?;
             check_range(&f("length"), l.length, 0.0, true)?;
@@ -276,17 +381,13 @@ impl LinkageScene {
             ));
         }
         let mut locked = 0;
+        check_names(
+            "joints",
+            "joint",
+            self.joints.iter().map(|j| j.name.as_str()),
+        )?;
         for (i, j) in self.joints.iter().enumerate() {
             let f = |k: &str| format!("joints.{}.{k}", j.name);
-            if j.name.is_empty() {
-                return Err(bad(
-                    format!("joints[{i}].name"),
-                    "a joint needs a name".into(),
-                ));
-            }
-            if self.joints[..i].iter().any(|o| o.name == j.name) {
-                return Err(bad(f("name"), format!("two joints are named {:?}", j.name)));
-            }
             for (k, name) in [("parent", &j.parent), ("child", &j.child)] {
                 if self.link_index(name).is_none() {
                     return Err(self.unknown_link(&f(k), name));
@@ -319,32 +420,15 @@ impl LinkageScene {
                 ));
             }
             check_point(&f("at"), j.at)?;
-            match j.joint {
-                Joint::Spring { k, c, rest } => {
-                    check_range(&f("k"), k, 0.0, false)?;
-                    check_range(&f("c"), c, 0.0, false)?;
-                    check_finite(&f("rest_deg"), rest)?;
+            for (k, value) in j.fields().1 {
+                if matches!(k, "k" | "c") {
+                    check_range(&f(k), value, 0.0, false)?;
+                } else {
+                    check_finite(&f(k), value)?;
                 }
-                Joint::Driven {
-                    rate,
-                    amplitude,
-                    omega,
-                    phase,
-                } => {
-                    for (k, v, what) in [
-                        ("rate", rate, "a finite rate [rad/s]"),
-                        ("amplitude_deg", amplitude, "a finite amplitude [deg]"),
-                        ("frequency", omega, "a finite frequency [Hz]"),
-                        ("phase_deg", phase, "a finite phase [deg]"),
-                    ] {
-                        if !v.is_finite() {
-                            return Err(GranrsError::InvalidParameter {
-                                field: f(k),
-                                value: v,
-                                allowed: format!("a finite trajectory: {what}"),
-                            });
-                        }
-                    }
+            }
+            match j.joint {
+                Joint::Driven { amplitude, .. } => {
                     if amplitude != 0.0 && n >= MAX_LINKS {
                         return Err(GranrsError::InvalidParameter {
                             field: "links".into(),
@@ -363,7 +447,7 @@ impl LinkageScene {
                     locked += 1;
                 }
                 Joint::Locked => locked += 1,
-                Joint::Free => {}
+                Joint::Free | Joint::Spring { .. } => {}
             }
             if j.table.is_some() && j.joint != Joint::Table {
                 return Err(bad(
@@ -420,67 +504,49 @@ impl LinkageScene {
             if self.link_index(&c.link).is_none() {
                 return Err(self.unknown_link(&f("link"), &c.link));
             }
-            match c.shape {
-                ContactShape::Rod {
-                    tip,
-                    length,
-                    diameter,
-                } => {
-                    check_point(&f("at"), tip)?;
-                    check_range(&f("length"), length, 0.0, true)?;
-                    check_range(&f("diameter"), diameter, 0.0, true)?;
+            if let ContactShape::Box {
+                thesis_angle_of: Some(i),
+                ..
+            } = c.shape
+            {
+                if i >= self.links.len() {
+                    return Err(bad(
+                        f("thesis_angle_of"),
+                        "names no link of this linkage".into(),
+                    ));
                 }
-                ContactShape::Box {
-                    corner,
-                    length,
-                    height,
-                    width,
-                    l_ref,
-                    thesis_angle_of,
-                } => {
-                    if thesis_angle_of.is_some_and(|i| i >= self.links.len()) {
-                        return Err(bad(
-                            f("thesis_angle_of"),
-                            "names no link of this linkage".into(),
-                        ));
+            }
+            check_point(&f("at"), c.shape.at())?;
+            for (k, value) in c.shape.fields().1 {
+                match k {
+                    "start_deg" | "end_deg" => {
+                        check_finite(&f(k), value)?;
                     }
-                    check_point(&f("at"), corner)?;
-                    check_range(&f("length"), length, 0.0, true)?;
-                    check_range(&f("height"), height, 0.0, true)?;
-                    check_range(&f("width"), width, 0.0, true)?;
-                    check_range(&f("l_ref"), l_ref, 0.0, true)?;
+                    "chords" => {
+                        if !(value >= 1.0 && value <= MAX_CHORDS as f64 && value.fract() == 0.0) {
+                            return Err(GranrsError::InvalidParameter {
+                                field: f(k),
+                                value,
+                                allowed: format!("a whole number from 1 to {MAX_CHORDS}"),
+                            });
+                        }
+                    }
+                    _ => {
+                        check_range(&f(k), value, 0.0, true)?;
+                    }
                 }
-                ContactShape::Arc {
-                    centre,
-                    radius,
-                    start,
-                    end,
-                    width,
-                    chords,
-                } => {
-                    check_point(&f("at"), centre)?;
-                    check_range(&f("radius"), radius, 0.0, true)?;
-                    check_finite(&f("start_deg"), start)?;
-                    check_finite(&f("end_deg"), end)?;
-                    let span = end - start;
-                    if !(span > 0.0 && span <= std::f64::consts::TAU * (1.0 + 1e-12)) {
-                        return Err(GranrsError::InvalidParameter {
-                            field: f("end_deg"),
-                            value: end.to_degrees(),
-                            allowed: format!(
-                                "start_deg < end_deg <= start_deg + 360 (start_deg = {})",
-                                start.to_degrees()
-                            ),
-                        });
-                    }
-                    check_range(&f("width"), width, 0.0, true)?;
-                    if !(chords >= 1.0 && chords <= MAX_CHORDS as f64 && chords.fract() == 0.0) {
-                        return Err(GranrsError::InvalidParameter {
-                            field: f("chords"),
-                            value: chords,
-                            allowed: format!("a whole number from 1 to {MAX_CHORDS}"),
-                        });
-                    }
+            }
+            if let ContactShape::Arc { start, end, .. } = c.shape {
+                let span = end - start;
+                if !(span > 0.0 && span <= std::f64::consts::TAU * (1.0 + 1e-12)) {
+                    return Err(GranrsError::InvalidParameter {
+                        field: f("end_deg"),
+                        value: end.to_degrees(),
+                        allowed: format!(
+                            "start_deg < end_deg <= start_deg + 360 (start_deg = {})",
+                            start.to_degrees()
+                        ),
+                    });
                 }
             }
         }

@@ -387,8 +387,8 @@ impl Term for Rft {
                 name: "zeta",
                 unit: "N/m^3",
                 default: f64::NAN,
-                source: "none: a property of the medium (Li et al. 2013 measured ~1e6 for \
-                         their media)",
+                source: "none: a property of the medium (granrs.media's cards give values \
+                         with sources; the docs tabulate them)",
                 min: 0.0,
                 description: "alpha_z of a horizontal plate pushed straight down, per unit depth",
                 integer: false,

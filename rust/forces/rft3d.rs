@@ -454,7 +454,7 @@ impl Term for Rft3d {
                 unit: "N/m^3",
                 default: f64::NAN,
                 source: "none: the medium's scale xi_n (granrs.space.xi_n from its density and \
-                         internal friction, or fitted)",
+                         internal friction, a granrs.media card, or fitted)",
                 min: 0.0,
                 description: "material scale of the generic stress",
                 integer: false,

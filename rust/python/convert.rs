@@ -208,7 +208,6 @@ pub fn body_linkage<'py>(
     check: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     use crate::bodies::{ContactShape, RootKind};
-    use crate::body::Joint;
     let err = |e| super::errors::to_pyerr(py, e);
     let l = spec_from_dict(scene).body_scene().map_err(err)?;
     if check {
@@ -227,90 +226,50 @@ pub fn body_linkage<'py>(
         let d = py_dict!(py, {
             "name": &j.name, "parent": &j.parent, "child": &j.child, "at": pair(j.at),
         });
-        match j.joint {
-            Joint::Free => d.set_item("kind", "free")?,
-            Joint::Locked => d.set_item("kind", "locked")?,
-            Joint::Spring { k, c, rest } => {
-                d.set_item("kind", "spring")?;
-                d.set_item("k", k)?;
-                d.set_item("c", c)?;
-                d.set_item("rest_deg", rest.to_degrees())?;
+        let (kind, fields) = j.fields();
+        d.set_item("kind", kind)?;
+        for (k, value) in fields {
+            // A driven joint's sinusoid is written only when it has one.
+            let sinusoid = matches!(k, "amplitude_deg" | "frequency" | "phase_deg");
+            if !sinusoid || j.joint.reads_clock() {
+                d.set_item(k, value)?;
             }
-            Joint::Driven {
-                rate,
-                amplitude,
-                omega,
-                phase,
-            } => {
-                d.set_item("kind", "driven")?;
-                d.set_item("rate", rate)?;
-                if amplitude != 0.0 {
-                    d.set_item("amplitude_deg", amplitude.to_degrees())?;
-                    d.set_item("frequency", omega / (2.0 * std::f64::consts::PI))?;
-                    d.set_item("phase_deg", phase.to_degrees())?;
-                }
-            }
-            Joint::Table => {
-                d.set_item("kind", "driven")?;
-                if let Some(t) = &j.table {
-                    let rows: Vec<(f64, f64)> = t
-                        .times
-                        .iter()
-                        .zip(&t.angles)
-                        .map(|(&t, &a)| (t, a.to_degrees()))
-                        .collect();
-                    d.set_item("table", rows)?;
-                }
-            }
+        }
+        if let Some(t) = &j.table {
+            let rows: Vec<(f64, f64)> = t
+                .times
+                .iter()
+                .zip(&t.angles)
+                .map(|(&t, &a)| (t, a.to_degrees()))
+                .collect();
+            d.set_item("table", rows)?;
         }
         joints.append(d)?;
     }
     let contacts = PyList::empty(py);
     for c in &l.contacts {
-        let d = match c.shape {
-            ContactShape::Rod {
-                tip,
-                length,
-                diameter,
-            } => py_dict!(py, {
-                "shape": "rod", "at": pair(tip), "length": length, "diameter": diameter,
-            }),
-            ContactShape::Box {
-                thesis_angle_of: Some(_),
-                ..
-            } => {
-                return Err(err(crate::error::GranrsError::InvalidScene {
-                    field: "sole_model".into(),
-                    message: "the thesis form of the sole (eqs. 5.5-5.7) reads the shank's \
-                              angle; a linkage's box contact is the geometric box (sole_model \
-                              = \"box\")"
-                        .into(),
-                }))
+        if let ContactShape::Box {
+            thesis_angle_of: Some(_),
+            ..
+        } = c.shape
+        {
+            return Err(err(crate::error::GranrsError::InvalidScene {
+                field: "sole_model".into(),
+                message: "the thesis form of the sole (eqs. 5.5-5.7) reads the shank's \
+                          angle; a linkage's box contact is the geometric box (sole_model \
+                          = \"box\")"
+                    .into(),
+            }));
+        }
+        let (shape, fields) = c.shape.fields();
+        let d = py_dict!(py, { "shape": shape, "at": pair(c.shape.at()) });
+        for (k, value) in fields {
+            if k == "chords" {
+                d.set_item(k, value as usize)?;
+            } else {
+                d.set_item(k, value)?;
             }
-            ContactShape::Box {
-                corner,
-                length,
-                height,
-                width,
-                l_ref,
-                thesis_angle_of: None,
-            } => py_dict!(py, {
-                "shape": "box", "at": pair(corner), "length": length, "height": height,
-                "width": width, "l_ref": l_ref,
-            }),
-            ContactShape::Arc {
-                centre,
-                radius,
-                start,
-                end,
-                width,
-                chords,
-            } => py_dict!(py, {
-                "shape": "arc", "at": pair(centre), "radius": radius,
-                "start_deg": start.to_degrees(), "end_deg": end.to_degrees(), "width": width,
-                "chords": chords as usize,
-            }),
-        };
+        }
         d.set_item("name", &c.name)?;
         d.set_item("link", &c.link)?;
         contacts.append(d)?;

@@ -51,8 +51,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FORCE_INPUTS", crate::evaluate::INPUTS.to_vec())?;
     m.add("FORCE_OUTPUTS", crate::evaluate::OUTPUTS.to_vec())?;
     m.add_class::<mujoco::SandGeoms>()?;
-    m.add_class::<mujoco::GeomCoupling>()?;
-    m.add_class::<mujoco::SpaceCoupling>()?;
+    m.add_class::<mujoco::MujocoCoupling>()?;
     m.add("SPACE_GEOM_OUTPUTS", crate::space::engine::OUTPUTS.to_vec())?;
     m.add("SPACE_REST_SPEED", crate::space::engine::REST_SPEED)?;
     m.add("GEOM_STATE", crate::evaluate::geoms::STATE.to_vec())?;

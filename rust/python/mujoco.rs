@@ -293,15 +293,28 @@ impl Arrays {
         })
     }
 
-    /// The arrays as slices, with `qfrc_passive` (`passive`) or `qfrc_applied` as the
-    /// target of the generalized force.
+    /// The bound arrays (`bound`: `None` before `class`'s `bind`, an error) as slices, with
+    /// `qfrc_passive` (`passive`) or `qfrc_applied` as the target of the generalized force.
     ///
     /// # Safety
     /// Each array was checked contiguous with its shape at `bind`; MuJoCo never reallocates
     /// an mjData's arrays, the buffers are the `Sand`'s own, and no two slices alias
     /// (distinct arrays). The caller holds the mjData while the views live, and nothing
     /// else reads or writes these arrays meanwhile.
-    unsafe fn views<'a>(&'a self, py: Python<'a>, passive: bool) -> Views<'a> {
+    unsafe fn views<'a>(
+        bound: &'a Option<Arrays>,
+        class: &str,
+        py: Python<'a>,
+        passive: bool,
+    ) -> PyResult<Views<'a>> {
+        let Some(a) = bound else {
+            return Err(PyValueError::new_err(format!("{class}.step before bind")));
+        };
+        Ok(a.views_of(py, passive))
+    }
+
+    /// [`Arrays::views`] of bound arrays.
+    unsafe fn views_of<'a>(&'a self, py: Python<'a>, passive: bool) -> Views<'a> {
         Views {
             state: EngineState {
                 geom_xpos: ro(py, &self.geom_xpos),
@@ -329,6 +342,25 @@ impl Arrays {
 }
 
 impl Views<'_> {
+    /// One evaluation: `f` reads the state and writes the engine's outputs, then the
+    /// generalized force goes into MuJoCo's ([`Views::deliver`]).
+    fn run<R>(
+        &mut self,
+        passive: bool,
+        fresh: bool,
+        f: impl FnOnce(&EngineState<'_>, EngineOut<'_>) -> R,
+    ) -> R {
+        let out = EngineOut {
+            outputs: &mut *self.outputs,
+            applied: &mut *self.applied,
+            h_lambda: &mut *self.h_lambda,
+            generalized: &mut *self.generalized,
+        };
+        let r = f(&self.state, out);
+        self.deliver(passive, fresh);
+        r
+    }
+
     /// Put the generalized force into MuJoCo's: added to `qfrc_passive` (`passive`, the
     /// callback), or into `qfrc_applied` keeping the user's entries ([`keep_user_entries`]).
     fn deliver(&mut self, passive: bool, fresh: bool) {
@@ -347,24 +379,33 @@ impl Views<'_> {
     }
 }
 
-/// [`SandGeoms`] placed on the bodies of a MuJoCo model: one call per evaluation reads the
-/// model's arrays, evaluates every geom and puts the generalized force into MuJoCo's (see
-/// `granrs.mujoco.Sand`).
+/// The sand's engine under a MuJoCo model: rods and soles in the plane ([`Coupling`]), or
+/// shapes in space ([`space_engine::SpaceCoupling`]).
+enum Engine {
+    Planar(Box<Coupling>),
+    Space(space_engine::SpaceCoupling),
+}
+
+/// The sand placed on the bodies of a MuJoCo model (`granrs.mujoco.Sand`): one call per
+/// evaluation reads the model's arrays, evaluates every geom and puts the generalized force
+/// into MuJoCo's. Made by [`MujocoCoupling::planar`] ([`SandGeoms`], rod and sole geoms) or
+/// [`MujocoCoupling::space`] (geoms as shapes in space under the terms in space, see
+/// `crate::space::engine`).
 #[pyclass(module = "granrs._granrs", unsendable)]
-pub struct GeomCoupling {
-    inner: Coupling,
+pub struct MujocoCoupling {
+    engine: Engine,
     bound: Option<Arrays>,
 }
 
 #[pymethods]
-impl GeomCoupling {
+impl MujocoCoupling {
     /// `rods` on MuJoCo's geoms `geom` (bodies `body`, tree roots `root`, tip `reach` from
     /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
     /// height and patch in x; `stick` for the static terms as reactions;
     /// `implicit_damping` the dof damping the engine's step takes implicitly (nv).
-    #[new]
+    #[staticmethod]
     #[allow(clippy::too_many_arguments)]
-    fn new(
+    fn planar(
         rods: PyRef<'_, SandGeoms>,
         geom: Vec<usize>,
         body: Vec<usize>,
@@ -400,8 +441,8 @@ impl GeomCoupling {
                 dofs: dofs[i].clone(),
             })
             .collect();
-        Ok(GeomCoupling {
-            inner: Coupling {
+        Ok(MujocoCoupling {
+            engine: Engine::Planar(Box::new(Coupling {
                 rods: rods.inner.clone(),
                 places,
                 nv,
@@ -412,32 +453,153 @@ impl GeomCoupling {
                 implicit_damping,
                 work: Work::new(n, nv),
                 held: vec![None; n],
-            },
+            })),
             bound: None,
         })
     }
 
-    /// Bind the arrays of one `mjData` and the caller's buffers, in the order of the
-    /// bound arrays (`outputs` per geom in GEOM_OUTPUTS order, `applied` force and moment
-    /// n x 3), each checked for its shape once.
+    /// `names` and `shapes` per geom (a `granrs.space` shape's dict), `forces` the terms
+    /// in space (`(name, params)` pairs; no `gravity`: the engine applies it), the sand's
+    /// `rho_g`, `surface`, `patch` (x_min, x_max, y_min, y_max) and `rest_speed`, the
+    /// surface rule's `quadrature` nodes; each geom's place (`geom`, `body`, `root`,
+    /// `dofs`) in a model of `nv` dofs, and the dof damping its integrator takes
+    /// implicitly. Every error names the geom, term or parameter.
+    #[staticmethod]
+    #[allow(clippy::too_many_arguments)]
+    fn space(
+        py: Python<'_>,
+        names: Vec<String>,
+        shapes: &Bound<'_, PyList>,
+        forces: &Bound<'_, PyAny>,
+        rho_g: f64,
+        surface: f64,
+        patch: [f64; 4],
+        rest_speed: f64,
+        quadrature: usize,
+        geom: Vec<usize>,
+        body: Vec<usize>,
+        root: Vec<usize>,
+        dofs: Vec<Vec<usize>>,
+        nv: usize,
+        implicit_damping: Vec<f64>,
+    ) -> PyResult<Self> {
+        let err = |e: GranrsError| to_pyerr(py, e);
+        let n = names.len();
+        if [shapes.len(), geom.len(), body.len(), root.len(), dofs.len()]
+            .iter()
+            .any(|&l| l != n)
+            || dofs.iter().flatten().any(|&j| j >= nv)
+            || implicit_damping.len() != nv
+        {
+            return Err(PyValueError::new_err(
+                "one shape and place per geom, dofs below nv",
+            ));
+        }
+        crate::error::check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
+        crate::error::check_finite("surface", surface).map_err(err)?;
+        crate::error::check_range("rest_speed", rest_speed, 0.0, true).map_err(err)?;
+        if !(1..=Quadrature::MAX_NODES).contains(&quadrature) {
+            return Err(err(GranrsError::InvalidParameter {
+                field: "quadrature".into(),
+                value: quadrature as f64,
+                allowed: format!("an integer in 1..={}", Quadrature::MAX_NODES),
+            }));
+        }
+        let specs = super::space::forces_of(forces).map_err(err)?;
+        let mut geoms = Vec::with_capacity(n);
+        for i in 0..n {
+            let field = format!("geoms[{i}]");
+            let shape = super::space::shape_at(&shapes.get_item(i)?, &field).map_err(err)?;
+            let terms = Terms3::from_specs(&specs, &shape).map_err(err)?;
+            if terms.field != 0.0 {
+                return Err(err(GranrsError::InvalidScene {
+                    field: "forces.gravity".into(),
+                    message: "MuJoCo applies the model's own gravity; list only the sand's \
+                              terms (rft3d, rft3d_inertial, poncelet)"
+                        .into(),
+                }));
+            }
+            if !terms.any_sand() {
+                return Err(err(GranrsError::InvalidScene {
+                    field: "forces".into(),
+                    message: "no term of the sand in space (rft3d, rft3d_inertial, poncelet)"
+                        .into(),
+                }));
+            }
+            let centre = match &shape {
+                Shape::Mesh(m) => -m.offset,
+                _ => nalgebra::Vector3::zeros(),
+            };
+            let sand = Sand::new(
+                shape,
+                terms,
+                Medium { rho_g, g: 9.81 },
+                surface,
+                Quadrature::new(quadrature),
+            );
+            geoms.push(space_engine::SpaceGeom {
+                sand,
+                centre,
+                place: space_engine::Place {
+                    geom: geom[i],
+                    body: body[i],
+                    root: root[i],
+                    dofs: dofs[i].clone(),
+                },
+            });
+        }
+        Ok(MujocoCoupling {
+            engine: Engine::Space(space_engine::SpaceCoupling {
+                geoms,
+                nv,
+                patch,
+                rest_speed,
+                implicit_damping,
+                previous: vec![0.0; nv],
+                held: vec![None; n],
+                solved: vec![None; n],
+            }),
+            bound: None,
+        })
+    }
+
+    /// Bind the arrays of one `mjData` and the caller's buffers, in the order of
+    /// [`Arrays`] (`cvel` only in the plane; `outputs` per geom in GEOM_OUTPUTS or
+    /// SPACE_GEOM_OUTPUTS order; `applied` per geom, force and moment n x 3 in the plane, the
+    /// wrench n x 6 in space), each checked for its shape once.
     #[pyo3(signature = (*arrays))]
     fn bind(&mut self, arrays: &Bound<'_, PyTuple>) -> PyResult<()> {
-        let c = &self.inner;
-        let places = c.places.iter().map(|p| (p.geom, p.body.max(p.root)));
-        let sizes = Sizes::of(places, c.nv, crate::evaluate::geoms::OUTPUTS.len(), 3, true);
-        self.bound = Some(Arrays::bind("GeomCoupling", &sizes, arrays)?);
+        let (class, sizes) = match &self.engine {
+            Engine::Planar(c) => {
+                let places = c.places.iter().map(|p| (p.geom, p.body.max(p.root)));
+                let width = crate::evaluate::geoms::OUTPUTS.len();
+                ("planar", Sizes::of(places, c.nv, width, 3, true))
+            }
+            Engine::Space(c) => {
+                let places = c
+                    .geoms
+                    .iter()
+                    .map(|g| (g.place.geom, g.place.body.max(g.place.root)));
+                let width = space_engine::OUTPUTS.len();
+                ("space", Sizes::of(places, c.nv, width, 6, false))
+            }
+        };
+        let class = format!("MujocoCoupling.{class}");
+        self.bound = Some(Arrays::bind(&class, &sizes, arrays)?);
         Ok(())
     }
 
     /// One evaluation at the bound arrays (the mass matrix filled by the caller): writes
-    /// each geom's outputs, applied force and moment and `h_lambda`, and the generalized
-    /// force, and puts it into MuJoCo's: with `passive`, added to `qfrc_passive` (the
-    /// callback); else into `qfrc_applied`, where an entry still equal to `after` (what
-    /// the last step left there) is restored to `before` (what it held before), any other
-    /// entry is the user's, the new contribution is added and `before` and `after` kept
-    /// (`fresh`: no last step, every entry is the user's); `hold`: a later stage of RK4's
-    /// step, which keeps the static reactions of its first. Returns the largest `h_lambda`
-    /// and its geom.
+    /// each geom's outputs, applied force and moment (wrench) and `h_lambda`, and the
+    /// generalized force, and puts it into MuJoCo's: with `passive`, added to
+    /// `qfrc_passive` (the callback); else into `qfrc_applied`, where an entry still equal
+    /// to `after` (what the last step left there) is restored to `before` (what it held
+    /// before), any other entry is the user's, the new contribution is added and `before`
+    /// and `after` kept (`fresh`: no last step, every entry is the user's); `hold`: a later
+    /// stage of RK4's step, which keeps the static reactions of its first. In space the GIL
+    /// is released and the step is implicit. Returns the largest `h_lambda`, its geom, the
+    /// Newton iterations, the solve's relative residual, whether it converged and whether
+    /// the step fell back to sticking or sliding (in the plane: 0, 0.0, true, false).
     fn step(
         &mut self,
         py: Python<'_>,
@@ -445,29 +607,40 @@ impl GeomCoupling {
         passive: bool,
         fresh: bool,
         hold: bool,
-    ) -> PyResult<(f64, usize)> {
-        let Some(b) = &self.bound else {
-            return Err(PyValueError::new_err("GeomCoupling.step before bind"));
-        };
-        // SAFETY: as `Arrays::views`; with the GIL held nothing else touches the arrays
-        // during the call.
+    ) -> PyResult<(f64, usize, usize, f64, bool, bool)> {
+        // SAFETY: as `Arrays::views`; the caller holds the mjData while this call runs (a
+        // `Sand` method), and nothing of granrs's touches these arrays from another thread.
         unsafe {
-            let mut v = b.views(py, passive);
-            let out = EngineOut {
-                outputs: &mut *v.outputs,
-                applied: &mut *v.applied,
-                h_lambda: &mut *v.h_lambda,
-                generalized: &mut *v.generalized,
-            };
-            self.inner.step(&v.state, timestep, hold, out);
-            v.deliver(passive, fresh);
-            let (mut k, mut top) = (0, 0.0);
-            for (i, &x) in v.h_lambda.iter().enumerate() {
-                if x > top {
-                    (k, top) = (i, x);
+            let mut v = Arrays::views(&self.bound, "MujocoCoupling", py, passive)?;
+            match &mut self.engine {
+                Engine::Planar(c) => {
+                    v.run(passive, fresh, |state, out| {
+                        c.step(state, timestep, hold, out)
+                    });
+                    let (mut k, mut top) = (0, 0.0);
+                    for (i, &x) in v.h_lambda.iter().enumerate() {
+                        if x > top {
+                            (k, top) = (i, x);
+                        }
+                    }
+                    Ok((top, k, 0, 0.0, true, false))
+                }
+                Engine::Space(c) => {
+                    let r = py.detach(|| {
+                        v.run(passive, fresh, |state, out| {
+                            c.step(state, timestep, hold, out)
+                        })
+                    });
+                    Ok((
+                        r.h_lambda,
+                        r.geom,
+                        r.iterations,
+                        r.residual,
+                        r.converged,
+                        r.fallback,
+                    ))
                 }
             }
-            Ok((top, k))
         }
     }
 }
@@ -551,179 +724,3 @@ unsafe fn rw<'a, D: numpy::ndarray::Dimension>(
 
 type Bound1<'py> = Bound<'py, PyArray1<f64>>;
 type Bound2<'py> = Bound<'py, PyArray2<f64>>;
-
-/// Geoms of a MuJoCo model as shapes in space under the terms in space
-/// (`granrs.mujoco.Sand` in three dimensions; see `crate::space::engine`).
-#[pyclass(module = "granrs._granrs", unsendable)]
-pub struct SpaceCoupling {
-    inner: space_engine::SpaceCoupling,
-    bound: Option<Arrays>,
-}
-
-#[pymethods]
-impl SpaceCoupling {
-    /// `names` and `shapes` per geom (a `granrs.space` shape's dict), `forces` the terms
-    /// in space (`(name, params)` pairs; no `gravity`: the engine applies it), the sand's
-    /// `rho_g`, `surface`, `patch` (x_min, x_max, y_min, y_max) and `rest_speed`, the
-    /// surface rule's `quadrature` nodes; each geom's place (`geom`, `body`, `root`,
-    /// `dofs`) in a model of `nv` dofs, and the dof damping its integrator takes
-    /// implicitly. Every error names the geom, term or parameter.
-    #[new]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        py: Python<'_>,
-        names: Vec<String>,
-        shapes: &Bound<'_, PyList>,
-        forces: &Bound<'_, PyAny>,
-        rho_g: f64,
-        surface: f64,
-        patch: [f64; 4],
-        rest_speed: f64,
-        quadrature: usize,
-        geom: Vec<usize>,
-        body: Vec<usize>,
-        root: Vec<usize>,
-        dofs: Vec<Vec<usize>>,
-        nv: usize,
-        implicit_damping: Vec<f64>,
-    ) -> PyResult<Self> {
-        let err = |e: GranrsError| to_pyerr(py, e);
-        let n = names.len();
-        if [shapes.len(), geom.len(), body.len(), root.len(), dofs.len()]
-            .iter()
-            .any(|&l| l != n)
-            || dofs.iter().flatten().any(|&j| j >= nv)
-            || implicit_damping.len() != nv
-        {
-            return Err(PyValueError::new_err(
-                "one shape and place per geom, dofs below nv",
-            ));
-        }
-        crate::error::check_range("rho_g", rho_g, 0.0, true).map_err(err)?;
-        crate::error::check_finite("surface", surface).map_err(err)?;
-        crate::error::check_range("rest_speed", rest_speed, 0.0, true).map_err(err)?;
-        if !(1..=Quadrature::MAX_NODES).contains(&quadrature) {
-            return Err(err(GranrsError::InvalidParameter {
-                field: "quadrature".into(),
-                value: quadrature as f64,
-                allowed: format!("an integer in 1..={}", Quadrature::MAX_NODES),
-            }));
-        }
-        let specs = super::space::forces_of(forces).map_err(err)?;
-        let mut geoms = Vec::with_capacity(n);
-        for i in 0..n {
-            let field = format!("geoms[{i}]");
-            let shape = super::space::shape_at(&shapes.get_item(i)?, &field).map_err(err)?;
-            let terms = Terms3::from_specs(&specs, &shape).map_err(err)?;
-            if terms.field != 0.0 {
-                return Err(err(GranrsError::InvalidScene {
-                    field: "forces.gravity".into(),
-                    message: "MuJoCo applies the model's own gravity; list only the sand's \
-                              terms (rft3d, rft3d_inertial, poncelet)"
-                        .into(),
-                }));
-            }
-            if !terms.any_sand() {
-                return Err(err(GranrsError::InvalidScene {
-                    field: "forces".into(),
-                    message: "no term of the sand in space (rft3d, rft3d_inertial, poncelet)"
-                        .into(),
-                }));
-            }
-            let centre = match &shape {
-                Shape::Mesh(m) => -m.offset,
-                _ => nalgebra::Vector3::zeros(),
-            };
-            let sand = Sand::new(
-                shape,
-                terms,
-                Medium { rho_g, g: 9.81 },
-                surface,
-                Quadrature::new(quadrature),
-            );
-            geoms.push(space_engine::SpaceGeom {
-                sand,
-                centre,
-                place: space_engine::Place {
-                    geom: geom[i],
-                    body: body[i],
-                    root: root[i],
-                    dofs: dofs[i].clone(),
-                },
-            });
-        }
-        Ok(SpaceCoupling {
-            inner: space_engine::SpaceCoupling {
-                geoms,
-                nv,
-                patch,
-                rest_speed,
-                implicit_damping,
-                previous: vec![0.0; nv],
-                held: vec![None; n],
-                solved: vec![None; n],
-            },
-            bound: None,
-        })
-    }
-
-    /// Bind the arrays of one `mjData` and the caller's buffers, in the order of the
-    /// bound arrays without `cvel` (`outputs` per geom in SPACE_GEOM_OUTPUTS order, the
-    /// `applied` wrench per geom n x 6), each checked for its shape once.
-    #[pyo3(signature = (*arrays))]
-    fn bind(&mut self, arrays: &Bound<'_, PyTuple>) -> PyResult<()> {
-        let c = &self.inner;
-        let places = c
-            .geoms
-            .iter()
-            .map(|g| (g.place.geom, g.place.body.max(g.place.root)));
-        let sizes = Sizes::of(places, c.nv, space_engine::OUTPUTS.len(), 6, false);
-        self.bound = Some(Arrays::bind("SpaceCoupling", &sizes, arrays)?);
-        Ok(())
-    }
-
-    /// One evaluation at the bound arrays (the mass matrix filled by the caller), with the
-    /// GIL released: writes each geom's outputs, applied wrench and `h_lambda` and the
-    /// generalized force, and puts it into MuJoCo's as `GeomCoupling.step` does
-    /// (`passive`: added to `qfrc_passive`; else into `qfrc_applied`, keeping the user's
-    /// entries; `hold`: a later stage of RK4's step). Returns the largest `h_lambda`, its
-    /// geom, the Newton iterations, the solve's relative residual, whether it converged
-    /// and whether the step fell back to sticking or sliding.
-    fn step(
-        &mut self,
-        py: Python<'_>,
-        timestep: f64,
-        passive: bool,
-        fresh: bool,
-        hold: bool,
-    ) -> PyResult<(f64, usize, usize, f64, bool, bool)> {
-        let Some(b) = &self.bound else {
-            return Err(PyValueError::new_err("SpaceCoupling.step before bind"));
-        };
-        let inner = &mut self.inner;
-        // SAFETY: as `Arrays::views`; the caller holds the mjData while this call runs (a
-        // `Sand` method), and nothing of granrs's touches these arrays from another thread.
-        unsafe {
-            let mut v = b.views(py, passive);
-            let report = py.detach(|| {
-                let out = EngineOut {
-                    outputs: &mut *v.outputs,
-                    applied: &mut *v.applied,
-                    h_lambda: &mut *v.h_lambda,
-                    generalized: &mut *v.generalized,
-                };
-                let report = inner.step(&v.state, timestep, hold, out);
-                v.deliver(passive, fresh);
-                report
-            });
-            Ok((
-                report.h_lambda,
-                report.geom,
-                report.iterations,
-                report.residual,
-                report.converged,
-                report.fallback,
-            ))
-        }
-    }
-}

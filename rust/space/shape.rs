@@ -508,8 +508,10 @@ impl Shape {
         out: &mut Elements,
     ) {
         // Out of the sand: nothing (a mesh's triangles are each skipped when above, without
-        // a second pass over its vertices).
-        if !matches!(self, Shape::Mesh(_)) && self.lowest_point(c, q).z >= surface {
+        // a second pass over its vertices). A face that lies on the surface is in: the load
+        // at the instant a body enters is the limit from inside (a flat end's drag, c rho_g A
+        // v^2 under `poncelet`, acts from the first instant, as the planar engine's does).
+        if !matches!(self, Shape::Mesh(_)) && self.lowest_point(c, q).z > surface {
             return;
         }
         let motion = Motion {
@@ -594,7 +596,7 @@ impl Shape {
                         c + r * m.vertices[t[1]],
                         c + r * m.vertices[t[2]],
                     ];
-                    if pts.iter().all(|p| p.z >= surface) {
+                    if pts.iter().all(|p| p.z > surface) {
                         continue;
                     }
                     polygon(&motion, &pts, rule, out);
@@ -681,7 +683,7 @@ fn sphere_patch(
     rule: &Quadrature,
     out: &mut Elements,
 ) {
-    if b.z - r >= m.surface {
+    if b.z - r > m.surface {
         return;
     }
     let vb = m.velocity_at(b);

@@ -409,7 +409,8 @@ impl Body {
                     t1 = t + theta * h;
                 }
                 if t_entry.is_nan() {
-                    t_entry = t1;
+                    // On the surface at the step's start (theta = 0): it enters there.
+                    t_entry = if theta == 0.0 { t } else { t1 };
                 }
                 events += 1;
             } else if z1 < 0.0 && vz0 < 0.0 && vz1 >= 0.0 && t_s.is_nan() {

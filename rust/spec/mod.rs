@@ -10,6 +10,7 @@ use std::borrow::Cow;
 
 use nalgebra::Vector2;
 
+use crate::bodies::linkage::{JOINT_FIELDS, SHAPE_FIELDS};
 use crate::bodies::{
     ContactShape, ContactSpec, JointSpec, LinkSpec, LinkageScene, RootKind, RootSpec,
 };
@@ -526,27 +527,6 @@ impl<'a> Element<'a> {
     }
 }
 
-/// The keys each contact shape reads beyond `name`, `shape`, `link` and `at`.
-const SHAPE_KEYS: &[(&str, &[&str])] = &[
-    ("rod", &["length", "diameter"]),
-    ("box", &["length", "height", "width", "l_ref"]),
-    (
-        "arc",
-        &["radius", "start_deg", "end_deg", "width", "chords"],
-    ),
-];
-
-/// The keys each joint kind reads beyond `name`, `parent`, `child`, `at` and `kind`.
-const JOINT_KEYS: &[(&str, &[&str])] = &[
-    ("free", &[]),
-    ("locked", &[]),
-    ("spring", &["k", "c", "rest_deg"]),
-    (
-        "driven",
-        &["rate", "amplitude_deg", "frequency", "phase_deg", "table"],
-    ),
-];
-
 /// A driven joint's table, `[(time [s], angle [deg]), ...]`, with its angles in radians
 /// (its values are checked by the linkage).
 fn drive_table(field: &str, v: &Value) -> Result<DriveTable> {
@@ -636,7 +616,7 @@ impl SceneSpec {
                 None => "free",
                 Some(_) => e.str("kind")?,
             };
-            e.only_for(&format!("a joint of kind {kind:?}"), JOINT_KEYS, kind)?;
+            e.only_for(&format!("a joint of kind {kind:?}"), JOINT_FIELDS, kind)?;
             let parent = e.str("parent")?.to_string();
             let child = e.str("child")?.to_string();
             let table = match e.get("table") {
@@ -684,14 +664,15 @@ impl SceneSpec {
                 "driven" if table.is_some() => Joint::Table,
                 "driven" => {
                     let amplitude = e.num_or("amplitude_deg", 0.0)?;
+                    let frequency = if amplitude != 0.0 {
+                        e.num("frequency")?
+                    } else {
+                        e.num_or("frequency", 0.0)?
+                    };
                     Joint::Driven {
                         rate: e.num_or("rate", 0.0)?,
                         amplitude: amplitude.to_radians(),
-                        omega: if amplitude != 0.0 {
-                            2.0 * std::f64::consts::PI * e.num("frequency")?
-                        } else {
-                            e.num_or("frequency", 0.0)?
-                        },
+                        omega: std::f64::consts::TAU * frequency,
                         phase: e.num_or("phase_deg", 0.0)?.to_radians(),
                     }
                 }
@@ -717,16 +698,13 @@ impl SceneSpec {
             let (e, name) = Element::new("contact", "contacts", i, v)?;
             let at = e.point_or("at", Vector2::zeros())?;
             let shape_name = e.str("shape")?;
-            if !SHAPE_KEYS.iter().any(|(k, _)| *k == shape_name) {
-                return Err(unknown(
-                    &e.field("shape"),
-                    shape_name,
-                    &["rod", "box", "arc"],
-                ));
+            let shapes: Vec<&str> = SHAPE_FIELDS.iter().map(|(k, _)| *k).collect();
+            if !shapes.contains(&shape_name) {
+                return Err(unknown(&e.field("shape"), shape_name, &shapes));
             }
             e.only_for(
                 &format!("a contact of shape {shape_name:?}"),
-                SHAPE_KEYS,
+                SHAPE_FIELDS,
                 shape_name,
             )?;
             let length = if shape_name == "arc" {
@@ -756,7 +734,7 @@ impl SceneSpec {
                     l_ref: e.num_or("l_ref", length)?,
                     thesis_angle_of: None,
                 },
-                other => return Err(unknown(&e.field("shape"), other, &["rod", "box", "arc"])),
+                other => return Err(unknown(&e.field("shape"), other, &shapes)),
             };
             contacts.push(ContactSpec {
                 name,

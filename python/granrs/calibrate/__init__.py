@@ -75,6 +75,7 @@ from __future__ import annotations
 
 from .fit import CalibrationResult, calibrate, evaluate, within
 from .measurements import BODIES, QUANTITIES, THESIS_MEASUREMENTS, Measurements
+from .posterior import Posterior
 
 __all__ = [
     "BODIES",
@@ -82,6 +83,7 @@ __all__ = [
     "THESIS_MEASUREMENTS",
     "CalibrationResult",
     "Measurements",
+    "Posterior",
     "calibrate",
     "evaluate",
     "within",

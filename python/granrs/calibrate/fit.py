@@ -9,7 +9,7 @@ import difflib
 import math
 import os
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -23,8 +23,10 @@ from ..errors import (
     SimulationError,
     UnknownNameError,
 )
+from . import posterior as _posterior
 from .measurements import _KEY_COLUMNS, BODIES, QUANTITIES, Measurements, _is_number
 from .model import _JOINT_START, _JOINTS, LawSpec, _Model, _Param, _parse_param
+from .posterior import Posterior
 
 __all__ = ["CalibrationResult", "calibrate", "evaluate", "within"]
 
@@ -74,6 +76,9 @@ class CalibrationResult:
         unresolved_runs: simulations during the fit whose step did not resolve the contact
             (the core's :class:`~granrs.StepSizeWarning` check; counted, not warned); the
             ``unresolved`` column of :attr:`residuals` flags them at the optimum.
+        posterior: the posterior samples and their diagnostics
+            (:class:`~granrs.calibrate.Posterior`) when calibrate was asked for
+            them (``posterior=``), else None.
     """
 
     body: str
@@ -100,6 +105,44 @@ class CalibrationResult:
     _model: _Model = field(repr=False, compare=False)
     _measurements: Measurements = field(repr=False, compare=False)
     _threads: int | None = field(default=None, repr=False, compare=False)
+    posterior: Posterior | None = field(default=None, repr=False, compare=False)
+
+    def predictive(
+        self,
+        measurements: Measurements | None = None,
+        *,
+        draws: int = 200,
+        level: float = 0.9,
+        seed: int = 0,
+    ) -> pd.DataFrame:
+        """Posterior predictive intervals of depth and t_s for each row of
+        ``measurements`` (default: the fitted ones): the values simulated at ``draws``
+        posterior samples (one sweep), their median and central ``level`` interval
+        (``<q>_median``, ``<q>_lo``, ``<q>_hi``), beside the measured mean and sd. Needs
+        ``calibrate(..., posterior=...)``."""
+        if self.posterior is None:
+            raise InvalidParameterError(
+                "no posterior samples: calibrate with posterior=<steps>", field="posterior"
+            )
+        if isinstance(draws, bool) or not isinstance(draws, int) or draws < 2:
+            raise InvalidParameterError(
+                f"draws must be an integer >= 2; got {draws!r}", field="draws"
+            )
+        if not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
+            raise InvalidParameterError(f"level must be in (0, 1); got {level!r}", field="level")
+        m = self._measurements if measurements is None else measurements
+        _check_measurements(m, self.body)
+
+        def simulate(vectors: Sequence[Sequence[float]]) -> tuple[np.ndarray, np.ndarray]:
+            depth, t_s, _ = self._model.simulate(m.rows, vectors, self._threads)
+            return depth, t_s
+
+        pred = _posterior.predictive(simulate, self.posterior, draws, level, seed)
+        keys = [c for c in _KEY_COLUMNS[m.body] if c in m.rows.columns]
+        frame = m.rows[[*keys, "depth_mean", "depth_sd", "t_s_mean", "t_s_sd"]].copy()
+        for k, v in pred.items():
+            frame[k] = v
+        return frame
 
     def predict(self, measurements: Measurements) -> pd.DataFrame:
         """The residuals (as in :attr:`residuals`, without the start columns) of other
@@ -267,12 +310,18 @@ def _check_law(law: Any) -> LawSpec | None:
 
 
 def _check_body(cases: Any) -> str:
-    """The body named by ``cases`` (one of :data:`BODIES`), with a did-you-mean if not."""
-    if not isinstance(cases, str) or cases not in BODIES:
+    """The body named by ``cases`` (one of :data:`BODIES`), with a did-you-mean if not; a
+    function of the row (that makes a body in space's scene) is ``"space"``."""
+    if callable(cases):
+        return "space"
+    if not isinstance(cases, str) or cases not in BODIES or cases == "space":
         hint = difflib.get_close_matches(str(cases), BODIES, n=1)
         more = f"; did you mean {hint[0]!r}?" if hint else ""
         raise UnknownNameError(
-            f"unknown cases {cases!r}{more}; calibrate fits {', '.join(BODIES)}", field="cases"
+            f"unknown cases {cases!r}{more}; calibrate fits "
+            f"{', '.join(b for b in BODIES if b != 'space')}, or bodies in space through a "
+            "function of the measurement row that returns a granrs.space.Scene",
+            field="cases",
         )
     return cases
 
@@ -335,6 +384,14 @@ def _check_quantities(quantities: Sequence[str] | str) -> list[str]:
 
 def _check_base(base: str | Coefficients | None, body: str) -> str | Coefficients:
     """The base coefficients' name (the body's default for None) or the Coefficients."""
+    if body == "space":
+        if base is not None:
+            raise InvalidParameterError(
+                "a body in space has no thesis coefficients: its law is its scene's forces "
+                "(or forces=)",
+                field="base",
+            )
+        return "none"
     if base is None:
         base = "table_3_4" if body == "free_link" else "thesis"
     if isinstance(base, str):
@@ -641,7 +698,7 @@ def _final_residuals(objective: _Objective, natural: np.ndarray, x0: np.ndarray)
 
 
 def calibrate(
-    cases: str,
+    cases: str | Callable[[dict[str, Any]], Any],
     measurements: Measurements | str | os.PathLike[str],
     params: Sequence[str] = ("eta_h", "eta_d", "eta_v", "lam"),
     *,
@@ -660,6 +717,8 @@ def calibrate(
     max_nfev: int = 200,
     threads: int | None = None,
     progress: bool | None = False,
+    posterior: int = 0,
+    walkers: int | None = None,
     **overrides: Any,
 ) -> CalibrationResult:
     """Fit ``params`` so that the simulated depth and stopping time match ``measurements``.
@@ -668,7 +727,10 @@ def calibrate(
         cases: the body, built per row by the :mod:`granrs.cases` function of that name:
             ``"free_link"`` (a row runs ``cases.free_link(q_deg, v0_mean)``), ``"chain"``
             (a case's two rows run ``cases.chain`` with both links' angles and the mean of
-            their speeds, ``end="all_stops"``) or ``"leg"`` (``cases.leg(v0_mean)``).
+            their speeds, ``end="all_stops"``) or ``"leg"`` (``cases.leg(v0_mean)``); or,
+            for bodies in space, a function of the measurement row (a dict of its columns)
+            returning that row's :class:`granrs.space.Scene`: its forces are the law (or
+            ``forces=``) and its step ``dt``; the measurements' body is then ``"space"``.
         measurements: a :class:`Measurements`, a thesis name (``"table_3_1"``,
             ``"table_4_chain"``, ``"table_5_1_means"``, ...; ``"thesis:"`` may prefix it) or
             the path of a CSV with the same columns.
@@ -711,6 +773,12 @@ def calibrate(
         progress: a tqdm bar counting the fit's runs on stderr: False (default: calibrate
             is called inside compare and the report), True, or None (when stderr is a
             terminal; ``granrs calibrate`` asks for that).
+        posterior: the steps of a posterior sampler's chains (emcee's ensemble, each
+            chain's first half dropped as burn-in; at least 20) run from the optimum:
+            the result's ``posterior`` holds the samples and their diagnostics, and its
+            ``predictive()`` the predictive intervals. 0 (default): none.
+        walkers: the sampler's walkers (an even number, at least twice the parameters;
+            default 4 per parameter, at least 8).
         **overrides: any other :class:`~granrs.Scene` field for every run (e.g.
             ``mass=0.017`` for the chain's links, ``apply_at="E"``).
 
@@ -742,10 +810,20 @@ def calibrate(
         )
     base = _check_base(base, body)
     _check_options(dt, rel_step, starts, max_nfev, error_scale)
+    _posterior.check_options(posterior, walkers, len(parsed))
     fixed = _check_joints(joints, body)
     box = _bounds_for(parsed, bounds)
     law = _check_law(forces)
-    model = _Model(body, tuple(parsed), base, float(dt), dict(overrides), fixed, law)
+    model = _Model(
+        body,
+        tuple(parsed),
+        base,
+        float(dt),
+        dict(overrides),
+        fixed,
+        law,
+        scene_of=cases if body == "space" else None,
+    )
     x_start = _start_values(parsed, box, start, model, m, fixed)
     # Build every scene once up front: bad overrides or values fail here, before any run.
     model.scenes(m.rows, x_start)
@@ -764,12 +842,25 @@ def calibrate(
         x = best.x
         jmat = objective.jac(x)
         r = objective.fun(x)
-        chi2, dof, scale, _cov, se_x, corr = _covariance(jmat, r, n_res, error_scale)
+        chi2, dof, scale, cov, se_x, corr = _covariance(jmat, r, n_res, error_scale)
         natural = model.to_natural(x)
         values, se, intervals, at_bound = _natural_estimates(parsed, natural, x, se_x, lo_x, hi_x)
 
         # Residual tables at the optimum and at the start (one sweep).
         frame = _final_residuals(objective, natural, x0)
+        samples = None
+        if posterior:
+            samples = _posterior.sample(
+                objective.evaluate,
+                model.to_natural,
+                names,
+                x,
+                cov / scale**2,
+                (lo_x, hi_x),
+                posterior,
+                walkers,
+                seed,
+            )
     finally:
         objective.bar.close()
     counters = objective.counters
@@ -798,6 +889,7 @@ def calibrate(
         _model=model,
         _measurements=m,
         _threads=threads,
+        posterior=samples,
     )
 
 
@@ -809,7 +901,7 @@ def _exp(u: float) -> float:
 
 
 def evaluate(
-    cases: str,
+    cases: str | Callable[[dict[str, Any]], Any],
     measurements: Measurements | str | os.PathLike[str],
     *,
     base: str | Coefficients | None = None,
@@ -822,15 +914,20 @@ def evaluate(
     """The residuals of ``measurements`` with the base coefficients, nothing fitted (e.g.
     the thesis's Table 3.4 rows): a frame as :attr:`CalibrationResult.residuals` without
     the start columns. Arguments as in :func:`calibrate`."""
-    if not isinstance(cases, str) or cases not in BODIES:
-        raise UnknownNameError(
-            f"unknown cases {cases!r}; calibrate fits {', '.join(BODIES)}", field="cases"
-        )
-    m = _check_measurements(measurements, cases)
-    if base is None:
-        base = "table_3_4" if cases == "free_link" else "thesis"
-    fixed = _check_joints(joints, cases)
-    model = _Model(cases, (), base, float(dt), dict(overrides), fixed, _check_law(forces))
+    body = _check_body(cases)
+    m = _check_measurements(measurements, body)
+    base = _check_base(base, body)
+    fixed = _check_joints(joints, body)
+    model = _Model(
+        body,
+        (),
+        base,
+        float(dt),
+        dict(overrides),
+        fixed,
+        _check_law(forces),
+        scene_of=cases if body == "space" else None,
+    )
     # Build every scene up front: a bad dt or override raises here (naming the field), not
     # as a failed run of every row.
     model.scenes(m.rows, [])

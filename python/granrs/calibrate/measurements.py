@@ -25,9 +25,10 @@ from ..errors import (
 
 __all__ = ["BODIES", "QUANTITIES", "THESIS_MEASUREMENTS", "THESIS_RESOLUTION", "Measurements"]
 
-#: The bodies :func:`calibrate` can fit, each built by the function of :mod:`granrs.cases`
-#: of the same name.
-BODIES: tuple[str, ...] = ("free_link", "chain", "leg")
+#: The bodies :func:`calibrate` can fit: the thesis's, each built by the function of
+#: :mod:`granrs.cases` of the same name, and ``"space"``, bodies in space, each row's
+#: :class:`granrs.space.Scene` made by a function of the row that the caller gives.
+BODIES: tuple[str, ...] = ("free_link", "chain", "leg", "space")
 #: The measured quantities: depth at the stop [m] and stopping time [s].
 QUANTITIES: tuple[str, ...] = ("depth", "t_s")
 #: Columns every measurement table has (besides the body's own, see :data:`_KEY_COLUMNS`).
@@ -37,6 +38,8 @@ _KEY_COLUMNS: dict[str, tuple[str, ...]] = {
     "free_link": ("q_deg", "v0_mean"),
     "chain": ("link", "v0_case", "q0_deg", "v0_mean"),
     "leg": ("v0_mean",),
+    # Bodies in space: the columns the caller's function of the row reads.
+    "space": (),
 }
 #: The thesis's measurements by name: (body, data table, what the rows are).
 THESIS_MEASUREMENTS: dict[str, tuple[str, str, str]] = {
@@ -70,10 +73,12 @@ class Measurements:
     """Measured depths and stopping times with their spread, one row per measured case.
 
     Attributes:
-        body: ``"free_link"``, ``"chain"`` or ``"leg"``: what the rows were measured on.
+        body: ``"free_link"``, ``"chain"``, ``"leg"`` or ``"space"`` (bodies in space):
+            what the rows were measured on.
         rows: one row per case: the body's key columns (free link: ``q_deg`` [deg],
             ``v0_mean`` [m/s]; chain: ``link`` (1 or 2), ``v0_case``, ``q0_deg`` [deg],
-            ``v0_mean`` [m/s], one row per link; leg: ``v0_mean`` [m/s]), then
+            ``v0_mean`` [m/s], one row per link; leg: ``v0_mean`` [m/s]; space: whatever
+            the function that makes each row's scene reads), then
             ``t_s_mean``, ``t_s_sd`` [s], ``depth_mean``, ``depth_sd`` [m], and any other
             columns of the source (ignored).
         source: where the rows come from (a thesis table or a file name).

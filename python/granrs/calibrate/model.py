@@ -6,6 +6,7 @@ a set of parameter values.
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import math
 import re
@@ -50,6 +51,7 @@ BODY_PARAMS: dict[str, tuple[str, ...]] = {
     "free_link": ("mass",),
     "chain": ("mass", "pin_mass"),
     "leg": ("joints.k", "joints.c"),
+    "space": (),
 }
 #: Parameters fitted as they are (not in log space): exponents, which may be 0.
 _PLAIN: frozenset[tuple[str, str]] = frozenset({("static_v", "lam")})
@@ -281,6 +283,8 @@ class _Model:
     fixed_joints: dict[str, float]
     #: The law's terms (None: the thesis's, from ``base``'s coefficients).
     law: LawSpec | None = None
+    #: Bodies in space: the function of the row that makes its scene.
+    scene_of: Callable[[dict[str, Any]], Any] | None = None
     #: Per vector and row of the last :meth:`simulate`: the step did not resolve the run.
     last_unresolved: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool))
 
@@ -298,6 +302,8 @@ class _Model:
 
     def base_terms(self, row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
         """The law's terms for one row (one contact), before the fitted parameters."""
+        if self.law is None and self.body == "space":
+            return tuple(self.space_scene(row).forces)
         if self.law is None:
             return _forces.thesis(self.base_coefficients(row))
         terms = self.law(row) if callable(self.law) else self.law
@@ -307,9 +313,14 @@ class _Model:
             for t in _forces.as_terms(terms)
         )
 
-    def row_terms(self, row: Mapping[str, Any], values: Sequence[float]) -> tuple[Any, ...]:
-        """The terms of one row (one contact) at the natural parameter ``values``."""
-        terms = {t.name: dict(t.params) for t in self.base_terms(row)}
+    def row_terms(
+        self, row: Mapping[str, Any], values: Sequence[float], scene: Any = None
+    ) -> tuple[Any, ...]:
+        """The terms of one row (one contact) at the natural parameter ``values``; ``scene``:
+        a body in space's scene of the row, already made (its forces are the law's base)."""
+        given = scene.forces if scene is not None and self.law is None else None
+        base_terms = self.base_terms(row) if given is None else tuple(given)
+        terms = {t.name: dict(t.params) for t in base_terms}
         base = {name: dict(p) for name, p in terms.items()}
         nodes: dict[tuple[str, str], list[tuple[float, float, bool]]] = {}
         for p, v in zip(self.params, values, strict=True):
@@ -371,9 +382,31 @@ class _Model:
             joints = {**_JOINT_START, **self.fixed_joints, **named}
         return fields, joints
 
-    def scenes(self, rows: pd.DataFrame, values: Sequence[float]) -> list[Scene]:
-        """One scene per run: per row (free link, leg) or per chain case (two rows)."""
+    def space_scene(self, row: Mapping[str, Any]) -> Any:
+        """A body in space's scene of one row, from the caller's function (checked)."""
+        from .. import space
+
+        assert self.scene_of is not None
+        scene = self.scene_of(dict(row))
+        if not isinstance(scene, space.Scene):
+            raise InvalidParameterError(
+                "cases: the function of the measurement row must return a "
+                f"granrs.space.Scene; got {type(scene).__name__}",
+                field="cases",
+            )
+        return scene
+
+    def scenes(self, rows: pd.DataFrame, values: Sequence[float]) -> list[Any]:
+        """One scene per run: per row (free link, leg, space) or per chain case (two rows)."""
         records = rows.to_dict("records")
+        if self.body == "space":
+            out = []
+            for r in records:
+                # The caller's function runs once per row.
+                scene = self.space_scene(r)
+                terms = self.row_terms(r, values, scene)
+                out.append(dataclasses.replace(scene, forces=terms, dt=self.dt))
+            return out
         fields, joints = self.body_values(values)
         if self.body == "free_link":
             return [
@@ -423,7 +456,7 @@ class _Model:
         """
         from ..batch import sweep
 
-        scenes: list[Scene] = []
+        scenes: list[Any] = []
         invalid = np.zeros(len(vectors), dtype=bool)
         n_runs = len(rows) if self.body != "chain" else len(_chain_pairs(rows))
         for v, values in enumerate(vectors):
