@@ -429,6 +429,8 @@ pub(super) struct Landing<'a, const N: usize> {
     pub probe: &'a State<N>,
     /// See the struct.
     pub lookahead: &'a State<N>,
+    /// The lookahead's time [s]: the end of the step that found the event.
+    pub t_lookahead: f64,
 }
 
 /// The events' state through a run.
@@ -690,12 +692,12 @@ impl Events {
                     if choose_slip(model, modes, ci, axis, at.y, at.lookahead, stats)
                         && !modes[ci].stopped
                     {
-                        obs.overshot_stick(ci);
+                        obs.overshot_stick(ci, axis, at.t);
                     }
                 }
                 Kind::Stop => {
                     modes[ci].stopped = true;
-                    obs.stopped(model, ci, at.t, at.y, at.e);
+                    obs.stopped(model, ci, at.t, at.y, at.e, at.t_lookahead - at.t);
                     terminal |= match end {
                         EndCondition::FirstStop => true,
                         EndCondition::AllStops => modes[..nc].iter().all(|m| m.stopped),

@@ -130,6 +130,9 @@ pub(super) struct Observer<const N: usize> {
     /// them): its stop's estimated error past [`STOP_TIME_ERROR`] (or its depth's at the end
     /// without a stop), or a stick decision the step made ([`Observer::overshot_stick`]).
     unresolved: Vec<bool>,
+    /// Each contact: the time [s] and axis of its first stick the step decided
+    /// ([`Observer::overshot_stick`]), judged at its stop or at the end ([`Observer::slid`]).
+    overshot: Vec<Option<(f64, usize)>>,
     /// The terms' stiffest moments at the start, the step ends and the events so far.
     terms: TermStiffest<N>,
     /// The run's error so far, as its steps estimate it ([`super::stepper::companion`]):
@@ -205,6 +208,7 @@ impl<const N: usize> Observer<N> {
             },
             rates_on: model.forces.reads_frame,
             unresolved: vec![false; nc],
+            overshot: vec![None; nc],
             err_q: SVector::zeros(),
             err_qd: SVector::zeros(),
             step_error: 0.0,
@@ -379,12 +383,28 @@ impl<const N: usize> Observer<N> {
         }
     }
 
-    /// Contact `ci` slid on where its static bound would have held it, because the located
-    /// sign switch overshot the zero (see `events::choose_slip`): the step, not the contact,
-    /// decided, and the contact counts in `unresolved_stops`.
-    pub(super) fn overshot_stick(&mut self, ci: usize) {
-        if self.estimates {
-            self.unresolved[ci] = true;
+    /// Contact `ci` slid on along `axis` at `t` where its static bound would have held it,
+    /// because the located sign switch overshot the zero (see `events::choose_slip`): the
+    /// step, not the contact, decided. Judged at its stop or at the end ([`Observer::slid`]).
+    pub(super) fn overshot_stick(&mut self, ci: usize, axis: usize, t: f64) {
+        if self.estimates && self.overshot[ci].is_none() {
+            self.overshot[ci] = Some((t, axis));
+        }
+    }
+
+    /// Whether contact `ci`'s stick the step decided ([`Observer::overshot_stick`]) moved
+    /// its results: by `t`, where E moves at `v_e` and the tip is `depth` deep, E slid that
+    /// way for `t - t_o`, speeding up (`events::runs_away`), so by at most |v_e| (t - t_o);
+    /// more than [`STOP_TIME_ERROR`] of the depth counts it in `unresolved_stops` (an
+    /// `rft` rod at the centroid slid up for 0.04 s and stopped at 0.049 s against 0.198 s;
+    /// a chain's link that stops 17 us after the switch does not move).
+    fn slid(&mut self, ci: usize, t: f64, v_e: Vector2<f64>, depth: f64) {
+        if let Some((t_o, axis)) = self.overshot[ci] {
+            if t - t_o > STOP_TIME_ERROR * t
+                || v_e[axis].abs() * (t - t_o) > STOP_TIME_ERROR * depth
+            {
+                self.unresolved[ci] = true;
+            }
         }
     }
 
@@ -396,7 +416,8 @@ impl<const N: usize> Observer<N> {
         }
     }
 
-    /// Contact `ci` stopped at `t`, at the state `y` (its evaluation `e`).
+    /// Contact `ci` stopped at `t`, at the state `y` (its evaluation `e`), `rest` [s] before
+    /// the end of the step that found the stop (where the tip rises).
     pub(super) fn stopped(
         &mut self,
         model: &Model<N>,
@@ -404,6 +425,7 @@ impl<const N: usize> Observer<N> {
         t: f64,
         y: &State<N>,
         e: &Eval<N>,
+        rest: f64,
     ) {
         let energies = model.energies(&y.q, &y.qd);
         // The stop's switching function there (zero where the step resolves the stop) over
@@ -429,23 +451,28 @@ impl<const N: usize> Observer<N> {
             }
         };
         let v_res = e.contacts[ci].v_tip.y;
-        // Still sinking where the stop was located, and not slowing down: the interpolant's
-        // root is not one of the run's own map, whose velocity moves away from zero there;
-        // the stop may come much later or not at all. Its time error is of the order of t_s.
-        // Not under the plain `sign()`, whose static terms chatter through every stop by
-        // construction (see `estimates`).
-        let spurious = self.estimates && v_res < -STOP_SPEED && accel.y <= 0.0;
         let mut relative = ratio(v_res.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
+        // Still sinking where the stop was located, and not slowing down: the interpolant's
+        // root is not one of the run's own map, whose velocity moves away from zero there
+        // (a force that follows a velocity's direction flipped inside the step). The map's
+        // own root lies between here and the step's end, where the tip rises (the stop was
+        // found there): the stop time's error is at most the `rest` of the step, the depth's
+        // the tip's sinking over it. Not under the plain `sign()`, whose static terms chatter
+        // through every stop by construction (see `estimates`).
+        let spurious = self.estimates && v_res < -STOP_SPEED && accel.y <= 0.0;
         if spurious {
-            relative = relative.max(1.0);
+            let rest = rest.max(0.0);
+            relative = relative
+                .max(ratio(rest, t))
+                .max(ratio(v_res.abs() * rest, depth));
         }
         self.step_error = self.step_error.max(relative);
-        if spurious
-            || v_res.abs() > STOP_TIME_ERROR * t * accel.y.abs()
+        if (!spurious && v_res.abs() > STOP_TIME_ERROR * t * accel.y.abs())
             || (self.estimates && relative > STOP_TIME_ERROR)
         {
             self.unresolved[ci] = true;
         }
+        self.slid(ci, t, e.contacts[ci].v_centroid, depth);
         let s = &mut self.summaries[ci];
         s.stopped = true;
         s.t_s = t;
@@ -498,6 +525,8 @@ impl<const N: usize> Observer<N> {
         for ci in 0..self.summaries.len() {
             if !self.summaries[ci].stopped {
                 self.settle(model, ci, y, &e_end.contacts[ci], energies);
+                let c = &e_end.contacts[ci];
+                self.slid(ci, t, c.v_centroid, (-c.tip.y).max(0.0));
                 if options.method == Method::Rk4 {
                     let (dy, _) = self.tip_errors(model, ci, &y.q, &y.qd);
                     let depth = (-e_end.contacts[ci].tip.y).max(0.0);
