@@ -63,7 +63,9 @@ pub struct Stats {
     /// end without one) above [`STOP_TIME_ERROR`]; or a sign switch's located velocity
     /// overshot zero where the static bound would have held the contact, so that it slid on
     /// the other way, speeding up: the step, not the contact, decided (an `rft` rod that
-    /// sticks at dt = 1e-5 slides on at 1e-4 and stops 16 % early). Each contact counts once.
+    /// sticks at dt = 1e-5 slides on at 1e-4 and stops 16 % early), and by its stop (or the
+    /// end) that slide had lasted [`STOP_TIME_ERROR`] of the time or moved E by as much of
+    /// the depth. Each contact counts once.
     ///
     /// [`STOP_TIME_ERROR`]: super::observe::STOP_TIME_ERROR
     pub unresolved_stops: usize,
