@@ -8,13 +8,17 @@ than 1 % (or its status does); it *warned* when ``granrs.simulate`` warned
 :class:`granrs.StepSizeWarning` or refused the run as diverged. The script prints, per dt,
 the confusion counts (moved & warned, moved & silent, still & warned, still & silent), each
 miss and false alarm with its ``h_lambda``, ``step_error`` and ``unresolved_stops``, and the
-mirror check:
-the largest relative difference of ``t_s`` and depth between a silent run and its mirror
-image (q, vx0, omega0 -> -q, -vx0, -omega0).
+mirror count: each scene is run again as its mirror image (x -> -x: the angle q, vx0 and
+omega0 -> -q, -vx0, -omega0); of the pairs where neither warns, how many differ by more
+than 1e-9 (relative, in ``t_s`` and depth), and how many pairs only one of the two warns.
+
+With ``--deep`` a run that agrees with dt / 10 is also compared with dt / 100 and counts as
+moved if that differs: dt / 10 can be as wrong as dt (a stick that both steps' overshoot
+decided, which only dt / 100 resolves).
 
 Usage::
 
-    python benches/step_warning.py [--scenes 200] [--seed 7]
+    python benches/step_warning.py [--scenes 200] [--seed 7] [--deep]
 """
 
 from __future__ import annotations
@@ -156,11 +160,18 @@ class Study:
     counts: dict[float, dict[str, int]] = field(default_factory=dict)
     misses: list[tuple[int, str, float, dict[str, Any]]] = field(default_factory=list)
     false_alarms: list[tuple[int, str, float, dict[str, Any]]] = field(default_factory=list)
-    #: (scene, dt, gap) for every silent run.
+    #: (scene, dt, gap) for every pair of silent runs (a scene and its mirror image).
     mirror: list[tuple[int, float, float]] = field(default_factory=list)
+    #: (scene, dt) where only one of a scene and its mirror image warned.
+    mirror_warned: list[tuple[int, float]] = field(default_factory=list)
 
 
-def study(drawn: list[Scene], dts: tuple[float, ...] = (1e-3, 1e-4), mirrors: bool = True) -> Study:
+def study(
+    drawn: list[Scene],
+    dts: tuple[float, ...] = (1e-3, 1e-4),
+    mirrors: bool = True,
+    deep: bool = False,
+) -> Study:
     out = Study()
     for dt in dts:
         out.counts[dt] = dict.fromkeys(
@@ -172,6 +183,9 @@ def study(drawn: list[Scene], dts: tuple[float, ...] = (1e-3, 1e-4), mirrors: bo
             coarse = fine.get(dt) or run(sc.at(dt))
             fine[dt / 10] = finer = run(sc.at(dt / 10))
             m = moved(coarse, finer)
+            if deep and not m:
+                # dt / 10 may be as unresolved as dt (a stick decided by both steps).
+                m = moved(coarse, run(sc.at(dt / 100)))
             key = f"{'moved' if m else 'still'}&{'warned' if coarse.warned else 'silent'}"
             out.counts[dt][key] += 1
             info = {
@@ -184,8 +198,12 @@ def study(drawn: list[Scene], dts: tuple[float, ...] = (1e-3, 1e-4), mirrors: bo
                 out.misses.append((i, sc.law, dt, info))
             if coarse.warned and not m:
                 out.false_alarms.append((i, sc.law, dt, info))
-            if mirrors and not coarse.warned:
-                out.mirror.append((i, dt, mirror_gap(coarse, run(sc.at(dt, mirror=True)))))
+            if mirrors:
+                image = run(sc.at(dt, mirror=True))
+                if coarse.warned != image.warned:
+                    out.mirror_warned.append((i, dt))
+                elif not coarse.warned:
+                    out.mirror.append((i, dt, mirror_gap(coarse, image)))
     return out
 
 
@@ -207,13 +225,17 @@ def report(s: Study, drawn: list[Scene]) -> str:
                 f"t_s {info['t_s']:.6g} against {info['t_s_fine']:.6g}, depth "
                 f"{info['depth']:.6g} against {info['depth_fine']:.6g}"
             )
-    if s.mirror:
-        worst = max(s.mirror, key=lambda r: r[2])
+    if s.mirror or s.mirror_warned:
         over = sum(1 for _, _, g in s.mirror if g > 1e-9)
-        lines.append(
-            f"mirror images of silent runs: {len(s.mirror)} compared, {over} differ by more "
-            f"than 1e-9 (largest {worst[2]:.3g}: scene {worst[0]} at dt {worst[1]:g})"
+        line = (
+            f"mirror images: {len(s.mirror)} silent pairs compared, {over} differ by more than 1e-9"
         )
+        if s.mirror:
+            worst = max(s.mirror, key=lambda r: r[2])
+            line += f" (largest {worst[2]:.3g}: scene {worst[0]} at dt {worst[1]:g})"
+        only = ", ".join(f"scene {i} at dt {dt:g}" for i, dt in s.mirror_warned)
+        line += f"; {len(s.mirror_warned)} pairs where only one warns{': ' + only if only else ''}"
+        lines.append(line)
     return "\n".join(lines)
 
 
@@ -221,10 +243,15 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", type=int, default=200)
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument(
+        "--deep",
+        action="store_true",
+        help="a run that agrees with dt / 10 is also compared with dt / 100",
+    )
     args = parser.parse_args(argv)
     drawn = scenes(args.scenes, args.seed)
-    print(f"{args.scenes} scenes, seed {args.seed}")
-    print(report(study(drawn), drawn))
+    print(f"{args.scenes} scenes, seed {args.seed}{', deep' if args.deep else ''}")
+    print(report(study(drawn, deep=args.deep), drawn))
     return 0
 
 

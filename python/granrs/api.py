@@ -30,9 +30,9 @@ def step_advice(
 ) -> str:
     """What to tell a user whose run did not resolve its contact: ``h_lambda`` above
     :data:`RK4_STABILITY_LIMIT`, ``unresolved_stops`` contacts the step did not resolve
-    (the steps' own error estimate ``step_error`` above :data:`STEP_ERROR_LIMIT`, or a stop
-    that fell between the steps), or ``unresolved`` steps the sign modes chattered
-    through."""
+    (the steps' own error estimate ``step_error`` above :data:`STEP_ERROR_LIMIT`, a stop
+    that fell between the steps, or a stick that the step's overshoot decided), or
+    ``unresolved`` steps the sign modes chattered through."""
     if h_lambda > RK4_STABILITY_LIMIT:
         why = (
             f"dt times the contact's fastest rate reached {h_lambda:.3g} (RK4 is stable below "
@@ -47,9 +47,11 @@ def step_advice(
         advice = f"use dt <= {dt / 10:.2g} s (dt / 10)"
     elif unresolved_stops:
         why = (
-            f"{unresolved_stops} stop{'s' if unresolved_stops != 1 else ''} fell between "
-            "the steps (the tip's vertical velocity was not zero where the stop was located: "
-            "the impact is over in too few steps)"
+            f"{unresolved_stops} contact{'s' if unresolved_stops != 1 else ''} did not "
+            "resolve: a stop fell between the steps (the tip's vertical velocity was not zero "
+            "where the stop was located: the impact is over in too few steps), or the step "
+            "decided a stick (the located sign switch overshot zero, and the contact slid on "
+            "where the sand would have held it)"
         )
         advice = f"use dt <= {dt / 10:.2g} s (dt / 10)"
     else:

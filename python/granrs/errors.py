@@ -68,10 +68,13 @@ class StepSizeWarning(UserWarning):
     """The fixed step did not resolve the run: at the contact's stiffest moment, ``dt`` times
     its fastest rate (``Result.summary["h_lambda"]``: the drag's, and each listed force term's
     own stiffness in velocity and depth) exceeded RK4's stability limit
-    (:data:`granrs.RK4_STABILITY_LIMIT`), or steps where the force's signs chattered gained
-    energy. The run finished with finite numbers, but they are not the converged answer: the
-    message gives the ``dt`` used and a ``dt`` that resolves it; rerun with that ``dt`` or
-    ``method="dopri5"``."""
+    (:data:`granrs.RK4_STABILITY_LIMIT`), a contact's result was not resolved
+    (``Result.summary["unresolved_stops"]``: the steps' own error estimates put t_s or the
+    depth more than 1 % off, ``summary["step_error"]``, or a stop or a stick was decided by
+    where the step located it rather than by the run), or steps where the force's signs
+    chattered gained energy. The run finished with finite numbers, but they are not the
+    converged answer: the message gives the ``dt`` used and a ``dt`` that resolves it; rerun
+    with that ``dt`` or ``method="dopri5"``."""
 
 
 class CoefficientsWarning(UserWarning):

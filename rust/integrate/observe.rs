@@ -26,6 +26,10 @@ pub const RK4_STABILITY_LIMIT: f64 = 2.785;
 /// stop): that velocity over the tip's vertical acceleration.
 pub const STOP_TIME_ERROR: f64 = 0.01;
 
+/// The tip's vertical velocity [m/s] below which a located stop that is still sinking counts
+/// as reached (round-off at a stop the step resolves is far below it).
+const STOP_SPEED: f64 = 1e-9;
+
 /// The fastest rate [1/s] of a quadratic drag `F = -c |v| v` on a point of inverse effective
 /// mass `w`, with `k = |F| / |v|` and `dir` the unit velocity: the largest eigenvalue of
 /// `w K`, `K = dF/dv = -k (I + dir dir^T)` (twice as stiff along the motion as across).
@@ -122,9 +126,13 @@ pub(super) struct Observer<const N: usize> {
     /// term reads the contact's boundary (`rft`, `rft_inertial`, `poncelet`), whose rates the
     /// drag's |F_d| / |v_E| does not see. The thesis's terms keep the drag's estimate alone.
     rates_on: bool,
-    /// Stops whose estimated time error was past [`STOP_TIME_ERROR`]
-    /// (`Stats::unresolved_stops`).
-    unresolved_stops: usize,
+    /// Each contact: whether the step did not resolve it (`Stats::unresolved_stops` counts
+    /// them): its stop's estimated error past [`STOP_TIME_ERROR`] (or its depth's at the end
+    /// without a stop), or a stick decision the step made ([`Observer::overshot_stick`]).
+    unresolved: Vec<bool>,
+    /// Each contact: the time [s] and axis of its first stick the step decided
+    /// ([`Observer::overshot_stick`]), judged at its stop or at the end ([`Observer::slid`]).
+    overshot: Vec<Option<(f64, usize)>>,
     /// The terms' stiffest moments at the start, the step ends and the events so far.
     terms: TermStiffest<N>,
     /// The run's error so far, as its steps estimate it ([`super::stepper::companion`]):
@@ -199,7 +207,8 @@ impl<const N: usize> Observer<N> {
                 q: y.q,
             },
             rates_on: model.forces.reads_frame,
-            unresolved_stops: 0,
+            unresolved: vec![false; nc],
+            overshot: vec![None; nc],
             err_q: SVector::zeros(),
             err_qd: SVector::zeros(),
             step_error: 0.0,
@@ -374,6 +383,31 @@ impl<const N: usize> Observer<N> {
         }
     }
 
+    /// Contact `ci` slid on along `axis` at `t` where its static bound would have held it,
+    /// because the located sign switch overshot the zero (see `events::choose_slip`): the
+    /// step, not the contact, decided. Judged at its stop or at the end ([`Observer::slid`]).
+    pub(super) fn overshot_stick(&mut self, ci: usize, axis: usize, t: f64) {
+        if self.estimates && self.overshot[ci].is_none() {
+            self.overshot[ci] = Some((t, axis));
+        }
+    }
+
+    /// Whether contact `ci`'s stick the step decided ([`Observer::overshot_stick`]) moved
+    /// its results: by `t`, where E moves at `v_e` and the tip is `depth` deep, E slid that
+    /// way for `t - t_o`, speeding up (`events::runs_away`), so by at most |v_e| (t - t_o);
+    /// more than [`STOP_TIME_ERROR`] of the depth counts it in `unresolved_stops` (an
+    /// `rft` rod at the centroid slid up for 0.04 s and stopped at 0.049 s against 0.198 s;
+    /// a chain's link that stops 17 us after the switch does not move).
+    fn slid(&mut self, ci: usize, t: f64, v_e: Vector2<f64>, depth: f64) {
+        if let Some((t_o, axis)) = self.overshot[ci] {
+            if t - t_o > STOP_TIME_ERROR * t
+                || v_e[axis].abs() * (t - t_o) > STOP_TIME_ERROR * depth
+            {
+                self.unresolved[ci] = true;
+            }
+        }
+    }
+
     /// Contact `ci` entered the sand at `t` (the first entry counts).
     pub(super) fn entered(&mut self, ci: usize, t: f64) {
         let s = &mut self.summaries[ci];
@@ -382,7 +416,8 @@ impl<const N: usize> Observer<N> {
         }
     }
 
-    /// Contact `ci` stopped at `t`, at the state `y` (its evaluation `e`).
+    /// Contact `ci` stopped at `t`, at the state `y` (its evaluation `e`), `rest` [s] before
+    /// the end of the step that found the stop (where the tip rises).
     pub(super) fn stopped(
         &mut self,
         model: &Model<N>,
@@ -390,6 +425,7 @@ impl<const N: usize> Observer<N> {
         t: f64,
         y: &State<N>,
         e: &Eval<N>,
+        rest: f64,
     ) {
         let energies = model.energies(&y.q, &y.qd);
         // The stop's switching function there (zero where the step resolves the stop) over
@@ -414,14 +450,29 @@ impl<const N: usize> Observer<N> {
                 0.0
             }
         };
-        let relative =
-            ratio(e.contacts[ci].v_tip.y.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
+        let v_res = e.contacts[ci].v_tip.y;
+        let mut relative = ratio(v_res.abs() + dv, t * accel.y.abs()).max(ratio(dy, depth));
+        // Still sinking where the stop was located, and not slowing down: the interpolant's
+        // root is not one of the run's own map, whose velocity moves away from zero there
+        // (a force that follows a velocity's direction flipped inside the step). The map's
+        // own root lies between here and the step's end, where the tip rises (the stop was
+        // found there): the stop time's error is at most the `rest` of the step, the depth's
+        // the tip's sinking over it. Not under the plain `sign()`, whose static terms chatter
+        // through every stop by construction (see `estimates`).
+        let spurious = self.estimates && v_res < -STOP_SPEED && accel.y <= 0.0;
+        if spurious {
+            let rest = rest.max(0.0);
+            relative = relative
+                .max(ratio(rest, t))
+                .max(ratio(v_res.abs() * rest, depth));
+        }
         self.step_error = self.step_error.max(relative);
-        if e.contacts[ci].v_tip.y.abs() > STOP_TIME_ERROR * t * accel.y.abs()
+        if (!spurious && v_res.abs() > STOP_TIME_ERROR * t * accel.y.abs())
             || (self.estimates && relative > STOP_TIME_ERROR)
         {
-            self.unresolved_stops += 1;
+            self.unresolved[ci] = true;
         }
+        self.slid(ci, t, e.contacts[ci].v_centroid, depth);
         let s = &mut self.summaries[ci];
         s.stopped = true;
         s.t_s = t;
@@ -474,13 +525,15 @@ impl<const N: usize> Observer<N> {
         for ci in 0..self.summaries.len() {
             if !self.summaries[ci].stopped {
                 self.settle(model, ci, y, &e_end.contacts[ci], energies);
+                let c = &e_end.contacts[ci];
+                self.slid(ci, t, c.v_centroid, (-c.tip.y).max(0.0));
                 if options.method == Method::Rk4 {
                     let (dy, _) = self.tip_errors(model, ci, &y.q, &y.qd);
                     let depth = (-e_end.contacts[ci].tip.y).max(0.0);
                     if depth > 0.0 && dy > 0.0 {
                         self.step_error = self.step_error.max((dy / depth).min(f64::MAX));
                         if self.estimates && dy > STOP_TIME_ERROR * depth {
-                            self.unresolved_stops += 1;
+                            self.unresolved[ci] = true;
                         }
                     }
                 }
@@ -502,7 +555,7 @@ impl<const N: usize> Observer<N> {
             options.dt * drag.max(self.terms.rate(model))
         };
         let mut stats = stats;
-        stats.unresolved_stops = self.unresolved_stops;
+        stats.unresolved_stops = self.unresolved.iter().filter(|&&u| u).count();
         let step_error = if options.method == Method::Rk4 {
             self.step_error
         } else {

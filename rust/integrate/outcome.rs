@@ -60,7 +60,12 @@ pub struct Stats {
     /// [`STOP_TIME_ERROR`] of t_s (the stop is located on the step's interpolant; an impact
     /// over in a few steps misses it, by up to several per cent in t_s); or the steps' own
     /// error estimate ([`Outcome::step_error`]) put its t_s or depth (at the stop, or at the
-    /// end without one) above [`STOP_TIME_ERROR`].
+    /// end without one) above [`STOP_TIME_ERROR`]; or a sign switch's located velocity
+    /// overshot zero where the static bound would have held the contact, so that it slid on
+    /// the other way, speeding up: the step, not the contact, decided (an `rft` rod that
+    /// sticks at dt = 1e-5 slides on at 1e-4 and stops 16 % early), and by its stop (or the
+    /// end) that slide had lasted [`STOP_TIME_ERROR`] of the time or moved E by as much of
+    /// the depth. Each contact counts once.
     ///
     /// [`STOP_TIME_ERROR`]: super::observe::STOP_TIME_ERROR
     pub unresolved_stops: usize,

@@ -478,6 +478,7 @@ impl<const N: usize> Run<N> {
             e: &e_star,
             probe: &probe,
             lookahead: &y1,
+            t_lookahead: t_next,
         };
         let terminal = events.handle(model, modes, earliest, &at, options.end, obs, stats);
         *y = y_star;
