@@ -336,23 +336,9 @@ def rest_laws() -> dict[str, dict[str, object]]:
 
 def hopper_model(foot: str) -> mujoco.MjModel:
     """Gymnasium's hopper, no contacts (no floor), its foot a capsule or a box."""
-    import os
+    from granrs.gym import hopper_model as model
 
-    import gymnasium
-
-    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/hopper.xml")
-    with open(path) as f:
-        xml = f.read()
-    if foot == "box":
-        capsule = 'quat="0.70710678118654757 0 -0.70710678118654746 0" name="foot_geom" '
-        xml = xml.replace(capsule, 'name="foot_geom" ').replace(
-            'name="foot_geom" size="0.06 0.195" type="capsule"',
-            'name="foot_geom" size="0.195 0.05 0.03" type="box"',
-        )
-    m = mujoco.MjModel.from_xml_string(xml)
-    m.geom_contype[:] = 0
-    m.geom_conaffinity[:] = 0
-    return m
+    return model(foot)
 
 
 def hopper_rest(law: str, mode: str, foot: str, seconds: float = 10.0) -> dict[str, float]:

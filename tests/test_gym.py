@@ -585,3 +585,18 @@ def test_import_without_gymnasium_says_what_to_install(monkeypatch):
     monkeypatch.delitem(sys.modules, "granrs.gym")
     with pytest.raises(ImportError, match="pip install gymnasium"):
         importlib.import_module("granrs.gym")
+
+
+def test_hopper_model_swaps_the_foot_and_refuses_an_unknown_one() -> None:
+    """granrs.gym.hopper_model: Gymnasium's hopper with no contacts, its foot the shipped
+    capsule or a box of the same length; any other foot is a typed error naming it."""
+    from granrs.gym import hopper_model
+
+    capsule, box = hopper_model(), hopper_model("box")
+    gid = mujoco.mj_name2id(capsule, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
+    assert capsule.geom_type[gid] == mujoco.mjtGeom.mjGEOM_CAPSULE
+    assert box.geom_type[gid] == mujoco.mjtGeom.mjGEOM_BOX
+    assert list(box.geom_size[gid]) == pytest.approx([0.195, 0.05, 0.03])
+    assert not capsule.geom_contype.any() and not capsule.geom_conaffinity.any()
+    with pytest.raises(granrs.InvalidParameterError, match="foot"):
+        hopper_model("sphere")

@@ -7,7 +7,6 @@ that ``import granrs`` works without it.
 from __future__ import annotations
 
 import math
-import os
 import subprocess
 import sys
 import warnings
@@ -388,21 +387,10 @@ def test_a_box_dropped_flat_settles_without_gaining_energy():
 
 def _hopper(foot: str):
     """Gymnasium's own hopper (RK4 at 2 ms), no floor, its foot a capsule or a box."""
-    gymnasium = pytest.importorskip("gymnasium")
-    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/hopper.xml")
-    with open(path) as f:
-        xml = f.read()
-    if foot == "box":
-        capsule = 'quat="0.70710678118654757 0 -0.70710678118654746 0" name="foot_geom" '
-        xml = xml.replace(capsule, 'name="foot_geom" ').replace(
-            'name="foot_geom" size="0.06 0.195" type="capsule"',
-            'name="foot_geom" size="0.195 0.05 0.03" type="box"',
-        )
-        assert 'type="box"' in xml
-    model = mujoco.MjModel.from_xml_string(xml)
-    model.geom_contype[:] = 0
-    model.geom_conaffinity[:] = 0
-    return model
+    pytest.importorskip("gymnasium")
+    from granrs.gym import hopper_model
+
+    return hopper_model(foot)
 
 
 @pytest.mark.parametrize("mode", ["step", "callback"])

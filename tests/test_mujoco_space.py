@@ -251,20 +251,10 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_rft3d(mode, foot):
     # its foot in the sand (no floor), 10 s at its own RK4 2 ms: the foot moves less than
     # 0.1 mm over the last 5 s, the sand's force is the weight without step-to-step spread,
     # and the sand never does positive work.
-    gymnasium = pytest.importorskip("gymnasium")
-    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/hopper.xml")
-    with open(path) as f:
-        xml = f.read()
-    if foot == "box":
-        capsule = 'quat="0.70710678118654757 0 -0.70710678118654746 0" name="foot_geom" '
-        xml = xml.replace(capsule, 'name="foot_geom" ').replace(
-            'name="foot_geom" size="0.06 0.195" type="capsule"',
-            'name="foot_geom" size="0.195 0.05 0.03" type="box"',
-        )
-        assert 'type="box"' in xml
-    m = mujoco.MjModel.from_xml_string(xml)
-    m.geom_contype[:] = 0
-    m.geom_conaffinity[:] = 0
+    pytest.importorskip("gymnasium")
+    from granrs.gym import hopper_model
+
+    m = hopper_model(foot)
     d = mujoco.MjData(m)
     mujoco.mj_forward(m, d)
     foot_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")

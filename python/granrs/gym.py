@@ -46,7 +46,16 @@ from .errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from .forces import Term
 from .mujoco import Sand
 
-__all__ = ["FEET", "INFO_KEYS", "SAND_ARGUMENTS", "Feet", "SandWrapper", "default_forces", "make"]
+__all__ = [
+    "FEET",
+    "INFO_KEYS",
+    "SAND_ARGUMENTS",
+    "Feet",
+    "SandWrapper",
+    "default_forces",
+    "hopper_model",
+    "make",
+]
 
 
 class Feet(NamedTuple):
@@ -99,6 +108,47 @@ def default_forces() -> list[Term]:
     and an internal friction coefficient of 0.4 (about 4.6e5 N/m^3), after Agarwal, Goldman
     & Kamrin (2023)."""
     return [_forces.rft3d(zeta=_space.xi_n(_DENSITY, _FRICTION))]
+
+
+#: The hopper's feet :func:`hopper_model` builds: Gymnasium's own capsule, or a box of the
+#: same length (0.39 x 0.1 x 0.06 m).
+HOPPER_FEET = ("capsule", "box")
+
+
+def hopper_model(foot: str = "capsule") -> mujoco.MjModel:
+    """Gymnasium's own hopper (its ``hopper.xml``: RK4 at 2 ms) with no contacts (its floor
+    would hold the foot up: the sand is to), its foot a capsule lying side-on, as shipped,
+    or a box of the same length (``foot="box"``): the model of the docs' rest checks.
+
+    Args:
+        foot: ``"capsule"`` or ``"box"``.
+
+    Returns:
+        A new ``mujoco.MjModel``; the foot geom is ``"foot_geom"``.
+
+    Raises:
+        InvalidParameterError: an unknown ``foot``.
+    """
+    if foot not in HOPPER_FEET:
+        raise InvalidParameterError(f"foot: {foot!r} is not one of {', '.join(HOPPER_FEET)}")
+    import os
+
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/hopper.xml")
+    with open(path, encoding="utf-8") as f:
+        xml = f.read()
+    if foot == "box":
+        capsule = 'quat="0.70710678118654757 0 -0.70710678118654746 0" name="foot_geom" '
+        box = xml.replace(capsule, 'name="foot_geom" ').replace(
+            'name="foot_geom" size="0.06 0.195" type="capsule"',
+            'name="foot_geom" size="0.195 0.05 0.03" type="box"',
+        )
+        if 'type="box"' not in box:  # pragma: no cover - a Gymnasium that changed its hopper
+            raise InvalidSceneError("foot: this Gymnasium's hopper.xml has no capsule foot to swap")
+        xml = box
+    model = mujoco.MjModel.from_xml_string(xml)
+    model.geom_contype[:] = 0
+    model.geom_conaffinity[:] = 0
+    return model
 
 
 def _known_feet(unwrapped: Any) -> tuple[str, Feet] | None:
