@@ -36,6 +36,8 @@ def test_granrs_imports_without_mujoco_and_says_what_to_install():
 
 
 mujoco = pytest.importorskip("mujoco")
+from hopper_hold import hold_upright  # noqa: E402
+
 from granrs.mujoco import Sand, free_link_mjcf, rod_drop  # noqa: E402
 
 ROD = free_link_mjcf(granrs.cases.free_link(q_deg=0, v0=2.0))
@@ -409,24 +411,15 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_planar_rft(mode, foot):
     foot_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
     rft = forces.term("rft", zeta=463082.2272)
     sand = Sand(model, ["foot_geom"], [rft], apply_at="centroid")
-    q0 = data.qpos[3:6].copy()
     h = model.opt.timestep
     weight = model.body_subtreemass[1] * np.linalg.norm(model.opt.gravity)
     pos, fz = [], []
-    if mode == "callback":
-        sand.install()
-    try:
-        for _ in range(round(10.0 / h)):
-            pd = 200.0 * (q0 - data.qpos[3:6]) - 10.0 * data.qvel[3:6]
-            data.ctrl[:] = np.clip(pd, -200, 200) / 200
-            if mode == "step":
-                sand.step(data)
-            mujoco.mj_step(model, data)
-            pos.append(data.geom_xpos[foot_id].copy())
-            fz.append(sand.applied[0, 1])
-    finally:
-        if mode == "callback":
-            sand.uninstall()
+
+    def record(d):
+        pos.append(d.geom_xpos[foot_id].copy())
+        fz.append(sand.applied[0, 1])
+
+    hold_upright(model, data, sand, mode, 10.0, record)
     last = slice(-round(5.0 / h), None)
     assert np.all(np.isfinite(pos))
     assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4

@@ -14,6 +14,8 @@ import granrs
 from granrs import forces, space
 
 mujoco = pytest.importorskip("mujoco")
+from hopper_hold import hold_upright  # noqa: E402
+
 from granrs.mujoco import Sand, body_drop, body_mjcf  # noqa: E402
 
 ZETA = 1e6
@@ -259,24 +261,16 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_rft3d(mode, foot):
     mujoco.mj_forward(m, d)
     foot_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
     sand = Sand(m, ["foot_geom"], [forces.rft3d(zeta=space.xi_n(1520.0, 0.4))])
-    q0 = d.qpos[3:6].copy()
     h = m.opt.timestep
     weight = m.body_subtreemass[1] * np.linalg.norm(m.opt.gravity)
     pos, fz, power = [], [], []
-    if mode == "callback":
-        sand.install()
-    try:
-        for _ in range(round(10.0 / h)):
-            d.ctrl[:] = np.clip(200.0 * (q0 - d.qpos[3:6]) - 10.0 * d.qvel[3:6], -200, 200) / 200
-            if mode == "step":
-                sand.step(d)
-            mujoco.mj_step(m, d)
-            pos.append(d.geom_xpos[foot_id].copy())
-            fz.append(sand.applied[0, 2])
-            power.append(sand.applied[0, :3] @ sand.output[0, 8:11])
-    finally:
-        if mode == "callback":
-            sand.uninstall()
+
+    def record(d):
+        pos.append(d.geom_xpos[foot_id].copy())
+        fz.append(sand.applied[0, 2])
+        power.append(sand.applied[0, :3] @ sand.output[0, 8:11])
+
+    hold_upright(m, d, sand, mode, 10.0, record)
     last = slice(-round(5.0 / h), None)
     assert np.all(np.isfinite(pos))
     assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
