@@ -8,8 +8,8 @@ converged answer), for q = 0, 30 and 60 deg, MuJoCo timesteps 1e-4, 1e-3 and 2e-
 Euler (MuJoCo's default), RK4 and implicitfast integrators, with ``Sand.step`` before
 ``mj_step`` (the force held through MuJoCo's step) and, for RK4, also as the passive callback
 (evaluated at each stage). The stop is the first step whose end has the tip's vertical
-velocity >= 0 (within 1e-9 m/s), interpolated linearly inside the step. The laws: the
-thesis's (Table 3.4's row nearest q) and, where the core has it, ``rft(zeta=1e6,
+velocity >= 0 (within the Sand's ``rest_speed``), interpolated linearly inside the step. The
+laws: the thesis's (Table 3.4's row nearest q) and, where the core has it, ``rft(zeta=1e6,
 elements=64)``. A row passes when the depth is within 2 % and t_s within 5 %.
 
 **Cost (``--part cost``).** The gallery's walker (:func:`granrs.mujoco.walker_mjcf`, 7 dofs,
