@@ -220,6 +220,8 @@ BAD_MODELS = {
         (ROD, ["rod"], THESIS, {"surface": math.inf}, "surface"),
         (ROD, ["rod"], THESIS, {"apply_at": "heel"}, "apply_at"),
         (ROD, ["rod"], THESIS, {"patch": (1.0, 0.0)}, "patch"),
+        (ROD, ["rod"], [RFT], {"rest_speed": 0.0}, "rest_speed"),
+        (ROD, ["rod"], [RFT], {"rest_speed": math.nan}, "rest_speed"),
     ],
 )
 def test_bad_input_is_a_typed_error_naming_it_before_the_first_step(
