@@ -381,6 +381,15 @@ pub mod geoms {
             self.models.iter().any(|m| m.forces.names.contains(&"rft"))
         }
 
+        /// Geom `i`'s length [m]: a rod's L, a sole box's f_s.
+        pub fn length(&self, i: usize) -> f64 {
+            match &self.models[i].contacts[0].shape {
+                Shape::Rod(rod) => rod.length,
+                Shape::Sole(sole) => sole.length,
+                Shape::Arc(arc) => arc.radius * arc.span.abs(),
+            }
+        }
+
         /// Whether geom `i` is a sole box (else a rod).
         pub fn is_sole(&self, i: usize) -> bool {
             matches!(self.models[i].contacts[0].shape, Shape::Sole(_))
@@ -603,6 +612,11 @@ pub mod geoms {
         /// Under a term that resists turning ([`SandGeoms::resist_turning`]), with `stick`:
         /// each geom's whole wrench at R as last solved (force x, y [N], moment [N m]).
         pub held_wrench: Vec<Option<[f64; 3]>>,
+        /// Under a term that resists turning, with `stick`: the speed [m/s] at which a geom
+        /// held by the sand creeps under the sand's whole resistance (a geom carrying a
+        /// load creeps at this speed times the load over that resistance), so that the
+        /// reaction opposes the motion it leaves and the sand does no positive work.
+        pub rest_speed: f64,
     }
 
     /// The x and z rows of the Jacobian of world point `p` on the tree of `place` into
@@ -945,15 +959,25 @@ pub mod geoms {
                     self.rods.evaluate(i, &state, &mut row);
                     full.rows_mut(3 * a, 3).copy_from_slice(&row[..3]);
                 }
-                w = stick_or_slide(
-                    &(timestep * resp),
-                    &free,
-                    &full,
-                    k,
-                    3,
-                    2,
-                    Slide::AsEvaluated,
-                );
+                // The sand at rest as a stiff viscous law: each geom's twist at the step's
+                // end is its creep `-C w` (C: `rest_speed` over the geom's resistance, the
+                // rotation's over the resistance times its length squared), so that the
+                // reaction's power at that twist, `-w C w`, is never positive; a stick that
+                // brought the twist to zero exactly did positive work whenever the rest of
+                // the world's force moved between the steps (the reaction is solved against
+                // the last step's).
+                let mut ha = timestep * resp;
+                for (a, &i) in active.iter().enumerate() {
+                    let resistance = full.rows(3 * a, 2).norm();
+                    if resistance > 0.0 {
+                        let c = self.rest_speed / resistance;
+                        let length = self.rods.length(i);
+                        ha[(3 * a, 3 * a)] += c;
+                        ha[(3 * a + 1, 3 * a + 1)] += c;
+                        ha[(3 * a + 2, 3 * a + 2)] += c / (length * length);
+                    }
+                }
+                w = stick_or_slide(&ha, &free, &full, k, 3, 2, Slide::AsEvaluated);
                 self.held_wrench.fill(None);
                 for (a, &i) in active.iter().enumerate() {
                     self.held_wrench[i] = Some([w[3 * a], w[3 * a + 1], w[3 * a + 2]]);

@@ -221,6 +221,7 @@ class MujocoCoupling:
         patch: tuple[float, float],
         stick: bool,
         implicit_damping: list[float],
+        rest_speed: float,
     ) -> MujocoCoupling: ...
     @staticmethod
     def space(

@@ -186,7 +186,9 @@ class Sand:
             ``None`` (default): three dimensions where a term of :data:`SPACE_TERMS` is
             listed.
         rest_speed: in space: below this speed [m/s] the rate-independent terms fade to a
-            viscous law (:data:`REST_SPEED`).
+            viscous law (:data:`REST_SPEED`). Planar, under ``rft`` with
+            ``statics="stick"``: a geom the sand holds creeps at this speed times its load
+            over the sand's resistance, so that the sand never does positive work.
         quadrature: in space: Gauss-Legendre nodes per panel of a curved surface
             (:data:`granrs.space.DEFAULT_QUADRATURE`).
         medium: the granular medium (:mod:`granrs.media`): a shipped card's name, a card
@@ -301,8 +303,15 @@ class Sand:
         self._after = np.zeros(model.nv)
         #: The largest of ``h_lambda`` over every step so far.
         self.max_h_lambda = 0.0
+        speed = _number(rest_speed, "rest_speed")
+        if speed <= 0.0:
+            raise InvalidParameterError(
+                f"`rest_speed` must be > 0, got {speed}", field="rest_speed"
+            )
+        #: The sand's creep speed at rest [m/s] (the ``rest_speed`` argument).
+        self.rest_speed = speed
         if self.space:
-            self._init_space(names, terms, rho, rest_speed, quadrature)
+            self._init_space(names, terms, rho, quadrature)
             return
         if len(self.patch) == 4 and math.isfinite(self.patch[2] - self.patch[3]):
             raise InvalidParameterError(
@@ -366,6 +375,7 @@ class Sand:
             self.patch,
             statics == "stick",
             self._implicit_damping(),
+            self.rest_speed,
         )
         n = len(names)
         #: Each geom's evaluation at the last step (columns :data:`GEOM_OUTPUTS`).
@@ -424,15 +434,8 @@ class Sand:
             np.array(m.mesh_face[f0 : f0 + nface], dtype=np.int64),
         )
 
-    def _init_space(
-        self, names: list[str], terms: list[Term], rho: float, rest_speed: Any, quadrature: Any
-    ) -> None:
+    def _init_space(self, names: list[str], terms: list[Term], rho: float, quadrature: Any) -> None:
         m = self.model
-        speed = _number(rest_speed, "rest_speed")
-        if speed <= 0.0:
-            raise InvalidParameterError(
-                f"`rest_speed` must be > 0, got {speed}", field="rest_speed"
-            )
         if isinstance(quadrature, bool | np.bool_) or not isinstance(quadrature, int | np.integer):
             raise InvalidParameterError(
                 f"`quadrature` must be an integer, got {quadrature!r}", field="quadrature"
@@ -448,7 +451,6 @@ class Sand:
         self._ids = np.asarray(ids, dtype=np.intp)
         self._body = np.asarray(m.geom_bodyid[self._ids], dtype=np.intp)
         self._root = np.asarray(m.body_rootid[self._body], dtype=np.intp)
-        self.rest_speed = speed
         self.apply_at = "centre"
         self._coupling = _granrs.MujocoCoupling.space(
             list(names),
@@ -457,7 +459,7 @@ class Sand:
             rho,
             self.surface,
             list(self.patch),
-            speed,
+            self.rest_speed,
             int(quadrature),
             [int(g) for g in self._ids],
             [int(b) for b in self._body],
@@ -763,10 +765,12 @@ def rod_drop(
     terms, from the scene's initial state (tip at the surface, velocity (vx0, -v0), spin
     omega0), until its stop, and ``t_after`` seconds on.
 
-    The stop is the first step at whose end the tip's vertical velocity is >= 0 (or within
-    1e-9 m/s of it: the stick brings it to zero to round-off), interpolated linearly inside
-    the step. Returns ``t_s`` [s], ``depth`` [m] (the tip's, at the stop), ``steps``, and
-    after the stop ``t``, ``tip`` (x, z) and ``energy`` (KE + gravitational PE [J]) per step.
+    The stop is the first step at whose end the tip's vertical velocity is >= 0 or within
+    the Sand's ``rest_speed`` of it (the thesis's static terms stick to round-off; a rod held
+    under ``rft`` creeps slower than ``rest_speed``), interpolated linearly inside the step
+    to where that velocity is 0. Returns ``t_s`` [s], ``depth`` [m] (the tip's, at the
+    stop), ``steps``, and after the stop ``t``, ``tip`` (x, z) and ``energy`` (KE +
+    gravitational PE [J]) per step.
     ``mode`` is ``"step"`` (:meth:`Sand.step`) or ``"callback"`` (:meth:`Sand.install`).
     """
     from . import forces as _forces
@@ -822,8 +826,8 @@ def rod_drop(
                 sand.step(data)
             mujoco.mj_step(model, data)
             _, z, v = tip()
-            if v >= -1e-9:
-                f = -v_prev / (v - v_prev) if v != v_prev else 1.0
+            if v >= -sand.rest_speed:
+                f = min(-v_prev / (v - v_prev), 1.0) if v != v_prev else 1.0
                 t_s = t_prev + f * (data.time - t_prev)
                 depth = -(z_prev + f * (z - z_prev))
                 break

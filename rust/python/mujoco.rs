@@ -402,10 +402,12 @@ impl MujocoCoupling {
     /// `rods` on MuJoCo's geoms `geom` (bodies `body`, tree roots `root`, tip `reach` from
     /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
     /// height and patch in x; `stick` for the static terms as reactions;
-    /// `implicit_damping` the dof damping the engine's step takes implicitly (nv).
+    /// `implicit_damping` the dof damping the engine's step takes implicitly (nv);
+    /// `rest_speed` the creep speed of a geom held under a term that resists turning.
     #[staticmethod]
     #[allow(clippy::too_many_arguments)]
     fn planar(
+        py: Python<'_>,
         rods: PyRef<'_, SandGeoms>,
         geom: Vec<usize>,
         body: Vec<usize>,
@@ -417,8 +419,11 @@ impl MujocoCoupling {
         patch: (f64, f64),
         stick: bool,
         implicit_damping: Vec<f64>,
+        rest_speed: f64,
     ) -> PyResult<Self> {
         let n = rods.inner.len();
+        crate::error::check_range("rest_speed", rest_speed, 0.0, true)
+            .map_err(|e| to_pyerr(py, e))?;
         if [geom.len(), body.len(), root.len(), reach.len(), dofs.len()]
             .iter()
             .any(|&l| l != n)
@@ -454,6 +459,7 @@ impl MujocoCoupling {
                 work: Work::new(n, nv),
                 held: vec![None; n],
                 held_wrench: vec![None; n],
+                rest_speed,
             })),
             bound: None,
         })
