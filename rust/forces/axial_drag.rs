@@ -223,8 +223,8 @@ mod tests {
             let power = out[0] * v_e[0] + out[1] * v_e[1];
             assert!(power <= 0.0);
             assert!((power + 4.0 * face * v_a.abs().powi(3)).abs() < 1e-12 * scale);
-            // Applied at E: no moment about E.
-            assert_eq!(out[2], 0.0);
+            // Applied at E: no moment about E (to rounding: P and E are computed apart).
+            assert!(out[2].abs() <= 1e-15 * scale, "{out:?}");
             // Applied at the tip: r x F with r = E - T.
             let mut tip = [0.0; 18];
             geoms(4.0, ApplyAt::Tip).evaluate(0, &state, &mut tip);
