@@ -57,8 +57,9 @@ JOINT_FIELDS = ("pin_joint", "ankle", "knee", "hip")
 NAMES = (
     "free_link chain leg tip centroid modes raw smooth rk4 dopri5 first_stop all_stops time "
     "state forces energy gravity drag static_h static_v joint_springs free locked box thesis "
-    "rft rft_inertial poncelet zeta elements c k A00 Bm11 driven table arc radius start_deg "
-    "end_deg chords rate pinned moving medium thesis_sand thesis_fine_sand li2013_generic"
+    "rft rft_inertial poncelet axial_drag eta_a zeta elements c k A00 Bm11 driven table arc "
+    "radius start_deg end_deg chords rate pinned moving medium thesis_sand thesis_fine_sand "
+    "li2013_generic"
 ).split()
 
 
@@ -190,6 +191,15 @@ def base_scenes() -> list[Scene]:
         # The field's laws (issue 17), on each body.
         cases.free_link(30.0, 2.0, forces=[forces.gravity(), forces.rft(zeta=1e6, elements=4)]),
         cases.chain(case=2, forces=[forces.gravity(), forces.poncelet(c=1.0, k=100.0)]),
+        cases.free_link(
+            30.0,
+            2.0,
+            forces=[
+                forces.gravity(),
+                forces.axial_drag(eta_a=6.0),
+                *forces.select(forces.thesis(), "static_h", "static_v"),
+            ],
+        ),
         cases.leg(
             v0=2.0,
             forces=[forces.gravity(), forces.rft(zeta=1e6, elements=2), forces.rft_inertial()],
@@ -245,6 +255,7 @@ def mutate_toml(rng: random.Random, text: str) -> str:
                         *("[coefficients]", "[coefficients2]", "[knee]", "[[q_deg]]", "[x.y]"),
                         *("[[forces]]", 'term = "drag"', 'term = "stati_v"', "eta_d = [1.0]"),
                         *('term = "rft"', 'term = "poncelet"', "elements = 0", "zeta = -1"),
+                        *('term = "axial_drag"', "eta_a = 6.0", "eta_a = -1"),
                     ]
                 ),
             )

@@ -92,13 +92,14 @@ def random_scenes(rng: np.random.Generator, n: int, dt_range: bool, max_steps: i
 def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
     """The thesis's terms at 0..10x Table 3.4's q = 0 row; in a third of the scenes a random
     subset of them (issue 16); in a quarter, one of the field's laws (issue 17) with random
-    parameters: rft (zeta 0..1e7 N/m^3, 1..16 elements), rft + rft_inertial, or poncelet
-    (c 0..5, k 0..1000 N/m)."""
+    parameters: rft (zeta 0..1e7 N/m^3, 1..16 elements), rft + rft_inertial, poncelet
+    (c 0..5, k 0..1000 N/m), or the thesis's static terms with the axial drag (eta_a
+    0..20)."""
     u = rng.random()
     if u < 0.25:
         zeta = 1e7 * f[0] / 10.0
         n = int(rng.integers(1, 17))
-        law = rng.integers(0, 3)
+        law = rng.integers(0, 4)
         if law == 0:
             extra: tuple[forces.Term, ...] = (forces.rft(zeta=zeta, elements=n),)
         elif law == 1:
@@ -106,8 +107,14 @@ def _law(rng: np.random.Generator, f: np.ndarray) -> dict[str, object]:
                 forces.rft(zeta=zeta, elements=n),
                 forces.rft_inertial(lam=float(f[1]) / 5.0, elements=n),
             )
-        else:
+        elif law == 2:
             extra = (forces.poncelet(c=float(f[2]) / 2.0, k=100.0 * float(f[3])),)
+        else:
+            extra = (
+                forces.axial_drag(eta_a=2.0 * float(f[2])),
+                forces.static_h(eta_h=SCALE["eta_h"] * float(f[0])),
+                forces.static_v(eta_v=SCALE["eta_v"] * float(f[1]), lam=SCALE["lam"] * float(f[3])),
+            )
         return {"forces": (forces.gravity(), *extra)}
     values = {k: SCALE[k] * x for k, x in zip(("eta_h", "eta_d", "eta_v", "lam"), f, strict=True)}
     terms = forces.thesis(Coefficients(**values))

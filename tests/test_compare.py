@@ -516,6 +516,7 @@ def _build_chapter(tmp_path_factory, laws):
         if laws == FAST_LAWS:
             mp.setattr(laws_sums, "SUM_PIECES", _fast_pieces())
             mp.setattr(laws_sums, "SUM_MAX_TERMS", 1)
+            mp.setattr(laws_sums, "SUM_ON_LAWS", ())
         out = tmp_path_factory.mktemp("laws") / "out"
         path = reproduce(out, chapters=["laws"], progress=False)
     return out, path.read_text(encoding="utf-8"), subset
@@ -781,6 +782,38 @@ def test_laws_add_their_terms_and_fits_and_refuse_a_term_listed_twice():
     with pytest.raises(granrs.InvalidParameterError, match="both list the term 'poncelet'") as e:
         _ = a + LAWS["poncelet"]
     assert e.value.field == "laws"
+
+
+def test_a_name_spells_a_sum_of_named_laws_and_pieces():
+    """``"thesis_refit+axial_drag"`` is LAWS["thesis_refit"] + PIECES["axial_drag"]; a named
+    law whose own name has a ``+`` keeps it; a piece alone, or an unknown part, is no law."""
+    from granrs.compare import PIECES, _law_list
+
+    (law,) = _law_list("thesis_refit+axial_drag")
+    assert law == LAWS["thesis_refit"] + PIECES["axial_drag"]
+    assert law.needs()[-1] == "axial_drag" and "axial_drag.eta_a" in law.fit
+    (law,) = _law_list("rft+rft_inertial+axial_drag")
+    assert law == LAWS["rft+rft_inertial"] + PIECES["axial_drag"]
+    for bad in ("axial_drag", "thesis_refit+axial_dreg", "axial_drag+axial_drag"):
+        with pytest.raises(UnknownNameError, match="pieces to add") as e:
+            _law_list(bad)
+        assert e.value.field == "laws"
+    with pytest.raises(InvalidParameterError, match="both list the term 'poncelet'"):
+        _law_list("poncelet+thesis+poncelet")
+
+
+def test_the_chapters_sums_add_the_axial_drag_to_the_thesis_refit():
+    """The laws chapter's search: the thesis's law refit plus the axial drag, and no sum
+    listing a term twice or with no term growing with depth (or two)."""
+    from granrs.report.laws_sums import sum_laws
+
+    names = [law.name for law in sum_laws()]
+    assert "thesis_refit+axial_drag" in names
+    assert "axial_drag+thesis_static" in names and "axial_drag+rft" in names
+    assert "axial_drag+rft_inertial" not in names  # no depth term: never stops
+    assert "axial_drag+thesis_static+rft" not in names  # two laws of the static resistance
+    for law in sum_laws():
+        assert len(set(law.needs())) == len(law.needs()), law.name
 
 
 def test_sums_compares_every_small_sum_in_one_call():

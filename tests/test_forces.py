@@ -85,6 +85,7 @@ def test_every_term_describes_itself_from_the_core() -> None:
         "static_v",
         "joint_springs",
         "poncelet",
+        "axial_drag",
         "rft",
         "rft_inertial",
         "rft3d",

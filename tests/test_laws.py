@@ -1,4 +1,5 @@
-"""The field's force laws (issue 17): ``rft``, ``rft_inertial`` and ``poncelet``.
+"""The field's force laws (issue 17): ``rft``, ``rft_inertial``, ``poncelet`` and
+``axial_drag``.
 
 Exact answers are derived here from the laws' equations (docs/laws.md) with numbers typed
 from the papers (``shared/LAWS.md``), not from granrs: a vertical drop under each law has a
@@ -86,8 +87,17 @@ def stop_time(v2, depth: float) -> float:
     return val
 
 
+#: The same vertical law two ways: poncelet's drag along v, or the axial drag along the
+#: rod's axis (on the same end face) beside poncelet's depth friction alone.
+_PONCELET_LAWS = {
+    "poncelet": lambda c, k: [f.gravity(), f.poncelet(c=c, k=k)],
+    "axial_drag": lambda c, k: [f.gravity(), f.axial_drag(eta_a=c), f.poncelet(c=0.0, k=k)],
+}
+
+
+@pytest.mark.parametrize("law", sorted(_PONCELET_LAWS))
 @pytest.mark.parametrize("v0", [0.5, 1.0, 2.0, 3.0])
-def test_poncelet_vertical_drop_has_the_lambert_w_depth(v0: float) -> None:
+def test_poncelet_vertical_drop_has_the_lambert_w_depth(v0: float, law: str) -> None:
     p = rod()
     c, k = 0.8, 150.0
     area = math.pi * p["d_c"] ** 2 / 4  # axial motion: the rod's cross-section
@@ -106,7 +116,7 @@ def test_poncelet_vertical_drop_has_the_lambert_w_depth(v0: float) -> None:
 
     assert abs(v2(depth)) < 1e-12
     t_s = stop_time(v2, depth)
-    s = granrs.cases.free_link(0.0, v0).replace(forces=[f.gravity(), f.poncelet(c=c, k=k)])
+    s = granrs.cases.free_link(0.0, v0).replace(forces=_PONCELET_LAWS[law](c, k))
     r = granrs.simulate(s)
     assert r.status == "stopped"
     assert abs(r.depth - depth) <= 1e-7 * depth, (r.depth, depth)

@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from .forces import ParamValue, Term
 
 __all__ = [
+    "axial_drag",
     "drag",
     "gravity",
     "joint_springs",
@@ -157,6 +158,33 @@ def poncelet(
             medium (m / d1 = c rho_g A; granrs.media)).
         k: depth-friction coefficient [N/m]; required (no default; none: fitted per body and
             medium (granrs.media)).
+
+    Returns:
+        The term, its parameters checked by the core.
+    """
+
+def axial_drag(
+    eta_a: ParamValue,
+) -> Term:
+    """``axial_drag``: quadratic drag along a rod's axis, on its end face, at the immersed
+    centroid E.
+
+    Equation, in granrs's frame::
+
+        F = -eta_a rho_g (pi d_c^2 / 4) |v_a| v_a e  at E,  v_a = e . v_E (e: the rod's
+            axis)
+
+    Acts on each contact in the sand (adds to the thesis's F_d). Reads rho_g; the contact's
+    axis e, diameter d_c, E and v_E; the held signs of v_E (sticking). Series columns with
+    ``record=('forces',)``: ``F_ax``, ``F_ay``. Source: Katsuragi & Durian, Nature Physics 3
+    (2007) 420, eq. 1 (the inertial term), along the rod's axis.
+
+    Generated from the core's registry (``granrs.forces.info('axial_drag')``); unknown or
+    bad parameters raise a :class:`granrs.GranrsError` naming ``axial_drag.<parameter>``.
+
+    Args:
+        eta_a: axial drag coefficient on the rod's end face [-]; required (no default; none:
+            fitted per medium (c_a = eta_a rho_g pi d_c^2 / 4 [kg/m]; granrs.media)).
 
     Returns:
         The term, its parameters checked by the core.

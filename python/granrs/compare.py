@@ -8,8 +8,10 @@ subject) is predicted by the law fitted to the other groups. It returns a
 
 A law is data (:class:`~granrs.compare.Law`): the terms that act, and the parameters to
 fit with their starting values and bounds. :data:`~granrs.compare.LAWS` holds the named
-laws; a law whose term the core does not have (yet) is reported as unavailable, with the
-reason, instead of failing.
+laws, :data:`~granrs.compare.PIECES` named pieces that are no law alone (a drag that never
+stops a body) but add to one: ``"thesis_refit+axial_drag"`` names their sum. A law whose
+term the core does not have (yet) is reported as unavailable, with the reason, instead of
+failing.
 
 The numbers, per dataset and law (columns of the frame, and keys of
 :func:`~granrs.compare.to_json`):
@@ -78,6 +80,7 @@ __all__ = [
     "DATASETS",
     "JSON_KEYS",
     "LAWS",
+    "PIECES",
     "Dataset",
     "FitParam",
     "Law",
@@ -279,6 +282,21 @@ LAWS: dict[str, Law] = {
     )
 }
 
+#: Named pieces of laws, compared only in a sum (``"thesis_refit+axial_drag"``, or
+#: ``LAWS["thesis_refit"] + PIECES["axial_drag"]``): alone they stop nothing.
+PIECES: dict[str, Law] = {
+    law.name: law
+    for law in (
+        Law(
+            "axial_drag",
+            "a quadratic drag along the rod's axis on its end face, eta_a rho_g (pi d_c^2 / 4) "
+            "|v_a| v_a at E, eta_a fitted",
+            terms=(("axial_drag", {}),),
+            fit={"axial_drag.eta_a": (5.0, 1e-3, 1e3)},
+        ),
+    )
+}
+
 #: The body's unknowns fitted with every law that fits (``Law.body_unknowns``), by body.
 #: The leg's joint stiffness, within a physiological range (see
 #: :data:`~granrs.compare.DATASETS`). The chain's link mass is not in the thesis, but it
@@ -364,11 +382,15 @@ def _law_list(laws: Any) -> list[Law]:
             out.append(item)
         elif isinstance(item, str) and item in LAWS:
             out.append(LAWS[item])
+        elif isinstance(item, str) and (law := _named_sum(item)) is not None:
+            out.append(law)
         else:
-            hint = difflib.get_close_matches(str(item), list(LAWS), n=1)
+            names = [*LAWS, *PIECES]
+            hint = difflib.get_close_matches(str(item), names, n=1)
             more = f"; did you mean {hint[0]!r}?" if hint else ""
             raise UnknownNameError(
-                f"unknown law {item!r}{more} (laws: {', '.join(LAWS)}; or a granrs.compare.Law)",
+                f"unknown law {item!r}{more} (laws: {', '.join(LAWS)}; pieces to add to "
+                f"them with '+': {', '.join(PIECES)}; or a granrs.compare.Law)",
                 field="laws",
             )
     if not out:
@@ -382,6 +404,29 @@ def _law_list(laws: Any) -> list[Law]:
         if names.count(n) > 1:
             raise InvalidParameterError(f"law {n!r} is given twice", field="laws")
     return out
+
+
+def _named_sum(name: str) -> Law | None:
+    """The sum a name like ``"thesis_refit+axial_drag"`` spells: names of :data:`LAWS` and
+    :data:`PIECES` joined with ``+`` (a named law's own ``+`` kept: the longest name first),
+    at least one of them a law; ``None`` if it spells none."""
+    known = {**PIECES, **LAWS}
+    parts = name.split("+")
+    found: list[Law] = []
+    i = 0
+    while i < len(parts):
+        j = next((j for j in range(len(parts), i, -1) if "+".join(parts[i:j]) in known), None)
+        if j is None:
+            return None
+        found.append(known["+".join(parts[i:j])])
+        i = j
+    if len(found) < 2 or not any(law.name in LAWS for law in found):
+        return None
+    # Two parts listing the same term: the sum's own error, naming them.
+    total = found[0]
+    for law in found[1:]:
+        total = total + law
+    return total
 
 
 def _datasets(measurements: Any) -> dict[str, Measurements]:

@@ -9,7 +9,7 @@
 //! the error messages all read it.
 //!
 //! Two kinds of term:
-//! - **contact terms** ([`Acts::Contact`]: `drag`, `static_h`, `static_v`) read one
+//! - **contact terms** ([`Acts::Contact`]: `drag`, `static_h`, `static_v`, ...) read one
 //!   contact's geometry and kinematics ([`ContactState`]) and return the force on it
 //!   ([`TermForce`]), applied at the scene's point of application; their parameters may
 //!   differ per contact;
@@ -36,6 +36,7 @@ use nalgebra::SVector;
 
 use crate::body::{Link, Mechanism};
 
+pub mod axial_drag;
 #[cfg(test)]
 pub mod constant;
 pub mod drag;

@@ -5,8 +5,8 @@
 //! [`TermInfo`] in the order the docs list them.
 
 use super::{
-    drag, gravity, joint_springs, poncelet, rft, rft3d, static_h, static_v, Acts, Class,
-    ContactState, Medium, Rates, Real, Switch, Term, TermForce, TermInfo,
+    axial_drag, drag, gravity, joint_springs, poncelet, rft, rft3d, static_h, static_v, Acts,
+    Class, ContactState, Medium, Rates, Real, Switch, Term, TermForce, TermInfo,
 };
 use crate::body::{Link, Mechanism};
 use crate::error::{suggest, GranrsError, Result};
@@ -153,6 +153,7 @@ registry! {
     StaticV(static_v::StaticV),
     JointSprings(joint_springs::JointSprings),
     Poncelet(poncelet::Poncelet),
+    AxialDrag(axial_drag::AxialDrag),
     Rft(rft::Rft),
     RftInertial(rft::RftInertial),
     Rft3d(rft3d::Rft3d),

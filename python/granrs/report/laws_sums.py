@@ -1,6 +1,7 @@
 """The laws chapter's sums of terms: the axial quadratic drag (:data:`SUM_BASE`) plus up
 to :data:`SUM_MAX_TERMS` of :data:`SUM_PIECES` (the thesis's static terms, planar RFT,
-its inertial term), and each piece alone, fitted to Table 3.1 and ranked out of sample
+its inertial term), each piece alone, and the named laws of :data:`SUM_ON_LAWS` plus the
+drag, fitted to Table 3.1 and ranked out of sample
 (leave one angle out) beside the named laws; the out-of-sample residuals per row of the
 best; the media cards of the best fits (:meth:`granrs.CalibrationResult.card`); and the
 best fitted law on the chain and the leg. :func:`section` returns the chapter's Markdown
@@ -19,7 +20,7 @@ import pandas as pd
 
 from ..calibrate import Measurements
 from ..cases import FREE_LINK, free_link
-from ..compare import DATASETS, LAWS, Law, _rank, compare, to_json
+from ..compare import DATASETS, LAWS, PIECES, Law, _rank, compare, to_json
 from ..errors import InvalidParameterError
 from .format import _fmt, md_table
 from .framework import ReportContext
@@ -30,6 +31,7 @@ __all__ = [
     "SUMS_JSON",
     "SUM_BASE",
     "SUM_MAX_TERMS",
+    "SUM_ON_LAWS",
     "SUM_PIECES",
     "THESIS_STATIC",
     "section",
@@ -39,17 +41,10 @@ __all__ = [
 #: The sums' data file in the output directory (``{dataset: {law: {...}}}``, as
 #: ``laws.json``).
 SUMS_JSON = "laws_sums.json"
-#: A quadratic drag at E along the velocity, c rho_g A |v| v: Poncelet's drag alone
-#: (k = 0). A is the immersed cross-section normal to v, the rod's end face (pi d_c^2 / 4)
-#: for a rod moving along its axis, so it is the axial, velocity-dependent drag the
-#: thesis's law lacks at q = 0 (its drag needs a velocity across the rod).
-AXIAL_DRAG = Law(
-    "axial_drag",
-    "a quadratic drag c rho_g A |v| v at E (poncelet with k = 0; A the rod's end face when "
-    "it moves along its axis)",
-    terms=(("poncelet", {"k": 0.0}),),
-    fit={"poncelet.c": (1.0, 1e-3, 1e3)},
-)
+#: The quadratic drag along the rod's axis on its end face (the term ``axial_drag``,
+#: :data:`granrs.compare.PIECES`): the axial, velocity-dependent drag the thesis's law lacks
+#: at q = 0 (its drag needs a velocity across the rod).
+AXIAL_DRAG = PIECES["axial_drag"]
 #: The thesis's static terms alone (no drag): each a factor on its default (Table 3.4 at
 #: q = 0), the same for every angle.
 THESIS_STATIC = Law(
@@ -75,6 +70,9 @@ RFT_INERTIAL = Law(
 SUM_PIECES: tuple[Law, ...] = (THESIS_STATIC, LAWS["rft"], RFT_INERTIAL)
 #: The law every searched sum is built on.
 SUM_BASE: Law = AXIAL_DRAG
+#: The named laws the base is added to (``thesis_refit+axial_drag``): the thesis's law
+#: refit, with the axial drag it lacks.
+SUM_ON_LAWS: tuple[str, ...] = ("thesis_refit",)
 #: The most pieces added to the base.
 SUM_MAX_TERMS = 2
 #: The terms whose force grows with depth: a sum without one (a drag alone) never stops
@@ -98,17 +96,17 @@ def sum_laws(
     named: Mapping[str, Law] | None = None,
     base: Law | None = None,
 ) -> list[Law]:
-    """The sums searched: each piece alone, and ``base`` (default :data:`SUM_BASE`) plus
-    every sum of 1 to ``max_terms`` of ``pieces`` (added with ``+`` as
-    :func:`granrs.compare.sums` adds them; a sum listing a term twice left out), keeping
-    those with exactly one term growing with depth (``static_v`` or ``rft``) and without
-    those named as a law of ``named`` (default :data:`granrs.compare.LAWS`): those are
-    compared already."""
+    """The sums searched: each piece alone, the laws of :data:`SUM_ON_LAWS` plus ``base``
+    (default :data:`SUM_BASE`), and ``base`` plus every sum of 1 to ``max_terms`` of
+    ``pieces`` (added with ``+`` as :func:`granrs.compare.sums` adds them; a sum listing a
+    term twice left out), keeping those with exactly one term growing with depth
+    (``static_v`` or ``rft``) and without those named as a law of ``named`` (default
+    :data:`granrs.compare.LAWS`): those are compared already."""
     pieces = SUM_PIECES if pieces is None else tuple(pieces)
     max_terms = SUM_MAX_TERMS if max_terms is None else max_terms
     named = LAWS if named is None else named
     base = SUM_BASE if base is None else base
-    candidates = list(pieces)
+    candidates = list(pieces) + [LAWS[n] + base for n in SUM_ON_LAWS]
     for k in range(1, min(max_terms, len(pieces)) + 1):
         for combo in itertools.combinations(pieces, k):
             law = base
@@ -120,8 +118,16 @@ def sum_laws(
             candidates.append(law)
     out = []
     for law in candidates:
-        depth = {t for t, _ in law.terms} & _DEPTH_TERMS
-        if len(depth) == 1 and law.name not in named and law.name not in {x.name for x in out}:
+        # Every term the law lists, the thesis's included (a term twice: no law).
+        terms = law.needs()
+        depth = set(terms) & _DEPTH_TERMS
+        once = len(set(terms)) == len(terms)
+        if (
+            once
+            and len(depth) == 1
+            and law.name not in named
+            and law.name not in {x.name for x in out}
+        ):
             out.append(law)
     return out
 
@@ -198,8 +204,12 @@ def _per_row(laws: Sequence[Mapping[str, Any]]) -> str:
     return md_table(header, body, "r")
 
 
+#: The axial drag's fitted coefficient, as the comparison names it.
+_DRAG_PARAM = "axial_drag.eta_a"
+
+
 def _has_drag(law: Mapping[str, Any]) -> bool:
-    return "poncelet.c" in law["params"]
+    return _DRAG_PARAM in law["params"]
 
 
 def _drag_evidence(laws: Sequence[Mapping[str, Any]]) -> str:
@@ -225,24 +235,24 @@ def _drag_evidence(laws: Sequence[Mapping[str, Any]]) -> str:
         )
         no_vertical = next((f for f in law["folds"] if f["held_out"] == 0.0), None)
         note = ""
-        if "poncelet.c" in full["at_bound"]:
+        if _DRAG_PARAM in full["at_bound"]:
             note = (
-                " Fitted to every row, the drag's c ends on its lower bound: the law takes "
+                " Fitted to every row, the drag's eta_a ends on its lower bound: the law takes "
                 "its dependence on speed from its other terms, not from the axial drag."
             )
-        elif no_vertical is not None and "poncelet.c" in no_vertical["at_bound"]:
+        elif no_vertical is not None and _DRAG_PARAM in no_vertical["at_bound"]:
             note = (
-                " Fitted without the vertical drops, the drag's c ends on its lower bound: "
+                " Fitted without the vertical drops, the drag's eta_a ends on its lower bound: "
                 "the oblique drops do not ask for it, so the fold that predicts the vertical "
                 "drops has no axial drag."
             )
-        c = full["values"]["poncelet.c"]
+        eta = full["values"][_DRAG_PARAM]
         # In kg/m at the density of the free link's scenes, which the fit ran.
-        axial = c * free_link(0.0, 1.0).rho_g * math.pi * FREE_LINK["diameter"] ** 2 / 4.0
+        axial = eta * free_link(0.0, 1.0).rho_g * math.pi * FREE_LINK["diameter"] ** 2 / 4.0
         out.append(
             f"- **{law['law']}**: the vertical drops' depth/t_s z in sample {ins}; out of "
-            f"sample {oos}. Fitted to every row, the axial drag is c rho_g pi d_c^2 / 4 = "
-            f"{axial:.3g} kg/m.{note} Fitted values ({folds})."
+            f"sample {oos}. Fitted to every row, the axial drag is eta_a rho_g pi d_c^2 / 4 "
+            f"= {axial:.3g} kg/m.{note} Fitted values ({folds})."
         )
     return "\n".join(out)
 
@@ -430,8 +440,9 @@ def section(ctx: ReportContext, main: pd.DataFrame, starts: int) -> str:
     shown = [r for r in ranked[:_PER_ROW]]
     return f"""### Sums of terms (Table 3.1)
 
-The axial drag (`{SUM_BASE.name}`: {SUM_BASE.summary}) plus up to {SUM_MAX_TERMS} of these
-pieces, and each piece alone, each sum with one term growing with depth
+The axial drag (`{SUM_BASE.name}`: {SUM_BASE.summary}) added to
+{", ".join(f"`{n}`" for n in SUM_ON_LAWS)} and to up to {SUM_MAX_TERMS} of these pieces, and
+each piece alone, each sum with one term growing with depth
 ({len(laws)} sums beside the laws above: {", ".join(f"`{law.name}`" for law in laws)}),
 fitted to Table 3.1 and predicted out of sample (leave one angle out), ranked with the
 laws above by the out-of-sample χ²; the numbers are in `{SUMS_JSON}`:
