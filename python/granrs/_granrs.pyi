@@ -40,6 +40,7 @@ __all__ = [
     "fast_lanes",
     "leg_segments",
     "max_threads",
+    "output_fields",
     "resistance_force",
     "rft3d_alpha",
     "rft_alpha",
