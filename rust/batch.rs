@@ -743,7 +743,10 @@ mod tests {
             vec!["depth".into(), "t_s".into(), "F_d_max".into()];
         for forces in [
             None,
-            Some(vec![TermSpec::new("gravity", &[]), TermSpec::new("rft", &[])]),
+            Some(vec![
+                TermSpec::new("gravity", &[]),
+                TermSpec::new("rft", &[("zeta", 1e6)]),
+            ]),
             Some(vec![
                 TermSpec::new("gravity", &[]),
                 TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]),
