@@ -780,6 +780,28 @@ mod tests {
         }
     }
 
+    /// What a run's outputs leave out is not computed: the parts of the observation only
+    /// those fields need are left at their start (NaN or 0), while the steps' error
+    /// estimate, which every run computes (`Needs::ALWAYS`), is there.
+    #[test]
+    fn fields_left_out_are_not_computed() {
+        let mut spec = base();
+        spec.set("outputs", Value::Names(vec!["depth".into(), "t_s".into()]));
+        let lean = spec.build().unwrap().run().unwrap();
+        let full = base().build().unwrap().run().unwrap();
+        let (c, f) = (&lean.contacts[0], &full.contacts[0]);
+        assert_eq!(
+            (c.depth.to_bits(), c.t_s.to_bits()),
+            (f.depth.to_bits(), f.t_s.to_bits())
+        );
+        assert!(lean.h_lambda.is_nan() && full.h_lambda > 0.0);
+        assert!(c.f_d_max == 0.0 && f.f_d_max > 0.0);
+        assert!(c.d_ke.is_nan() && c.link_d_ke.is_nan() && f.d_ke.is_finite());
+        assert_eq!(lean.stats, full.stats);
+        assert!(lean.step_error.is_finite());
+        assert_eq!(lean.step_error.to_bits(), full.step_error.to_bits());
+    }
+
     #[test]
     fn validation_names_the_first_bad_run() {
         let src = Source::Product {
