@@ -47,7 +47,9 @@ granrs itself is timed per impact, summary only (no time series):
 
 * through ``granrs.simulate(scene)`` per scene from Python, with the default sign model
   ``"modes"`` (each sign a mode held through a step, switches located exactly) and with
-  ``"raw"`` (the thesis's plain sign: the peers' algorithm, with granrs's exact stop);
+  ``"raw"`` (the thesis's plain sign: the peers' algorithm, with granrs's exact stop); and
+  with the scene asking only for the depth and t_s (``outputs=("depth", "t_s")``: what the
+  peers return; the rest of the summary is not computed);
 * Rust only: criterion's ``impact/table_3_5_all`` and ``impact/table_3_5_all_raw``
   (``benches/free_link.rs``), run by this script through ``cargo bench`` unless
   ``--no-criterion``; and, in the same interleaved loop as the peers, the run alone as the
@@ -58,7 +60,8 @@ granrs itself is timed per impact, summary only (no time series):
   and two threads (a
   perfectly parallel loop: the ceiling of what two cores give). The sweep is timed with its
   SIMD lanes (the default, ``lanes=True``: four scenes per lane group) and on the scalar
-  path (``lanes=False``), in the same loop.
+  path (``lanes=False``), in the same loop; and with its lanes asking only for the depth and
+  t_s (``outputs=("depth", "t_s")``: the columns the numba loop returns).
 
 It prints a work-precision table and writes its figure (``--figure``, a PNG): every peer at
 several steps (solve_ivp at several rtols), the median over the scenes of the depth error
@@ -135,6 +138,12 @@ TARGET_SCALAR = 1.0
 TARGET_SWEEP = 1.0 / 3.0
 TARGET_SCALING = 0.95
 TARGET_SOLVE_IVP = 1.0
+#: Targets of granrs.simulate against the hand-tuned loop (``numba_scalar``) with a scene that
+#: asks only for ``LEAN_OUTPUTS`` (its ``outputs``), and with the default summary.
+TARGET_SCALAR_LEAN = 1.2
+TARGET_SCALAR_DEFAULT = 1.6
+#: What the lean rows ask for: the depth and the stopping time (the peers' two results).
+LEAN_OUTPUTS = ("depth", "t_s")
 #: Copies of the scenes in one timed sweep (so that a sweep's fixed cost is spread), and
 #: the sweeps' repeats per repeat of the per-scene timing: a sweep is timed as a whole, and
 #: on a shared machine only a best of many short batches escapes the other loads.
@@ -617,10 +626,12 @@ def match_tolerance(runs: list[SceneRun], ref_dt: float, progress: bool) -> None
 def methods(runs: list[SceneRun]) -> dict[str, Callable[[SceneRun], Any]]:
     """Name -> one impact of a scene (what is timed)."""
     raw = {id(r): r.scene.replace(sign_model="raw") for r in runs}
-    for scene in raw.values():
+    lean = {id(r): r.scene.replace(outputs=LEAN_OUTPUTS) for r in runs}
+    for scene in [*raw.values(), *lean.values()]:
         scene._compiled()  # compiled once here, as the default scenes are, not in the timing
     return {
         "granrs": lambda r: granrs.simulate(r.scene),
+        "granrs_lean": lambda r: granrs.simulate(lean[id(r)]),
         "granrs_raw": lambda r: granrs.simulate(raw[id(r)]),
         # The run alone, as the core times it (no Python around it), in the same loop.
         "granrs_core": lambda r: _granrs.run(r.scene._compiled()).run_seconds,
@@ -672,8 +683,13 @@ def time_sweeps(runs: list[SceneRun], repeats: int, copies: int) -> dict[str, fl
     out = np.empty(len(scenes))
     batch_scalar(y0s[:1], ps[:1], DT, T_END, out[:1])  # compile
 
+    lean = [s.replace(outputs=LEAN_OUTPUTS) for s in scenes[: len(runs)]] * copies
+
     def sweep(threads: int, lanes: bool = True) -> None:
         granrs.sweep(scenes, threads=threads, progress=False, lanes=lanes)
+
+    def sweep_lean(threads: int) -> None:
+        granrs.sweep(lean, threads=threads, progress=False)
 
     def in_prange(threads: int) -> None:
         set_num_threads(threads)
@@ -684,6 +700,8 @@ def time_sweeps(runs: list[SceneRun], repeats: int, copies: int) -> dict[str, fl
         "sweep_2": lambda: sweep(2),
         "sweep_scalar_1": lambda: sweep(1, lanes=False),
         "sweep_scalar_2": lambda: sweep(2, lanes=False),
+        "sweep_lean_1": lambda: sweep_lean(1),
+        "sweep_lean_2": lambda: sweep_lean(2),
         "numba_parallel_1": lambda: in_prange(1),
         "numba_parallel_2": lambda: in_prange(2),
     }
@@ -877,6 +895,7 @@ def summarize(
     ]
     labels = {
         "granrs": 'granrs.simulate, sign_model="modes" (default)',
+        "granrs_lean": 'granrs.simulate, outputs=("depth", "t_s")',
         "granrs_raw": 'granrs.simulate, sign_model="raw"',
         "granrs_core": "granrs modes, the run alone (timed in the core, same loop)",
         "rust": "granrs modes, Rust only (criterion impact/table_3_5_all)",
@@ -890,6 +909,8 @@ def summarize(
         "sweep_2": "granrs.sweep, SIMD lanes, 2 threads (per impact)",
         "sweep_scalar_1": "granrs.sweep, scalar path (lanes=False), 1 thread (per impact)",
         "sweep_scalar_2": "granrs.sweep, scalar path (lanes=False), 2 threads (per impact)",
+        "sweep_lean_1": 'granrs.sweep, SIMD lanes, outputs=("depth", "t_s"), 1 thread',
+        "sweep_lean_2": 'granrs.sweep, SIMD lanes, outputs=("depth", "t_s"), 2 threads',
         "numba_parallel_1": "numba scalars in a prange, 1 thread (per impact)",
         "numba_parallel_2": "numba scalars in a prange, 2 threads (per impact)",
     }
@@ -914,6 +935,14 @@ def summarize(
     ratio("granrs run alone / numba user", "granrs_core", "numba_user", TARGET_NUMBA, True)
     ratio("granrs Rust only (criterion) / numba user", "rust", "numba_user", TARGET_NUMBA, True)
     ratio("granrs (simulate) / numba scalar", "granrs", "numba_scalar", TARGET_SCALAR, True)
+    ratio("granrs (simulate), default summary / numba scalar", "granrs", "numba_scalar",
+          TARGET_SCALAR_DEFAULT, True)  # fmt: skip
+    ratio('granrs (simulate), outputs=("depth", "t_s") / numba scalar', "granrs_lean",
+          "numba_scalar", TARGET_SCALAR_LEAN, True)  # fmt: skip
+    ratio('granrs sweep (lanes), outputs=("depth", "t_s"), 1 thread / numba scalar',
+          "sweep_lean_1", "numba_scalar", None, True)  # fmt: skip
+    ratio('granrs sweep lanes, outputs=("depth", "t_s") / all columns, 1 thread',
+          "sweep_lean_1", "sweep_1", None, True)  # fmt: skip
     ratio("granrs run alone / numba scalar", "granrs_core", "numba_scalar", None, True)
     ratio("granrs sweep (lanes) 1 thread / numba scalar", "sweep_1", "numba_scalar",
           TARGET_SWEEP, True)  # fmt: skip

@@ -18,7 +18,7 @@ use crate::bodies::LinkageScene;
 use crate::error::{GranrsError, Result};
 use crate::integrate::cancel::Watch;
 use crate::integrate::lanes::{run_lanes, LaneIsa, LaneScene};
-use crate::integrate::{Outcome, Status, OUTCOME_FIELDS};
+use crate::integrate::{Outcome, Outputs, Status};
 use crate::spec::{SceneSpec, Value};
 
 /// Status codes of the `status` column ([`Status::code`]).
@@ -43,36 +43,36 @@ pub fn body_shape(scene: &LinkageScene) -> (usize, usize) {
     )
 }
 
-/// The summary columns of a body of `shape` ([`body_shape`]), in row order: the run's
-/// fields of [`OUTCOME_FIELDS`], then each contact's (prefixed `c{i}.`) and each reported
+/// The summary columns of a body of `shape` ([`body_shape`]) whose runs return `outputs`,
+/// in row order: the run's fields of [`crate::integrate::OUTCOME_FIELDS`] in `outputs`
+/// (`status` first, always), then each contact's (prefixed `c{i}.`) and each reported
 /// joint's (`joint{j}.`).
-pub fn columns((nc, nj): (usize, usize)) -> Vec<String> {
-    let fields = &OUTCOME_FIELDS;
-    let mut out: Vec<String> = fields.run.iter().map(|f| f.name.to_string()).collect();
+pub fn columns((nc, nj): (usize, usize), outputs: Outputs) -> Vec<String> {
+    let mut out: Vec<String> = outputs.run().map(|f| f.name.to_string()).collect();
     for i in 0..nc {
-        out.extend(fields.contact.iter().map(|f| format!("c{i}.{}", f.name)));
+        out.extend(outputs.contact().map(|f| format!("c{i}.{}", f.name)));
     }
     for j in 0..nj {
-        out.extend(fields.joint.iter().map(|f| format!("joint{j}.{}", f.name)));
+        out.extend(outputs.joint().map(|f| format!("joint{j}.{}", f.name)));
     }
     out
 }
 
-/// Write one outcome into its row (`row.len() == columns(shape).len()`).
+/// Write one outcome into its row (`row.len() == columns(shape, out.outputs).len()`).
 pub fn summarize(out: &Outcome, row: &mut [f64]) {
-    let fields = &OUTCOME_FIELDS;
+    let fields = out.outputs;
     let mut cells = row.iter_mut();
-    for (f, cell) in fields.run.iter().zip(&mut cells) {
+    for (f, cell) in fields.run().zip(&mut cells) {
         *cell = (f.read)(out).as_f64();
     }
     for c in &out.contacts {
-        for (f, cell) in fields.contact.iter().zip(&mut cells) {
+        for (f, cell) in fields.contact().zip(&mut cells) {
             *cell = (f.read)(c).as_f64();
         }
     }
     // The row has room for the body's reported joints (none for a free link).
     for j in &out.joints {
-        for (f, cell) in fields.joint.iter().zip(&mut cells) {
+        for (f, cell) in fields.joint().zip(&mut cells) {
             *cell = (f.read)(j).as_f64();
         }
     }
@@ -166,6 +166,65 @@ impl Source {
         (0..self.len().min(16))
             .find_map(|i| self.scene(i).ok().map(|s| body_shape(&s)))
             .unwrap_or((1, 0))
+    }
+
+    /// The output fields of the batch's runs, its columns ([`columns`]): the base scene's
+    /// `outputs`, or the listed scenes', which must all be the same; a product may not vary
+    /// them (an error names the field `outputs`).
+    pub fn outputs(&self) -> Result<Outputs> {
+        let one_set = |message: String| GranrsError::InvalidScene {
+            field: "outputs".into(),
+            message,
+        };
+        match self {
+            Source::Product { base, axes } => {
+                if axes.iter().any(|(f, _)| f == "outputs") {
+                    return Err(one_set(
+                        "a sweep returns one set of columns: give outputs once, not as an axis"
+                            .into(),
+                    ));
+                }
+                base.outputs()
+            }
+            Source::List(runs) => {
+                let Some(first) = runs.first() else {
+                    return Ok(Outputs::ALL);
+                };
+                let outputs = first.spec.outputs()?;
+                for (i, s) in runs.iter().enumerate().skip(1) {
+                    if s.spec.outputs().map_err(|e| in_run(i, e))? != outputs {
+                        return Err(one_set(format!(
+                            "a sweep returns one set of columns: run {i} asks for other \
+                             outputs than run 0 (give the sweep outputs=... for all)"
+                        )));
+                    }
+                }
+                Ok(outputs)
+            }
+        }
+    }
+
+    /// Every run returns `outputs` (a sweep's `outputs=`): the base scene's field, or each
+    /// listed scene's (its spec, and the scene built from it, whose options take them; no
+    /// scene is built again).
+    pub fn set_outputs(&mut self, names: Vec<std::borrow::Cow<'static, str>>) -> Result<()> {
+        let outputs = Outputs::from_names(&names)?;
+        match self {
+            Source::Product { base, .. } => base.set("outputs", Value::Names(names)),
+            Source::List(runs) => {
+                for run in runs.iter_mut() {
+                    let mut spec = (*run.spec).clone();
+                    spec.set("outputs", Value::Names(names.clone()));
+                    run.spec = Arc::new(spec);
+                    if let Some(built) = &run.built {
+                        let mut scene = (**built).clone();
+                        scene.options.outputs = outputs;
+                        run.built = Some(Arc::new(scene));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The one body of the batch (every run must share it).
@@ -346,6 +405,11 @@ pub struct BatchOut {
     pub data: Vec<f64>,
     /// Runs that failed, by index within the batch, with their messages.
     pub failures: Vec<(usize, String)>,
+    /// Runs with a contact whose result the step did not resolve (`unresolved_stops` > 0,
+    /// which every run computes whatever its outputs: see `Needs::ALWAYS`), by index within
+    /// the batch, in order: what the sweep's step-size warning reads when its columns do
+    /// not hold `unresolved_stops`.
+    pub unresolved: Vec<usize>,
     /// Whether the batch was cancelled before every run finished.
     pub cancelled: bool,
 }
@@ -409,11 +473,20 @@ pub fn run(
     path: Path,
 ) -> BatchOut {
     let shape = src.shape();
-    let columns = columns(shape);
+    // (`sweep` checks the outputs before it runs anything.)
+    let columns = columns(shape, src.outputs().unwrap_or_default());
     let width = columns.len();
     let start = range.start;
     let mut data = vec![f64::NAN; range.len() * width];
     let failures = Mutex::new(Vec::new());
+    let unresolved = Mutex::new(Vec::new());
+    // A run's row, and whether the step resolved its contacts.
+    let summarize = |i: usize, out: &Outcome, row: &mut [f64]| {
+        summarize(out, row);
+        if out.stats.unresolved_stops > 0 {
+            unresolved.lock().unwrap_or_else(|p| p.into_inner()).push(i);
+        }
+    };
     let fail = |i: usize, row: &mut [f64], e: GranrsError| {
         if let GranrsError::Cancelled = e {
             row.fill(f64::NAN);
@@ -458,7 +531,7 @@ pub fn run(
                             return Some((j, scene.model::<3>(), q0, qd0, scene.options));
                         }
                         Ok(scene) => match scene.run() {
-                            Ok(out) => summarize(&out, row),
+                            Ok(out) => summarize(start + j, &out, row),
                             Err(e) => fail(start + j, row, e),
                         },
                         Err(e) => fail(start + j, row, e),
@@ -470,7 +543,7 @@ pub fn run(
                 // SAFETY: scene `j`'s row, written by the lane that ran it alone.
                 let row = unsafe { rows.row(j) };
                 match out {
-                    Ok(out) => summarize(&out, row),
+                    Ok(out) => summarize(start + j, &out, row),
                     Err(e) => fail(start + j, row, e),
                 }
                 done.fetch_add(1, Ordering::Relaxed);
@@ -491,7 +564,7 @@ pub fn run(
                 continue;
             }
             match src.scene(start + j).and_then(|s| s.run()) {
-                Ok(out) => summarize(&out, row),
+                Ok(out) => summarize(start + j, &out, row),
                 Err(e) => fail(start + j, row, e),
             }
             done.fetch_add(1, Ordering::Relaxed);
@@ -499,10 +572,13 @@ pub fn run(
     }
     let mut failures = failures.into_inner().unwrap_or_else(|p| p.into_inner());
     failures.sort_by_key(|(i, _)| *i);
+    let mut unresolved = unresolved.into_inner().unwrap_or_else(|p| p.into_inner());
+    unresolved.sort_unstable();
     BatchOut {
         columns,
         data,
         failures,
+        unresolved,
         cancelled: cancel.load(Ordering::Relaxed),
     }
 }
@@ -654,6 +730,76 @@ mod tests {
             lean_steps += lean.stats.steps;
         }
         assert!(lean_steps > 100_000, "{lean_steps} steps");
+    }
+
+    /// A batch whose runs ask for some outputs has those columns only (`status` first), and
+    /// their values are the full batch's bit for bit, on the lanes and the scalar path,
+    /// under the thesis's terms and under frame laws (whose runs the lanes then accept
+    /// plain steps of: nothing reads the terms' own stiffness).
+    #[test]
+    fn fewer_outputs_are_the_full_rows_columns_bitwise() {
+        use crate::forces::TermSpec;
+        let names: Vec<std::borrow::Cow<'static, str>> =
+            vec!["depth".into(), "t_s".into(), "F_d_max".into()];
+        for forces in [
+            None,
+            Some(vec![
+                TermSpec::new("gravity", &[]),
+                TermSpec::new("rft", &[("zeta", 1e6)]),
+            ]),
+            Some(vec![
+                TermSpec::new("gravity", &[]),
+                TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]),
+            ]),
+        ] {
+            let mut full = base();
+            if let Some(terms) = forces {
+                full.set("forces", Value::Terms(terms));
+            }
+            let axes = vec![
+                ("q_deg".into(), num(&[-60.0, 0.0, 5.0, 45.0, 85.0])),
+                ("v0".into(), num(&[0.5, 2.214, 4.0])),
+                ("vx0".into(), num(&[0.0, 0.4])),
+            ];
+            let full = Source::Product { base: full, axes };
+            let mut lean = full.clone();
+            lean.set_outputs(names.clone()).unwrap();
+            let all = columns(full.shape(), Outputs::ALL);
+            let some = columns(lean.shape(), lean.outputs().unwrap());
+            assert_eq!(some, ["status", "c0.t_s", "c0.depth", "c0.F_d_max"]);
+            let want = rows_bits(&full, Path::Scalar);
+            for path in [Path::Lanes, Path::Scalar] {
+                let got = rows_bits(&lean, path);
+                for (r, row) in got.chunks(some.len()).enumerate() {
+                    for (c, name) in some.iter().enumerate() {
+                        let k = all.iter().position(|a| a == name).unwrap();
+                        assert_eq!(row[c], want[r * all.len() + k], "{path:?} run {r} {name}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// What a run's outputs leave out is not computed: the parts of the observation only
+    /// those fields need are left at their start (NaN or 0), while the steps' error
+    /// estimate, which every run computes (`Needs::ALWAYS`), is there.
+    #[test]
+    fn fields_left_out_are_not_computed() {
+        let mut spec = base();
+        spec.set("outputs", Value::Names(vec!["depth".into(), "t_s".into()]));
+        let lean = spec.build().unwrap().run().unwrap();
+        let full = base().build().unwrap().run().unwrap();
+        let (c, f) = (&lean.contacts[0], &full.contacts[0]);
+        assert_eq!(
+            (c.depth.to_bits(), c.t_s.to_bits()),
+            (f.depth.to_bits(), f.t_s.to_bits())
+        );
+        assert!(lean.h_lambda.is_nan() && full.h_lambda > 0.0);
+        assert!(c.f_d_max == 0.0 && f.f_d_max > 0.0);
+        assert!(c.d_ke.is_nan() && c.link_d_ke.is_nan() && f.d_ke.is_finite());
+        assert_eq!(lean.stats, full.stats);
+        assert!(lean.step_error.is_finite());
+        assert_eq!(lean.step_error.to_bits(), full.step_error.to_bits());
     }
 
     #[test]

@@ -112,6 +112,8 @@ scene_fields! {
         "the integrator: \"rk4\" (default: classical RK4 on the grid n dt) or \"dopri5\" (adaptive Dormand-Prince 5(4) with rtol and atol)";
     "omega0": "start", "rad/s", "finite",
         "initial angular velocity dq/dt";
+    "outputs": "outputs", "", "names of summary fields (status always); left out: all",
+        "the summary fields a run computes and returns (Result.summary's keys, a sweep's columns): names from granrs.OUTPUTS; None (default): every field. A field left out is not computed: its share of the run's work is saved (the energies at the stop, the largest drag, the stiffness sampling behind h_lambda, the steps' error estimate, the joints' loads); status is always returned";
     "pin_joint": "body", "", "free, locked or { k = N m/rad, c = N m s/rad }",
         "the pin: \"free\" (the thesis's frictionless joint, sec. 4.1), \"locked\" or a spring-damper (rest angle: the initial one)";
     "pin_mass": "body", "kg", ">= 0",

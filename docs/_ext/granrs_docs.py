@@ -53,7 +53,16 @@ API_SECTIONS: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     (
         "Running impacts",
         "A scene is one impact; :func:`granrs.simulate` runs one and :func:`granrs.sweep` many.",
-        ("simulate", "sweep", "Scene", "cases", "scenefile", "RECORDS", "RK4_STABILITY_LIMIT"),
+        (
+            "simulate",
+            "sweep",
+            "Scene",
+            "cases",
+            "scenefile",
+            "RECORDS",
+            "OUTPUTS",
+            "RK4_STABILITY_LIMIT",
+        ),
     ),
     (
         "Bodies in space",

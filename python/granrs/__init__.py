@@ -48,7 +48,7 @@ from .errors import (
 )
 from .force import ResistanceForce, resistance_force
 from .result import ContactResult, Result
-from .scene import RECORDS, Scene
+from .scene import OUTPUTS, RECORDS, Scene
 
 if TYPE_CHECKING:
     from ._animation import ImpactAnimation, animate
@@ -56,6 +56,7 @@ if TYPE_CHECKING:
 __version__: str = _granrs.__version__
 
 __all__ = [
+    "OUTPUTS",
     "RECORDS",
     "RK4_STABILITY_LIMIT",
     "AnimationSizeWarning",

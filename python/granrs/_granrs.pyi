@@ -40,6 +40,7 @@ __all__ = [
     "fast_lanes",
     "leg_segments",
     "max_threads",
+    "output_fields",
     "resistance_force",
     "rft3d_alpha",
     "rft_alpha",
@@ -100,6 +101,10 @@ class RunOutcome:
 def run(compiled: Compiled) -> RunOutcome:
     """Run a compiled scene."""
 
+def output_fields() -> list[dict[str, str]]:
+    """The one table of a run's output fields (name, part, unit, and what the run computes
+    for it beyond its steps), what a scene's ``outputs`` may list."""
+
 def run_scene(fields: dict[str, Any], core_fields: dict[str, tuple[str, ...]]) -> RunOutcome:
     """Run a Scene from its ``__dict__``: ``compiled_scene`` then ``run``."""
 
@@ -118,16 +123,19 @@ def sweep(
     threads: int = 0,
     progress: Callable[[int], None] | None = None,
     lanes: bool = True,
+    outputs: list[str] | tuple[str, ...] | None = None,
 ) -> dict[str, Any]:
     """Run runs start..stop of a batch (the product of axes over base, or a list of scene
-    dicts or compiled scenes) on `threads` threads (0, or more than the cores: every core);
-    return columns, data (rows x columns), failures [(run, message)] and body."""
+    dicts or compiled scenes) on `threads` threads (0, or more than the cores: every core),
+    each returning `outputs` (None: the scenes' own); return columns, data (rows x columns),
+    failures [(run, message)] and body."""
 
 def validate_sweep(
     base: dict[str, Any] | None = None,
     axes: list[tuple[str, list[Any]]] | None = None,
     scenes: list[dict[str, Any] | Compiled] | None = None,
     threads: int = 0,
+    outputs: list[str] | tuple[str, ...] | None = None,
 ) -> int:
     """Validate every run of a batch without running it; return the number of runs."""
 

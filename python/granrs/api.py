@@ -101,7 +101,8 @@ def simulate(scene: Scene | space.Scene) -> Result | space.Result:
         or outcome.unresolved_stops
         or (
             outcome.unresolved
-            and energy_rose(result.summary["energy_start"], result.summary["energy_end"])
+            # (The run's energies are always computed, whatever its outputs.)
+            and energy_rose(result._raw_dict()["energy_start"], result._raw_dict()["energy_end"])
         )
     ):
         advice = step_advice(

@@ -17,6 +17,7 @@ import difflib
 import functools
 import itertools
 import math
+import re
 import uuid
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
@@ -38,7 +39,8 @@ from .errors import (
 )
 from .forces import Term
 from .result import JOINT_NAMES
-from .scene import Scene, axis_rows
+from .scene import OUTPUTS, Scene, axis_rows
+from .scene import _names as _listed
 
 __all__ = ["STATUSES", "sweep"]
 
@@ -136,7 +138,7 @@ def _names(columns: Sequence[str], body: str) -> list[str]:
     """The DataFrame's names of the core's columns (a free link drops ``c0.``; a built-in
     body's joints by name; a linkage's keep the core's ``joint<i>``, i in the engine's
     order of links, since the core names them by the link each carries)."""
-    n_contacts = sum(1 for c in columns if c.endswith(".t_s"))
+    n_contacts = len({c.partition(".")[0] for c in columns if re.fullmatch(r"c\d+\..+", c)})
     joints = JOINT_NAMES.get(body, ())
     names = []
     for c in columns:
@@ -358,6 +360,7 @@ def _run_local(
     bar = _progress_bar(stop - start, progress)
     table: _Table | None = None
     failures: list[tuple[int, str]] = []
+    unresolved: list[int] = []
     body = ""
     columns: list[str] = []
     try:
@@ -376,11 +379,19 @@ def _run_local(
                 table = _Table(columns, body, stop - start)
             table.put(np.asarray(raw["data"]), lo - start)
             failures += raw["failures"]
+            unresolved += raw["unresolved"]
             del raw
     finally:
         if bar is not None:
             bar.close()
-    return {"table": table, "failures": failures, "body": body, "columns": columns, "start": start}
+    return {
+        "table": table,
+        "failures": failures,
+        "unresolved": unresolved,
+        "body": body,
+        "columns": columns,
+        "start": start,
+    }
 
 
 def run_chunk(kwargs: dict[str, Any], start: int, stop: int, threads: int) -> dict[str, Any]:
@@ -424,6 +435,7 @@ def _run_dask(
         "columns": parts[0]["columns"],
         "data": np.concatenate([p["data"] for p in parts]),
         "failures": [f for p in parts for f in p["failures"]],
+        "unresolved": [i for p in parts for i in p["unresolved"]],
         "body": parts[0]["body"],
         "start": 0,
     }
@@ -538,6 +550,7 @@ def sweep(
     client: Any = None,
     chunk_size: int | None = None,
     lanes: bool = True,
+    outputs: Sequence[str] | None = None,
     **axes: Any,
 ) -> pd.DataFrame:
     """Run many scenes in parallel and return one row of summaries per run.
@@ -563,8 +576,13 @@ def sweep(
             the CPU has it (default). The results are the same bit for bit as with
             ``lanes=False``, which runs every scene alone on the scalar path (for
             comparisons and benchmarks). Other scenes always run alone.
-        **axes: field name = values (any Scene field but ``body``; a single value is an
-            axis of one). The sweep runs their Cartesian product, the last axis varying
+        outputs: the output fields every run computes and returns, from
+            :data:`granrs.OUTPUTS` (``status`` always): the result's columns. None (default)
+            keeps the scenes' own ``outputs`` (by default every field; a list of scenes must
+            then agree on them). A field left out is not computed: ``outputs=("depth",
+            "t_s")`` runs only what those need (see the sweeps guide, "Outputs").
+        **axes: field name = values (any Scene field but ``body`` and ``outputs``; a single
+            value is an axis of one). The sweep runs their Cartesian product, the last axis varying
             fastest, as ``itertools.product``.
 
     Returns:
@@ -573,8 +591,9 @@ def sweep(
         ``failed`` or ``cancelled``), the work counters, the energies, and the contact
         results of :attr:`granrs.Result.summary` (``t_s``, ``depth``, ``dq``, ...; the
         chain's prefixed ``c0.`` and ``c1.``), and per joint ``<joint>.F_max``,
-        ``<joint>.torque_max`` and ``<joint>.impulse_work``. A run that failed has status
-        ``"failed"`` and its message in an ``error`` column (present only then).
+        ``<joint>.torque_max`` and ``<joint>.impulse_work``: those of ``outputs`` only, when
+        given, in that same order. A run that failed has status ``"failed"`` and its message
+        in an ``error`` column (present only then).
 
     Raises:
         InvalidSceneError: (or a subclass) before anything runs, naming the field, with
@@ -590,6 +609,8 @@ def sweep(
         (6, ['q_deg', 'v0', 'status'])
     """
     n_threads = _threads(threads)
+    if outputs is not None:
+        outputs = list(_listed(outputs, "outputs", OUTPUTS))
     if axes and not isinstance(scene, Scene | space.Scene):
         raise InvalidParameterError(
             "sweep() over a list of scenes takes no axes; vary the scenes instead",
@@ -601,6 +622,12 @@ def sweep(
         and len(scene) > 0
         and isinstance(scene[0], space.Scene)
     ):
+        if outputs is not None:
+            raise InvalidParameterError(
+                "a sweep of bodies in space returns granrs.space.SUMMARY_FIELDS; it takes no "
+                "outputs",
+                field="outputs",
+            )
         return _sweep_space(scene, n_threads, progress, client, axes)
     if isinstance(scene, Scene):
         kwargs, plain_axes = _axis_sweep(scene, axes)
@@ -628,6 +655,8 @@ def sweep(
     if not isinstance(lanes, bool):
         raise InvalidParameterError(f"lanes must be True or False; got {lanes!r}", field="lanes")
     kwargs["lanes"] = lanes
+    if outputs is not None:
+        kwargs["outputs"] = outputs
     if client is not None and chunk_size is not None:
         if not isinstance(chunk_size, int) or chunk_size < 1:
             raise InvalidParameterError(
@@ -651,15 +680,16 @@ def sweep(
         raw = run(kwargs, n)
         table = _table(raw)
         failures, start = raw["failures"], raw["start"]
+        unresolved = [i - start for i in raw["unresolved"]]
         del raw
     else:
         # Every run validated first, so that an error names its index in the whole sweep.
         _granrs.validate_sweep(
             **{k: v for k, v in kwargs.items() if k != "lanes"}, threads=n_threads
         )
-        table, failures = _run_by_row(kwargs, *rows, n, lambda kw, c: run(kw, c, True))
+        table, failures, unresolved = _run_by_row(kwargs, *rows, n, lambda kw, c: run(kw, c, True))
         start = 0
-    _warn_unresolved(table)
+    _warn_unresolved(table, unresolved)
     frame = table.frame(failures, start, axis_columns)
     del axis_columns, table
     return frame
@@ -671,7 +701,7 @@ def _run_by_row(
     terms: list[Any],
     n: int,
     run: Any,
-) -> tuple[_Table, list[tuple[int, str]]]:
+) -> tuple[_Table, list[tuple[int, str]], list[int]]:
     """A product sweep whose ``field`` axis selects each run's force terms (``terms``, one
     per value of that axis): one product per distinct set of terms, over the values that
     select it, each row put at its place in the whole product (the last axis fastest)."""
@@ -689,6 +719,7 @@ def _run_by_row(
     index = np.arange(n).reshape(shape)
     table: _Table | None = None
     failures: list[tuple[int, str]] = []
+    unresolved: list[int] = []
     for group_terms, members in groups:
         sub_axes = list(axes)
         sub_axes[k] = (field, [axes[k][1][i] for i in members])
@@ -706,39 +737,49 @@ def _run_by_row(
             table.blocks[kind][:, where] = block
         table.status[where] = part.status
         failures += [(int(where[i - raw["start"]]), message) for i, message in raw["failures"]]
+        unresolved += [int(where[i - raw["start"]]) for i in raw["unresolved"]]
     assert table is not None
-    return table, failures
+    return table, failures, sorted(unresolved)
 
 
-def _warn_unresolved(table: _Table) -> None:
+def _warn_unresolved(table: _Table, unresolved: Sequence[int]) -> None:
     """One :class:`~granrs.errors.StepSizeWarning` for the runs whose step did not resolve
     their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, the steps' own
     error estimate ``step_error`` above 1 %, a stop the step missed, or steps the sign
     modes chattered through, ``unresolved`` > 0, with a rise in energy: see
-    :func:`granrs.api.energy_rose`)."""
-    if "h_lambda" not in table.layout.rows_of:
-        return
-    h_lambda = table.column("h_lambda")
-    # The energy test only where a step was unresolved (few rows: no full-length temporaries).
-    maybe = np.flatnonzero(table.column("unresolved") > 0)
-    start = table.column("energy_start")[maybe]
-    end = table.column("energy_end")[maybe]
-    with np.errstate(invalid="ignore"):
-        rose = end - start > ENERGY_ROSE_RTOL * np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
-    flagged = np.flatnonzero(
-        (h_lambda > RK4_STABILITY_LIMIT) | (table.column("unresolved_stops") > 0)
-    )
-    bad = np.union1d(flagged, maybe[rose])
+    :func:`granrs.api.energy_rose`). ``unresolved`` are the rows with ``unresolved_stops``
+    > 0, which every run computes whatever its outputs; the other tests need their columns
+    in the sweep's outputs (``h_lambda``: the default has it)."""
+    have = table.layout.rows_of
+    flagged = np.zeros(table.n, dtype=bool)
+    if "h_lambda" in have:
+        flagged |= table.column("h_lambda") > RK4_STABILITY_LIMIT
+    flagged[np.asarray(unresolved, dtype=np.intp)] = True
+    bad = np.flatnonzero(flagged)
+    if {"unresolved", "energy_start", "energy_end"} <= set(have):
+        # The energy test only where a step was unresolved (few rows: no full-length
+        # temporaries).
+        maybe = np.flatnonzero(table.column("unresolved") > 0)
+        start = table.column("energy_start")[maybe]
+        end = table.column("energy_end")[maybe]
+        with np.errstate(invalid="ignore"):
+            scale = np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
+            rose = end - start > ENERGY_ROSE_RTOL * scale
+        bad = np.union1d(bad, maybe[rose])
     if bad.size:
         rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
+        largest = (
+            f"; the largest h_lambda is {np.nanmax(table.column('h_lambda')[bad]):.3g}"
+            if "h_lambda" in have
+            else ""
+        )
         warnings.warn(
             StepSizeWarning(
                 f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
                 f"(h_lambda above {RK4_STABILITY_LIMIT}, 'step_error' above 0.01, "
                 "'unresolved_stops' the step missed, or "
-                "'unresolved' steps where the sign modes chattered and the energy rose); the "
-                "largest h_lambda is "
-                f"{np.nanmax(h_lambda[bad]):.3g}. "
+                "'unresolved' steps where the sign modes chattered and the energy rose)"
+                f"{largest}. "
                 "Use a smaller dt (dt * rate <= 0.5) for those runs"
             ),
             stacklevel=3,

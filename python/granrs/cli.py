@@ -713,13 +713,17 @@ def summary_text(result: Any, source: str | None = None) -> str:
     contacts says so) and each joint's largest force and torque."""
     from .result import SUMMARY_UNITS
 
-    s = result.summary
+    summary = result.summary
+
+    def s(key: str) -> str:
+        # A field the scene's outputs leave out: "-".
+        return _number(summary.get(key, math.nan))
+
     title = f"{source}: " if source else ""
     lines = [
-        f"{title}{result.scene.kind}, status {result.status} at t = {_number(s['t_final'])} s "
-        f"({s['steps']} steps, {s['rhs_evals']} rhs evaluations, {s['events']} events)",
-        f"energy: {_number(s['energy_start'])} J at the start, "
-        f"{_number(s['energy_end'])} J at the end",
+        f"{title}{result.scene.kind}, status {result.status} at t = {s('t_final')} s "
+        f"({s('steps')} steps, {s('rhs_evals')} rhs evaluations, {s('events')} events)",
+        f"energy: {s('energy_start')} J at the start, {s('energy_end')} J at the end",
     ]
     if result.contacts:
         lines += [f"coefficients: {result.scene.coefficients_source}", ""]

@@ -9,38 +9,17 @@ from typing import Any
 
 import numpy as np
 
+from . import _granrs
 from .scene import Scene
 
 __all__ = ["JOINT_NAMES", "LINK_NAMES", "SUMMARY_UNITS", "ContactResult", "Result"]
 
-#: Units of the summary fields.
+#: Units of the summary fields (the core's one table of output fields; ``status`` and a
+#: contact's ``stopped`` have none, and a joint's fields are in ``Result.joints``).
 SUMMARY_UNITS: dict[str, str] = {
-    "t_s": "s",
-    "depth": "m",
-    "dq": "rad",
-    "omega_end": "rad/s",
-    "F_d_max": "N",
-    "F_s_end": "N",
-    "F_r_end": "N",
-    "dKE": "J",
-    "dPE": "J",
-    "dE": "J",
-    "work_sand": "J",
-    "x_tip_end": "m",
-    "t_entry": "s",
-    "link_dKE": "J",
-    "link_dPE": "J",
-    "link_dE": "J",
-    "dissipated": "J",
-    "steps": "-",
-    "rhs_evals": "-",
-    "root_evals": "-",
-    "events": "-",
-    "rejected": "-",
-    "unresolved": "-",
-    "unresolved_stops": "-",
-    "h_lambda": "-",
-    "step_error": "-",
+    f["name"]: f["unit"]
+    for f in _granrs.output_fields()
+    if f["part"] != "joint" and f["name"] not in ("status", "stopped")
 }
 
 # Friendly names of the generalized coordinates of each body.
@@ -132,7 +111,8 @@ class Result:
         t_s: stopping time of contact 0 [s] (NaN if it did not stop).
         depth: depth of contact 0 at its stop [m].
         summary: contact 0's results plus the run's: t_s, depth, dq, omega_end, F_d_max,
-            F_s_end, F_r_end, dKE, dPE, dE (thesis eqs. 3.22-3.26), steps, rhs_evals, ...
+            F_s_end, F_r_end, dKE, dPE, dE (thesis eqs. 3.22-3.26), steps, rhs_evals, ...;
+            those of ``scene.outputs`` only, when the scene lists them (``status`` always).
         contacts: per contact (the chain's link 1 and link 2; the leg's foot).
         joints: per joint, by name (see ``JOINT_NAMES``): ``F_max`` [N], the largest force
             the joint passes to the link it carries, ``torque_max`` [N m] (a spring's, a
@@ -170,9 +150,12 @@ class Result:
         if self._d is None:
             raw = self._raw_dict()
             scene = self.scene
+            # Every run's t_s and depth, whatever its outputs.
             contacts = [
-                ContactResult(t_s=c["t_s"], depth=c["depth"], stopped=stopped, summary=c)
-                for c, stopped in zip(raw["contacts"], raw["stopped"], strict=True)
+                ContactResult(t_s=t_s, depth=depth, stopped=stopped, summary=c)
+                for c, stopped, t_s, depth in zip(
+                    raw["contacts"], raw["stopped"], raw["t_s"], raw["depth"], strict=True
+                )
             ]
             # A body without contacts (a linkage in the air) has the run's entries only.
             summary = dict(raw["contacts"][0]) if raw["contacts"] else {}
@@ -201,13 +184,13 @@ class Result:
     @property
     def t_s(self) -> float:
         if isinstance(self._core, dict):
-            return float(self._core["contacts"][0]["t_s"])
+            return float(self._core["t_s"][0])
         return float(self._core.t_s)
 
     @property
     def depth(self) -> float:
         if isinstance(self._core, dict):
-            return float(self._core["contacts"][0]["depth"])
+            return float(self._core["depth"][0])
         return float(self._core.depth)
 
     @property
@@ -293,7 +276,8 @@ class Result:
         t_s = "not stopped" if math.isnan(self.t_s) else f"{self.t_s * 1e3:.4f} ms"
         return (
             f"Result(status={self.status!r}, t_s={t_s}, depth={self.depth * 1e3:.4f} mm, "
-            f"steps={self.summary['steps']}, rhs_evals={self.summary['rhs_evals']})"
+            f"steps={self.summary.get('steps', '-')}, "
+            f"rhs_evals={self.summary.get('rhs_evals', '-')})"
         )
 
 

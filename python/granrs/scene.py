@@ -64,6 +64,7 @@ __all__ = [
     "FIELD_INFO",
     "JOINTS",
     "KINDS",
+    "OUTPUTS",
     "OWN_FORCES",
     "RECORDS",
     "JointSpec",
@@ -85,6 +86,11 @@ OWN_FORCES = "the scene's forces"
 
 #: Time series a scene may list in ``record``.
 RECORDS: tuple[str, ...] = ("state", "forces", "energy")
+
+#: The output fields of a run, from the core's one table of them: what a scene's
+#: ``outputs`` may list (``Result.summary``'s keys, a contact's and a joint's, and a sweep's
+#: columns), the run's first, then a contact's, then a joint's.
+OUTPUTS: tuple[str, ...] = tuple(f["name"] for f in _granrs.output_fields())
 
 #: The thesis's law with each term's defaults (Table 3.4 of the thesis at q = 0).
 _THESIS_DEFAULT: tuple[Term, ...] = thesis()
@@ -367,6 +373,7 @@ class Scene:
     end: str = "first_stop"
     record: tuple[str, ...] = ()
     record_stride: int = 1
+    outputs: tuple[str, ...] | None = None
     q2_deg: float | None = None
     pin_mass: float = 0.0
     pin_joint: JointSpec = "free"
@@ -427,6 +434,8 @@ class Scene:
         object.__setattr__(self, "forces", as_terms(self.forces))
         media.apply(self)
         object.__setattr__(self, "record", _names(self.record, "record", RECORDS))
+        if self.outputs is not None:
+            object.__setattr__(self, "outputs", _names(self.outputs, "outputs", OUTPUTS))
         rule = _ROW_RULES.get(kind)
         change = _row_change(self, getattr(self, rule.field)) if rule else None
         if isinstance(change, tuple):
@@ -486,6 +495,7 @@ class Scene:
         d["body"] = self.body._core_value  # type: ignore[union-attr]
         d["forces"] = [t.to_dict() for t in self.forces]
         d["record"] = list(self.record)
+        d["outputs"] = None if self.outputs is None else list(self.outputs)
         if self.medium is not None:
             card = self.medium
             d["medium"] = media.reference(card) or card.to_dict()  # type: ignore[arg-type,union-attr]

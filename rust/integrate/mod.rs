@@ -21,8 +21,8 @@ pub use drives::Drives;
 pub use observe::{DIVERGENCE_FACTOR, RK4_STABILITY_LIMIT};
 pub use options::{EndCondition, Record, SolveOptions};
 pub use outcome::{
-    ContactSummary, Field, FieldValue, Impulse, JointSummary, Outcome, OutcomeFields, Series,
-    Stats, Status, OUTCOME_FIELDS,
+    ContactSummary, Field, FieldValue, Impulse, JointSummary, Needs, Outcome, OutcomeFields,
+    Outputs, Series, Stats, Status, OUTCOME_FIELDS,
 };
 pub use solve::{solve, solve_driven, Run};
 pub use stepper::{Method, RTOL_MIN};

@@ -9,7 +9,7 @@ use nalgebra::{SVector, Vector2};
 
 use super::options::{Record, SolveOptions};
 use super::outcome::{
-    ContactSummary, Impulse, JointSummary, Outcome, Series, Stats, Status, OUTCOME_FIELDS,
+    ContactSummary, Impulse, JointSummary, Needs, Outcome, Series, Stats, Status, OUTCOME_FIELDS,
 };
 use super::stepper::{companion, Deriv, Method, State};
 use crate::dynamics::{ContactEval, DragStiffness, Eval, Model, Modes, Shape, SignModel, Slip};
@@ -114,6 +114,13 @@ impl<const N: usize> Stiffest<N> {
 /// What a run keeps of itself as it goes: each contact's and joint's summary, the drag's
 /// stiffest moment, the recorded series, and the start's energies the summaries compare to.
 pub(super) struct Observer<const N: usize> {
+    /// What the run's output fields need computed ([`super::outcome::Outputs::needs`]): a
+    /// part no field asked for is not computed (its fields stay NaN or 0 and are not
+    /// returned).
+    needs: Needs,
+    /// Whether the joints' loads are followed: the body reports them ([`joint_loads`]) and
+    /// an output field needs them.
+    loads_on: bool,
     summaries: Vec<ContactSummary>,
     joints: Vec<JointSummary>,
     impulses: Vec<Impulse>,
@@ -174,7 +181,15 @@ fn link_energy<const N: usize>(model: &Model<N>, y: &State<N>, i: usize) -> (f64
 impl<const N: usize> Observer<N> {
     /// Start observing a run from `y` in `modes` (a contact in the sand at the start
     /// entered it at t = 0).
-    pub(super) fn new(model: &Model<N>, y: &State<N>, modes: &Modes, record: Record) -> Self {
+    pub(super) fn new(
+        model: &Model<N>,
+        y: &State<N>,
+        modes: &Modes,
+        options: &SolveOptions,
+    ) -> Self {
+        let record = options.record;
+        let needs = options.outputs.needs().union(Needs::ALWAYS);
+        let rates_on = model.forces.reads_frame && needs.has(Needs::STIFFNESS);
         let nc = model.contacts.len();
         let (ke0, pe0) = model.energies(&y.q, &y.qd);
         let summaries = (0..nc)
@@ -199,6 +214,8 @@ impl<const N: usize> Observer<N> {
             .collect();
         let n_links = model.mechanism.n_links();
         Observer {
+            needs,
+            loads_on: joint_loads(model) && needs.has(Needs::JOINT_LOADS),
             summaries,
             joints: vec![JointSummary::default(); n_links],
             impulses: Vec::new(),
@@ -206,7 +223,7 @@ impl<const N: usize> Observer<N> {
                 best: DragStiffness::default(),
                 q: y.q,
             },
-            rates_on: model.forces.reads_frame,
+            rates_on,
             unresolved: vec![false; nc],
             overshot: vec![None; nc],
             err_q: SVector::zeros(),
@@ -218,7 +235,7 @@ impl<const N: usize> Observer<N> {
                     damping: (0.0, y.q, 0),
                     spring: (0.0, y.q, 0),
                 };
-                if model.forces.reads_frame {
+                if rates_on {
                     terms.offer(model, y, modes);
                 }
                 terms
@@ -228,7 +245,11 @@ impl<const N: usize> Observer<N> {
             q0: y.q,
             ke0,
             pe0,
-            link_e0: (0..n_links).map(|i| link_energy(model, y, i)).collect(),
+            link_e0: if needs.has(Needs::ENERGY) {
+                (0..n_links).map(|i| link_energy(model, y, i)).collect()
+            } else {
+                Vec::new()
+            },
         }
     }
 
@@ -236,19 +257,23 @@ impl<const N: usize> Observer<N> {
     /// ([`Observer::step_end`]'s part for that contact): its largest drag and stiffness.
     #[inline(always)]
     pub(super) fn drag_at(&mut self, q: &SVector<f64, N>, s: &DragStiffness) {
-        let f_d_max = &mut self.summaries[s.contact].f_d_max;
-        if s.drag2 > *f_d_max * *f_d_max {
-            *f_d_max = s.drag2.sqrt();
+        if self.needs.has(Needs::DRAG_MAX) {
+            let f_d_max = &mut self.summaries[s.contact].f_d_max;
+            if s.drag2 > *f_d_max * *f_d_max {
+                *f_d_max = s.drag2.sqrt();
+            }
         }
-        self.stiffest.offer(|| *q, s);
+        if self.needs.has(Needs::STIFFNESS) {
+            self.stiffest.offer(|| *q, s);
+        }
     }
 
     /// Whether [`Observer::step_end`] and [`Observer::record_step`] need nothing of a step's
     /// end but each contact's drag ([`Observer::drag_at`]): nothing is recorded and the body
     /// reports no joint loads.
     #[inline]
-    pub(super) fn drag_only(&self, model: &Model<N>) -> bool {
-        !self.recorder.on.any() && !joint_loads(model) && !self.rates_on
+    pub(super) fn drag_only(&self) -> bool {
+        !self.recorder.on.any() && !self.loads_on && !self.rates_on
     }
 
     /// The terms' stiffness at a step's end or an event `y` ([`Observer::rates_on`]).
@@ -262,6 +287,9 @@ impl<const N: usize> Observer<N> {
     /// `k5`: add its error estimate ([`super::stepper::companion`]) to the run's.
     #[inline(always)]
     pub(super) fn step_error(&mut self, h: f64, k4: &Deriv<N>, k5: &Deriv<N>) {
+        if !self.needs.has(Needs::STEP_ERROR) {
+            return;
+        }
         let (dq, dqd) = companion(h, k4, k5);
         self.err_q += dq;
         self.err_qd += dqd;
@@ -302,20 +330,38 @@ impl<const N: usize> Observer<N> {
     /// `s` is the stiffest yet).
     #[inline(always)]
     pub(super) fn offer(&mut self, q: impl FnOnce() -> SVector<f64, N>, s: &DragStiffness) {
-        self.stiffest.offer(q, s);
+        if self.needs.has(Needs::STIFFNESS) {
+            self.stiffest.offer(q, s);
+        }
+    }
+
+    /// Whether the stiffness is sampled ([`Observer::offer`]): else its caller need not
+    /// compute what it reads.
+    #[inline(always)]
+    pub(super) fn wants_stiffness(&self) -> bool {
+        self.needs.has(Needs::STIFFNESS)
+    }
+
+    /// Whether a step's error estimate is asked for ([`Observer::step_error`]): else its
+    /// caller need not compute what it reads.
+    #[inline(always)]
+    pub(super) fn wants_step_error(&self) -> bool {
+        self.needs.has(Needs::STEP_ERROR)
     }
 
     /// A step ended at `y` (its evaluation `e`): the largest drag of each contact not yet
     /// stopped, the drag's stiffness there, and the joints' largest loads.
     #[inline(always)]
     pub(super) fn step_end(&mut self, model: &Model<N>, y: &State<N>, e: &Eval<N>, modes: &Modes) {
-        let n = self.summaries.len();
-        for (ci, (m, c)) in modes.iter().zip(&e.contacts).take(n).enumerate() {
-            if !m.stopped {
-                self.drag_at(&y.q, &DragStiffness::of(ci, c));
+        if self.needs.has(Needs::DRAG_MAX) || self.needs.has(Needs::STIFFNESS) {
+            let n = self.summaries.len();
+            for (ci, (m, c)) in modes.iter().zip(&e.contacts).take(n).enumerate() {
+                if !m.stopped {
+                    self.drag_at(&y.q, &DragStiffness::of(ci, c));
+                }
             }
         }
-        if !joint_loads(model) {
+        if !self.loads_on {
             return;
         }
         let f = model.joint_forces(&y.q, &y.qd, e, modes);
@@ -387,7 +433,7 @@ impl<const N: usize> Observer<N> {
     /// because the located sign switch overshot the zero (see `events::choose_slip`): the
     /// step, not the contact, decided. Judged at its stop or at the end ([`Observer::slid`]).
     pub(super) fn overshot_stick(&mut self, ci: usize, axis: usize, t: f64) {
-        if self.estimates && self.overshot[ci].is_none() {
+        if self.estimates && self.needs.has(Needs::STEP_ERROR) && self.overshot[ci].is_none() {
             self.overshot[ci] = Some((t, axis));
         }
     }
@@ -427,7 +473,31 @@ impl<const N: usize> Observer<N> {
         e: &Eval<N>,
         rest: f64,
     ) {
-        let energies = model.energies(&y.q, &y.qd);
+        if self.needs.has(Needs::STEP_ERROR) {
+            self.stop_error(model, ci, t, y, e, rest);
+        }
+        let s = &mut self.summaries[ci];
+        s.stopped = true;
+        s.t_s = t;
+        let energies = if self.needs.has(Needs::ENERGY) {
+            model.energies(&y.q, &y.qd)
+        } else {
+            (f64::NAN, f64::NAN)
+        };
+        self.settle(model, ci, y, &e.contacts[ci], energies);
+    }
+
+    /// The error of contact `ci`'s stop at `t` (`Outcome::step_error`), and whether the
+    /// step resolved it (`Stats::unresolved_stops`): see [`Observer::stopped`].
+    fn stop_error(
+        &mut self,
+        model: &Model<N>,
+        ci: usize,
+        t: f64,
+        y: &State<N>,
+        e: &Eval<N>,
+        rest: f64,
+    ) {
         // The stop's switching function there (zero where the step resolves the stop) over
         // its rate, the tip's vertical acceleration: the stop time's error.
         let contact = &model.contacts[ci];
@@ -473,10 +543,6 @@ impl<const N: usize> Observer<N> {
             self.unresolved[ci] = true;
         }
         self.slid(ci, t, e.contacts[ci].v_centroid, depth);
-        let s = &mut self.summaries[ci];
-        s.stopped = true;
-        s.t_s = t;
-        self.settle(model, ci, y, &e.contacts[ci], energies);
     }
 
     /// Write contact `ci`'s results at the state `y` (`c` its findings there, `(ke, pe)` the
@@ -490,20 +556,23 @@ impl<const N: usize> Observer<N> {
         (ke, pe): (f64, f64),
     ) {
         let link = model.contacts[ci].link();
-        let (lk, lp) = link_energy(model, y, link);
+        let energy = self.needs.has(Needs::ENERGY);
         let s = &mut self.summaries[ci];
         s.depth = (-c.tip.y).max(0.0);
         s.dq = y.q[2 + link] - self.q0[2 + link];
         s.omega_end = y.qd[2 + link];
         s.f_s_end = c.force.static_magnitude();
         s.f_r_end = c.force.total_magnitude();
-        s.d_ke = self.ke0 - ke;
-        s.d_pe = self.pe0 - pe;
-        s.d_e = s.d_ke + s.d_pe;
         s.work_sand = y.work;
         s.tip_end = c.tip;
-        s.link_d_ke = self.link_e0[link].0 - lk;
-        s.link_d_pe = self.link_e0[link].1 - lp;
+        if energy {
+            let (lk, lp) = link_energy(model, y, link);
+            s.d_ke = self.ke0 - ke;
+            s.d_pe = self.pe0 - pe;
+            s.d_e = s.d_ke + s.d_pe;
+            s.link_d_ke = self.link_e0[link].0 - lk;
+            s.link_d_pe = self.link_e0[link].1 - lp;
+        }
     }
 
     /// The run ended at `t` in the state `y` with `status`: the results of the contacts that
@@ -525,6 +594,9 @@ impl<const N: usize> Observer<N> {
         for ci in 0..self.summaries.len() {
             if !self.summaries[ci].stopped {
                 self.settle(model, ci, y, &e_end.contacts[ci], energies);
+                if !self.needs.has(Needs::STEP_ERROR) {
+                    continue;
+                }
                 let c = &e_end.contacts[ci];
                 self.slid(ci, t, c.v_centroid, (-c.tip.y).max(0.0));
                 if options.method == Method::Rk4 {
@@ -543,7 +615,7 @@ impl<const N: usize> Observer<N> {
             self.recorder.push(model, t, y, &e_end, modes);
         }
         let best = &self.stiffest.best;
-        let h_lambda = if options.method != Method::Rk4 {
+        let h_lambda = if options.method != Method::Rk4 || !self.needs.has(Needs::STIFFNESS) {
             f64::NAN
         } else {
             let drag = if best.k2() > 0.0 {
@@ -556,7 +628,7 @@ impl<const N: usize> Observer<N> {
         };
         let mut stats = stats;
         stats.unresolved_stops = self.unresolved.iter().filter(|&&u| u).count();
-        let step_error = if options.method == Method::Rk4 {
+        let step_error = if options.method == Method::Rk4 && self.needs.has(Needs::STEP_ERROR) {
             self.step_error
         } else {
             f64::NAN
@@ -576,8 +648,9 @@ impl<const N: usize> Observer<N> {
             impulses: self.impulses,
             series: self.recorder.finish(),
             terms: model.forces.names.clone(),
+            outputs: options.outputs,
         };
-        check_outcome(model, &out)?;
+        check_outcome(model, &out, self.needs)?;
         Ok(out)
     }
 }
@@ -588,12 +661,13 @@ impl<const N: usize> Observer<N> {
 pub const DIVERGENCE_FACTOR: f64 = 10.0;
 
 /// Refuse an outcome that is not a physical answer: a non-finite result (a contact field of
-/// [`OUTCOME_FIELDS`] marked `finite`), or a run whose mechanical energy grew past
+/// [`OUTCOME_FIELDS`] marked `finite`, of those the run computed: whose `needs` are in
+/// `needs`), or a run whose mechanical energy grew past
 /// [`DIVERGENCE_FACTOR`] times the body's energy scale (|E(0)| + M g l, with M the total
 /// mass and l the links' size). Both happen only when the step is beyond RK4's stability
 /// limit for the scene's contact stiffness; the error says so instead of returning a
 /// "stopped" run with enormous numbers.
-fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> {
+fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome, needs: Needs) -> Result<()> {
     let fail = |message: String| {
         Err(GranrsError::NonFinite {
             t: out.t_final,
@@ -604,7 +678,7 @@ fn check_outcome<const N: usize>(model: &Model<N>, out: &Outcome) -> Result<()> 
         let bad = OUTCOME_FIELDS
             .contact
             .iter()
-            .filter(|f| f.finite)
+            .filter(|f| f.finite && needs.has(f.needs))
             .map(|f| (f.name, (f.read)(c).as_f64()))
             .find(|(_, v)| !v.is_finite());
         if let Some((name, v)) = bad {

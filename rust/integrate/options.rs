@@ -1,7 +1,8 @@
-//! A run's options: the step, the stepper, when it ends and what it records. The ground
-//! floor of `integrate`: every other file of it reads these, and they read only the stepper's
-//! [`Method`].
+//! A run's options: the step, the stepper, when it ends, what it records and which output
+//! fields it returns. The ground floor of `integrate`: every other file of it reads these,
+//! and they read only the stepper's [`Method`] and the set of output fields, [`Outputs`].
 
+use super::outcome::Outputs;
 use super::stepper::Method;
 
 /// When a run ends.
@@ -28,6 +29,8 @@ pub struct SolveOptions {
     pub end: EndCondition,
     /// What to record.
     pub record: Record,
+    /// Which output fields to compute and return (default: all).
+    pub outputs: Outputs,
 }
 
 impl Default for SolveOptions {
@@ -38,6 +41,7 @@ impl Default for SolveOptions {
             t_end: 1.0,
             end: EndCondition::FirstStop,
             record: Record::default(),
+            outputs: Outputs::ALL,
         }
     }
 }

@@ -192,6 +192,9 @@ pub struct Outcome {
     pub series: Option<Series>,
     /// The terms that acted, in the scene's order.
     pub terms: Vec<&'static str>,
+    /// The output fields the run computed and returns (its options' `outputs`): the
+    /// others hold NaN or 0 and are not returned.
+    pub outputs: Outputs,
 }
 
 /// The value of one output field.
@@ -238,8 +241,82 @@ pub struct Field<T> {
     /// Whether a run that ends with it non-finite is refused (see
     /// `observe::check_outcome`); the others may be NaN (no stop, no entry).
     pub finite: bool,
+    /// What the run must compute for it beyond what every run computes (a scene whose
+    /// [`Outputs`] leave out every field that needs a part does not compute that part).
+    pub needs: Needs,
     /// Its value in `T`.
     pub read: fn(&T) -> FieldValue,
+}
+
+impl<T> Field<T> {
+    /// The same field, needing `needs`.
+    const fn needing(self, needs: Needs) -> Self {
+        Field {
+            name: self.name,
+            unit: self.unit,
+            finite: self.finite,
+            needs,
+            read: self.read,
+        }
+    }
+}
+
+/// The parts of a run's observation that only some output fields need, as a set: what a run
+/// computes beyond its steps, its events and the state at its stops and its end (which give
+/// every other field for nothing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Needs(u8);
+
+impl Needs {
+    /// Nothing beyond what every run computes.
+    pub const NONE: Needs = Needs(0);
+    /// The largest drag of each contact, at every step's end and event (`F_d_max`).
+    pub const DRAG_MAX: Needs = Needs(1);
+    /// The contact's stiffness at every RK4 stage, step end and event, and with a term that
+    /// reads the contact's boundary each term's own rates there (`h_lambda`).
+    pub const STIFFNESS: Needs = Needs(1 << 1);
+    /// Each step's error estimate, summed over the run and carried to the tip at each stop
+    /// (`step_error`, and the part of `unresolved_stops` that reads it).
+    pub const STEP_ERROR: Needs = Needs(1 << 2);
+    /// The body's and each contact link's energies at each stop (`dKE`, `dPE`, `dE`,
+    /// `link_dKE`, `link_dPE`, `link_dE`).
+    pub const ENERGY: Needs = Needs(1 << 3);
+    /// The joints' forces and torques at every step's end (`F_max`, `torque_max`).
+    pub const JOINT_LOADS: Needs = Needs(1 << 4);
+    /// Every part.
+    pub const ALL: Needs = Needs((1 << 5) - 1);
+    /// What every run computes, whatever its outputs: the steps' error estimate and the
+    /// checks of each stop behind `unresolved_stops`, which `granrs.StepSizeWarning` reads
+    /// (a safety output, and cheap: one estimate per step from stages the step has, against
+    /// the stiffness sampling's four offers a step). Returned only when asked for.
+    pub const ALWAYS: Needs = Needs::STEP_ERROR;
+
+    /// Both sets.
+    #[inline]
+    pub const fn union(self, other: Needs) -> Needs {
+        Needs(self.0 | other.0)
+    }
+
+    /// Whether every part of `other` is in this set.
+    #[inline]
+    pub const fn has(self, other: Needs) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// The parts' names (for the documentation of the fields).
+    pub fn names(self) -> Vec<&'static str> {
+        [
+            (Needs::DRAG_MAX, "the largest drag"),
+            (Needs::STIFFNESS, "the stiffness sampling"),
+            (Needs::STEP_ERROR, "the steps' error estimate"),
+            (Needs::ENERGY, "the energies at the stop"),
+            (Needs::JOINT_LOADS, "the joints' loads"),
+        ]
+        .into_iter()
+        .filter(|(n, _)| n.0 != 0 && self.has(*n))
+        .map(|(_, name)| name)
+        .collect()
+    }
 }
 
 /// The output fields of a run, by what they belong to, each in its order.
@@ -259,6 +336,7 @@ const fn real<T>(name: &'static str, unit: &'static str, read: fn(&T) -> FieldVa
         name,
         unit,
         finite: false,
+        needs: Needs::NONE,
         read,
     }
 }
@@ -269,6 +347,7 @@ const fn finite<T>(name: &'static str, unit: &'static str, read: fn(&T) -> Field
         name,
         unit,
         finite: true,
+        needs: Needs::NONE,
         read,
     }
 }
@@ -279,6 +358,7 @@ const fn count<T>(name: &'static str, read: fn(&T) -> FieldValue) -> Field<T> {
         name,
         unit: "-",
         finite: false,
+        needs: Needs::NONE,
         read,
     }
 }
@@ -293,6 +373,7 @@ pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
             name: "status",
             unit: "-",
             finite: false,
+            needs: Needs::NONE,
             read: |o| FieldValue::Status(o.status),
         },
         real("t_final", "s", |o| Real(o.t_final)),
@@ -302,43 +383,191 @@ pub const OUTCOME_FIELDS: OutcomeFields = OutcomeFields {
         count("events", |o| Count(o.stats.events)),
         count("rejected", |o| Count(o.stats.rejected)),
         count("unresolved", |o| Count(o.stats.unresolved)),
-        count("unresolved_stops", |o| Count(o.stats.unresolved_stops)),
+        count("unresolved_stops", |o: &Outcome| {
+            Count(o.stats.unresolved_stops)
+        })
+        .needing(Needs::STEP_ERROR),
         real("energy_start", "J", |o| Real(o.energy_start)),
         real("energy_end", "J", |o| Real(o.energy_end)),
         real("dissipated", "J", |o| Real(o.dissipated)),
-        real("h_lambda", "-", |o| Real(o.h_lambda)),
-        real("step_error", "-", |o| Real(o.step_error)),
+        real("h_lambda", "-", |o: &Outcome| Real(o.h_lambda)).needing(Needs::STIFFNESS),
+        real("step_error", "-", |o: &Outcome| Real(o.step_error)).needing(Needs::STEP_ERROR),
     ],
     contact: &[
         Field {
             name: "stopped",
             unit: "-",
             finite: false,
+            needs: Needs::NONE,
             read: |c| Flag(c.stopped),
         },
         real("t_s", "s", |c| Real(c.t_s)),
         finite("depth", "m", |c| Real(c.depth)),
         finite("dq", "rad", |c| Real(c.dq)),
         finite("omega_end", "rad/s", |c| Real(c.omega_end)),
-        finite("F_d_max", "N", |c| Real(c.f_d_max)),
+        finite("F_d_max", "N", |c: &ContactSummary| Real(c.f_d_max)).needing(Needs::DRAG_MAX),
         finite("F_s_end", "N", |c| Real(c.f_s_end)),
         finite("F_r_end", "N", |c| Real(c.f_r_end)),
-        finite("dKE", "J", |c| Real(c.d_ke)),
-        finite("dPE", "J", |c| Real(c.d_pe)),
-        real("dE", "J", |c| Real(c.d_e)),
+        finite("dKE", "J", |c: &ContactSummary| Real(c.d_ke)).needing(Needs::ENERGY),
+        finite("dPE", "J", |c: &ContactSummary| Real(c.d_pe)).needing(Needs::ENERGY),
+        real("dE", "J", |c: &ContactSummary| Real(c.d_e)).needing(Needs::ENERGY),
         finite("work_sand", "J", |c| Real(c.work_sand)),
         finite("x_tip_end", "m", |c| Real(c.tip_end.x)),
         real("t_entry", "s", |c| Real(c.t_entry)),
-        real("link_dKE", "J", |c| Real(c.link_d_ke)),
-        real("link_dPE", "J", |c| Real(c.link_d_pe)),
-        real("link_dE", "J", |c| Real(c.link_d_ke + c.link_d_pe)),
+        real("link_dKE", "J", |c: &ContactSummary| Real(c.link_d_ke)).needing(Needs::ENERGY),
+        real("link_dPE", "J", |c: &ContactSummary| Real(c.link_d_pe)).needing(Needs::ENERGY),
+        real("link_dE", "J", |c: &ContactSummary| {
+            Real(c.link_d_ke + c.link_d_pe)
+        })
+        .needing(Needs::ENERGY),
     ],
     joint: &[
-        real("F_max", "N", |j| Real(j.f_max)),
-        real("torque_max", "N m", |j| Real(j.torque_max)),
+        real("F_max", "N", |j: &JointSummary| Real(j.f_max)).needing(Needs::JOINT_LOADS),
+        real("torque_max", "N m", |j: &JointSummary| Real(j.torque_max))
+            .needing(Needs::JOINT_LOADS),
         real("impulse_work", "J", |j| Real(j.impulse_work)),
     ],
 };
+
+/// The set of `n` fields' bits (`n` <= 64).
+const fn first_bits(n: usize) -> u64 {
+    if n >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << n) - 1
+    }
+}
+
+/// Which output fields of [`OUTCOME_FIELDS`] a run returns: a scene's `outputs`, as a set
+/// (one bit per field of each part; a contact's field is every contact's, a joint's every
+/// joint's). `status` is always in it. The run computes the parts of its observation that
+/// the fields in it need ([`Outputs::needs`]) and no other: a field left out is neither
+/// computed nor returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Outputs {
+    run: u64,
+    contact: u64,
+    joint: u64,
+}
+
+impl Default for Outputs {
+    /// Every field (what a scene without `outputs` returns).
+    fn default() -> Self {
+        Outputs::ALL
+    }
+}
+
+impl Outputs {
+    /// Every field.
+    pub const ALL: Outputs = Outputs {
+        run: first_bits(OUTCOME_FIELDS.run.len()),
+        contact: first_bits(OUTCOME_FIELDS.contact.len()),
+        joint: first_bits(OUTCOME_FIELDS.joint.len()),
+    };
+
+    /// The fields named in `names` (and `status`, always): an unknown name or one listed
+    /// twice is an error naming the field `outputs`.
+    pub fn from_names<S: AsRef<str>>(names: &[S]) -> crate::error::Result<Outputs> {
+        use crate::error::GranrsError;
+        let fields = &OUTCOME_FIELDS;
+        // `status` (the run's first field) is always returned.
+        let mut out = Outputs {
+            run: 1,
+            contact: 0,
+            joint: 0,
+        };
+        let mut listed = Outputs {
+            run: 0,
+            contact: 0,
+            joint: 0,
+        };
+        for name in names {
+            let name = name.as_ref();
+            let find = |part: &[&'static str]| part.iter().position(|&n| n == name);
+            let (set, bit) = if let Some(i) = find(&Self::part_names(fields.run)) {
+                (&mut listed.run, i)
+            } else if let Some(i) = find(&Self::part_names(fields.contact)) {
+                (&mut listed.contact, i)
+            } else if let Some(i) = find(&Self::part_names(fields.joint)) {
+                (&mut listed.joint, i)
+            } else {
+                return Err(GranrsError::UnknownName {
+                    field: "outputs".into(),
+                    value: name.to_string(),
+                    allowed: Self::names().join(", "),
+                });
+            };
+            if *set & (1 << bit) != 0 {
+                return Err(GranrsError::InvalidScene {
+                    field: "outputs".into(),
+                    message: format!("lists {name:?} twice (each field once)"),
+                });
+            }
+            *set |= 1 << bit;
+        }
+        out.run |= listed.run;
+        out.contact |= listed.contact;
+        out.joint |= listed.joint;
+        Ok(out)
+    }
+
+    fn part_names<T>(part: &[Field<T>]) -> Vec<&'static str> {
+        part.iter().map(|f| f.name).collect()
+    }
+
+    /// Every output field's name: the run's, then a contact's, then a joint's, each in
+    /// [`OUTCOME_FIELDS`]' order (what a scene's `outputs` may list).
+    pub fn names() -> Vec<&'static str> {
+        let fields = &OUTCOME_FIELDS;
+        let mut out = Self::part_names(fields.run);
+        out.extend(Self::part_names(fields.contact));
+        out.extend(Self::part_names(fields.joint));
+        out
+    }
+
+    /// Whether every field is in it.
+    #[inline]
+    pub fn is_all(&self) -> bool {
+        *self == Outputs::ALL
+    }
+
+    /// What the run must compute for these fields beyond what every run computes.
+    pub fn needs(&self) -> Needs {
+        let mut needs = Needs::NONE;
+        for f in self.run() {
+            needs = needs.union(f.needs);
+        }
+        for f in self.contact() {
+            needs = needs.union(f.needs);
+        }
+        for f in self.joint() {
+            needs = needs.union(f.needs);
+        }
+        needs
+    }
+
+    fn pick<T>(part: &'static [Field<T>], bits: u64) -> impl Iterator<Item = &'static Field<T>> {
+        part.iter()
+            .enumerate()
+            .filter(move |(i, _)| bits & (1 << i) != 0)
+            .map(|(_, f)| f)
+    }
+
+    /// The run's fields in it, in [`OUTCOME_FIELDS`]' order (`status` first).
+    pub fn run(&self) -> impl Iterator<Item = &'static Field<Outcome>> {
+        Self::pick(OUTCOME_FIELDS.run, self.run)
+    }
+
+    /// Each contact's fields in it, in order.
+    pub fn contact(&self) -> impl Iterator<Item = &'static Field<ContactSummary>> {
+        Self::pick(OUTCOME_FIELDS.contact, self.contact)
+    }
+
+    /// Each joint's fields in it, in order.
+    pub fn joint(&self) -> impl Iterator<Item = &'static Field<JointSummary>> {
+        Self::pick(OUTCOME_FIELDS.joint, self.joint)
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -355,5 +584,44 @@ mod tests {
         unique(OUTCOME_FIELDS.run.iter().map(|f| f.name).collect());
         unique(OUTCOME_FIELDS.contact.iter().map(|f| f.name).collect());
         unique(OUTCOME_FIELDS.joint.iter().map(|f| f.name).collect());
+        // A scene's `outputs` names fields of every part in one list.
+        unique(Outputs::names());
+    }
+
+    #[test]
+    fn outputs_select_fields_and_what_they_need() {
+        let o = Outputs::from_names(&["depth", "t_s"]).unwrap();
+        let run: Vec<_> = o.run().map(|f| f.name).collect();
+        let contact: Vec<_> = o.contact().map(|f| f.name).collect();
+        assert_eq!(run, ["status"]);
+        assert_eq!(contact, ["t_s", "depth"]);
+        assert_eq!(o.joint().count(), 0);
+        assert_eq!(o.needs(), Needs::NONE);
+        let o = Outputs::from_names(&["F_d_max", "h_lambda", "dE", "F_max"]).unwrap();
+        assert!(o.needs().has(Needs::DRAG_MAX.union(Needs::STIFFNESS)));
+        assert!(o.needs().has(Needs::ENERGY.union(Needs::JOINT_LOADS)));
+        assert!(!o.needs().has(Needs::STEP_ERROR));
+        assert_eq!(Outputs::ALL.needs(), Needs::ALL);
+        assert_eq!(
+            Outputs::from_names(&Outputs::names()).unwrap(),
+            Outputs::ALL
+        );
+        assert_eq!(Outputs::ALL.run().count(), OUTCOME_FIELDS.run.len());
+    }
+
+    #[test]
+    fn unknown_or_repeated_outputs_name_the_field() {
+        match Outputs::from_names(&["depth", "dpeth"]) {
+            Err(crate::error::GranrsError::UnknownName { field, value, .. }) => {
+                assert_eq!((field.as_str(), value.as_str()), ("outputs", "dpeth"));
+            }
+            other => panic!("{other:?}"),
+        }
+        match Outputs::from_names(&["t_s", "t_s"]) {
+            Err(crate::error::GranrsError::InvalidScene { field, .. }) => {
+                assert_eq!(field, "outputs");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -125,7 +125,7 @@ impl<const N: usize> Run<N> {
             dissipated: 0.0,
         };
         let modes = events::initial_modes(model, &y, options.dt, &mut stats);
-        let mut obs = Observer::new(model, &y, &modes, options.record);
+        let mut obs = Observer::new(model, &y, &modes, options);
         let control = Control::new(options);
         let events = Events::new();
         let t = 0.0f64;
@@ -325,9 +325,11 @@ impl<const N: usize> Run<N> {
         if !end.pivots_ok() {
             return None;
         }
-        for k in 0..3 {
-            let (q, stiff) = end.stage::<N>(k);
-            self.obs.offer(|| q, &stiff);
+        if self.obs.wants_stiffness() {
+            for k in 0..3 {
+                let (q, stiff) = end.stage::<N>(k);
+                self.obs.offer(|| q, &stiff);
+            }
         }
         end.eval.write(&self.layout, &mut self.evals[1 - self.cur]);
         self.stats.rhs_evals += 4;
@@ -507,7 +509,7 @@ impl<const N: usize> Run<N> {
             && self.status.is_none()
             && self.drives.time(self.next_time).is_none()
             && !model.any_stuck(&self.modes)
-            && self.obs.drag_only(model)
+            && self.obs.drag_only()
     }
 
     /// Accept the step (of the size [`Run::next_step`] gave) taken in lane `i` of `end` if it
@@ -545,23 +547,27 @@ impl<const N: usize> Run<N> {
         {
             return false;
         }
-        for st in &end.stages {
-            let (q, stiff) = st.seen_in_lane::<N>(i);
-            self.obs.offer(q, &stiff);
+        if self.obs.wants_stiffness() {
+            for st in &end.stages {
+                let (q, stiff) = st.seen_in_lane::<N>(i);
+                self.obs.offer(q, &stiff);
+            }
         }
-        let k4 = Deriv {
-            q: SVector::from_fn(|k, _| lane(end.qd4[k])),
-            qd: SVector::from_fn(|k, _| lane(end.qdd4[k])),
-            work: 0.0,
-            dissipated: 0.0,
-        };
-        let k5 = Deriv {
-            q: y1.qd,
-            qd: SVector::from_fn(|k, _| lane(end.eval.qdd[k])),
-            work: 0.0,
-            dissipated: 0.0,
-        };
-        self.obs.step_error(self.t_next - self.t, &k4, &k5);
+        if self.obs.wants_step_error() {
+            let k4 = Deriv {
+                q: SVector::from_fn(|k, _| lane(end.qd4[k])),
+                qd: SVector::from_fn(|k, _| lane(end.qdd4[k])),
+                work: 0.0,
+                dissipated: 0.0,
+            };
+            let k5 = Deriv {
+                q: y1.qd,
+                qd: SVector::from_fn(|k, _| lane(end.eval.qdd[k])),
+                work: 0.0,
+                dissipated: 0.0,
+            };
+            self.obs.step_error(self.t_next - self.t, &k4, &k5);
+        }
         self.stats.rhs_evals += 4;
         self.y = y1;
         self.t = self.t_next;

@@ -41,6 +41,7 @@ fn _granrs(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::compiled_scene, m)?)?;
     m.add_function(wrap_pyfunction!(run::run_scene, m)?)?;
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(run::output_fields, m)?)?;
     m.add_class::<run::Compiled>()?;
     m.add_class::<run::RunOutcome>()?;
     m.add_function(wrap_pyfunction!(run::validate, m)?)?;

@@ -16,7 +16,7 @@ use super::errors::to_pyerr;
 use crate::bodies::LinkageScene;
 use crate::error::GranrsError;
 use crate::integrate::cancel::Watch;
-use crate::integrate::{FieldValue, Outcome, OUTCOME_FIELDS};
+use crate::integrate::{FieldValue, Outcome, Outputs, OUTCOME_FIELDS};
 use crate::spec::SceneSpec;
 
 /// A field's value as a Python value: a float, an int, a bool, or a status's name.
@@ -30,22 +30,23 @@ fn field_to_py(py: Python<'_>, v: FieldValue) -> PyResult<Bound<'_, PyAny>> {
 }
 
 /// Convert an outcome to a dict of Python values, its summaries read from the one table of
-/// output fields ([`OUTCOME_FIELDS`]); series move into numpy without copying.
+/// output fields ([`OUTCOME_FIELDS`]), those the run computed (its `outputs`); series move
+/// into numpy without copying.
 fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, PyDict>> {
-    let fields = &OUTCOME_FIELDS;
+    let fields = out.outputs;
     let d = PyDict::new(py);
     d.set_item("status", out.status.name())?;
     d.set_item("t_final", out.t_final)?;
     // The work counters; and the run-level entries of Result.summary (the counters first),
     // merged there with contact 0's in one update.
     let stats = PyDict::new(py);
-    for f in fields.run {
+    for f in fields.run() {
         if let v @ FieldValue::Count(_) = (f.read)(&out) {
             stats.set_item(f.name, field_to_py(py, v)?)?;
         }
     }
     let run = stats.copy()?;
-    for f in fields.run {
+    for f in fields.run() {
         match (f.read)(&out) {
             FieldValue::Count(_) => {}
             v => run.set_item(f.name, field_to_py(py, v)?)?,
@@ -57,24 +58,31 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
     d.set_item("energy_end", out.energy_end)?;
     d.set_item("work_sand", out.work_sand)?;
     d.set_item("terms", PyTuple::new(py, &out.terms)?)?;
-    // Each contact's summary; whether it stopped goes in a list of its own.
+    // Each contact's summary; whether it stopped, its t_s and its depth (every run's,
+    // whatever its outputs) go in lists of their own.
     let contacts = PyList::empty(py);
     let stopped = PyList::empty(py);
+    let t_s = PyList::empty(py);
+    let depth = PyList::empty(py);
     for c in &out.contacts {
         stopped.append(c.stopped)?;
+        t_s.append(c.t_s)?;
+        depth.append(c.depth)?;
         let cd = PyDict::new(py);
-        for f in fields.contact.iter().filter(|f| f.name != "stopped") {
+        for f in fields.contact().filter(|f| f.name != "stopped") {
             cd.set_item(f.name, field_to_py(py, (f.read)(c))?)?;
         }
         contacts.append(cd)?;
     }
     d.set_item("contacts", contacts)?;
     d.set_item("stopped", stopped)?;
+    d.set_item("t_s", t_s)?;
+    d.set_item("depth", depth)?;
     d.set_item("dissipated", out.dissipated)?;
     let joints = PyList::empty(py);
     for j in &out.joints {
         let jd = PyDict::new(py);
-        for f in fields.joint {
+        for f in fields.joint() {
             jd.set_item(f.name, field_to_py(py, (f.read)(j))?)?;
         }
         joints.append(jd)?;
@@ -99,6 +107,32 @@ fn outcome_to_dict<'py>(py: Python<'py>, out: Outcome) -> PyResult<Bound<'py, Py
         }
     }
     Ok(d)
+}
+
+/// The output fields a scene's `outputs` may list ([`OUTCOME_FIELDS`], by [`Outputs::names`]):
+/// name, part (`run`, `contact` or `joint`), unit, and what the run computes for it beyond
+/// its steps (empty: nothing), for `granrs.OUTPUTS`, `granrs.result.SUMMARY_UNITS` and the
+/// docs.
+#[pyfunction]
+pub(super) fn output_fields(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    let fields = &OUTCOME_FIELDS;
+    let out = PyList::empty(py);
+    let add = |part: &str, name: &str, unit: &str, needs: crate::integrate::Needs| {
+        out.append(py_dict!(py, {
+            "name": name, "part": part, "unit": unit, "computes": needs.names().join(", "),
+        }))
+    };
+    for f in fields.run {
+        add("run", f.name, f.unit, f.needs)?;
+    }
+    for f in fields.contact {
+        add("contact", f.name, f.unit, f.needs)?;
+    }
+    for f in fields.joint {
+        add("joint", f.name, f.unit, f.needs)?;
+    }
+    debug_assert_eq!(out.len(), Outputs::names().len());
+    Ok(out)
 }
 
 /// A scene converted and validated once (`compile`), to run many times without parsing: its

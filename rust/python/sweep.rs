@@ -21,8 +21,35 @@ use crate::spec::Value;
 /// no slower a 155-run sweep on two threads: `benches/bench_sweep.py --part fixed`).
 const YIELD_WAIT: std::time::Duration = std::time::Duration::from_micros(200);
 
-/// The batch a `sweep` call describes.
+/// The batch a `sweep` call describes: its runs, and the output fields every run returns
+/// (`outputs`: None keeps the scenes' own), checked (the typed error names the field).
 fn source_from_py(
+    py: Python<'_>,
+    base: Option<Bound<'_, PyDict>>,
+    axes: Option<Vec<(String, Bound<'_, PyAny>)>>,
+    scenes: Option<Vec<Bound<'_, PyAny>>>,
+    outputs: Option<Bound<'_, PyAny>>,
+) -> PyResult<Source> {
+    let mut src = source_of(base, axes, scenes)?;
+    let err = |e: GranrsError| to_pyerr(py, e);
+    if let Some(outputs) = outputs.filter(|o| !o.is_none()) {
+        match value_from_py(&outputs) {
+            Value::Names(names) => src.set_outputs(names).map_err(err)?,
+            other => {
+                return Err(err(GranrsError::WrongType {
+                    field: "outputs".into(),
+                    expected: "a list of names".into(),
+                    got: other.kind(),
+                }))
+            }
+        }
+    }
+    src.outputs().map_err(err)?;
+    Ok(src)
+}
+
+/// The runs a `sweep` call describes.
+fn source_of(
     base: Option<Bound<'_, PyDict>>,
     axes: Option<Vec<(String, Bound<'_, PyAny>)>>,
     scenes: Option<Vec<Bound<'_, PyAny>>>,
@@ -170,16 +197,17 @@ pub(super) fn fast_lanes() -> bool {
 /// `threads` threads (as `sweep`); raises the typed error of the first bad run, naming the
 /// field and the run. Ctrl-C stops it (within milliseconds) and raises.
 #[pyfunction]
-#[pyo3(signature = (base=None, axes=None, scenes=None, threads=0))]
+#[pyo3(signature = (base=None, axes=None, scenes=None, threads=0, outputs=None))]
 pub(super) fn validate_sweep<'py>(
     py: Python<'py>,
     base: Option<Bound<'py, PyDict>>,
     axes: Option<Vec<(String, Bound<'py, PyAny>)>>,
     scenes: Option<Vec<Bound<'py, PyAny>>>,
     threads: usize,
+    outputs: Option<Bound<'py, PyAny>>,
 ) -> PyResult<usize> {
     let err = |e: GranrsError| to_pyerr(py, e);
-    let src = source_from_py(base, axes, scenes)?;
+    let src = source_from_py(py, base, axes, scenes, outputs)?;
     src.body().map_err(err)?;
     let n = src.len();
     let (pool, workers) = pool_for(py, threads)?;
@@ -200,13 +228,17 @@ pub(super) fn validate_sweep<'py>(
 /// second from the calling thread; Ctrl-C (or an exception in `progress`) cancels the batch,
 /// the runs in flight and the validation included, within milliseconds, and raises. Returns
 /// a dict: `columns` (names), `data` (a rows x columns float array, input order),
-/// `failures` (list of (run, message)), `body`.
+/// `failures` (list of (run, message)), `unresolved` (the runs with `unresolved_stops` > 0,
+/// whatever the outputs), `body`.
+///
+/// `outputs` (a list of output field names, or None for the scenes' own) are the fields
+/// every run computes and returns: the table's columns.
 ///
 /// `lanes` (default true) runs the free-link scenes under the thesis's terms or a frame law
 /// (`rft`, `poncelet`, `rft_inertial`) four at a time in SIMD lanes (`batch::Path::Lanes`;
 /// the same results bit for bit); false runs every scene alone on the scalar path.
 #[pyfunction]
-#[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None, lanes=true))]
+#[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None, lanes=true, outputs=None))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn sweep<'py>(
     py: Python<'py>,
@@ -218,6 +250,7 @@ pub(super) fn sweep<'py>(
     threads: usize,
     progress: Option<Bound<'py, PyAny>>,
     lanes: bool,
+    outputs: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let path = if lanes {
         batch::Path::Lanes
@@ -225,7 +258,7 @@ pub(super) fn sweep<'py>(
         batch::Path::Scalar
     };
     let err = |e: GranrsError| to_pyerr(py, e);
-    let src = source_from_py(base, axes, scenes)?;
+    let src = source_from_py(py, base, axes, scenes, outputs)?;
     let n = src.len();
     let stop = stop.unwrap_or(n).min(n);
     let range = start.min(stop)..stop;
@@ -244,6 +277,7 @@ pub(super) fn sweep<'py>(
     d.set_item("columns", out.columns)?;
     d.set_item("data", out.data.into_pyarray(py).reshape([rows, width])?)?;
     d.set_item("failures", out.failures)?;
+    d.set_item("unresolved", out.unresolved)?;
     d.set_item("body", body)?;
     Ok(d)
 }

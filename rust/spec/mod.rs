@@ -19,7 +19,7 @@ use crate::body::{DriveTable, Joint};
 use crate::dynamics::SignModel;
 use crate::error::{check_range, GranrsError, Result};
 use crate::forces::{Coefficients, ForceSet, Medium, TermSpec};
-use crate::integrate::{EndCondition, Method, Record, SolveOptions};
+use crate::integrate::{EndCondition, Method, Outputs, Record, SolveOptions};
 use crate::presets::{self, Fields, Setting};
 
 #[cfg(test)]
@@ -284,6 +284,15 @@ impl SceneSpec {
         Ok(r)
     }
 
+    /// The output fields a run returns: the names listed in `outputs` (absent or `None`:
+    /// every field).
+    pub fn outputs(&self) -> Result<Outputs> {
+        match self.names("outputs")? {
+            None => Ok(Outputs::ALL),
+            Some(names) => Outputs::from_names(names),
+        }
+    }
+
     /// The fields every body shares but its forces.
     fn common_numerics(&self) -> Result<Common> {
         // The fields that one sign model or one method reads are checked whichever is
@@ -333,6 +342,7 @@ impl SceneSpec {
                 t_end: self.f64("t_end")?,
                 end,
                 record: self.record()?,
+                outputs: self.outputs()?,
             },
         })
     }

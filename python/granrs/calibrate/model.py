@@ -476,7 +476,10 @@ class _Model:
             # Runs the step did not resolve are counted (``unresolved``), not warned about
             # once per sweep of a fit.
             warnings.simplefilter("ignore", _StepSizeWarning)
-            frame = sweep(scenes, threads=threads, progress=False)
+            # (A body in space's sweep has its own fixed columns.)
+            planar = isinstance(scenes[0], Scene)
+            outputs = _SWEEP_OUTPUTS if planar else None
+            frame = sweep(scenes, threads=threads, progress=False, outputs=outputs)
         failed = (frame["status"] == "failed").to_numpy()
         run_unresolved = np.zeros(len(frame), dtype=bool)
         if "unresolved" in frame.columns:
@@ -510,6 +513,11 @@ class _Model:
         depth[~ok] = np.nan
         t_s[~ok] = np.nan
         return depth, t_s, ok
+
+
+#: The columns a fit's sweep reads (and so the only fields its runs compute): the depth and
+#: t_s (the run's end for a run without a stop), and what says the step did not resolve a run.
+_SWEEP_OUTPUTS = ("t_s", "depth", "t_final", "unresolved", "unresolved_stops", "h_lambda")
 
 
 def _chain_pairs(rows: pd.DataFrame) -> list[tuple[int, int]]:
