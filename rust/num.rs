@@ -52,6 +52,9 @@ pub trait Real:
     fn powf(self, e: Self) -> Self;
     /// `1 / self`.
     fn recip(self) -> Self;
+    /// `self * b + c` rounded once (a fused multiply-add: one instruction where the CPU
+    /// has FMA and the code is compiled for it, else libm's `fma`, the same result).
+    fn mul_add(self, b: Self, c: Self) -> Self;
     /// Square root.
     fn sqrt(self) -> Self;
     /// Absolute value.
@@ -84,6 +87,10 @@ impl Real for f64 {
     #[inline(always)]
     fn recip(self) -> Self {
         1.0 / self
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        f64::mul_add(self, b, c)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -189,6 +196,11 @@ impl Real for F64x4 {
     #[inline(always)]
     fn recip(self) -> Self {
         self.map(|x| 1.0 / x)
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        let (a, b, c) = (self.0, b.0, c.0);
+        F64x4(std::array::from_fn(|i| a[i].mul_add(b[i], c[i])))
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

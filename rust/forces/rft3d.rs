@@ -102,15 +102,35 @@ pub fn xi_n(rho_c: f64, mu: f64) -> f64 {
 /// round-off).
 #[inline(always)]
 pub fn fitted<F: Real>(x1: F, x2: F, x3: F) -> [F; 3] {
+    fitted_as::<F, false>(x1, x2, x3)
+}
+
+/// [`fitted`], each product and sum `a b + c` of its nested form rounded once where
+/// `FUSED` (a fused multiply-add: half the operations and a shorter chain; the element
+/// kernel's), else twice (the same bits as the sums written out).
+#[inline(always)]
+pub fn fitted_as<F: Real, const FUSED: bool>(x1: F, x2: F, x3: F) -> [F; 3] {
+    // a b + c; unfused, the same operations as `c + a b`.
+    let fma = |a: F, b: F, c: F| if FUSED { a.mul_add(b, c) } else { a * b + c };
     let mut f = [F::splat(0.0); 3];
     for (fi, c) in f.iter_mut().zip(COEFFICIENTS.iter()) {
         let k = |i: usize| F::splat(c[i]);
-        let p0 = k(0)
-            + x3 * (k(3) + x3 * (k(6) + x3 * k(12)))
-            + x2 * (k(2) + x3 * (k(8) + x3 * k(15)) + x2 * (k(5) + x3 * k(16) + x2 * k(11)));
-        let p1 = k(1) + x3 * (k(9) + x3 * k(18)) + x2 * (k(7) + x3 * k(19) + x2 * k(13));
-        let p2 = k(4) + x2 * k(14) + x3 * k(17);
-        *fi = p0 + x1 * (p1 + x1 * (p2 + x1 * k(10)));
+        let p0 = fma(
+            x2,
+            fma(
+                x2,
+                fma(x2, k(11), fma(x3, k(16), k(5))),
+                fma(x3, fma(x3, k(15), k(8)), k(2)),
+            ),
+            fma(x3, fma(x3, fma(x3, k(12), k(6)), k(3)), k(0)),
+        );
+        let p1 = fma(
+            x2,
+            fma(x2, k(13), fma(x3, k(19), k(7))),
+            fma(x3, fma(x3, k(18), k(9)), k(1)),
+        );
+        let p2 = fma(x3, k(17), fma(x2, k(14), k(4)));
+        *fi = fma(x1, fma(x1, fma(x1, k(10), p2), p1), p0);
     }
     f
 }
@@ -121,14 +141,14 @@ pub fn fitted<F: Real>(x1: F, x2: F, x3: F) -> [F; 3] {
 #[inline(always)]
 pub fn generic_stress<F: Real>(n: [F; 3], vh: [F; 3]) -> [F; 3] {
     let nv = n[0] * vh[0] + n[1] * vh[1] + n[2] * vh[2];
-    generic_stress_nv(n, vh, nv)
+    generic_stress_nv::<F, false>(n, vh, nv)
 }
 
 /// [`generic_stress`] with `n . vh` given (as [`stress`] has it already). With `m = s n`,
 /// `s = +-1`: `x3 = m . v^ = s (n . v^)` and `f1 m = (s f1) n`, bit for bit (a product by
 /// +-1 is exact).
 #[inline(always)]
-fn generic_stress_nv<F: Real>(n: [F; 3], vh: [F; 3], nv: F) -> [F; 3] {
+fn generic_stress_nv<F: Real, const FUSED: bool>(n: [F; 3], vh: [F; 3], nv: F) -> [F; 3] {
     // m: the plate's normal facing down (n where n_z < -tol, else -n). The law jumps where
     // a face turns through vertical (f1 m flips, and f1 is not zero there); the tie within
     // round-off goes one way, so that a vertical wall is one plate whatever the round-off
@@ -137,7 +157,7 @@ fn generic_stress_nv<F: Real>(n: [F; 3], vh: [F; 3], nv: F) -> [F; 3] {
     let x1 = -vh[2];
     let x2 = n[2].abs();
     let x3 = s * nv;
-    let [f1, f2, f3] = fitted(x1, x2, x3);
+    let [f1, f2, f3] = fitted_as::<F, FUSED>(x1, x2, x3);
     let f1 = s * f1;
     [
         f1 * n[0] + f2 * vh[0],
@@ -162,6 +182,17 @@ pub fn stress_capped<F: Real, const CAP: bool>(
     n: [F; 3],
     v: [F; 3],
 ) -> [F; 3] {
+    stress_as::<F, CAP, false>(law, n, v)
+}
+
+/// [`stress_capped`], its fitted functions fused where `FUSED` ([`fitted_as`]: the element
+/// kernel's form; the same stress to round-off).
+#[inline(always)]
+pub fn stress_as<F: Real, const CAP: bool, const FUSED: bool>(
+    law: &Rft3dLanes<F>,
+    n: [F; 3],
+    v: [F; 3],
+) -> [F; 3] {
     let zero = F::splat(0.0);
     let speed2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     // 1 / |v|, finite at rest (the element is then left out below).
@@ -171,7 +202,7 @@ pub fn stress_capped<F: Real, const CAP: bool>(
     let nv = n[0] * vh[0] + n[1] * vh[1] + n[2] * vh[2];
     // Leading: n . v^ > -tol (grazing counted) or > tol (grazing left out).
     let leading = (nv + law.threshold).select_pos(F::splat(1.0), zero) * moving;
-    let a = generic_stress_nv(n, vh, nv);
+    let a = generic_stress_nv::<F, FUSED>(n, vh, nv);
     let k = law.zeta * leading;
     if !CAP {
         return [k * a[0], k * a[1], k * a[2]];
@@ -747,6 +778,52 @@ mod tests {
             checked += 1;
         }
         assert!(checked > 300 && ramped > 20, "{checked} {ramped}");
+    }
+
+    /// Both nested forms of the fitted functions (fused and not) against the sum of the
+    /// table times the monomials written out, on a grid over the invariants' range.
+    #[test]
+    fn the_nested_forms_are_the_table_times_the_monomials() {
+        let mut checked = 0;
+        for i in 0..=10 {
+            for j in 0..=10 {
+                for k in 0..=10 {
+                    let (a, b, c) = (-1.0 + 0.2 * i as f64, 0.1 * j as f64, -1.0 + 0.2 * k as f64);
+                    let t = [
+                        1.0,
+                        a,
+                        b,
+                        c,
+                        a * a,
+                        b * b,
+                        c * c,
+                        a * b,
+                        b * c,
+                        c * a,
+                        a * a * a,
+                        b * b * b,
+                        c * c * c,
+                        a * b * b,
+                        b * a * a,
+                        b * c * c,
+                        c * b * b,
+                        c * a * a,
+                        a * c * c,
+                        a * b * c,
+                    ];
+                    let plain = fitted_as::<f64, false>(a, b, c);
+                    let fused = fitted_as::<f64, true>(a, b, c);
+                    for f in 0..3 {
+                        let sum: f64 = (0..20).map(|m| COEFFICIENTS[f][m] * t[m]).sum();
+                        assert!((plain[f] - sum).abs() < 1e-14, "{a} {b} {c}: f{f}");
+                        assert!((fused[f] - sum).abs() < 1e-14, "{a} {b} {c}: f{f}");
+                    }
+                    assert_eq!(plain, fitted(a, b, c));
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 1331);
     }
 
     #[test]
