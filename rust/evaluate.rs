@@ -959,24 +959,11 @@ pub mod geoms {
                     self.rods.evaluate(i, &state, &mut row);
                     full.rows_mut(3 * a, 3).copy_from_slice(&row[..3]);
                 }
-                // The sand at rest as a stiff viscous law: each geom's twist at the step's
-                // end is its creep `-C w` (C: `rest_speed` over the geom's resistance, the
-                // rotation's over the resistance times its length squared), so that the
-                // reaction's power at that twist, `-w C w`, is never positive; a stick that
-                // brought the twist to zero exactly did positive work whenever the rest of
-                // the world's force moved between the steps (the reaction is solved against
-                // the last step's).
+                // The sand at rest as a stiff viscous law ([`creep`]).
                 let mut ha = timestep * resp;
-                for (a, &i) in active.iter().enumerate() {
-                    let resistance = full.rows(3 * a, 2).norm();
-                    if resistance > 0.0 {
-                        let c = self.rest_speed / resistance;
-                        let length = self.rods.length(i);
-                        ha[(3 * a, 3 * a)] += c;
-                        ha[(3 * a + 1, 3 * a + 1)] += c;
-                        ha[(3 * a + 2, 3 * a + 2)] += c / (length * length);
-                    }
-                }
+                creep(&mut ha, &full, 3, 2, self.rest_speed, |a| {
+                    self.rods.length(active[a])
+                });
                 w = stick_or_slide(&ha, &free, &full, k, 3, 2, Slide::AsEvaluated);
                 self.held_wrench.fill(None);
                 for (a, &i) in active.iter().enumerate() {
@@ -1021,6 +1008,39 @@ pub mod geoms {
         applied[3 * i] = row[0] + d[0];
         applied[3 * i + 1] = row[1] + d[1];
         applied[3 * i + 2] = row[2] + lever[1] * d[0] - lever[0] * d[1];
+    }
+
+    /// The sand at rest as a stiff viscous law, added to `ha` (the twists' response to the
+    /// wrenches over the step, `block` rows per geom, its first `force` the force) before
+    /// [`stick_or_slide`]: each geom's twist at the step's end is then its creep `-C w` (C:
+    /// `rest_speed` over the geom's resistance, the size of its force in `full`; the
+    /// rotation's over the resistance times `length(a)` squared), so that the reaction's
+    /// power at that twist, `-w C w`, is never positive, and a geom carrying a load creeps
+    /// at about `rest_speed` times the load over its resistance. A stick that brought the
+    /// twist to zero exactly did positive work whenever the rest of the world's force moved
+    /// between the steps (the reaction is solved against the last step's).
+    pub fn creep(
+        ha: &mut nalgebra::DMatrix<f64>,
+        full: &nalgebra::DVector<f64>,
+        block: usize,
+        force: usize,
+        rest_speed: f64,
+        length: impl Fn(usize) -> f64,
+    ) {
+        for a in 0..full.len() / block {
+            let resistance = full.rows(block * a, force).norm();
+            if resistance > 0.0 {
+                let c = rest_speed / resistance;
+                let l = length(a);
+                for r in block * a..block * (a + 1) {
+                    ha[(r, r)] += if r < block * a + force {
+                        c
+                    } else {
+                        c / (l * l)
+                    };
+                }
+            }
+        }
     }
 
     /// What a sliding geom receives in [`stick_or_slide`]: the stick's wrench scaled down

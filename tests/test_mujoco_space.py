@@ -280,6 +280,54 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_rft3d(mode, foot):
     assert max(power[last]) <= 1e-9
 
 
+@pytest.mark.parametrize("mode", ["step", "callback"])
+@pytest.mark.parametrize("foot", ["capsule", "box"])
+def test_gymnasiums_hopper_foot_rests_on_sand_under_poncelet_in_space(mode, foot):
+    # The same hopper on poncelet in space (its depth term k d does not vanish at rest):
+    # over the last 5 s of 10 s the sand's own work (its generalized force, J^T of its
+    # wrench from MuJoCo's own Jacobians at the step's start, on each step's displacement)
+    # never rises by more than 1e-6 J/s over max(t, 1 s), and no step's power is
+    # positive; the foot holds still and the force balances the weight.
+    pytest.importorskip("gymnasium")
+    from granrs.gym import hopper_model
+
+    m = hopper_model(foot)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    foot_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
+    body = m.geom_bodyid[foot_id]
+    sand = Sand(m, ["foot_geom"], [forces.poncelet(c=1.0, k=2000.0)], space=True)
+    h = m.opt.timestep
+    weight = m.body_subtreemass[1] * np.linalg.norm(m.opt.gravity)
+    assert m.nq == m.nv  # slides and hinges: the displacement is the change of qpos
+    pos, fz, power = [], [], []
+    before = [d.qpos.copy()]
+    jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+
+    def record(d):
+        # After mj_step the kinematics are still the step's start's: the sand's pose.
+        mujoco.mj_jac(m, d, jacp, jacr, d.geom_xpos[foot_id], body)
+        generalized = jacp.T @ sand.applied[0, :3] + jacr.T @ sand.applied[0, 3:]
+        power.append(generalized @ (d.qpos - before[0]) / h)
+        before[0] = d.qpos.copy()
+        pos.append(d.geom_xpos[foot_id].copy())
+        fz.append(sand.applied[0, 2])
+
+    hold_upright(m, d, sand, mode, 10.0, record)
+    last = slice(-round(5.0 / h), None)
+    assert np.all(np.isfinite(pos))
+    assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
+    fz = np.array(fz)[last]
+    assert abs(fz.mean() / weight - 1) < 1e-3
+    assert np.max(np.abs(np.diff(fz))) < 0.05 * weight
+    w = np.array(power)[last]
+    work = np.cumsum(w) * h
+    work -= work[0]
+    elapsed = np.arange(len(work)) * h
+    assert np.max(work / np.maximum(elapsed, 1.0)) <= 1e-6
+    assert np.max(w) <= 0.0, np.max(w)
+
+
 def test_gymnasiums_humanoid_dropped_on_sand_stays_finite():
     gymnasium = pytest.importorskip("gymnasium")
     path = os.path.join(os.path.dirname(gymnasium.__file__), "envs/mujoco/assets/humanoid.xml")
