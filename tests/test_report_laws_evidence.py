@@ -98,7 +98,7 @@ def test_leg_section_factors_reproduce_the_depths_in_independent_runs() -> None:
     rows = m.rows.to_dict("records")
     sole = tuple(t for t in terms if t.name != "axial_drag")
 
-    def depths(eta_v_factor: float) -> list[float]:
+    def runs(eta_v_factor: float) -> list[granrs.Result]:
         out = []
         for r in rows:
             scaled = tuple(
@@ -106,21 +106,25 @@ def test_leg_section_factors_reproduce_the_depths_in_independent_runs() -> None:
                 for t in sole
             )
             scene = cases.leg(r["v0_mean"], joints="locked", forces=scaled)
-            out.append(granrs.simulate(scene).depth)
+            out.append(granrs.simulate(scene))
         return out
+
+    def depths(eta_v_factor: float) -> list[float]:
+        return [r.depth for r in runs(eta_v_factor)]
 
     # The depths as carried (factor 1), from independent runs.
     row = next(x for x in text.splitlines() if x.startswith("| thesis_refit+axial_drag"))
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[2] == ", ".join(f"{d * 1e3:.1f}" for d in depths(1.0))
+    assert cells[4].startswith(", ".join(f"{r.t_s * 1e3:.1f}" for r in runs(1.0)))
     # eta_v alone: its factor, run here, puts both depths within the tolerance.
-    found = re.search(r"static_v\.eta_v ([0-9.]+)x", cells[4])
-    assert found, cells[4]
+    found = re.search(r"static_v\.eta_v ([0-9.]+)x", cells[5])
+    assert found, cells[5]
     f = float(found.group(1))
     for d, r in zip(depths(f), rows, strict=True):
         assert abs(d - r["depth_mean"]) / r["depth_mean"] <= tol + 0.01
     assert line.startswith("- **Leg, laws fitted on Table 3.1**")
-    assert ("**met**" in line) == (cells[5] == "yes")
+    assert ("**met**" in line) == (cells[6] == "yes")
 
 
 def test_chain_measured_facts_from_tables_4_1_and_4_2() -> None:
@@ -154,3 +158,10 @@ def test_chain_section_counts_in_and_out_of_sample() -> None:
         z = (depth - r["depth_mean"]) / r["depth_sd"]
         out, _ = cells[4].split(" / ")
         assert float(out) == pytest.approx(z, abs=0.051)
+    # The link that stops first per case, from the same independent runs.
+    firsts = []
+    for c in (1, 2, 3):
+        t1, t2 = (runs[c].contacts[i].t_s for i in (0, 1))
+        firsts.append("1" if t1 < t2 else "2" if t2 < t1 else "0")
+    row = next(x for x in text.splitlines() if x.startswith("| thesis_published |"))
+    assert f"(first: {', '.join(firsts)})" in row

@@ -448,6 +448,12 @@ def _measured_facts(m: Measurements) -> str:
     )
 
 
+def _firsts(order: Mapping[str, Any]) -> str:
+    """The link predicted to stop first, case by case (``stop_order``'s ``per_case``)."""
+    per_case = order["per_case"]
+    return "first: " + ", ".join(str(per_case[c]["predicted_first"]) for c in sorted(per_case))
+
+
 def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tuple[str, str]:
     """Why the chain's targets are missed: ``laws`` are the comparison's records on the
     chain (leave one case out, with their fit to every row). Returns the Markdown and the
@@ -455,7 +461,7 @@ def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tupl
     m = Measurements.thesis(DATASETS["chain"].measurements)
     ran = [r for r in laws if r["available"]]
     ran = sorted(ran, key=lambda r: r["oos_chi2"] if math.isfinite(r["oos_chi2"]) else math.inf)
-    body, insample = [], {}
+    body, insample, chi2_in = [], {}, {}
     for r in ran:
         rows_in = _in_sample_rows(r, m)
         so = r["stop_order"]
@@ -467,10 +473,11 @@ def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tupl
             so_in = _stop_order(rows_in)
             d_in = _within(rows_in, "depth", 1.0)
             insample[r["law"]] = (so_in["in_order"], d_in)
+            chi2_in[r["law"]] = r["chi2_dof"]
             full = r["folds"][0]
             d_fit = sum(1 for x in rows_in if abs(x["depth_zfit"]) <= 1.0 + 1e-12)
             cells = [
-                f"{so_in['in_order']}/{so_in['cases']}",
+                f"{so_in['in_order']}/{so_in['cases']} ({_firsts(so_in)})",
                 f"{d_in}/{n}",
                 f"{d_fit}/{n}",
                 _fmt(full["chi2"] / full["dof"], ".1f") if full["dof"] > 0 else "n/a",
@@ -478,7 +485,7 @@ def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tupl
         body.append(
             [
                 r["law"],
-                f"{so['in_order']}/{so['cases']}",
+                f"{so['in_order']}/{so['cases']} ({_firsts(so)})",
                 f"{int(r['depth_within_1sd'])}/{n}",
                 f"{int(r['ts_within_2sd'])}/{n}",
                 *cells,
@@ -487,7 +494,7 @@ def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tupl
     counts = md_table(
         [
             "law",
-            "stop order (out of sample)",
+            "stop order (out of sample; link first in cases 1, 2, 3, 0: together)",
             "depth ≤ 1 sd",
             "t_s ≤ 2 sd",
             "stop order (in sample)",
@@ -521,6 +528,7 @@ def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tupl
         z_header += [f"{r['law']}: depth z (out / in)", "t_s z (out / in)"]
     meets_in = [law for law, (o, d) in insample.items() if o == 3 and d >= CHAIN_DEPTHS]
     best_in = max(insample.items(), key=lambda kv: (kv[1][1], kv[1][0]), default=None)
+    never = [law for law, (o, _) in insample.items() if o == 0]
     if meets_in:
         cause = (
             f"In sample {', '.join(meets_in)} meet{'s' if len(meets_in) == 1 else ''} the target: "
@@ -533,11 +541,23 @@ def chain_section(ctx: ReportContext, laws: Sequence[Mapping[str, Any]]) -> tupl
             "set the fit finds (its least χ², two starts) gives the stop order in every case "
             f"with ≥ {CHAIN_DEPTHS} depths within 1 sd"
             + (
-                f" (the most: {best_in[0]}, order {best_in[1][0]}/3, depths {best_in[1][1]}/6)"
+                f" (the most: {best_in[0]}, order {best_in[1][0]}/3, depths {best_in[1][1]}/6"
+                + (
+                    f", at χ²/dof {chi2_in[best_in[0]]:.2g}: the fit weighs depth and t_s "
+                    "together, and its least χ² is not the most rows within 1 sd"
+                    if best_in[0] in chi2_in
+                    else ""
+                )
+                + ")"
                 if best_in
                 else ""
             )
             + ". The miss is the laws', not the cross-validation's."
+        )
+    if never:
+        cause += (
+            f" {', '.join(never)} stop{'s' if len(never) == 1 else ''} the links in the "
+            "measured order in no case even in sample."
         )
     line = (
         f'- **Chain, why**: {cause} The section "Why the chain misses" below has every law\'s '
