@@ -14,6 +14,7 @@ each row's z for the best laws. Both return their Markdown and the target's line
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -22,10 +23,11 @@ import pandas as pd
 
 from .. import cases
 from .. import forces as _forces
+from ..api import STEP_ERROR_LIMIT
 from ..calibrate import Measurements
 from ..coefficients import table_3_2
 from ..compare import DATASETS, _rows, _stop_order
-from ..errors import GranrsError
+from ..errors import GranrsError, StepSizeWarning
 from .format import _fmt, md_table, relative_error
 from .format import _rows as _data_rows
 from .framework import ReportContext
@@ -185,35 +187,49 @@ def _thesis_scaling(rho_g: float) -> tuple[str, float]:
     return table, worst
 
 
-def _leg_depths(
-    ctx: ReportContext, m: Measurements, terms_of: Callable[[Mapping[str, Any]], Any]
-) -> tuple[Callable[[Sequence[tuple[str, str]], float], list[float]], dict[Any, list[float]]]:
-    """A function (coefficients, factor) -> the leg's depth per Table 5.1 row, and the
-    stopping times of its every call by (coefficients, factor)."""
-    joints = DATASETS["leg"].published.get("joints")
-    rows = m.rows.to_dict("records")
-    stops: dict[Any, list[float]] = {}
+class _LegRuns:
+    """The leg's runs of one law: :meth:`depths` (coefficients, factor) -> the depth per
+    Table 5.1 row; the stopping times of every call and whether its step resolved the
+    contact, by (coefficients, factor). Runs the step does not resolve (the core's
+    :class:`~granrs.StepSizeWarning` check) are counted, not warned about once per run of
+    a search."""
 
-    def depths(which: Sequence[tuple[str, str]], factor: float) -> list[float]:
-        out, t_s = [], []
-        stops[(tuple(which), factor)] = t_s
-        for r in rows:
+    def __init__(
+        self, ctx: ReportContext, m: Measurements, terms_of: Callable[[Mapping[str, Any]], Any]
+    ) -> None:
+        self.ctx, self.terms_of = ctx, terms_of
+        self.joints = DATASETS["leg"].published.get("joints")
+        self.rows = m.rows.to_dict("records")
+        self.t_s: dict[Any, list[float]] = {}
+        self.unresolved: dict[Any, bool] = {}
+        self.runs = 0
+        self.unresolved_runs = 0
+
+    def depths(self, which: Sequence[tuple[str, str]], factor: float) -> list[float]:
+        out, t_s, flagged = [], [], False
+        for r in self.rows:
             scene = cases.leg(
                 r["v0_mean"],
-                joints=joints,
-                dt=ctx.dt,
-                forces=_scaled(terms_of(r), which, factor),
+                joints=self.joints,
+                dt=self.ctx.dt,
+                forces=_scaled(self.terms_of(r), which, factor),
             )
-            try:
-                res = ctx.run(scene)
-                out.append(float(res.depth))
-                t_s.append(float(res.t_s))
-            except GranrsError:
-                out.append(math.nan)
-                t_s.append(math.nan)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", StepSizeWarning)
+                try:
+                    res = self.ctx.run(scene)
+                    out.append(float(res.depth))
+                    t_s.append(float(res.t_s))
+                except GranrsError:
+                    out.append(math.nan)
+                    t_s.append(math.nan)
+            self.runs += 1
+            if any(issubclass(w.category, StepSizeWarning) for w in caught):
+                self.unresolved_runs += 1
+                flagged = True
+        self.t_s[(tuple(which), factor)] = t_s
+        self.unresolved[(tuple(which), factor)] = flagged
         return out
-
-    return depths, stops
 
 
 def _stops(
@@ -306,9 +322,11 @@ def leg_section(ctx: ReportContext, ranked: Sequence[Mapping[str, Any]]) -> tupl
         runs.append(
             (f"{r['law']} (rank {int(r['rank'])})", lambda _row, t=terms: t, which, dropped)
         )
+    total = unresolved = 0
     with ctx.step("laws: the laws fitted on Table 3.1 on the leg, scaled"):
         for label, terms_of, which, dropped in runs:
-            depths, stops = _leg_depths(ctx, m, terms_of)
+            legs = _LegRuns(ctx, m, terms_of)
+            depths, stops = legs.depths, legs.t_s
             at_one = depths([], 1.0)
             at_one_ts = stops[((), 1.0)]
             magnitudes = [w for w in which if w not in _EXPONENTS]
@@ -316,13 +334,22 @@ def leg_section(ctx: ReportContext, ranked: Sequence[Mapping[str, Any]]) -> tupl
             each = {w: _search(depths, [w], targets, tol) for w in which}
             if common is not None and len(magnitudes) == 1:
                 each[magnitudes[0]] = common
+            total += legs.runs
+            unresolved += legs.unresolved_runs
+
+            def mark(key: Any, legs: _LegRuns = legs) -> str:
+                return " (step not resolved)" if legs.unresolved.get(key) else ""
+
             sizes = [_size(common)] if common else []
             sizes += [_size(v) for v in each.values()]
             smallest = min(sizes, default=math.inf)
             if label != _THESIS_OWN:
+                name = label.split(" (rank")[0]
+                if mark(((), 1.0)):
+                    name += " (its leg runs' step did not resolve the contact)"
                 verdicts.append(
                     (
-                        label.split(" (rank")[0],
+                        name,
                         smallest,
                         _stops(stops, magnitudes, common, at_one_ts),
                     )
@@ -342,10 +369,15 @@ def leg_section(ctx: ReportContext, ranked: Sequence[Mapping[str, Any]]) -> tupl
                     + (
                         f"; left out (no term on the sole): {', '.join(dropped)}" if dropped else ""
                     ),
-                    ", ".join(f"{d * 1e3:.1f}" for d in at_one),
-                    _search_cell(common, tol) if common else "(no magnitude fitted)",
+                    ", ".join(f"{d * 1e3:.1f}" for d in at_one) + mark(((), 1.0)),
+                    _search_cell(common, tol) + mark((tuple(magnitudes), common.get("factor")))
+                    if common
+                    else "(no magnitude fitted)",
                     _stops(stops, magnitudes, common, at_one_ts),
-                    "; ".join(f"{t}.{p} {_search_cell(v, tol)}" for (t, p), v in each.items()),
+                    "; ".join(
+                        f"{t}.{p} {_search_cell(v, tol)}" + mark((((t, p),), v.get("factor")))
+                        for (t, p), v in each.items()
+                    ),
                     "yes" if smallest <= LEG_MAX_SCALE else "no",
                 ]
             )
@@ -400,7 +432,9 @@ q = 0 (the vertical rod), on the leg at the averages' speeds, joints
 have left out. Then the factor nearest 1 that brings both depths within
 {100 * tol:.1f} %: one factor on every magnitude (not the depth exponent lambda), and each
 coefficient alone (searched from {1 / _SEARCH:.2g}x to {_SEARCH:g}x; the factor is found
-to 0.5 %).
+to 0.5 %). Of the {total} leg runs, {unresolved} had a step that did not resolve the
+contact (the steps' own error estimate above {100 * STEP_ERROR_LIMIT:g} %); a factor or
+depth whose run is one of them is marked.
 
 {md_table(header, body, "l")}
 """
