@@ -344,14 +344,12 @@ def leg_section(ctx: ReportContext, ranked: Sequence[Mapping[str, Any]]) -> tupl
             sizes += [_size(v) for v in each.values()]
             smallest = min(sizes, default=math.inf)
             if label != _THESIS_OWN:
-                name = label.split(" (rank")[0]
-                if mark(((), 1.0)):
-                    name += " (its leg runs' step did not resolve the contact)"
                 verdicts.append(
                     (
-                        name,
+                        label.split(" (rank")[0],
                         smallest,
                         _stops(stops, magnitudes, common, at_one_ts),
+                        bool(mark(((), 1.0))),
                     )
                 )
             carried = "; ".join(
@@ -382,7 +380,11 @@ def leg_section(ctx: ReportContext, ranked: Sequence[Mapping[str, Any]]) -> tupl
                 ]
             )
     t_s_measured = ", ".join(f"{t * 1e3:.1f}" for t in m.rows["t_s_mean"])
-    met = [law for law, s, _ in verdicts if s <= LEG_MAX_SCALE]
+    met = [
+        law + (" (its leg runs' step did not resolve the contact)" if flagged else "")
+        for law, s, _, flagged in verdicts
+        if s <= LEG_MAX_SCALE
+    ]
     best = min(verdicts, key=lambda v: v[1], default=None)
     heights = ", ".join(
         f"{r['height_case']} {r['v0_mean']:.2f} m/s: {r['depth_mean'] * 1e3:.1f} mm"
