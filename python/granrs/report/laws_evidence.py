@@ -306,10 +306,14 @@ def leg_section(ctx: ReportContext, ranked: Sequence[Mapping[str, Any]]) -> tupl
     vertical = free.iloc[int(np.argmin(np.abs(free["q_deg"].to_numpy(dtype=float))))].to_dict()
     thesis_table, thesis_worst = _thesis_scaling(cases.LEG["rho_g"])
     body, verdicts = [], []
+
     # The thesis's own leg coefficients (per speed), for comparison: not fitted here.
-    own = [("drag", "eta_d"), ("static_h", "eta_h"), ("static_v", "eta_v"), ("static_v", "lam")]
+    def own_terms(row: Mapping[str, Any]) -> tuple[_forces.Term, ...]:
+        return tuple(cases.leg(row["v0_mean"]).forces)
+
+    own = [(t.name, p) for t in own_terms(m.rows.iloc[0]) for p in t.params]
     runs: list[tuple[str, Any, list[tuple[str, str]], list[str]]] = [
-        (_THESIS_OWN, lambda row: cases.leg(row["v0_mean"]).forces, own, [])
+        (_THESIS_OWN, own_terms, own, [])
     ]
     for r in _leg_candidates(ranked):
         fit = r["result"]
