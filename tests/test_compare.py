@@ -656,6 +656,33 @@ def test_chapter_writes_the_media_card_of_a_fit_and_a_drop_runs_in_it(chapter) -
     assert with_values >= 1
 
 
+def test_chapter_gives_the_leg_and_chain_evidence(chapter) -> None:
+    """The targets carry a line on the leg with the laws fitted on Table 3.1 and one on why
+    the chain misses; the leg's table runs thesis_refit; the chain's table lists every law
+    of laws.json's chain with its out-of-sample counts there, and a z line per link row of
+    Tables 4.1-4.2."""
+    out, text, _ = chapter
+    targets = text[text.index("### Targets") : text.index("### Free link, Table 3.1")]
+    assert "- **Leg, laws fitted on Table 3.1**" in targets
+    assert "- **Chain, why**" in targets
+    _, body = _md_rows(text, "#### The leg with the laws fitted on Table 3.1", "| law (Table")
+    assert any(r[0].startswith("thesis_refit (rank") for r in body)
+    assert all(r[-1] in ("yes", "no") for r in body)
+    chain = json.loads((out / "laws.json").read_text())["chain"]
+    _, counts = _md_rows(text, "#### Why the chain misses", "| law |")
+    assert {r[0] for r in counts} >= {k for k, v in chain.items() if v["available"]}
+    for r in counts:
+        if r[0] in chain:
+            entry = chain[r[0]]
+            assert r[1].startswith(f"{entry['stop_order']['in_order']}/3")
+            assert r[2] == f"{entry['depth_within_1sd']}/6"
+    _, z = _md_rows(text, "#### Why the chain misses", "| case |")
+    rows = pd.read_csv(granrs.data.path("table_4_chain_experiments"))
+    assert sorted((int(c[0]), int(c[1])) for c in z) == sorted(
+        zip(rows["v0_case"], rows["link"], strict=True)
+    )
+
+
 def test_chain_mass_and_force_scale_are_one_direction() -> None:
     """Why the comparison does not fit the link mass beside a law: halving the mass and
     every eta together leaves the motion unchanged (a = g + F/m)."""

@@ -32,6 +32,7 @@ from ..compare import BODY_UNKNOWNS, DATASETS, LAWS, compare, scenes, to_json
 from . import laws_sums
 from .format import _fmt, md_table
 from .framework import ReportContext, register_chapter
+from .laws_evidence import CHAIN_DEPTHS, LEG_MAX_SCALE
 
 __all__ = ["LAWS_JSON", "chapter_laws"]
 
@@ -44,11 +45,6 @@ _STARTS = 2
 #: The targets. Free link, out of sample: depth within 1 sd on >= 10 of 12 rows
 #: and t_s within 2 sd on >= 10 of 12.
 _FREE_LINK_TARGET = {"depth_within_1sd": 10, "ts_within_2sd": 10}
-#: Chain, out of sample: the measured stop order in every case, and the depth within 1 sd
-#: on at least this many of the 6 link rows of Tables 4.1-4.2.
-_CHAIN_DEPTHS = 4
-#: Leg: no coefficient scaled by more than this factor from the thesis's.
-_LEG_MAX_SCALE = 3.0
 #: The order of zeta Li, Zhang & Goldman (2013) measured for their media [N/m^3] (1 N/cm^3;
 #: ``docs/laws.md``, the rft law): the leg's scale check compares with it.
 _RFT_ZETA_REF = 1e6
@@ -601,7 +597,7 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
             for law in laws
             if law["stop_order"]
             and law["stop_order"]["in_order"] == law["stop_order"]["cases"]
-            and law["depth_within_1sd"] >= _CHAIN_DEPTHS
+            and law["depth_within_1sd"] >= CHAIN_DEPTHS
         ]
         order = "; ".join(
             f"{law['law']} {law['stop_order']['in_order']}/{law['stop_order']['cases']}"
@@ -611,7 +607,7 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
         depth = "; ".join(f"{law['law']} {law['depth_within_1sd']}/{law['n_rows']}" for law in laws)
         out.append(
             "- **Chain** (the measured stop order in every case and the links' depths within "
-            f"1 sd on at least {_CHAIN_DEPTHS} of the 6 link rows, out of sample): "
+            f"1 sd on at least {CHAIN_DEPTHS} of the 6 link rows, out of sample): "
             + (f"**met** by {', '.join(good)}" if good else "**not met** by any law run")
             + f". Cases in the measured order: {order}. Depths within 1 sd: {depth}. "
             + _chain_mass(ctx)
@@ -642,7 +638,7 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
             k_free = all(
                 "joints.k" not in f["at_bound"] for f in folds if "joints.k" in f["values"]
             )
-            if (oos or insample) and worst_scale <= _LEG_MAX_SCALE and k_free:
+            if (oos or insample) and worst_scale <= LEG_MAX_SCALE and k_free:
                 if full is None:
                     good.append(law["law"] + " (nothing fitted)")
                 else:
@@ -674,7 +670,7 @@ def _acceptance(ctx: ReportContext, frame: pd.DataFrame) -> str:
             )
         out.append(
             "- **Leg** (Table 5.1's averages within 1 sd, joints in a physiological range, no "
-            f"coefficient scaled by more than {_LEG_MAX_SCALE:g}x; out of sample, leave one "
+            f"coefficient scaled by more than {LEG_MAX_SCALE:g}x; out of sample, leave one "
             "height out, where the folds can test it, or at least in sample): "
             + (f"**met** by {', '.join(good)}" if good else "**not met** by any law run")
             + f". Joint stiffness k [N m/rad] fitted within {lo:g}-{hi:g} N m/rad (a joint "
@@ -701,7 +697,8 @@ def chapter_laws(ctx: ReportContext) -> str:
         fig_dt = _figure_depth_time(ctx, frame)
     verdict, headlines = _verdict(ctx, frame)
     acceptance = _acceptance(ctx, frame)
-    sums = laws_sums.section(ctx, frame, _STARTS)
+    sums, evidence = laws_sums.section(ctx, frame, _STARTS)
+    acceptance = "\n".join([acceptance, *evidence])
     for h in headlines:
         ctx.add_headline(h)
     n_fit = int(frame["simulations"].sum())

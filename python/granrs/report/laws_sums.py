@@ -24,6 +24,7 @@ from ..compare import DATASETS, LAWS, PIECES, Law, _rank, compare, to_json
 from ..errors import InvalidParameterError
 from .format import _fmt, md_table
 from .framework import ReportContext
+from .laws_evidence import CHAIN_DEPTHS, LEG_MAX_SCALE, chain_section, leg_section
 
 __all__ = [
     "AXIAL_DRAG",
@@ -84,10 +85,6 @@ _SHOWN = 10
 _PER_ROW = 3
 #: The targets on Table 3.1 (out of sample): depth within 1 sd, t_s within 2 sd.
 _TARGET = {"depth_within_1sd": 10, "ts_within_2sd": 10}
-#: Chain: the measured stop order in all cases, depths within 1 sd on this many links.
-_CHAIN_DEPTHS = 4
-#: Leg: no coefficient scaled by more than this factor.
-_LEG_MAX_SCALE = 3.0
 
 
 def sum_laws(
@@ -319,10 +316,10 @@ def _chain_leg_lines(frame: pd.DataFrame, how: str, law: str, free: Mapping[str,
     if chain and chain[0]["available"]:
         r = chain[0]
         so = r["stop_order"]
-        ok = so["in_order"] == so["cases"] and r["depth_within_1sd"] >= _CHAIN_DEPTHS
+        ok = so["in_order"] == so["cases"] and r["depth_within_1sd"] >= CHAIN_DEPTHS
         lines.append(
             f"- **Chain** with {law} (leave one case out; target: the measured stop order in "
-            f"all {so['cases']} cases and depths within 1 sd on ≥ {_CHAIN_DEPTHS} of "
+            f"all {so['cases']} cases and depths within 1 sd on ≥ {CHAIN_DEPTHS} of "
             f"{r['n_rows']} links): **{'met' if ok else 'not met'}**: stop order "
             f"{so['in_order']}/{so['cases']}, depths within 1 sd {int(r['depth_within_1sd'])}/"
             f"{r['n_rows']}, t_s within 2 sd {int(r['ts_within_2sd'])}/{r['n_rows']}."
@@ -333,12 +330,12 @@ def _chain_leg_lines(frame: pd.DataFrame, how: str, law: str, free: Mapping[str,
     factors_free = {
         p: v
         for p, v in (free["folds"][0]["values"] if free.get("folds") else {}).items()
-        if p.startswith("scale.") and max(v, 1 / v) > _LEG_MAX_SCALE
+        if p.startswith("scale.") and max(v, 1 / v) > LEG_MAX_SCALE
     }
     on_free = (
         " On Table 3.1 the law's fit already scales "
         + ", ".join(f"{p[6:]} by {v:.3g}" for p, v in factors_free.items())
-        + f" (more than {_LEG_MAX_SCALE:g}x either way)."
+        + f" (more than {LEG_MAX_SCALE:g}x either way)."
         if factors_free
         else ""
     )
@@ -367,7 +364,7 @@ def _chain_leg_lines(frame: pd.DataFrame, how: str, law: str, free: Mapping[str,
             ok = all_within
         else:
             big = max(worst[1], 1 / worst[1])
-            ok = big <= _LEG_MAX_SCALE and all_within
+            ok = big <= LEG_MAX_SCALE and all_within
             scale = (
                 f"largest factor {big:.2g} ({worst[0]}"
                 + (", against the free link's fit" if not worst[0].startswith("scale.") else "")
@@ -376,7 +373,7 @@ def _chain_leg_lines(frame: pd.DataFrame, how: str, law: str, free: Mapping[str,
         bound = f"; on a bound: {', '.join(full['at_bound'])}" if full and full["at_bound"] else ""
         lines.append(
             f"- **Leg** with {law} ({how}; target: Table 5.1's averages within 1 sd, no "
-            f"coefficient scaled by more than {_LEG_MAX_SCALE:g}x): "
+            f"coefficient scaled by more than {LEG_MAX_SCALE:g}x): "
             f"**{'met' if ok else 'not met'}**: {within}; {scale}{bound}.{on_free}"
         )
     elif leg:
@@ -387,8 +384,10 @@ def _chain_leg_lines(frame: pd.DataFrame, how: str, law: str, free: Mapping[str,
     return "\n".join(lines)
 
 
-def section(ctx: ReportContext, main: pd.DataFrame, starts: int) -> str:
-    """Fit the sums on Table 3.1, rank them with the named laws, and return the section."""
+def section(ctx: ReportContext, main: pd.DataFrame, starts: int) -> tuple[str, list[str]]:
+    """Fit the sums on Table 3.1, rank them with the named laws, and return the section
+    and the lines it adds to the chapter's targets (the leg with the laws fitted here, and
+    why the chain misses: :mod:`granrs.report.laws_evidence`)."""
     m = Measurements.thesis(DATASETS["free_link"].measurements)
     laws = sum_laws(named={n: LAWS[n] for n in main["law"]} if len(main) else LAWS)
     with ctx.step(f"laws: {len(laws)} sums of terms on Table 3.1"):
@@ -400,7 +399,7 @@ def section(ctx: ReportContext, main: pd.DataFrame, starts: int) -> str:
     frame["rank"] = _rank(frame)
     ranked = frame[frame["available"]].sort_values("rank").to_dict("records")
     if not ranked:
-        return "No law ran on Table 3.1."
+        return "No law ran on Table 3.1.", []
     best = ranked[0]
     met = [r["law"] for r in ranked if all(r[k] >= v for k, v in _TARGET.items())]
     closest = max(ranked, key=lambda r: (r["depth_within_1sd"] + r["ts_within_2sd"], -r["rank"]))
@@ -427,9 +426,17 @@ def section(ctx: ReportContext, main: pd.DataFrame, starts: int) -> str:
     fitted = next((r for r in ranked if r["folds"]), None)
     known = {law.name: law for law in [*laws, *(LAWS[n] for n in main["law"] if n in LAWS)]}
     elsewhere = ""
+    chain = main[main["dataset"] == "chain"]
     if fitted is not None and fitted["law"] in known:
         other, how = _elsewhere(ctx, known[fitted["law"]], main, starts)
         elsewhere = _chain_leg_lines(other, how, fitted["law"], fitted)
+        extra = other[(other["dataset"] == "chain") & ~other["law"].isin(chain["law"])]
+        chain = pd.concat([chain, extra], ignore_index=True)
+    leg_text, leg_line = leg_section(ctx, ranked)
+    chain_text, chain_line = (
+        chain_section(ctx, chain.to_dict("records")) if len(chain) else ("", "")
+    )
+    lines = [x for x in (leg_line, chain_line) if x]
     caveat = ""
     if not best["folds"]:
         caveat = (
@@ -438,7 +445,8 @@ def section(ctx: ReportContext, main: pd.DataFrame, starts: int) -> str:
             f"best law fitted here is {fitted['law'] if fitted else 'none'}."
         )
     shown = [r for r in ranked[:_PER_ROW]]
-    return f"""### Sums of terms (Table 3.1)
+    return (
+        f"""### Sums of terms (Table 3.1)
 
 The axial drag (`{SUM_BASE.name}`: {SUM_BASE.summary}) added to
 {", ".join(f"`{n}`" for n in SUM_ON_LAWS)} and to up to {SUM_MAX_TERMS} of these pieces, and
@@ -467,7 +475,11 @@ and t_s within 2 sd on ≥ {_TARGET["ts_within_2sd"]}/12): {target}.{caveat}
 
 {elsewhere or "(no law was fitted)"}
 
+{leg_text}
+{chain_text}
 #### Media cards written by the calibration
 
 {_cards(ctx, ranked)}
-"""
+""",
+        lines,
+    )
