@@ -1318,5 +1318,25 @@ pub mod geoms {
             .unwrap_err();
             assert!(err.to_string().contains("forces.gravity"), "{err}");
         }
+
+        #[test]
+        fn a_stick_within_the_resistance_rests_and_past_it_slides() {
+            // One geom, its twist's response h A = 1e-3 I, sinking at 1 cm/s without the
+            // sand: the stick that stops it is 10 N up.
+            let ha = nalgebra::DMatrix::<f64>::identity(6, 6) * 1e-3;
+            let free = nalgebra::DVector::from_row_slice(&[0.0, 0.0, -0.01, 0.0, 0.0, 0.0]);
+            let resistance =
+                |fz: f64| nalgebra::DVector::from_row_slice(&[0.0, 0.0, fz, 0.0, 0.0, 0.0]);
+            let (w, slid) = stick_or_slide(&ha, &free, &resistance(20.0), 1, 6, 3, Slide::Scaled);
+            assert!(!slid);
+            assert!(
+                (w[2] - 10.0).abs() < 1e-12 && w.rows(3, 3).amax() < 1e-12,
+                "{w}"
+            );
+            // A resistance of 5 N: the geom slides, its wrench scaled down to 5 N.
+            let (w, slid) = stick_or_slide(&ha, &free, &resistance(5.0), 1, 6, 3, Slide::Scaled);
+            assert!(slid);
+            assert!((w[2] - 5.0).abs() < 1e-12, "{w}");
+        }
     }
 }
