@@ -40,7 +40,9 @@ sand (the capsule foot, or a box of 0.39 x 0.1 x 0.06 m in its place), 10 s unde
 with ``Sand.step`` and as the callback. Over the last 5 s: how far the foot moves, the sand's
 vertical force's largest step-to-step change and its mean over the load, the largest power
 of the sand's generalized force (at the step's mean velocity), the largest rise of its work
-over ``max(t, 1 s)`` from the window's start, and its net work over the window per second.
+over ``max(t, 1 s)`` from the window's start, its net work over the window per second, and
+in space how many of the 10 s's steps fell back from the implicit solve (``Sand.fallbacks``;
+the foot's landing may, its rest does not).
 The work is the sand's own (its generalized force on the model's velocities), not MuJoCo's
 energy: the PD controller's motors do work on the hopper. A row passes below 0.1 mm, 5 % of
 the load and a rise of 1e-6 J/s.
@@ -375,7 +377,7 @@ def hopper_rest(law: str, mode: str, foot: str, seconds: float = 10.0) -> dict[s
                 mujoco.mj_step(m, d)
                 if not np.all(np.isfinite(d.qpos)):
                     inf = float("inf")
-                    keys = ("moved", "spread", "load", "power", "rise", "net")
+                    keys = ("moved", "spread", "load", "power", "rise", "net", "fallbacks")
                     return dict.fromkeys(keys, inf)
                 pos.append(d.geom_xpos[fid].copy())
                 fz.append(sand.applied[0, 1 if planar else 2])
@@ -395,24 +397,26 @@ def hopper_rest(law: str, mode: str, foot: str, seconds: float = 10.0) -> dict[s
         "power": float(w.max()),
         "rise": float(np.max(work / np.maximum(elapsed, 1.0))),
         "net": float(work[-1] / elapsed[-1]),
+        "fallbacks": float(sand.fallbacks) if sand.space else float("nan"),
     }
 
 
 def rest() -> None:
     print(
         "| law | foot | mode | moved [mm] | F_z spread / load | mean F_z / load | "
-        "largest power [W] | work's rise [J/s] | net work [J/s] | pass |"
+        "largest power [W] | work's rise [J/s] | net work [J/s] | fallbacks | pass |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for law in rest_laws():
         for foot in ("capsule", "box"):
             for mode in ("step", "callback"):
                 r = hopper_rest(law, mode, foot)
                 ok = r["moved"] < 1e-4 and r["spread"] < 0.05 and r["rise"] <= 1e-6
+                fell = "-" if np.isnan(r["fallbacks"]) else f"{r['fallbacks']:.0f}"
                 print(
                     f"| {law} | {foot} | {mode} | {r['moved'] * 1e3:.3g} | {r['spread']:.2g} | "
                     f"{r['load']:.4f} | {r['power']:.2g} | {r['rise']:.2g} | {r['net']:.2g} | "
-                    f"{'yes' if ok else 'no'} |",
+                    f"{fell} | {'yes' if ok else 'no'} |",
                     flush=True,
                 )
 

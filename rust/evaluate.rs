@@ -612,10 +612,11 @@ pub mod geoms {
         /// Under a term that resists turning ([`SandGeoms::resist_turning`]), with `stick`:
         /// each geom's whole wrench at R as last solved (force x, y [N], moment [N m]).
         pub held_wrench: Vec<Option<[f64; 3]>>,
-        /// Under a term that resists turning, with `stick`: the speed [m/s] at which a geom
-        /// held by the sand creeps under the sand's whole resistance (a geom carrying a
-        /// load creeps at this speed times the load over that resistance), so that the
-        /// reaction opposes the motion it leaves and the sand does no positive work.
+        /// With `stick`: the speed [m/s] at which a geom held by the sand creeps under the
+        /// sand's whole resistance (a term that resists turning: the law's wrench at the
+        /// motion without the sand; else the size of the static terms' bounds; a geom
+        /// carrying a load creeps at this speed times the load over that resistance), so
+        /// that the reaction opposes the motion it leaves and the sand does no positive work.
         pub rest_speed: f64,
     }
 
@@ -866,10 +867,19 @@ pub mod geoms {
                     let je = &w_.j_e[r * nv..(r + 1) * nv];
                     dot(je, s.qvel) / timestep + dot(je, &w_.tmp)
                 });
-                let w = nalgebra::DMatrix::from_row_slice(rows, rows, &w_.w[..rows * rows]);
+                // The sand at rest as a stiff viscous law ([`creep`]; each geom's
+                // resistance the size of its bounds): E at the step's end creeps at `-C r`.
+                // E slides along a tilting body (a rod lying nearly flat: its immersed
+                // length is the depth over the tilt), so the point a step holds still is
+                // not the next one's: a reaction that held E still exactly did positive
+                // work, 1.1e-6 to 1.2e-5 J/s on a hopper's capsule foot.
+                let mut hw =
+                    timestep * nalgebra::DMatrix::from_row_slice(rows, rows, &w_.w[..rows * rows]);
+                let resistance = nalgebra::DVector::from_column_slice(&bounds[..rows]);
+                creep(&mut hw, &resistance, 2, 2, self.rest_speed, |_| 1.0);
                 solve_boxed(
-                    &w,
-                    &b,
+                    &hw,
+                    &(timestep * b),
                     &bounds[..rows],
                     &soft[..rows],
                     &mut reaction[..rows],
@@ -964,7 +974,7 @@ pub mod geoms {
                 creep(&mut ha, &full, 3, 2, self.rest_speed, |a| {
                     self.rods.length(active[a])
                 });
-                w = stick_or_slide(&ha, &free, &full, k, 3, 2, Slide::AsEvaluated);
+                (w, _) = stick_or_slide(&ha, &free, &full, k, 3, 2, Slide::AsEvaluated);
                 self.held_wrench.fill(None);
                 for (a, &i) in active.iter().enumerate() {
                     self.held_wrench[i] = Some([w[3 * a], w[3 * a + 1], w[3 * a + 2]]);
@@ -1059,8 +1069,9 @@ pub mod geoms {
     /// `full` to its motion (the law's wrench at the twist without the sand): geom by geom,
     /// the one furthest past its resistance is held there ([`Slide`]) and the others are
     /// solved again with it held (an active set), so that no geom is pushed past rest by
-    /// another's. Shared by the planar coupling (rft's reactions) and the coupling in space
-    /// (the fallback of its implicit solve).
+    /// another's. Returns the wrenches and whether some geom slid (was held at its
+    /// resistance). Shared by the planar coupling (rft's reactions) and the coupling in space
+    /// (the rest, or the fallback, of its implicit solve).
     pub fn stick_or_slide(
         ha: &nalgebra::DMatrix<f64>,
         free: &nalgebra::DVector<f64>,
@@ -1069,7 +1080,7 @@ pub mod geoms {
         block: usize,
         force: usize,
         slide: Slide,
-    ) -> nalgebra::DVector<f64> {
+    ) -> (nalgebra::DVector<f64>, bool) {
         use nalgebra::{DMatrix, DVector};
         let rows = block * k;
         let mut w = DVector::zeros(rows);
@@ -1108,7 +1119,7 @@ pub mod geoms {
                 }
             }
             match worst {
-                None => return w,
+                None => return (w, held.contains(&true)),
                 Some((a, _)) => {
                     match slide {
                         Slide::Scaled => {
@@ -1125,7 +1136,7 @@ pub mod geoms {
                 }
             }
         }
-        w
+        (w, held.contains(&true))
     }
 
     /// `a . b`.
@@ -1306,6 +1317,26 @@ pub mod geoms {
             )
             .unwrap_err();
             assert!(err.to_string().contains("forces.gravity"), "{err}");
+        }
+
+        #[test]
+        fn a_stick_within_the_resistance_rests_and_past_it_slides() {
+            // One geom, its twist's response h A = 1e-3 I, sinking at 1 cm/s without the
+            // sand: the stick that stops it is 10 N up.
+            let ha = nalgebra::DMatrix::<f64>::identity(6, 6) * 1e-3;
+            let free = nalgebra::DVector::from_row_slice(&[0.0, 0.0, -0.01, 0.0, 0.0, 0.0]);
+            let resistance =
+                |fz: f64| nalgebra::DVector::from_row_slice(&[0.0, 0.0, fz, 0.0, 0.0, 0.0]);
+            let (w, slid) = stick_or_slide(&ha, &free, &resistance(20.0), 1, 6, 3, Slide::Scaled);
+            assert!(!slid);
+            assert!(
+                (w[2] - 10.0).abs() < 1e-12 && w.rows(3, 3).amax() < 1e-12,
+                "{w}"
+            );
+            // A resistance of 5 N: the geom slides, its wrench scaled down to 5 N.
+            let (w, slid) = stick_or_slide(&ha, &free, &resistance(5.0), 1, 6, 3, Slide::Scaled);
+            assert!(slid);
+            assert!((w[2] - 5.0).abs() < 1e-12, "{w}");
         }
     }
 }

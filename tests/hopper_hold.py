@@ -33,15 +33,31 @@ def hold_upright(
             sand.uninstall()
 
 
+def window(timestep: float) -> slice:
+    """The rest line's window: the last 5 s of a run recorded at each step."""
+    return slice(-round(5.0 / timestep), None)
+
+
 def assert_rests(pos: list[Any], force: list[float], weight: float, timestep: float) -> slice:
     """The rest line over the last 5 s of a run recorded at each step: the foot's position
     (``pos``) moves less than 0.1 mm, the sand's vertical force (``force``) balances
     ``weight`` to 1e-3 on average with a step-to-step spread under 5 % of it. Returns the
     window, for the energy checks each test makes its own way."""
-    last = slice(-round(5.0 / timestep), None)
+    last = window(timestep)
     assert np.all(np.isfinite(pos))
     assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
     fz = np.array(force)[last]
     assert abs(fz.mean() / weight - 1) < 1e-3
     assert np.max(np.abs(np.diff(fz))) < 0.05 * weight
     return last
+
+
+def at_pose(model: Any, scratch: Any, qpos: Any) -> Any:
+    """``scratch`` (an MjData of ``model``) at ``qpos``: its kinematics and the centres of
+    mass its Jacobians (``mj_jac``) take. The sand's wrench of a step is at the step's
+    start's pose, and after ``mj_step`` under RK4 ``data``'s kinematics are its last
+    stage's, near the step's end: the sand's own work takes its Jacobians here instead."""
+    scratch.qpos[:] = qpos
+    mujoco.mj_kinematics(model, scratch)
+    mujoco.mj_comPos(model, scratch)
+    return scratch

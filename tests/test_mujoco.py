@@ -36,7 +36,7 @@ def test_granrs_imports_without_mujoco_and_says_what_to_install():
 
 
 mujoco = pytest.importorskip("mujoco")
-from hopper_hold import assert_rests, hold_upright  # noqa: E402
+from hopper_hold import assert_rests, at_pose, hold_upright, window  # noqa: E402
 
 from granrs.mujoco import Sand, free_link_mjcf, rod_drop  # noqa: E402
 
@@ -434,3 +434,53 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_planar_rft(mode, foot):
     gained = np.cumsum(np.array(work)[last])
     elapsed = np.arange(1, len(gained) + 1) * h
     assert np.all(gained <= 1e-6 * np.maximum(elapsed, 1.0))
+
+
+@pytest.mark.parametrize("mode", ["step", "callback"])
+def test_gymnasiums_hopper_capsule_foot_rests_on_sand_under_the_thesis_law(mode):
+    """Acceptance (rest under the thesis's law): the hopper held upright on its capsule foot
+    (a rod lying nearly flat, the thesis's static terms as reactions at the immersed
+    centroid E), 10 s: the sand's own work (J^T of its force and moment at the rod's tip
+    from MuJoCo's own Jacobians at the step's start, on each step's displacement) never
+    rises by more than 1e-6 J/s over max(t, 1 s) in the last 5 s. E slides along the
+    tilting rod (its immersed length is the depth over the tilt), so the point the last
+    step held still is not the next one's: a reaction that held E's velocity at zero
+    exactly did positive work, 1.1e-6 to 1.2e-5 J/s. As the callback the rest line holds
+    too; with Sand.step the foot, a pivot under terms that act at one point (E), turns
+    about E and its centre moves 0.15 mm over the window."""
+    model = _hopper("capsule")
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    foot_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "foot_geom")
+    body = model.geom_bodyid[foot_id]
+    radius, half = model.geom_size[foot_id][:2]
+    sand = Sand(model, ["foot_geom"], THESIS, apply_at="centroid")
+    h = model.opt.timestep
+    weight = model.body_subtreemass[1] * np.linalg.norm(model.opt.gravity)
+    assert model.nq == model.nv  # slides and hinges: the displacement is the change of qpos
+    pos, fz, power = [], [], []
+    before = [data.qpos.copy()]
+    jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    scratch = mujoco.MjData(model)
+
+    def record(d):
+        # The applied force acts at the rod's tip (the lower end of its axis) at the step's
+        # start's pose.
+        s = at_pose(model, scratch, before[0])
+        axis = s.geom_xmat[foot_id].reshape(3, 3)[:, 2]
+        axis = -axis if axis[2] < 0.0 else axis
+        tip = s.geom_xpos[foot_id] - (half + radius) * axis
+        mujoco.mj_jac(model, s, jacp, jacr, tip, body)
+        fx, fz_, moment = sand.applied[0]
+        generalized = jacp.T @ [fx, 0.0, fz_] + jacr.T @ [0.0, moment, 0.0]
+        power.append(generalized @ (d.qpos - before[0]) / h)
+        before[0] = d.qpos.copy()
+        pos.append(d.geom_xpos[foot_id].copy())
+        fz.append(fz_)
+
+    hold_upright(model, data, sand, mode, 10.0, record)
+    last = assert_rests(pos, fz, weight, h) if mode == "callback" else window(h)
+    work = np.cumsum(np.array(power)[last]) * h
+    work -= work[0]
+    elapsed = np.arange(len(work)) * h
+    assert np.max(work / np.maximum(elapsed, 1.0)) <= 1e-6

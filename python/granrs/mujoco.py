@@ -186,9 +186,9 @@ class Sand:
             ``None`` (default): three dimensions where a term of :data:`SPACE_TERMS` is
             listed.
         rest_speed: in space: below this speed [m/s] the rate-independent terms fade to a
-            viscous law (:data:`REST_SPEED`). Planar, under ``rft`` with
-            ``statics="stick"``: a geom the sand holds creeps at this speed times its load
-            over the sand's resistance, so that the sand never does positive work.
+            viscous law (:data:`REST_SPEED`). Planar, with ``statics="stick"``: a geom the
+            sand holds creeps at this speed times its load over the sand's resistance, so
+            that the sand never does positive work.
         quadrature: in space: Gauss-Legendre nodes per panel of a curved surface
             (:data:`granrs.space.DEFAULT_QUADRATURE`).
         medium: the granular medium (:mod:`granrs.media`): a shipped card's name, a card
@@ -474,11 +474,12 @@ class Sand:
         self._rk4_applied = np.zeros((n, 6))
         self.h_lambda = np.zeros(n)
         #: Newton iterations of the last step's implicit solve, its residual (the twists'
-        #: largest error over their scale) and whether it converged (below 1e-10).
+        #: largest error over their scale) and whether it is solved (the residual below
+        #: 1e-10, or a rest: every geom at its creep within the sand's resistance).
         self.iterations, self.residual, self.converged = 0, 0.0, True
         #: The largest residual over every step so far.
         self.max_residual = 0.0
-        #: Steps whose implicit solve did not converge and stuck or slid instead.
+        #: Steps whose implicit solve did not converge and where a geom slid (not a rest).
         self.fallbacks = 0
 
     def _implicit_damping(self) -> list[float]:
@@ -766,8 +767,8 @@ def rod_drop(
     omega0), until its stop, and ``t_after`` seconds on.
 
     The stop is the first step at whose end the tip's vertical velocity is >= 0 or within
-    the Sand's ``rest_speed`` of it (the thesis's static terms stick to round-off; a rod held
-    under ``rft`` creeps slower than ``rest_speed``), interpolated linearly inside the step
+    the Sand's ``rest_speed`` of it (a rod the sand holds creeps slower than
+    ``rest_speed``), interpolated linearly inside the step
     to where that velocity is 0. Returns ``t_s`` [s], ``depth`` [m] (the tip's, at the
     stop), ``steps``, and after the stop ``t``, ``tip`` (x, z) and ``energy`` (KE +
     gravitational PE [J]) per step.

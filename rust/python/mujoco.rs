@@ -403,7 +403,7 @@ impl MujocoCoupling {
     /// the centre, moved by the dofs `dofs`) of a model with `nv` dofs; the sand's surface
     /// height and patch in x; `stick` for the static terms as reactions;
     /// `implicit_damping` the dof damping the engine's step takes implicitly (nv);
-    /// `rest_speed` the creep speed of a geom held under a term that resists turning.
+    /// `rest_speed` the creep speed of a geom the static reactions hold.
     #[staticmethod]
     #[allow(clippy::too_many_arguments)]
     fn planar(

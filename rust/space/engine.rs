@@ -26,15 +26,19 @@
 //! `rest_speed` times its load over the sand's full resistance), its force balances its
 //! load without chattering, and the step is backward Euler in the sand's velocity.
 //!
-//! Newton's method can fail where the law is far from smooth at a large step (a body
-//! toppling onto its side, a drop resolved in a few steps). Where its residual stays above
-//! [`FALLBACK`] the step sticks or slides instead, geom by geom: the wrench that brings
-//! every twist at the step's end to the sand's creep `-C w` (the viscous law at rest, so
-//! that the wrench never does positive work on the twist it leaves), a geom that would need
-//! more than the sand's resistance to its motion held at that resistance and the others
-//! solved again with it held ([`Solve::fallback`]). `poncelet`'s wrench at rest turns with
-//! the direction of the creep (its leading area's), which the rates leave out: a body
-//! resting on it falls back at nearly every step.
+//! Newton's method can fail where the law is far from smooth: at a large step (a body
+//! toppling onto its side, a drop resolved in a few steps), and at rest under `poncelet`,
+//! whose wrench turns with the direction of the creep (its leading area's centre moves
+//! with it, which the rates leave out) and which therefore has no smooth solution there.
+//! Where its residual stays above [`FALLBACK`] the step takes the rule of the sand at
+//! rest, geom by geom: the wrench that brings every twist at the step's end to the sand's
+//! creep `-C w` (the viscous law at rest, so that the wrench never does positive work on
+//! the twist it leaves). Where every geom's force is then within the sand's resistance to
+//! its motion (the law's wrench at the twist without the sand), the step is a rest
+//! ([`Solve::rest`]): the sand's rate-independent terms are set-valued at rest, and this
+//! wrench is their solution, not a failure. Otherwise a geom that would need more than its
+//! resistance is held at that resistance, the others solved again with it held, and the
+//! step falls back ([`Solve::fallback`]): the sand's law is not resolved at this step.
 
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, UnitQuaternion, Vector3};
 
@@ -87,10 +91,12 @@ pub struct SpaceGeom {
 pub struct Solve {
     /// Newton iterations taken (0: no geom in the sand, or the wrenches held).
     pub iterations: usize,
-    /// Whether the twist's residual came below its tolerance.
+    /// Whether the step is solved: Newton's residual came below its tolerance, or the step
+    /// is a rest ([`Solve::rest`]).
     pub converged: bool,
     /// The residual's largest component over the twists' scale (the largest of the twists
-    /// without the sand, plus `rest_speed`) at the end of the solve.
+    /// without the sand, plus `rest_speed`) at the end of Newton's solve (for a rest or a
+    /// fallback, Newton's last, not the rest rule's).
     pub residual: f64,
     /// The largest `h lambda`: the timestep times the frequency of the sand's depth
     /// stiffness on the geom's vertical response, `sqrt(A_zz |dF_z / dz|)` (the velocity
@@ -99,13 +105,19 @@ pub struct Solve {
     pub h_lambda: f64,
     /// The geom it belongs to.
     pub geom: usize,
-    /// Whether Newton's residual stayed above [`FALLBACK`] and the step stuck or slid
-    /// instead (the wrench that brings every twist to its creep at rest, each geom's scaled
-    /// down to the sand's resistance to its motion where it asks for more).
+    /// Whether Newton's residual stayed above [`FALLBACK`] and every geom rests: the wrench
+    /// that brings every twist to its creep at rest, each geom's force within the sand's
+    /// resistance to its motion, is the step's solution.
+    pub rest: bool,
+    /// Whether Newton's residual stayed above [`FALLBACK`] and some geom asked for more
+    /// than the sand's resistance to its motion: the step stuck or slid instead (the
+    /// wrench that brings every twist to its creep at rest, a sliding geom's scaled down to
+    /// its resistance).
     pub fallback: bool,
 }
 
-/// The solve's relative residual above which the step falls back to sticking or sliding.
+/// The solve's relative residual above which the step takes the rule of the sand at rest
+/// (a rest, or a fallback where a geom slides).
 pub const FALLBACK: f64 = 1e-2;
 
 /// The coupling: geoms in space on another engine's bodies.
@@ -367,14 +379,18 @@ impl SpaceCoupling {
                 // shape's reach): a stop to zero exactly did positive work whenever the
                 // rest of the world's force moved between the steps. A hopper resting on
                 // `poncelet`, whose wrench at rest turns with the direction of the creep
-                // and falls back at nearly every step, gained 2e-4 to 3e-4 J/s that way.
+                // and takes this rule at nearly every step, gained 2e-4 to 3e-4 J/s that
+                // way.
                 let mut ha = h * &resp;
                 creep(&mut ha, &full, 6, 3, self.rest_speed, |a| {
                     self.geoms[active[a]].sand.shape.reach()
                 });
-                w = stick_or_slide(&ha, &free, &full, k, 6, 3, Slide::Scaled);
+                let slid;
+                (w, slid) = stick_or_slide(&ha, &free, &full, k, 6, 3, Slide::Scaled);
                 xi = &free + h * (&resp * &w);
-                report.fallback = true;
+                report.rest = !slid;
+                report.fallback = slid;
+                report.converged = !slid;
             }
             wrenches = (0..k)
                 .map(|a| std::array::from_fn(|r| w[6 * a + r]))
