@@ -668,11 +668,13 @@ fn rft3d_value_with<const GRAZING: bool>(
         let cols: [&[f64]; 12] = std::array::from_fn(|k| unsafe {
             std::slice::from_raw_parts(buf[k].as_ptr().cast::<f64>(), len)
         });
-        // Each sum in the elements' order (twelve running sums side by side).
+        // Each sum in the elements' order (twelve running sums side by side: `j` runs over
+        // the elements, each column's).
         let mut acc = [
             out.w[0], out.w[1], out.w[2], out.w[3], out.w[4], out.w[5], out.kz[0], out.kz[1],
             out.kz[2], out.kz[3], out.kz[4], out.kz[5],
         ];
+        #[allow(clippy::needless_range_loop)]
         for j in 0..len {
             for (k, a) in acc.iter_mut().enumerate() {
                 *a += cols[k][j];
