@@ -30,7 +30,14 @@ sphere also on a path 30 degrees from vertical) with :func:`granrs.mujoco.body_d
 1e-3, 2e-3, 5e-3 and 1e-2 s and the Euler, implicitfast and RK4 integrators; and the cost of
 ``Sand`` on gymnasium's Ant (its four ankle capsules as sand geoms, standing in the sand under
 ``rft3d``, RK4 at its own 0.01 s), at 3, 5 and 6 Gauss nodes per panel (93, 265 and 396
-elements per foot), as ratios to ``mj_step`` measured in the same repeats.
+elements per foot), as ratios to ``mj_step`` measured in the same repeats: each call of
+``Sand.step`` and of ``mj_step`` timed on its own in one rollout, so that both meet the
+states of the Ant in the sand (not ``mj_step`` of an Ant falling onto the floor without the
+sand, nor ``Sand.step`` repeated on one state, whose solve then starts converged).
+
+**A Gymnasium rollout (``--part rollout``).** ``Ant-v5`` with seeded random actions, with
+:class:`granrs.gym.SandWrapper` and on its rigid floor, timed in turn within each repeat: env
+steps per second and their ratio.
 
 **At rest (``--part rest``).** Gymnasium's own hopper (``hopper.xml``, RK4 at 2 ms, no
 floor) held upright by a PD controller on its motors, its whole weight on its foot in the
@@ -49,7 +56,7 @@ the load and a rise of 1e-6 J/s.
 
 Usage::
 
-    python benches/bench_mujoco.py [--part all|table|cost|space-table|space-cost|rest]
+    python benches/bench_mujoco.py [--part all|table|cost|space-table|space-cost|rollout|rest]
                                    [--repeats 15] [--steps 1000]
 """
 
@@ -251,71 +258,134 @@ def space_table() -> list[dict[str, object]]:
     return rows
 
 
-def space_cost(repeats: int, steps: int) -> None:
-    """Sand on gymnasium's Ant standing in the sand, against mj_step."""
+def ant_in_sand(nodes: int) -> tuple[mujoco.MjModel, mujoco.MjData, Sand]:
+    """Gymnasium's Ant (its own ant.xml: RK4 at 0.01 s) with its four ankle capsules as sand
+    geoms under ``rft3d`` at ``nodes`` Gauss nodes per panel, standing in the sand."""
     import gymnasium
 
     path = f"{gymnasium.__path__[0]}/envs/mujoco/assets/ant.xml"
-    feet = ["left_ankle_geom", "right_ankle_geom", "third_ankle_geom", "fourth_ankle_geom"]
+    model = mujoco.MjModel.from_xml_path(path)
+    for g in ANT_FEET:
+        i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g)
+        model.geom_contype[i] = model.geom_conaffinity[i] = 0
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    sand = Sand(model, ANT_FEET, [forces.rft3d(zeta=space.xi_n(1520.0, 0.4))], quadrature=nodes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", granrs.StepSizeWarning)
+        for _ in range(300):  # stand
+            sand.step(data)
+            mujoco.mj_step(model, data)
+    return model, data, sand
+
+
+#: The Ant's sand geoms (its four ankle capsules).
+ANT_FEET = ["left_ankle_geom", "right_ankle_geom", "third_ankle_geom", "fourth_ankle_geom"]
+
+
+def space_cost(repeats: int, steps: int) -> None:
+    """Sand on gymnasium's Ant standing in the sand, against mj_step.
+
+    Each repeat runs the rollout ``Sand.step`` then ``mj_step`` for ``steps`` steps from the
+    same standing state and times each call on its own: both in the states the sand's own
+    rollout meets (``mj_step`` without the sand would let the Ant fall onto the floor, whose
+    contacts change its cost; ``Sand.step`` repeated on one state would find the last solve's
+    twist already converged). Then the same rollout with the Sand as the passive callback
+    (inside each of RK4's four stages), timed as a whole against the first's ``mj_step``."""
     print(f"Ant standing in sand under rft3d, {steps} steps, {repeats} repeats:")
     print(
         "| nodes | elements per foot | mj_step [us, min] | Sand.step [us, min] | "
-        "Sand.step / mj_step (median of repeats, range) | callback's extra / mj_step |"
+        "Sand.step / mj_step (median of repeats, range) | callback's extra / mj_step | "
+        "Newton iterations per step |"
     )
-    print("|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|")
+    clock = time.perf_counter
     for nodes in (3, 5, 6):
-        model = mujoco.MjModel.from_xml_path(path)
-        for g in feet:
-            i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, g)
-            model.geom_contype[i] = model.geom_conaffinity[i] = 0
-        data = mujoco.MjData(model)
-        mujoco.mj_forward(model, data)
-        sand = Sand(model, feet, [forces.rft3d(zeta=space.xi_n(1520.0, 0.4))], quadrature=nodes)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", granrs.StepSizeWarning)
-            for _ in range(300):  # stand
-                sand.step(data)
-                mujoco.mj_step(model, data)
+        model, data, sand = ant_in_sand(nodes)
         start = (data.qpos.copy(), data.qvel.copy(), data.qacc.copy(), data.time)
         elements = int(sand.output[0, 1])
 
         def restore(data: mujoco.MjData = data, start: tuple = start) -> None:
             data.qpos[:], data.qvel[:], data.qacc[:], data.time = start
+            data.qfrc_applied[:] = 0.0
 
         best = {"mj_step": np.inf, "Sand.step": np.inf, "callback": np.inf}
-        ratio, extra = [], []
-        for _ in range(repeats):
-            this = {}
-            restore()
-            t = time.perf_counter()
-            for _ in range(steps):
-                mujoco.mj_step(model, data)
-            this["mj_step"] = (time.perf_counter() - t) / steps
-            restore()
-            t = time.perf_counter()
-            for _ in range(steps):
-                sand.step(data)
-            this["Sand.step"] = (time.perf_counter() - t) / steps
-            restore()
-            sand.install()
+        ratio, extra, iterations = [], [], []
+        with warnings.catch_warnings():
             warnings.simplefilter("ignore", granrs.StepSizeWarning)
-            try:
-                t = time.perf_counter()
+            for _ in range(repeats):
+                this = {"mj_step": 0.0, "Sand.step": 0.0}
+                restore()
+                newton = 0
                 for _ in range(steps):
+                    t0 = clock()
+                    sand.step(data)
+                    t1 = clock()
                     mujoco.mj_step(model, data)
-                this["callback"] = (time.perf_counter() - t) / steps
-            finally:
-                sand.uninstall()
-            for k, v in this.items():
-                best[k] = min(best[k], v)
-            ratio.append(this["Sand.step"] / this["mj_step"])
-            extra.append(this["callback"] / this["mj_step"] - 1.0)
+                    t2 = clock()
+                    this["Sand.step"] += t1 - t0
+                    this["mj_step"] += t2 - t1
+                    newton += sand.iterations
+                iterations.append(newton / steps)
+                restore()
+                sand.install()
+                try:
+                    t = clock()
+                    for _ in range(steps):
+                        mujoco.mj_step(model, data)
+                    this["callback"] = clock() - t
+                finally:
+                    sand.uninstall()
+                for k, v in this.items():
+                    best[k] = min(best[k], v / steps)
+                ratio.append(this["Sand.step"] / this["mj_step"])
+                extra.append(this["callback"] / this["mj_step"] - 1.0)
         r, e = np.array(ratio), np.array(extra)
         print(
             f"| {nodes} | {elements} | {best['mj_step'] * 1e6:.1f} | "
             f"{best['Sand.step'] * 1e6:.1f} | {np.median(r):.2f} ({r.min():.2f} to "
-            f"{r.max():.2f}) | {np.median(e):.2f} ({e.min():.2f} to {e.max():.2f}) |"
+            f"{r.max():.2f}) | {np.median(e):.2f} ({e.min():.2f} to {e.max():.2f}) | "
+            f"{np.mean(iterations):.2f} |",
+            flush=True,
         )
+
+
+def rollout(repeats: int, steps: int) -> None:
+    """Gymnasium's Ant-v5 with random actions (seeded), with :class:`granrs.gym.SandWrapper`
+    and on its rigid floor: env steps per second over ``steps`` steps, the two timed in turn
+    within each repeat (reset at the start and whenever an episode ends)."""
+    import gymnasium
+
+    from granrs.gym import SandWrapper
+
+    def run(env: gymnasium.Env) -> float:
+        env.reset(seed=0)
+        env.action_space.seed(0)
+        actions = [env.action_space.sample() for _ in range(steps)]
+        t = time.perf_counter()
+        for a in actions:
+            _, _, terminated, truncated, _ = env.step(a)
+            if terminated or truncated:
+                env.reset()
+        return steps / (time.perf_counter() - t)
+
+    rigid = gymnasium.make("Ant-v5")
+    sand = SandWrapper(gymnasium.make("Ant-v5"))
+    ratios, best = [], {"rigid": 0.0, "sand": 0.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", granrs.StepSizeWarning)
+        for _ in range(repeats):
+            r, s = run(rigid), run(sand)
+            best["rigid"], best["sand"] = max(best["rigid"], r), max(best["sand"], s)
+            ratios.append(s / r)
+    q = np.array(ratios)
+    print(f"Ant-v5, random actions, {steps} env steps, {repeats} repeats:")
+    print("| rigid floor [steps/s, max] | sand [steps/s, max] | sand / rigid (median, range) |")
+    print("|---|---|---|")
+    print(
+        f"| {best['rigid']:.0f} | {best['sand']:.0f} | {np.median(q):.2f} "
+        f"({q.min():.2f} to {q.max():.2f}) |"
+    )
 
 
 #: The laws of ``--part rest``: the Sand's arguments (zeta as the docs' Ant and hopper).
@@ -425,7 +495,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument(
         "--part",
-        choices=("all", "table", "cost", "space-table", "space-cost", "rest"),
+        choices=("all", "table", "cost", "space-table", "space-cost", "rollout", "rest"),
         default="all",
     )
     parser.add_argument("--repeats", type=int, default=15)
@@ -439,6 +509,8 @@ def main() -> None:
         space_table()
     if args.part in ("all", "space-cost"):
         space_cost(args.repeats, args.steps)
+    if args.part in ("all", "rollout"):
+        rollout(args.repeats, args.steps)
     if args.part in ("all", "rest"):
         rest()
 

@@ -273,11 +273,13 @@ const GRADIENT: [[[f64; 10]; 3]; 3] = {
     g
 };
 
-/// The three fitted functions and their gradients: `(f, g)` with `g[i][k] = d f_i / d x_k`.
-pub fn fitted_with_gradient(x1: f64, x2: f64, x3: f64) -> ([f64; 3], [[f64; 3]; 3]) {
+/// The three fitted functions and their gradients: `(f, g)` with `g[i][k] = d f_i / d x_k`
+/// (generic over the number type: the element kernel runs it in lanes, the same operations).
+#[inline(always)]
+pub fn fitted_with_gradient<F: Real>(x1: F, x2: F, x3: F) -> ([F; 3], [[F; 3]; 3]) {
     let f = fitted(x1, x2, x3);
     let q = [
-        1.0,
+        F::splat(1.0),
         x1,
         x2,
         x3,
@@ -288,13 +290,13 @@ pub fn fitted_with_gradient(x1: f64, x2: f64, x3: f64) -> ([f64; 3], [[f64; 3]; 
         x2 * x3,
         x3 * x1,
     ];
-    let mut g = [[0.0; 3]; 3];
+    let mut g = [[F::splat(0.0); 3]; 3];
     for i in 0..3 {
         for k in 0..3 {
             let c = &GRADIENT[i][k];
-            let mut acc = 0.0;
+            let mut acc = F::splat(0.0);
             for j in 0..10 {
-                acc += c[j] * q[j];
+                acc = acc + F::splat(c[j]) * q[j];
             }
             g[i][k] = acc;
         }
@@ -324,12 +326,10 @@ pub fn stress_with_rate(
     eps: f64,
 ) -> ([f64; 3], [[f64; 3]; 3]) {
     let zero = ([0.0; 3], [[0.0; 3]; 3]);
-    let s2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    let (s2, s, vh, nu) = direction(n, u);
     if s2 <= 0.0 {
         return zero;
     }
-    let s = s2.sqrt();
-    let vh = [u[0] / s, u[1] / s, u[2] / s];
     let threshold = if law.grazing {
         GRAZING_TOL
     } else {
@@ -337,17 +337,10 @@ pub fn stress_with_rate(
     };
     // Leading: with eps, a ramp from n . u = -eps (nothing) to 0 (all; grazing counted),
     // or from 0 to eps where grazing elements are left out; else the law's step.
-    let nu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
     let (lead, dlead) = if eps > 0.0 {
-        let x = if law.grazing {
-            nu / eps + 1.0
-        } else {
-            nu / eps
-        };
-        if x >= 1.0 {
-            (1.0, 0.0)
-        } else if x > 0.0 {
-            (x, 1.0 / eps)
+        let x = ramp_position(nu, eps, law.grazing);
+        if x > 0.0 {
+            ramp(x, eps)
         } else {
             return zero;
         }
@@ -356,35 +349,10 @@ pub fn stress_with_rate(
     } else {
         return zero;
     };
-    // alpha and d alpha / d v^ (uncapped), as `generic_stress`.
-    let sign = if -n[2] - GRAZING_TOL > 0.0 { 1.0 } else { -1.0 };
-    let m = [sign * n[0], sign * n[1], sign * n[2]];
-    let x1 = -vh[2];
-    let x2 = n[2].abs();
-    let x3 = m[0] * vh[0] + m[1] * vh[1] + m[2] * vh[2];
-    let (f, g) = fitted_with_gradient(x1, x2, x3);
-    let mut a = [
-        f[0] * m[0] + f[1] * vh[0],
-        f[0] * m[1] + f[1] * vh[1],
-        f[0] * m[2] + f[1] * vh[2] - f[2],
-    ];
-    // d f_i / d v^ = -g_i1 z^ + g_i3 m
-    let df = |i: usize| [g[i][2] * m[0], g[i][2] * m[1], g[i][2] * m[2] - g[i][0]];
-    let (df1, df2, df3) = (df(0), df(1), df(2));
-    let mut ja = [[0.0; 3]; 3];
-    for r in 0..3 {
-        for c in 0..3 {
-            let z = if r == 2 { 1.0 } else { 0.0 };
-            let delta = if r == c { f[1] } else { 0.0 };
-            ja[r][c] = m[r] * df1[c] + delta + vh[r] * df2[c] - z * df3[c];
-        }
-    }
+    let (mut a, mut ja) = alpha_with_rate(n, vh);
     if law.mu_surf != f64::INFINITY {
         // The cap: alpha_c = an n + (cap / |at|) at where |at| > cap = mu |an|.
-        let an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
-        let at = [a[0] - an * n[0], a[1] - an * n[1], a[2] - an * n[2]];
-        let at_norm = (at[0] * at[0] + at[1] * at[1] + at[2] * at[2]).sqrt();
-        let cap = law.mu_surf * an.abs();
+        let (an, at, at_norm, cap) = cap_parts(law.mu_surf, n, a);
         if at_norm > cap {
             let k = cap / at_norm;
             let sg = if an >= 0.0 { 1.0 } else { -1.0 };
@@ -407,27 +375,210 @@ pub fn stress_with_rate(
                 }
             }
             ja = prod;
-            a = [
-                an * n[0] + k * at[0],
-                an * n[1] + k * at[1],
-                an * n[2] + k * at[2],
-            ];
+            a = capped(n, an, at, k);
         }
     }
-    // sigma = zeta lead(n . u) phi(s) alpha(u / s):
-    // d sigma / d u = zeta (lead (phi'(s) alpha v^T + (phi(s) / s) J_alpha (I - v^ v^T))
-    //                       + lead' phi(s) alpha n^T).
-    let root = (s2 + eps * eps).sqrt();
-    let phi = s / root;
-    let dphi = eps * eps / (root * root * root);
-    let over_s = 1.0 / root;
-    let mut sigma = [0.0; 3];
-    let mut jac = [[0.0; 3]; 3];
+    sigma_with_rate(law.zeta, lead, dlead, s, s2, eps, n, vh, a, ja)
+}
+
+/// [`stress_with_rate`]'s stress alone (its rate not computed), the same bits: for a
+/// solver's trial points, where only the value is read.
+pub fn stress_with_ramp(law: &Rft3d, n: [f64; 3], u: [f64; 3], eps: f64) -> [f64; 3] {
+    if eps > 0.0 && law.mu_surf == f64::INFINITY {
+        return stress_on_ramp(law.zeta, n, u, eps, law.grazing);
+    }
+    let (s2, s, vh, nu) = direction(n, u);
+    if s2 <= 0.0 {
+        return [0.0; 3];
+    }
+    let lead = if eps > 0.0 {
+        let x = ramp_position(nu, eps, law.grazing);
+        if x > 0.0 {
+            ramp(x, eps).0
+        } else {
+            return [0.0; 3];
+        }
+    } else {
+        let threshold = if law.grazing {
+            GRAZING_TOL
+        } else {
+            -GRAZING_TOL
+        };
+        if nu / s + threshold > 0.0 {
+            1.0
+        } else {
+            return [0.0; 3];
+        }
+    };
+    let (m, x1, x2, x3) = plate(n, vh);
+    let mut a = alpha_of(m, vh, fitted(x1, x2, x3));
+    if law.mu_surf != f64::INFINITY {
+        let (an, at, at_norm, cap) = cap_parts(law.mu_surf, n, a);
+        if at_norm > cap {
+            a = capped(n, an, at, cap / at_norm);
+        }
+    }
+    let (_, phi) = phi_of(s, s2, eps);
+    sigma_of(law.zeta, lead, phi, a)
+}
+
+/// [`stress_with_ramp`] of a law without a friction cap (`zeta`, `grazing`) at `eps > 0`,
+/// without a branch (so that the element kernel's loop runs in SIMD lanes): every part
+/// computed and the stress selected where the element moves and is on its ramp, else zero.
+/// The same operations, so the same bits.
+#[inline(always)]
+pub fn stress_on_ramp(zeta: f64, n: [f64; 3], u: [f64; 3], eps: f64, grazing: bool) -> [f64; 3] {
+    let (s2, s, vh, nu) = direction(n, u);
+    let x = ramp_position(nu, eps, grazing);
+    let (lead, _) = ramp(x, eps);
+    let (m, x1, x2, x3) = plate(n, vh);
+    let a = alpha_of(m, vh, fitted(x1, x2, x3));
+    let (_, phi) = phi_of(s, s2, eps);
+    let sigma = sigma_of(zeta, lead, phi, a);
+    // x where it moves (s2 > 0), else 0: positive where the stress is not zero.
+    let on = s2.select_pos(x, 0.0);
+    sigma.map(|v| on.select_pos(v, 0.0))
+}
+
+/// The cap's parts of alpha on an element of normal `n`: its normal part `an`, its
+/// tangential part `at` and that one's norm, and the cap `mu |an|`.
+#[inline(always)]
+fn cap_parts(mu: f64, n: [f64; 3], a: [f64; 3]) -> (f64, [f64; 3], f64, f64) {
+    let an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2];
+    let at = [a[0] - an * n[0], a[1] - an * n[1], a[2] - an * n[2]];
+    let at_norm = (at[0] * at[0] + at[1] * at[1] + at[2] * at[2]).sqrt();
+    (an, at, at_norm, mu * an.abs())
+}
+
+/// alpha capped: `an n + k at`.
+#[inline(always)]
+fn capped(n: [f64; 3], an: f64, at: [f64; 3], k: f64) -> [f64; 3] {
+    [
+        an * n[0] + k * at[0],
+        an * n[1] + k * at[1],
+        an * n[2] + k * at[2],
+    ]
+}
+
+/// An element's velocity `u`: `|u|^2`, `|u|`, its direction `u / |u|` (not finite at rest)
+/// and `n . u`.
+#[inline(always)]
+pub fn direction<F: Real>(n: [F; 3], u: [F; 3]) -> (F, F, [F; 3], F) {
+    let s2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    let s = s2.sqrt();
+    let vh = [u[0] / s, u[1] / s, u[2] / s];
+    let nu = n[0] * u[0] + n[1] * u[1] + n[2] * u[2];
+    (s2, s, vh, nu)
+}
+
+/// Where `n . u` is on the leading ramp over `eps`: `n . u / eps + 1` (grazing elements
+/// counted) or `n . u / eps`; the element leads where it is positive.
+#[inline(always)]
+pub fn ramp_position<F: Real>(nu: F, eps: F, grazing: bool) -> F {
+    if grazing {
+        nu / eps + F::splat(1.0)
+    } else {
+        nu / eps
+    }
+}
+
+/// The leading ramp and its rate at a positive position `x` ([`ramp_position`]): `(1, 0)`
+/// from `x = 1` on, `(x, 1 / eps)` below.
+#[inline(always)]
+pub fn ramp<F: Real>(x: F, eps: F) -> (F, F) {
+    let below = F::splat(1.0) - x;
+    (
+        below.select_pos(x, F::splat(1.0)),
+        below.select_pos(F::splat(1.0) / eps, F::splat(0.0)),
+    )
+}
+
+/// alpha (uncapped, as [`generic_stress`]) on an element of normal `n` moving along the
+/// unit `vh`, and `d alpha / d v^`: [`stress_with_rate`]'s and the element kernel's
+/// (`crate::space::load`, in lanes), the same operations.
+#[inline(always)]
+pub fn alpha_with_rate<F: Real>(n: [F; 3], vh: [F; 3]) -> ([F; 3], [[F; 3]; 3]) {
+    let (m, x1, x2, x3) = plate(n, vh);
+    let (f, g) = fitted_with_gradient(x1, x2, x3);
+    let a = alpha_of(m, vh, f);
+    // d f_i / d v^ = -g_i1 z^ + g_i3 m
+    let df = |i: usize| [g[i][2] * m[0], g[i][2] * m[1], g[i][2] * m[2] - g[i][0]];
+    let (df1, df2, df3) = (df(0), df(1), df(2));
+    let mut ja = [[F::splat(0.0); 3]; 3];
     for r in 0..3 {
-        sigma[r] = law.zeta * lead * phi * a[r];
-        let jv: f64 = (0..3).map(|j| ja[r][j] * vh[j]).sum();
         for c in 0..3 {
-            jac[r][c] = law.zeta
+            let z = F::splat(if r == 2 { 1.0 } else { 0.0 });
+            let delta = if r == c { f[1] } else { F::splat(0.0) };
+            ja[r][c] = m[r] * df1[c] + delta + vh[r] * df2[c] - z * df3[c];
+        }
+    }
+    (a, ja)
+}
+
+/// The plate's normal `m` facing down (as [`generic_stress`]) and the fitted functions'
+/// arguments `x1`, `x2`, `x3` on an element of normal `n` moving along the unit `vh`.
+#[inline(always)]
+fn plate<F: Real>(n: [F; 3], vh: [F; 3]) -> ([F; 3], F, F, F) {
+    let sign = (-n[2] - F::splat(GRAZING_TOL)).select_pos(F::splat(1.0), F::splat(-1.0));
+    let m = [sign * n[0], sign * n[1], sign * n[2]];
+    let x3 = m[0] * vh[0] + m[1] * vh[1] + m[2] * vh[2];
+    (m, -vh[2], n[2].abs(), x3)
+}
+
+/// alpha from the plate's normal `m`, the direction `vh` and the fitted functions `f`.
+#[inline(always)]
+fn alpha_of<F: Real>(m: [F; 3], vh: [F; 3], f: [F; 3]) -> [F; 3] {
+    [
+        f[0] * m[0] + f[1] * vh[0],
+        f[0] * m[1] + f[1] * vh[1],
+        f[0] * m[2] + f[1] * vh[2] - f[2],
+    ]
+}
+
+/// `sqrt(s^2 + eps^2)` and `phi(s) = s / sqrt(s^2 + eps^2)`.
+#[inline(always)]
+fn phi_of<F: Real>(s: F, s2: F, eps: F) -> (F, F) {
+    let root = (s2 + eps * eps).sqrt();
+    (root, s / root)
+}
+
+/// `sigma = zeta lead phi alpha`.
+#[inline(always)]
+fn sigma_of<F: Real>(zeta: F, lead: F, phi: F, a: [F; 3]) -> [F; 3] {
+    a.map(|x| zeta * lead * phi * x)
+}
+
+/// [`stress_with_rate`]'s last part, from alpha (`a`, capped where the law has a cap) and
+/// its rate `ja` in `v^`, the ramp `lead` and its rate `dlead`, the speed `s` (`s2` its
+/// square) and `eps`:
+///
+/// `sigma = zeta lead(n . u) phi(s) alpha(u / s)`,
+/// `d sigma / d u = zeta (lead (phi'(s) alpha v^T + (phi(s) / s) J_alpha (I - v^ v^T)) +
+/// lead' phi(s) alpha n^T)`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn sigma_with_rate<F: Real>(
+    zeta: F,
+    lead: F,
+    dlead: F,
+    s: F,
+    s2: F,
+    eps: F,
+    n: [F; 3],
+    vh: [F; 3],
+    a: [F; 3],
+    ja: [[F; 3]; 3],
+) -> ([F; 3], [[F; 3]; 3]) {
+    let (root, phi) = phi_of(s, s2, eps);
+    let dphi = eps * eps / (root * root * root);
+    let over_s = F::splat(1.0) / root;
+    let sigma = sigma_of(zeta, lead, phi, a);
+    let mut jac = [[F::splat(0.0); 3]; 3];
+    for r in 0..3 {
+        // (A sum of three from -0.0, as `Iterator::sum`: the same bits.)
+        let jv = ja[r][0] * vh[0] + ja[r][1] * vh[1] + ja[r][2] * vh[2];
+        for c in 0..3 {
+            jac[r][c] = zeta
                 * (lead * (dphi * a[r] * vh[c] + over_s * (ja[r][c] - jv * vh[c]))
                     + dlead * phi * a[r] * n[c]);
         }

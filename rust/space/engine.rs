@@ -261,23 +261,26 @@ impl SpaceCoupling {
             let row = &mut out.outputs[i * width..(i + 1) * width];
             row[2..8].copy_from_slice(xi0.as_slice()[6 * a..6 * a + 6].as_ref());
         }
-        let eval = |geoms: &[SpaceGeom], xi: &DVector<f64>| -> Vec<Wrench> {
+        // The wrenches at the twists `xi`, with their rates `k` where `rates` (else only the
+        // wrenches and their height rates, the same bits: a trial point of the line search
+        // that may be rejected).
+        let eval_with = |geoms: &[SpaceGeom], xi: &DVector<f64>, rates: bool| -> Vec<Wrench> {
             active
                 .iter()
                 .enumerate()
                 .map(|(a, &i)| {
                     let x = &xi.as_slice()[6 * a..6 * a + 6];
                     let (c, q) = &poses[i];
-                    geoms[i].sand.wrench(
-                        c,
-                        q,
-                        &V3::new(x[0], x[1], x[2]),
-                        &V3::new(x[3], x[4], x[5]),
-                        self.rest_speed,
-                    )
+                    let (v, w) = (V3::new(x[0], x[1], x[2]), V3::new(x[3], x[4], x[5]));
+                    let sand = &geoms[i].sand;
+                    match rates {
+                        true => sand.wrench(c, q, &v, &w, self.rest_speed),
+                        false => sand.wrench_value(c, q, &v, &w, self.rest_speed),
+                    }
                 })
                 .collect()
         };
+        let eval = |geoms: &[SpaceGeom], xi: &DVector<f64>| eval_with(geoms, xi, true);
         let mass = DMatrix::from_row_slice(nv, nv, s.mass);
         let mut hm = mass.clone();
         for (d, b) in self.implicit_damping.iter().enumerate() {
@@ -336,8 +339,14 @@ impl SpaceCoupling {
             }
             let mut converged = r.amax() <= tol;
             let mut iterations = 0;
+            // Whether `ws` holds the rates (a backtracked trial's wrench does not).
+            let mut rated = true;
             while !converged && iterations < 40 {
                 iterations += 1;
+                if !rated {
+                    ws = eval(&self.geoms, &xi);
+                    rated = true;
+                }
                 let mut kk = DMatrix::zeros(rows, rows);
                 for (a, wr) in ws.iter().enumerate() {
                     for p in 0..6 {
@@ -354,11 +363,13 @@ impl SpaceCoupling {
                 let mut moved = false;
                 for _ in 0..30 {
                     let trial = &xi + t * &step;
-                    let tw = eval(&self.geoms, &trial);
+                    // The full step with its rates (usually taken); a shorter one without.
+                    let tw = eval_with(&self.geoms, &trial, t == 1.0);
                     let tr = residual(&tw, &trial);
                     let tn = tr.norm();
                     if tn < (1.0 - 1e-4 * t) * norm || tr.amax() <= tol {
                         (xi, ws, r, norm) = (trial, tw, tr, tn);
+                        rated = t == 1.0;
                         moved = true;
                         break;
                     }
