@@ -14,7 +14,7 @@ from .errors import GranrsError, InvalidParameterError, SimulationError, StepSiz
 from .result import Result
 from .scene import _CORE_FIELDS, Scene
 
-__all__ = ["RK4_STABILITY_LIMIT", "STEP_CHECK_FACTOR", "STEP_MOVE_LIMIT", "simulate"]
+__all__ = ["RK4_STABILITY_LIMIT", "STEP_CHECK_FACTOR", "STEP_ERROR_LIMIT", "simulate"]
 
 #: ``h lambda`` beyond which the classical RK4 is unstable for a real, negative rate
 #: (the stability region's extent on the negative real axis, 2.785).
@@ -25,7 +25,7 @@ ENERGY_ROSE_RTOL = 1e-9
 #: 1 %. The step's check (``Scene.step_check``) warns when a run's t_s or depth moves by more
 #: than this at ``dt / STEP_CHECK_FACTOR`` (or its status changes); the steps' own error
 #: estimate ``step_error`` is read against it in the warning's text.
-STEP_MOVE_LIMIT = 0.01
+STEP_ERROR_LIMIT = 0.01
 #: The step's check runs a suspect again at ``dt / STEP_CHECK_FACTOR``.
 STEP_CHECK_FACTOR = 10
 #: A run whose steps' own error estimate (``step_error``) exceeds this is a suspect, checked
@@ -57,10 +57,10 @@ def step_advice(
             f"{RK4_STABILITY_LIMIT})"
         )
         advice = f"use dt <= {dt * 0.5 / h_lambda:.2g} s (dt * rate <= 0.5)"
-    elif step_error > STEP_MOVE_LIMIT:
+    elif step_error > STEP_ERROR_LIMIT:
         why = (
             f"the steps' own error estimates put t_s or the depth {100 * step_error:.3g} % off "
-            f"(step_error {step_error:.3g}, above {STEP_MOVE_LIMIT})"
+            f"(step_error {step_error:.3g}, above {STEP_ERROR_LIMIT})"
         )
         advice = finer
     elif unresolved_stops:
@@ -155,7 +155,7 @@ def step_move(
     """What the step's check measured: each contact's ``t_s`` and ``depth`` at ``dt``
     (``coarse``) and at ``fine_dt``, by name (``"t_s"``, ``"depth"``; a body with several
     contacts ``"c0.t_s"``, ...), the status at both, the largest relative move and whether
-    the run moved (by more than :data:`STEP_MOVE_LIMIT`, or its status changed)."""
+    the run moved (by more than :data:`STEP_ERROR_LIMIT`, or its status changed)."""
     moves: dict[str, float] = {}
     several = len(coarse["t_s"]) > 1
     for key in ("t_s", "depth"):
@@ -167,7 +167,7 @@ def step_move(
         "moves": moves,
         "status": status,
         "largest": largest,
-        "moved": status[0] != status[1] or largest > STEP_MOVE_LIMIT,
+        "moved": status[0] != status[1] or largest > STEP_ERROR_LIMIT,
     }
 
 
@@ -180,7 +180,7 @@ def describe_move(check: Mapping[str, Any]) -> str:
     if a != b:
         parts.append(f"its status is {b!r} {at} against {a!r}")
     name, move = max(check["moves"].items(), key=lambda kv: kv[1], default=("t_s", 0.0))
-    if move > STEP_MOVE_LIMIT:
+    if move > STEP_ERROR_LIMIT:
         size = "beyond measure" if math.isinf(move) else f"{100 * move:.3g} %"
         parts.append(f"{name} moves {size} {at}")
     return " and ".join(parts)

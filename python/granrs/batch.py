@@ -30,6 +30,7 @@ from . import _granrs, space
 from .api import (
     RK4_STABILITY_LIMIT,
     STEP_CHECK_FACTOR,
+    STEP_ERROR_LIMIT,
     describe_move,
     loud,
     step_move,
@@ -884,7 +885,8 @@ def _check_rows(
         listed = "; ".join(f"row {i}: {what}" for i, what in moved[:10])
         more = f"; and {len(moved) - 10} more" if len(moved) > 10 else ""
         parts.append(
-            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than 1 % "
+            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than "
+            f"{100 * STEP_ERROR_LIMIT:g} % "
             f"({listed}{more})"
         )
     if unchecked:
