@@ -6,7 +6,8 @@ speeds, spin and mass drawn too) is run at dt = 1e-3 and 1e-4, and each again at
 scene *moved* at a dt when its ``t_s`` or its depth differs from the dt / 10 run's by more
 than 1 % (or its status does); it *warned* when ``granrs.simulate`` warned
 :class:`granrs.StepSizeWarning` or refused the run as diverged. The script prints, per dt,
-the confusion counts (moved & warned, moved & silent, still & warned, still & silent), each
+the confusion counts (moved & warned, moved & silent, still & warned, still & silent), how
+many runs ``granrs.simulate``'s step check ran again at a finer step (its cost), each
 miss and false alarm with its ``h_lambda``, ``step_error`` and ``unresolved_stops``, and the
 mirror count: each scene is run again as its mirror image (x -> -x: the angle q, vx0 and
 omega0 -> -q, -vx0, -omega0); of the pairs where neither warns, how many differ by more
@@ -108,10 +109,12 @@ def scenes(n: int, seed: int) -> list[Scene]:
 
 @dataclass
 class Run:
-    """A run's summary (None if refused as diverged) and whether it warned."""
+    """A run's summary (None if refused as diverged), whether it warned, and whether
+    ``granrs.simulate``'s step check ran it again at a finer step (its cost)."""
 
     summary: dict[str, Any] | None
     warned: bool
+    checked: bool = False
 
 
 def run(scene: granrs.Scene) -> Run:
@@ -122,7 +125,7 @@ def run(scene: granrs.Scene) -> Run:
         except granrs.SimulationError:
             return Run(None, True)
     warned = any(issubclass(w.category, granrs.StepSizeWarning) for w in caught)
-    return Run(dict(r.summary), warned)
+    return Run(dict(r.summary), warned, r.step_check is not None)
 
 
 def moved(a: Run, b: Run) -> bool:
@@ -158,6 +161,8 @@ class Study:
     """The confusion counts per dt, the misses and false alarms, and the mirror gaps."""
 
     counts: dict[float, dict[str, int]] = field(default_factory=dict)
+    #: Per dt, how many runs simulate's step check ran again (the check's cost).
+    checked: dict[float, int] = field(default_factory=dict)
     misses: list[tuple[int, str, float, dict[str, Any]]] = field(default_factory=list)
     false_alarms: list[tuple[int, str, float, dict[str, Any]]] = field(default_factory=list)
     #: (scene, dt, gap) for every pair of silent runs (a scene and its mirror image).
@@ -188,6 +193,7 @@ def study(
                 m = moved(coarse, run(sc.at(dt / 100)))
             key = f"{'moved' if m else 'still'}&{'warned' if coarse.warned else 'silent'}"
             out.counts[dt][key] += 1
+            out.checked[dt] = out.checked.get(dt, 0) + coarse.checked
             info = {
                 k: (coarse.summary or {}).get(k, math.nan)
                 for k in ("h_lambda", "unresolved_stops", "step_error", "t_s", "depth")
@@ -212,7 +218,8 @@ def report(s: Study, drawn: list[Scene]) -> str:
     for dt, c in s.counts.items():
         lines.append(
             f"dt = {dt:g}: moved&warned {c['moved&warned']}, moved&silent {c['moved&silent']}, "
-            f"still&warned {c['still&warned']}, still&silent {c['still&silent']}"
+            f"still&warned {c['still&warned']}, still&silent {c['still&silent']}; "
+            f"checked again by simulate {s.checked.get(dt, 0)}"
         )
     for title, rows in (("moved & silent", s.misses), ("still & warned", s.false_alarms)):
         lines.append(f"{title}:")

@@ -140,6 +140,8 @@ scene_fields! {
         "height of the contact box above the sole; None: the tibia length (the sole's footprint carried up the leg, so V keeps growing as f_s w_s d past the ankle, as eq. 5.7 does); 0.039 H lets only the shoe count";
     "sole_model": "body", "", "box or thesis",
         "the sole's contact: \"box\" (the geometric box of docs/model.md) or \"thesis\" (eqs. 5.5-5.7 with the shank's angle; finite only for 1 <= shank angle <= 89 deg)";
+    "step_check": "solver", "", "true or false",
+        "check a run whose step looks too coarse by running it again at dt / 10 (true, default): granrs.StepSizeWarning is raised only if t_s, the depth or the status moves by more than 1 %; the returned result is the run at dt either way. false: no re-run, no warning (raw speed)";
     "t_end": "solver", "s", "> 0; t_end / dt <= 1e9 steps",
         "latest end time";
     "tibia_length": "body", "m", "> 0",

@@ -27,7 +27,15 @@ import numpy as np
 import pandas as pd
 
 from . import _granrs, space
-from .api import ENERGY_ROSE_RTOL, RK4_STABILITY_LIMIT
+from .api import (
+    RK4_STABILITY_LIMIT,
+    STEP_CHECK_FACTOR,
+    STEP_ERROR_LIMIT,
+    describe_move,
+    loud,
+    step_move,
+    suspects,
+)
 from .coefficients import Coefficients
 from .errors import (
     GranrsError,
@@ -595,6 +603,13 @@ def sweep(
         given, in that same order. A run that failed has status ``"failed"`` and its message
         in an ``error`` column (present only then).
 
+    Warns:
+        StepSizeWarning: once, listing the rows whose t_s, depth or status moves by more
+            than 1 % at ``dt / 10``: the rows whose step looks too coarse (as
+            :func:`granrs.simulate` judges a run) are run again together at ``dt / 10``, on
+            this machine, where their scene's ``step_check`` is on (the default); the
+            table's rows and columns are the runs at their own ``dt`` either way.
+
     Raises:
         InvalidSceneError: (or a subclass) before anything runs, naming the field, with
             the index of the first bad run.
@@ -689,7 +704,16 @@ def sweep(
         )
         table, failures, unresolved = _run_by_row(kwargs, *rows, n, lambda kw, c: run(kw, c, True))
         start = 0
-    _warn_unresolved(table, unresolved)
+    if isinstance(scene, Scene):
+        names, values = list(plain_axes), list(plain_axes.values())
+        shape = [len(v) for v in values]
+
+        def row_scene(i: int) -> Scene:
+            at = np.unravel_index(i, shape)
+            return scene.replace(**{k: v[j] for k, v, j in zip(names, values, at, strict=True)})
+    else:
+        row_scene = scenes.__getitem__
+    _check_rows(table, unresolved, row_scene, n_threads, lanes)
     frame = table.frame(failures, start, axis_columns)
     del axis_columns, table
     return frame
@@ -742,45 +766,141 @@ def _run_by_row(
     return table, failures, sorted(unresolved)
 
 
-def _warn_unresolved(table: _Table, unresolved: Sequence[int]) -> None:
-    """One :class:`~granrs.errors.StepSizeWarning` for the runs whose step did not resolve
-    their contact (``h_lambda`` above :data:`granrs.RK4_STABILITY_LIMIT`, the steps' own
-    error estimate ``step_error`` above 1 %, a stop the step missed, or steps the sign
-    modes chattered through, ``unresolved`` > 0, with a rise in energy: see
-    :func:`granrs.api.energy_rose`). ``unresolved`` are the rows with ``unresolved_stops``
-    > 0, which every run computes whatever its outputs; the other tests need their columns
-    in the sweep's outputs (``h_lambda``: the default has it)."""
+#: A contact's t_s and depth columns in a sweep's table (a body with several contacts
+#: prefixes them ``c0.``, ``c1.``, ...).
+_CONTACT_COLUMN = re.compile(r"(?:c(\d+)\.)?(t_s|depth)")
+
+
+def _contact_values(table: _Table, rows: np.ndarray) -> list[dict[str, list[float]]] | None:
+    """Each of ``rows``' contacts' ``t_s`` and ``depth`` from a sweep's table (None if its
+    outputs left them out)."""
+    found: dict[str, dict[int, np.ndarray]] = {"t_s": {}, "depth": {}}
+    for name in table.layout.names:
+        m = _CONTACT_COLUMN.fullmatch(name)
+        if m:
+            found[m[2]][int(m[1] or 0)] = table.column(name)[rows]
+    if not found["t_s"] or sorted(found["t_s"]) != sorted(found["depth"]):
+        return None
+    contacts = sorted(found["t_s"])
+    return [
+        {key: [float(found[key][c][k]) for c in contacts] for key in ("t_s", "depth")}
+        for k in range(len(rows))
+    ]
+
+
+def _rerun(
+    scenes: Sequence[Scene], threads: int, lanes: bool
+) -> tuple[list[int], _Table | None, list[tuple[int, str]]]:
+    """``scenes`` run through the sweep's machinery with the outputs the step's check reads
+    (``t_s`` and ``depth``; no series): the indices of those the core accepted, their table
+    and their failures (indices into the accepted). A scene the core refuses (a finer step
+    whose ``t_end / dt`` exceeds what a run may take) is left out."""
+    compiled, kept = [], []
+    for i, s in enumerate(scenes):
+        try:
+            compiled.append(s.replace(record=(), outputs=("t_s", "depth"))._compiled())
+        except GranrsError:
+            continue
+        kept.append(i)
+    if not compiled:
+        return kept, None, []
+    raw = _run_local({"scenes": compiled, "lanes": lanes}, 0, len(compiled), threads, False)
+    return kept, _table(raw), raw["failures"]
+
+
+def _check_rows(
+    table: _Table, unresolved: Sequence[int], row_scene: Any, threads: int, lanes: bool
+) -> None:
+    """The step's check of a sweep (see :func:`granrs.simulate`): the rows that look too
+    coarse (:func:`granrs.api.suspects`; ``unresolved`` are the rows with
+    ``unresolved_stops`` > 0, which every run computes whatever its outputs; ``h_lambda``,
+    ``step_error`` and the energies need their columns in the sweep's outputs, as the default
+    has them) and whose scene (``row_scene(i)``) has ``step_check`` on, run again together at
+    ``dt / STEP_CHECK_FACTOR`` through the sweep's machinery on this machine; one
+    :class:`~granrs.errors.StepSizeWarning` lists the rows that moved and their moves, and
+    the rows that warn unchecked (``step_check`` off, or a finer step no run may take). The
+    table is left as it is."""
+    n = table.n
     have = table.layout.rows_of
-    flagged = np.zeros(table.n, dtype=bool)
-    if "h_lambda" in have:
-        flagged |= table.column("h_lambda") > RK4_STABILITY_LIMIT
-    flagged[np.asarray(unresolved, dtype=np.intp)] = True
-    bad = np.flatnonzero(flagged)
-    if {"unresolved", "energy_start", "energy_end"} <= set(have):
-        # The energy test only where a step was unresolved (few rows: no full-length
-        # temporaries).
-        maybe = np.flatnonzero(table.column("unresolved") > 0)
-        start = table.column("energy_start")[maybe]
-        end = table.column("energy_end")[maybe]
-        with np.errstate(invalid="ignore"):
-            scale = np.maximum(np.maximum(abs(start), abs(end)), 1e-12)
-            rose = end - start > ENERGY_ROSE_RTOL * scale
-        bad = np.union1d(bad, maybe[rose])
-    if bad.size:
-        rows = f"{bad[:5].tolist()}{', ...' if bad.size > 5 else ''}"
-        largest = (
-            f"; the largest h_lambda is {np.nanmax(table.column('h_lambda')[bad]):.3g}"
-            if "h_lambda" in have
-            else ""
+
+    def column(name: str, fill: float) -> np.ndarray:
+        return table.column(name) if name in have else np.full(n, fill)
+
+    stops = np.zeros(n, dtype=np.int64)
+    stops[np.asarray(unresolved, dtype=np.intp)] = 1
+    chatter = column("unresolved", 0)
+    numbers = (
+        column("h_lambda", math.nan),
+        stops,
+        chatter,
+        column("energy_start", math.nan),
+        column("energy_end", math.nan),
+    )
+    loud_rows = loud(*numbers)
+    candidates = np.flatnonzero(
+        suspects(numbers[0], column("step_error", math.nan), *numbers[1:], True)
+    )
+    if candidates.size == 0:
+        return
+    checked, unchecked = [], []
+    for i in candidates.tolist():
+        s = row_scene(i)
+        if not s.step_check:
+            if loud_rows[i]:
+                unchecked.append(i)
+        elif s.sign_model != "raw" or loud_rows[i]:
+            checked.append((i, s))
+    fine_dt = {i: s.dt / STEP_CHECK_FACTOR for i, s in checked}
+    kept, fine, fine_failures = _rerun(
+        [s.replace(dt=fine_dt[i]) for i, s in checked], threads, lanes
+    )
+    unchecked += [i for k, (i, _) in enumerate(checked) if k not in set(kept)]
+    moved: list[tuple[int, str]] = []
+    if fine is not None:
+        rows = np.array([checked[k][0] for k in kept], dtype=np.intp)
+        coarse_values = _contact_values(table, rows)
+        coarse_status = table.status[rows]
+        if coarse_values is None:
+            # The sweep's outputs left t_s or depth out: the rows at their own dt too.
+            _, coarse, _ = _rerun([checked[k][1] for k in kept], threads, lanes)
+            assert coarse is not None
+            coarse_values = _contact_values(coarse, np.arange(len(kept)))
+            coarse_status = coarse.status
+        fine_values = _contact_values(fine, np.arange(len(kept)))
+        assert coarse_values is not None and fine_values is not None
+        failed = {j for j, _ in fine_failures}
+        for j, i in enumerate(rows.tolist()):
+            status = (STATUSES[coarse_status[j]], STATUSES[fine.status[j]])
+            if j in failed:
+                status = (status[0], "failed")
+            check = step_move(coarse_values[j], fine_values[j], status, fine_dt[i])
+            if check["moved"]:
+                moved.append((i, describe_move(check)))
+    if not moved and not unchecked:
+        return
+    bad = sorted([i for i, _ in moved] + unchecked)
+    rows_text = f"{bad[:5]}{', ...' if len(bad) > 5 else ''}"
+    parts = []
+    if moved:
+        listed = "; ".join(f"row {i}: {what}" for i, what in moved[:10])
+        more = f"; and {len(moved) - 10} more" if len(moved) > 10 else ""
+        parts.append(
+            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than "
+            f"{100 * STEP_ERROR_LIMIT:g} % "
+            f"({listed}{more})"
         )
-        warnings.warn(
-            StepSizeWarning(
-                f"{bad.size} of {table.n} runs (rows {rows}) did not resolve their contact "
-                f"(h_lambda above {RK4_STABILITY_LIMIT}, 'step_error' above 0.01, "
-                "'unresolved_stops' the step missed, or "
-                "'unresolved' steps where the sign modes chattered and the energy rose)"
-                f"{largest}. "
-                "Use a smaller dt (dt * rate <= 0.5) for those runs"
-            ),
-            stacklevel=3,
+    if unchecked:
+        listed = f"{sorted(unchecked)[:5]}{', ...' if len(unchecked) > 5 else ''}"
+        parts.append(
+            f"{len(unchecked)} unchecked (rows {listed}: h_lambda above "
+            f"{RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or 'unresolved' "
+            "steps where the sign modes chattered and the energy rose)"
         )
+    warnings.warn(
+        StepSizeWarning(
+            f"{len(bad)} of {n} runs (rows {rows_text}) did not resolve their contact: "
+            f"{'; '.join(parts)}. Use a "
+            f"smaller dt for those runs (dt / {STEP_CHECK_FACTOR} or less)"
+        ),
+        stacklevel=3,
+    )

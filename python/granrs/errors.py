@@ -72,9 +72,11 @@ class StepSizeWarning(UserWarning):
     (``Result.summary["unresolved_stops"]``: the steps' own error estimates put t_s or the
     depth more than 1 % off, ``summary["step_error"]``, or a stop or a stick was decided by
     where the step located it rather than by the run), or steps where the force's signs
-    chattered gained energy. The run finished with finite numbers, but they are not the
-    converged answer: the message gives the ``dt`` used and a ``dt`` that resolves it; rerun
-    with that ``dt`` or ``method="dopri5"``."""
+    chattered gained energy. Such a run is checked first (``Scene.step_check``, on by
+    default): run again at ``dt / 10``, it warns only if its t_s, depth or status moves by
+    more than 1 % there, and the message states that move. The run finished with finite
+    numbers, but they are not the converged answer: the message gives the ``dt`` used and a
+    ``dt`` that resolves it; rerun with that ``dt`` or ``method="dopri5"``."""
 
 
 class CoefficientsWarning(UserWarning):

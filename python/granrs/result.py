@@ -127,19 +127,29 @@ class Result:
             order: dicts with ``joint`` (its name), ``t`` [s], ``impulse`` (the angular
             impulse on the link it carries, N m s) and ``energy`` (the work it does, J; each
             joint's sum is its ``impulse_work`` in ``joints``).
+        step_check: what the step's check measured (``Scene.step_check``), or None where no
+            check ran (the run did not look too coarse, or the check is off): ``dt`` (the
+            finer step), ``moves`` (each contact's relative move of ``t_s`` and ``depth`` at
+            that step, by name: ``"t_s"``, ``"depth"``; several contacts ``"c0.t_s"``, ...),
+            ``status`` (at ``scene.dt`` and at the finer step), ``largest`` (the largest
+            move) and ``moved`` (more than 1 %, or the status changed: the run warned
+            :class:`~granrs.StepSizeWarning`). The result's other numbers are the run's at
+            ``scene.dt`` whether or not a check ran.
     """
 
-    __slots__ = ("_core", "_d", "_raw", "scene")
+    __slots__ = ("_core", "_d", "_raw", "scene", "step_check")
 
     def __init__(self, scene: Scene, core: Any) -> None:
         self.scene = scene
         self._core = core  # a granrs._granrs.RunOutcome, or the raw dict
         self._raw: dict[str, Any] | None = core if isinstance(core, dict) else None
         self._d: dict[str, Any] | None = None
+        self.step_check: dict[str, Any] | None = None
 
     def __reduce__(self) -> tuple[Any, ...]:
-        # Pickle the plain results, not the core's object.
-        return (Result, (self.scene, self._raw_dict()))
+        # Pickle the plain results, not the core's object (and what the step's check
+        # measured, a slot's state).
+        return (Result, (self.scene, self._raw_dict()), (None, {"step_check": self.step_check}))
 
     def _raw_dict(self) -> dict[str, Any]:
         if self._raw is None:

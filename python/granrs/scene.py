@@ -391,6 +391,7 @@ class Scene:
     trunk_deg: float = 10.0
     foot_deg: float = 0.0
     sole_model: str = "box"
+    step_check: bool = True
 
     def __post_init__(self) -> None:
         for name in ("pin_joint", "ankle", "knee", "hip"):

@@ -302,6 +302,12 @@ impl SceneSpec {
                 check_range(name, x, 0.0, true)?;
             }
         }
+        // Read by granrs.simulate and granrs.sweep (the step's check), not by the run: checked
+        // here with every field.
+        match self.get("step_check") {
+            None | Some(Value::Bool(_)) => {}
+            Some(other) => return Err(wrong("step_check", "true or false", other)),
+        }
         let apply_at = match self.str("apply_at")? {
             "tip" => ApplyAt::Tip,
             "centroid" => ApplyAt::Centroid,

@@ -106,6 +106,23 @@ fn errors_name_the_field() {
 }
 
 #[test]
+fn step_check_is_true_or_false() {
+    // Read by granrs.simulate and granrs.sweep, not by the run; checked with every field.
+    for ok in [Value::Bool(true), Value::Bool(false)] {
+        let mut s = free_link_spec();
+        s.set("step_check", ok);
+        assert!(s.build().is_ok());
+    }
+    for bad in [Value::Num(1.0), Value::Str("yes".into()), Value::None] {
+        let mut s = free_link_spec();
+        s.set("step_check", bad);
+        assert!(
+            matches!(s.build(), Err(GranrsError::WrongType { field, .. }) if field == "step_check")
+        );
+    }
+}
+
+#[test]
 fn scene_fields_have_their_own_slots() {
     assert!(SCENE_FIELDS.is_sorted_by(|a, b| a < b));
     for (i, name) in SCENE_FIELDS.iter().enumerate() {
