@@ -23,7 +23,7 @@ import pandas as pd
 
 from .. import cases
 from .. import forces as _forces
-from ..api import STEP_ERROR_LIMIT
+from ..api import STEP_CHECK_FACTOR, STEP_ERROR_LIMIT
 from ..calibrate import Measurements
 from ..coefficients import table_3_2
 from ..compare import DATASETS, _rows, _stop_order
@@ -439,7 +439,8 @@ have left out. Then the factor nearest 1 that brings both depths within
 {100 * tol:.1f} %: one factor on every magnitude (not the depth exponent lambda), and each
 coefficient alone (searched from {1 / _SEARCH:.2g}x to {_SEARCH:g}x; the factor is found
 to 0.5 %). Of the {total} leg runs, {unresolved} had a step that did not resolve the
-contact (the steps' own error estimate above {100 * STEP_ERROR_LIMIT:g} %); a factor or
+contact (its depth or t_s moved by more than {100 * STEP_ERROR_LIMIT:g} % when run again
+at dt / {STEP_CHECK_FACTOR:g}); a factor or
 depth whose run is one of them is marked.
 
 {md_table(header, body, "l")}
