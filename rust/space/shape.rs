@@ -144,8 +144,14 @@ impl Elements {
             self.n[k].push(n[k]);
         }
         self.area.push(area);
-        self.depth.push((surface - x.z).max(0.0));
+        self.depth.push(depth_below(surface, &x));
     }
+}
+
+/// A point's depth below the surface `z = surface` [m] (0 above it).
+#[inline(always)]
+fn depth_below(surface: f64, x: &V3) -> f64 {
+    (surface - x.z).max(0.0)
 }
 
 /// Where a triangle's 3-point rule puts its elements: [`Elements`] (growing) or the room
@@ -164,7 +170,7 @@ impl Sink for Elements {
         }
         self.area.extend_from_slice(&[area; 3]);
         self.depth
-            .extend_from_slice(&x.map(|p| (surface - p.z).max(0.0)));
+            .extend_from_slice(&x.map(|p| depth_below(surface, &p)));
     }
 }
 
@@ -201,7 +207,7 @@ impl Sink for Room<'_> {
             put(self.n[k], [n[k]; 3]);
         }
         put(self.area, [area; 3]);
-        put(self.depth, x.map(|p| (surface - p.z).max(0.0)));
+        put(self.depth, x.map(|p| depth_below(surface, &p)));
         self.len = i + 3;
     }
 }
@@ -1350,6 +1356,76 @@ mod tests {
                     for (a, b) in fast.area.iter().zip(&each.area) {
                         assert!((a - b).abs() <= 1e-15 * b, "z {z} v {v:?}: {a} vs {b}");
                     }
+                }
+            }
+        }
+    }
+
+    /// The same on a mesh of more triangles than the cut makes room for at a time (a
+    /// UV sphere of 2208, all under and at rest: every one whole), at two rules.
+    #[test]
+    fn a_big_mesh_cut_in_runs_is_the_clip_of_each_face() {
+        let (rings, around) = (24, 48);
+        let mut v = vec![[0.0, 0.0, 0.05]];
+        for i in 1..rings {
+            let th = PI * i as f64 / rings as f64;
+            for j in 0..around {
+                let ph = 2.0 * PI * j as f64 / around as f64;
+                let (s, c) = (0.05 * th.sin(), 0.05 * th.cos());
+                v.push([s * ph.cos(), s * ph.sin(), c]);
+            }
+        }
+        v.push([0.0, 0.0, -0.05]);
+        let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as i64;
+        let bottom = v.len() as i64 - 1;
+        let mut t = Vec::new();
+        for j in 0..around {
+            t.push([0, ring(1, j), ring(1, j + 1)]);
+            for i in 1..rings - 1 {
+                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+            }
+            t.push([bottom, ring(rings - 1, j + 1), ring(rings - 1, j)]);
+        }
+        assert_eq!(t.len(), 2208);
+        let shape = Shape::mesh("m", &v, &t).unwrap();
+        let Shape::Mesh(m) = &shape else {
+            unreachable!()
+        };
+        let q = UnitQuaternion::from_euler_angles(0.3, 0.5, -0.2);
+        let r = q.to_rotation_matrix();
+        for rule in [Quadrature::new(6), Quadrature::new(12)] {
+            for (z, v, w) in [
+                (-0.2, V3::zeros(), V3::zeros()),
+                (0.01, V3::new(0.3, -0.2, -1.0), V3::new(1.0, 2.0, -0.5)),
+            ] {
+                let c = V3::new(0.0, 0.0, z);
+                let mut fast = Elements::default();
+                shape.elements(&c, &q, &v, &w, 0.0, &rule, &mut fast);
+                let motion = Motion {
+                    c,
+                    v,
+                    omega: w,
+                    surface: 0.0,
+                };
+                let mut each = Elements::default();
+                for (t, nb) in m.triangles.iter().zip(&m.normals) {
+                    let pts = t.map(|i| c + r * m.vertices[i]);
+                    polygon_with(&motion, &pts, &(r * nb), &rule, &mut each);
+                }
+                if z < -0.1 {
+                    let k = rule.subdivisions();
+                    assert_eq!(fast.len(), 3 * k * k * t.len());
+                }
+                assert_eq!(
+                    (&fast.x, &fast.n, &fast.depth),
+                    (&each.x, &each.n, &each.depth)
+                );
+                // The areas: the mesh's against the world vertices' (their edges, 30 times
+                // shorter than their distance from the origin here, lose digits to it).
+                assert_eq!(fast.area.len(), each.area.len());
+                for (a, b) in fast.area.iter().zip(&each.area) {
+                    assert!((a - b).abs() <= 1e-13 * b, "{a} vs {b}");
                 }
             }
         }
