@@ -234,18 +234,24 @@ impl Sand {
             out.moment = moment;
             return out;
         }
-        out.wetted_area = e.area.iter().sum();
         if speed > 0.0 {
             let vh = v / speed;
-            let (mut a, mut centre) = (0.0, V3::zeros());
+            // The wetted area and the projected one in one pass (each sum in element order:
+            // two chains of additions that overlap).
+            let (mut wet, mut a, mut centre) = (0.0, 0.0, V3::zeros());
             for i in 0..e.len() {
-                let p = (e.normal(i).dot(&vh)).max(0.0) * e.area[i];
+                let area = e.area[i];
+                wet += area;
+                let p = (e.normal(i).dot(&vh)).max(0.0) * area;
                 a += p;
                 centre += p * e.point(i);
             }
+            out.wetted_area = wet;
             out.projected_area = a;
             let at = (a > 0.0).then(|| centre / a);
             self.poncelet(&mut out, &mut moment, c, q, v, omega, a, at);
+        } else {
+            out.wetted_area = e.area.iter().sum();
         }
         out.force = out.rft3d + out.inertial + out.poncelet;
         out.moment = moment;

@@ -20,6 +20,7 @@
 //! `space::load` estimates it by doubling them.
 
 use std::f64::consts::PI;
+use std::mem::MaybeUninit;
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
@@ -80,17 +81,60 @@ impl Elements {
         self.area.is_empty()
     }
 
-    /// Three elements of the same normal and area weight at once (a triangle's 3-point
-    /// rule): each array grows once, not three times.
-    #[inline]
-    fn push3(&mut self, x: [V3; 3], n: &V3, area: f64, surface: f64) {
+    /// Room for `more` elements past the current ones in every array.
+    fn reserve(&mut self, more: usize) {
         for k in 0..3 {
-            self.x[k].extend_from_slice(&[x[0][k], x[1][k], x[2][k]]);
-            self.n[k].extend_from_slice(&[n[k]; 3]);
+            self.x[k].reserve(more);
+            self.n[k].reserve(more);
         }
-        self.area.extend_from_slice(&[area; 3]);
-        self.depth
-            .extend_from_slice(&x.map(|p| (surface - p.z).max(0.0)));
+        self.area.reserve(more);
+        self.depth.reserve(more);
+    }
+
+    /// Run `f` with the arrays' spare room ([`Elements::reserve`]d before) to write
+    /// elements into by index, then count what it wrote (a mesh's whole triangles: no
+    /// array's length or capacity is read or written per element).
+    fn fill<R>(&mut self, f: impl FnOnce(&mut Room<'_>) -> R) -> R {
+        let [x0, x1, x2] = &mut self.x;
+        let [n0, n1, n2] = &mut self.n;
+        let mut room = Room {
+            x: [
+                x0.spare_capacity_mut(),
+                x1.spare_capacity_mut(),
+                x2.spare_capacity_mut(),
+            ],
+            n: [
+                n0.spare_capacity_mut(),
+                n1.spare_capacity_mut(),
+                n2.spare_capacity_mut(),
+            ],
+            area: self.area.spare_capacity_mut(),
+            depth: self.depth.spare_capacity_mut(),
+            len: 0,
+            cap: 0,
+        };
+        room.cap = room
+            .x
+            .iter()
+            .chain(&room.n)
+            .chain([&room.area, &room.depth])
+            .map(|s| s.len())
+            .min()
+            .unwrap_or(0);
+        let out = f(&mut room);
+        let more = room.len;
+        for v in self
+            .x
+            .iter_mut()
+            .chain(self.n.iter_mut())
+            .chain([&mut self.area, &mut self.depth])
+        {
+            // SAFETY: `Room::put3`, the only way `room.len` grows, wrote entries
+            // `..room.len` of every array's spare room (within its capacity: it indexes
+            // the spare slices, checked) before it counted them.
+            unsafe { v.set_len(v.len() + more) };
+        }
+        out
     }
 
     #[inline]
@@ -100,7 +144,71 @@ impl Elements {
             self.n[k].push(n[k]);
         }
         self.area.push(area);
-        self.depth.push((surface - x.z).max(0.0));
+        self.depth.push(depth_below(surface, &x));
+    }
+}
+
+/// A point's depth below the surface `z = surface` [m] (0 above it).
+#[inline(always)]
+fn depth_below(surface: f64, x: &V3) -> f64 {
+    (surface - x.z).max(0.0)
+}
+
+/// Where a triangle's 3-point rule puts its elements: [`Elements`] (growing) or the room
+/// [`Elements::fill`] lends.
+trait Sink {
+    /// Three elements of the same normal and area weight (a triangle's 3-point rule).
+    fn put3(&mut self, x: [V3; 3], n: &V3, area: f64, surface: f64);
+}
+
+impl Sink for Elements {
+    #[inline]
+    fn put3(&mut self, x: [V3; 3], n: &V3, area: f64, surface: f64) {
+        for k in 0..3 {
+            self.x[k].extend_from_slice(&[x[0][k], x[1][k], x[2][k]]);
+            self.n[k].extend_from_slice(&[n[k]; 3]);
+        }
+        self.area.extend_from_slice(&[area; 3]);
+        self.depth
+            .extend_from_slice(&x.map(|p| depth_below(surface, &p)));
+    }
+}
+
+/// The spare room of [`Elements`]' arrays, written by index ([`Elements::fill`]).
+struct Room<'a> {
+    x: [&'a mut [MaybeUninit<f64>]; 3],
+    n: [&'a mut [MaybeUninit<f64>]; 3],
+    area: &'a mut [MaybeUninit<f64>],
+    depth: &'a mut [MaybeUninit<f64>],
+    /// How many elements are written.
+    len: usize,
+    /// How many fit.
+    cap: usize,
+}
+
+impl Room<'_> {
+    /// How many more elements fit.
+    fn left(&self) -> usize {
+        self.cap - self.len
+    }
+}
+
+impl Sink for Room<'_> {
+    #[inline(always)]
+    fn put3(&mut self, x: [V3; 3], n: &V3, area: f64, surface: f64) {
+        let i = self.len;
+        let put = |to: &mut [MaybeUninit<f64>], v: [f64; 3]| {
+            for (t, v) in to[i..i + 3].iter_mut().zip(v) {
+                t.write(v);
+            }
+        };
+        for k in 0..3 {
+            put(self.x[k], [x[0][k], x[1][k], x[2][k]]);
+            put(self.n[k], [n[k]; 3]);
+        }
+        put(self.area, [area; 3]);
+        put(self.depth, x.map(|p| depth_below(surface, &p)));
+        self.len = i + 3;
     }
 }
 
@@ -628,13 +736,44 @@ impl Shape {
                 vel.clear();
                 world.extend(m.vertices.iter().map(|p| c + r * p));
                 vel.extend(world.iter().map(|p| motion.velocity_at(p)));
-                for ((t, nb), area) in m.triangles.iter().zip(&m.normals).zip(&m.areas) {
-                    let pts = [world[t[0]], world[t[1]], world[t[2]]];
-                    if pts.iter().all(|p| p.z > surface) {
-                        continue;
+                let (k, tris) = (rule.subdivisions(), &m.triangles);
+                let per = 3 * k * k;
+                let mut next = 0;
+                while next < tris.len() {
+                    // The whole triangles (most) written straight into the arrays' room (for
+                    // up to 1024 of them at a time: a big mesh's cut grows them as it needs),
+                    // up to the first one that needs the general cut.
+                    out.reserve(per * (tris.len() - next).min(1024));
+                    let stop = out.fill(|room| {
+                        while next < tris.len() {
+                            let i = next;
+                            let t = tris[i];
+                            let pts = [world[t[0]], world[t[1]], world[t[2]]];
+                            if pts.iter().all(|p| p.z > surface) {
+                                next += 1;
+                                continue;
+                            }
+                            let u = [vel[t[0]], vel[t[1]], vel[t[2]]];
+                            let n = r * m.normals[i];
+                            match facet(&motion, &pts, &u, &n) {
+                                Facet::Whole if room.left() < per => return None,
+                                Facet::Whole => {
+                                    let [a, b, c] = &pts;
+                                    triangle_with(a, b, c, &n, m.areas[i], k, surface, room);
+                                }
+                                Facet::Trailing => {}
+                                Facet::Cut => {
+                                    next += 1;
+                                    return Some((pts, n));
+                                }
+                            }
+                            next += 1;
+                        }
+                        None
+                    });
+                    if let Some((pts, n)) = stop {
+                        polygon_with(&motion, &pts, &n, rule, out);
                     }
-                    let u = [vel[t[0]], vel[t[1]], vel[t[2]]];
-                    mesh_triangle(&motion, &pts, &u, &(r * nb), *area, rule, out);
                 }
                 out.scratch = world;
                 out.scratch_v = vel;
@@ -914,44 +1053,37 @@ impl Poly {
     }
 }
 
-/// A mesh's triangle (vertices counter-clockwise seen from outside, `u` their
-/// velocities): [`polygon`], with its two common cases taken first at the vertices: wholly
-/// below the surface and leading (the triangle itself, as [`polygon`] keeps it), and
-/// wholly trailing by a margin far above the grazing test's (nothing, as [`polygon`]
-/// finds). The same elements, bit for bit, given the same normal `n` and area `area`
-/// (the mesh's own, turned: they differ from the world vertices' by round-off).
-fn mesh_triangle(
-    m: &Motion,
-    pts: &[V3; 3],
-    u: &[V3; 3],
-    n: &V3,
-    area: f64,
-    rule: &Quadrature,
-    out: &mut Elements,
-) {
-    let n = *n;
+/// What the cut keeps of a mesh's triangle.
+enum Facet {
+    /// All of it.
+    Whole,
+    /// None: trailing.
+    Trailing,
+    /// What [`polygon_with`] finds.
+    Cut,
+}
+
+/// A mesh's triangle (vertices `pts` counter-clockwise seen from outside, `u` their
+/// velocities, `n` its normal) classed at its vertices for [`polygon_with`]: its two common
+/// cases first, wholly below the surface and leading (the triangle itself, as
+/// [`polygon_with`] keeps it), and wholly trailing by a margin far above the grazing test's
+/// (nothing, as [`polygon_with`] finds); the rest is cut. The same elements, bit for bit,
+/// given the same normal `n` and area (the mesh's own, turned: they differ from the world
+/// vertices' by round-off).
+#[inline(always)]
+fn facet(m: &Motion, pts: &[V3; 3], u: &[V3; 3], n: &V3) -> Facet {
     let nu = [n.dot(&u[0]), n.dot(&u[1]), n.dot(&u[2])];
     if nu.iter().all(|x| *x >= 0.0) && pts.iter().all(|p| m.surface - p.z >= 0.0) {
-        triangle_with(
-            &pts[0],
-            &pts[1],
-            &pts[2],
-            &n,
-            area,
-            rule.subdivisions(),
-            m.surface,
-            out,
-        );
-        return;
+        return Facet::Whole;
     }
     let speed2 = u.iter().map(|x| x.norm_squared()).fold(0.0, f64::max);
     let least = nu.iter().map(|x| -x).fold(f64::INFINITY, f64::min);
     // Trailing at every vertex by more than 1e-6 |v|: so at every point of the face (n . v
     // is linear on it, |v| convex), far from the grazing test's 1e-12.
     if least > 0.0 && least * least > 1e-12 * speed2 {
-        return;
+        return Facet::Trailing;
     }
-    polygon_with(m, pts, &n, rule, out);
+    Facet::Cut
 }
 
 /// A flat face's outward unit normal (vertices counter-clockwise seen from outside).
@@ -1030,7 +1162,28 @@ fn triangle_with(
     area: f64,
     k: usize,
     surface: f64,
-    out: &mut Elements,
+    out: &mut impl Sink,
+) {
+    // The default rule's case (k = 1) on its own: the same operations, its divisions by 1
+    // and its loop's counters folded away by the compiler.
+    if k == 1 {
+        triangle_cut(a, b, c, n, area, 1, surface, out);
+    } else {
+        triangle_cut(a, b, c, n, area, k, surface, out);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn triangle_cut(
+    a: &V3,
+    b: &V3,
+    c: &V3,
+    n: &V3,
+    area: f64,
+    k: usize,
+    surface: f64,
+    out: &mut impl Sink,
 ) {
     if area <= 0.0 {
         return;
@@ -1043,7 +1196,7 @@ fn triangle_with(
     const SIXTH: f64 = 1.0 / 6.0;
     let mut emit = |p: V3, q: V3, r: V3| {
         let x = [4.0 * p + q + r, p + 4.0 * q + r, p + q + 4.0 * r].map(|x| x * SIXTH);
-        out.push3(x, n, weight, surface);
+        out.put3(x, n, weight, surface);
     };
     for i in 0..k {
         for j in 0..k - i {
@@ -1203,6 +1356,76 @@ mod tests {
                     for (a, b) in fast.area.iter().zip(&each.area) {
                         assert!((a - b).abs() <= 1e-15 * b, "z {z} v {v:?}: {a} vs {b}");
                     }
+                }
+            }
+        }
+    }
+
+    /// The same on a mesh of more triangles than the cut makes room for at a time (a
+    /// UV sphere of 2208, all under and at rest: every one whole), at two rules.
+    #[test]
+    fn a_big_mesh_cut_in_runs_is_the_clip_of_each_face() {
+        let (rings, around) = (24, 48);
+        let mut v = vec![[0.0, 0.0, 0.05]];
+        for i in 1..rings {
+            let th = PI * i as f64 / rings as f64;
+            for j in 0..around {
+                let ph = 2.0 * PI * j as f64 / around as f64;
+                let (s, c) = (0.05 * th.sin(), 0.05 * th.cos());
+                v.push([s * ph.cos(), s * ph.sin(), c]);
+            }
+        }
+        v.push([0.0, 0.0, -0.05]);
+        let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as i64;
+        let bottom = v.len() as i64 - 1;
+        let mut t = Vec::new();
+        for j in 0..around {
+            t.push([0, ring(1, j), ring(1, j + 1)]);
+            for i in 1..rings - 1 {
+                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+            }
+            t.push([bottom, ring(rings - 1, j + 1), ring(rings - 1, j)]);
+        }
+        assert_eq!(t.len(), 2208);
+        let shape = Shape::mesh("m", &v, &t).unwrap();
+        let Shape::Mesh(m) = &shape else {
+            unreachable!()
+        };
+        let q = UnitQuaternion::from_euler_angles(0.3, 0.5, -0.2);
+        let r = q.to_rotation_matrix();
+        for rule in [Quadrature::new(6), Quadrature::new(12)] {
+            for (z, v, w) in [
+                (-0.2, V3::zeros(), V3::zeros()),
+                (0.01, V3::new(0.3, -0.2, -1.0), V3::new(1.0, 2.0, -0.5)),
+            ] {
+                let c = V3::new(0.0, 0.0, z);
+                let mut fast = Elements::default();
+                shape.elements(&c, &q, &v, &w, 0.0, &rule, &mut fast);
+                let motion = Motion {
+                    c,
+                    v,
+                    omega: w,
+                    surface: 0.0,
+                };
+                let mut each = Elements::default();
+                for (t, nb) in m.triangles.iter().zip(&m.normals) {
+                    let pts = t.map(|i| c + r * m.vertices[i]);
+                    polygon_with(&motion, &pts, &(r * nb), &rule, &mut each);
+                }
+                if z < -0.1 {
+                    let k = rule.subdivisions();
+                    assert_eq!(fast.len(), 3 * k * k * t.len());
+                }
+                assert_eq!(
+                    (&fast.x, &fast.n, &fast.depth),
+                    (&each.x, &each.n, &each.depth)
+                );
+                // The areas: the mesh's against the world vertices' (their edges, 30 times
+                // shorter than their distance from the origin here, lose digits to it).
+                assert_eq!(fast.area.len(), each.area.len());
+                for (a, b) in fast.area.iter().zip(&each.area) {
+                    assert!((a - b).abs() <= 1e-13 * b, "{a} vs {b}");
                 }
             }
         }
