@@ -408,39 +408,81 @@ pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F;
     }
 }
 
-/// The forces of `law`'s terms on `state`: each term's own arithmetic, with its numbers
-/// from `numbers` in the lanes and its own in one lane (`contact_force`: a term's fast
-/// path for one scene, the same bits). `THESIS`: the thesis's three, known when compiled.
+/// The sums of one evaluation's terms: F_d, F_s, the moment, the sticking bounds, and each
+/// term's force (zero past the list).
+#[derive(Clone, Copy)]
+struct Sums<F> {
+    dynamic: [F; 2],
+    statics: [F; 2],
+    moment: F,
+    bound: [F; 2],
+    forces: [[F; 2]; MAX_TERMS],
+}
+
+impl<F: Real> Sums<F> {
+    /// No term.
+    #[inline(always)]
+    fn zero() -> Self {
+        let zero = F::splat(0.0);
+        Sums {
+            dynamic: [zero; 2],
+            statics: [zero; 2],
+            moment: zero,
+            bound: [zero; 2],
+            forces: [[zero; 2]; MAX_TERMS],
+        }
+    }
+
+    /// Term `k`'s force `tf` (of class `dynamic`) added as `terms_on` adds it.
+    #[inline(always)]
+    fn add(&mut self, k: usize, dynamic: bool, tf: TermForce<F>) {
+        let f = tf.force;
+        self.forces[k] = f;
+        if dynamic {
+            self.dynamic = [self.dynamic[0] + f[0], self.dynamic[1] + f[1]];
+        } else {
+            self.statics = [self.statics[0] + f[0], self.statics[1] + f[1]];
+        }
+        self.moment = self.moment + tf.moment;
+        self.bound = [self.bound[0] + tf.bound[0], self.bound[1] + tf.bound[1]];
+    }
+}
+
+/// The terms of `law` on `state`, summed in the list's order (`terms_on`): each term's own
+/// arithmetic, with its numbers from `numbers` in the lanes and its own in one lane
+/// (`contact_force`: a term's fast path for one scene, the same bits). `THESIS`: the
+/// thesis's three, known when compiled (`law.thesis`).
 #[inline(always)]
-fn term_forces<F: Real, const THESIS: bool>(
+fn term_sums<F: Real, const THESIS: bool>(
     law: &RodLaw,
     numbers: &[F; LANE_NUMBERS],
     state: &ContactState<F>,
     medium: &Medium<F>,
-    out: &mut [TermForce<F>; MAX_TERMS],
+    sums: &mut Sums<F>,
 ) {
     let lanes = F::LANES > 1;
     if THESIS {
-        if let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] = law.terms[..] {
-            if lanes {
-                out[0] = d.force_with(&numbers[0..1], state, medium);
-                out[1] = h.force_with(&numbers[1..2], state, medium);
-                out[2] = v.force_with(&numbers[2..4], state, medium);
-            } else {
-                out[0] = d.contact_force(state, medium);
-                out[1] = h.contact_force(state, medium);
-                out[2] = v.contact_force(state, medium);
-            }
-            return;
+        let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] = law.terms[..] else {
+            unreachable!("a law marked the thesis's lists its three terms");
+        };
+        if lanes {
+            sums.add(0, true, d.force_with(&numbers[0..1], state, medium));
+            sums.add(1, false, h.force_with(&numbers[1..2], state, medium));
+            sums.add(2, false, v.force_with(&numbers[2..4], state, medium));
+        } else {
+            sums.add(0, true, d.contact_force(state, medium));
+            sums.add(1, false, h.contact_force(state, medium));
+            sums.add(2, false, v.contact_force(state, medium));
         }
+        return;
     }
     for (k, t) in law.terms.iter().enumerate() {
-        out[k] = if lanes {
-            let n = &numbers[law.at[k]..];
-            t.force_with(n, state, medium)
+        let tf = if lanes {
+            t.force_with(&numbers[law.at[k]..], state, medium)
         } else {
             t.contact_force(state, medium)
         };
+        sums.add(k, law.dynamic[k], tf);
     }
 }
 
@@ -537,12 +579,7 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         sign,
         boundary: None,
     };
-    let none = TermForce {
-        force: [zero, zero],
-        bound: [zero, zero],
-        moment: zero,
-    };
-    let mut forces = [none; MAX_TERMS];
+    let mut sums = Sums::zero();
     // Out of the sand in every lane, each use of the law below is blended away: skip it
     // (its `pow`). The results are the same bit for bit.
     if !forced.all_zero() {
@@ -581,24 +618,18 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
                 boundary: Some(&b),
                 ..state
             };
-            term_forces::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut forces);
+            term_sums::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut sums);
         } else {
-            term_forces::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut forces);
+            term_sums::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut sums);
         }
     }
-    // The sums by class, the moment and the bounds, in the list's order (`terms_on`).
-    let len = if THESIS { 3 } else { law.terms.len() };
-    let (mut dynamic, mut statics, mut moment, mut bound) = ([zero; 2], [zero; 2], zero, [zero; 2]);
-    for (k, tf) in forces.iter().enumerate().take(len) {
-        let f = tf.force;
-        if (THESIS && k == 0) || (!THESIS && law.dynamic[k]) {
-            dynamic = [dynamic[0] + f[0], dynamic[1] + f[1]];
-        } else {
-            statics = [statics[0] + f[0], statics[1] + f[1]];
-        }
-        moment = moment + tf.moment;
-        bound = [bound[0] + tf.bound[0], bound[1] + tf.bound[1]];
-    }
+    let Sums {
+        dynamic,
+        statics,
+        moment,
+        bound,
+        forces,
+    } = sums;
     let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
     let lever_p = lever(p_local);
     let torque = total[0] * lever_p[0] + total[1] * lever_p[1];
@@ -657,10 +688,7 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
     // Each term's force, the reaction in its owner's place (`ContactForce::set_reaction`).
     let owner = if THESIS { [1, 2] } else { law.owner };
     let terms: [[F; 2]; MAX_TERMS] = std::array::from_fn(|k| {
-        if k >= len {
-            return [zero, zero];
-        }
-        let f = forces[k].force;
+        let f = forces[k];
         let fx = if k == owner[0] {
             sel(row_x, mult, f[0])
         } else {
