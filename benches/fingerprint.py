@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 import granrs
-from granrs import cases, forces, scenefile
+from granrs import cases, forces, scenefile, space
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "scenes"
 
@@ -47,11 +47,11 @@ def fingerprint() -> dict[str, Any]:
             for k in sorted(res.series):
                 a = np.asarray(res.series[k], dtype=float)
                 d["series." + k] = [float(np.nansum(a)), float(np.nansum(np.abs(a))), a.size]
-        for i, c in enumerate(res.contacts):
+        for i, c in enumerate(getattr(res, "contacts", ())):  # none in space
             for k, v in dataclasses.asdict(c).items():
                 if isinstance(v, (int, float)) and not isinstance(v, bool):
                     d[f"c{i}.{k}"] = float(v)
-        for joint, values in res.joints.items():
+        for joint, values in getattr(res, "joints", {}).items():
             for k, v in values.items():
                 if isinstance(v, (int, float)) and not isinstance(v, bool):
                     d[f"{joint}.{k}"] = float(v)
@@ -64,6 +64,12 @@ def fingerprint() -> dict[str, Any]:
             out[name] = {"error": f"{type(e).__name__}: {e}"}
 
     rec = ("state", "forces", "energy")
+
+    def recorded(scene: Any) -> Any:
+        """The scene recording every series: a planar scene names its series, a scene in
+        space records all of them (``record=True``)."""
+        return scene.replace(record=True if isinstance(scene, space.Scene) else rec)
+
     for q in [-60, -30, 0, 15, 45, 75]:
         for v0 in [0.5, 2.27]:
             run(
@@ -118,7 +124,7 @@ def fingerprint() -> dict[str, Any]:
 
         run(f"leg {sorted(kw)}", leg)
     for f in sorted(glob.glob(str(EXAMPLES / "*.toml"))):
-        run("file " + Path(f).name, lambda f=f: scenefile.load(f).replace(record=rec))
+        run("file " + Path(f).name, lambda f=f: recorded(scenefile.load(f)))
     sweeps = [
         (
             "free link",

@@ -31,3 +31,17 @@ def hold_upright(
     finally:
         if mode == "callback":
             sand.uninstall()
+
+
+def assert_rests(pos: list[Any], force: list[float], weight: float, timestep: float) -> slice:
+    """The rest line over the last 5 s of a run recorded at each step: the foot's position
+    (``pos``) moves less than 0.1 mm, the sand's vertical force (``force``) balances
+    ``weight`` to 1e-3 on average with a step-to-step spread under 5 % of it. Returns the
+    window, for the energy checks each test makes its own way."""
+    last = slice(-round(5.0 / timestep), None)
+    assert np.all(np.isfinite(pos))
+    assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
+    fz = np.array(force)[last]
+    assert abs(fz.mean() / weight - 1) < 1e-3
+    assert np.max(np.abs(np.diff(fz))) < 0.05 * weight
+    return last

@@ -14,7 +14,7 @@ import granrs
 from granrs import forces, space
 
 mujoco = pytest.importorskip("mujoco")
-from hopper_hold import hold_upright  # noqa: E402
+from hopper_hold import assert_rests, hold_upright  # noqa: E402
 
 from granrs.mujoco import Sand, body_drop, body_mjcf  # noqa: E402
 
@@ -271,12 +271,7 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_rft3d(mode, foot):
         power.append(sand.applied[0, :3] @ sand.output[0, 8:11])
 
     hold_upright(m, d, sand, mode, 10.0, record)
-    last = slice(-round(5.0 / h), None)
-    assert np.all(np.isfinite(pos))
-    assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
-    fz = np.array(fz)[last]
-    assert abs(fz.mean() / weight - 1) < 1e-3
-    assert np.max(np.abs(np.diff(fz))) < 0.05 * weight
+    last = assert_rests(pos, fz, weight, h)
     assert max(power[last]) <= 1e-9
 
 
@@ -314,12 +309,7 @@ def test_gymnasiums_hopper_foot_rests_on_sand_under_poncelet_in_space(mode, foot
         fz.append(sand.applied[0, 2])
 
     hold_upright(m, d, sand, mode, 10.0, record)
-    last = slice(-round(5.0 / h), None)
-    assert np.all(np.isfinite(pos))
-    assert np.max(np.ptp(np.array(pos)[last], axis=0)) < 1e-4
-    fz = np.array(fz)[last]
-    assert abs(fz.mean() / weight - 1) < 1e-3
-    assert np.max(np.abs(np.diff(fz))) < 0.05 * weight
+    last = assert_rests(pos, fz, weight, h)
     w = np.array(power)[last]
     work = np.cumsum(w) * h
     work -= work[0]

@@ -22,6 +22,7 @@ from granrs.cli import main as cli_main
 
 sys.path.insert(0, str(pathlib.Path(__file__).parent))
 from record_thesis_cases import cases
+from test_step_warning import short_impact  # a stop between the steps at dt = 1e-3
 
 CASES = cases()
 TABLE_3_5 = granrs.data.load("table_3_5", as_="numpy")
@@ -232,32 +233,6 @@ def test_a_sweep_refuses_bad_or_varying_outputs_before_running():
             base=base._plain(), axes=[("outputs", [["depth"], ["t_s"]])], outputs=None
         )
     assert info.value.field == "outputs"
-
-
-#: A stop that falls between the steps at dt = 1e-3, below the stability limit
-#: (``tests/test_step_warning.py``'s SHORT_IMPACT): its t_s is 3.4 % off.
-SHORT_IMPACT = {
-    "q_deg": -59.36603674137732,
-    "v0": 2.257535989222119,
-    "vx0": -0.5208720763409533,
-    "omega0": -1.9500340379203678,
-    "mass": 0.01561018995462787,
-}
-
-
-def short_impact(dt: float, **changes: object) -> granrs.Scene:
-    p = SHORT_IMPACT
-    return granrs.cases.free_link(p["q_deg"], p["v0"], dt=dt).replace(
-        vx0=p["vx0"],
-        omega0=p["omega0"],
-        mass=p["mass"],
-        apply_at="centroid",
-        forces=[
-            granrs.forces.gravity(),
-            granrs.forces.poncelet(c=2.022590768128497, k=344.6961170301384),
-        ],
-        **changes,
-    )
 
 
 def caught(fn):

@@ -27,11 +27,12 @@ ALL_CONTACT_TERMS = (
     forces.poncelet(c=0.8, k=150.0),
     forces.rft(zeta=1e6),
     forces.rft_inertial(),
+    forces.axial_drag(eta_a=6.0),
 )
 
 
 def test_every_contact_term_is_in_the_list() -> None:
-    """The registry's contact terms on a rod are the six above (a new one joins this test;
+    """The registry's contact terms on a rod are those above (a new one joins this test;
     the terms of bodies in space are tested in tests/test_space.py)."""
     contact = {
         t["name"]
@@ -42,7 +43,7 @@ def test_every_contact_term_is_in_the_list() -> None:
 
 
 def test_a_scene_lists_every_contact_term_at_once() -> None:
-    """All six contact terms (and gravity) on one rod: it runs, and each term's force is
+    """Every contact term (and gravity) on one rod: it runs, and each term's force is
     recorded, finite, and acts at some sample."""
     scene = granrs.cases.free_link(q_deg=20.0, v0=2.0).replace(
         forces=(forces.gravity(), *ALL_CONTACT_TERMS), record=["forces"]

@@ -108,7 +108,8 @@ SHORT_IMPACT = {
 }
 
 
-def short_impact(dt: float) -> granrs.Scene:
+def short_impact(dt: float, **changes: object) -> granrs.Scene:
+    """The scene of SHORT_IMPACT at step ``dt``, with other fields ``changes``."""
     p = SHORT_IMPACT
     return cases.free_link(p["q_deg"], p["v0"], dt=dt).replace(
         vx0=p["vx0"],
@@ -116,6 +117,7 @@ def short_impact(dt: float) -> granrs.Scene:
         mass=p["mass"],
         apply_at="centroid",
         forces=[f.gravity(), f.poncelet(c=p["c"], k=p["k"])],
+        **changes,
     )
 
 
