@@ -685,10 +685,18 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         ];
         (qdd, mult, a)
     };
-    // Each term's force, the reaction in its owner's place (`ContactForce::set_reaction`).
-    let owner = if THESIS { [1, 2] } else { law.owner };
-    let terms: [[F; 2]; MAX_TERMS] = std::array::from_fn(|k| {
-        let f = forces[k];
+    // Each listed term's force, the reaction in its owner's place
+    // (`ContactForce::set_reaction`); zero past the list (as the sums left them). A plain
+    // loop, inlined, so that a stage that does not read the forces drops them (measured:
+    // `std::array::from_fn` here stayed a call, which kept every stage's forces in memory,
+    // a tenth to a quarter of a free-link impact on one scene).
+    let (owner, listed) = if THESIS {
+        ([1, 2], 3)
+    } else {
+        (law.owner, law.terms.len())
+    };
+    let mut terms = [[zero; 2]; MAX_TERMS];
+    for (k, (term, f)) in terms.iter_mut().zip(forces).take(listed).enumerate() {
         let fx = if k == owner[0] {
             sel(row_x, mult, f[0])
         } else {
@@ -699,8 +707,8 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         } else {
             f[1]
         };
-        sel2(forced, [fx, fy], [zero, zero])
-    });
+        *term = sel2(forced, [fx, fy], [zero, zero]);
+    }
     let statics = sel2(
         forced,
         [sel(row_x, mult, statics[0]), sel(row_y, mult, statics[1])],
