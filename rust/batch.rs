@@ -417,8 +417,7 @@ pub struct BatchOut {
 /// How a batch runs its scenes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Path {
-    /// Free-link scenes under the thesis's terms or a frame law (`rft`, `poncelet`,
-    /// `rft_inertial`) four at a time in SIMD lanes (`integrate::lanes`, with AVX2 where the
+    /// Free-link scenes (under any terms) four at a time in SIMD lanes (`integrate::lanes`, with AVX2 where the
     /// CPU has it), every other scene alone. The default; the results are the scalar path's
     /// bit for bit.
     Lanes,

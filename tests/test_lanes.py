@@ -90,7 +90,7 @@ def test_table_3_5_in_lanes_equals_the_scalar_path(sign_model: str) -> None:
 
 
 def test_uncovered_scenes_mixed_in_run_alone_with_the_same_rows() -> None:
-    """The thesis's terms out of its order and Dopri5 (run alone); some of its terms, the raw
+    """Dopri5 (run alone); the thesis's terms out of its order, some of its terms, the raw
     and smooth sign models, gravity off and the centroid as the point of application (in
     lanes), in one sweep."""
     base = cases.free_link(q_deg=30, v0=2.0)

@@ -577,13 +577,11 @@ def sweep(
             runs (default: about four chunks per worker thread), each run by the Rust batch
             on a worker with one thread. The result is the same DataFrame.
         chunk_size: runs per Dask task.
-        lanes: run free-link scenes under the thesis's terms (``drag``, ``static_h``,
-            ``static_v`` in that order, or some of them) or under ``rft`` or ``poncelet``,
-            ``rft_inertial``, or one of the first two with ``rft_inertial`` (with or without
-            ``gravity``; any sign model; RK4) four at a time in SIMD lanes, with AVX2 where
-            the CPU has it (default). The results are the same bit for bit as with
-            ``lanes=False``, which runs every scene alone on the scalar path (for
-            comparisons and benchmarks). Other scenes always run alone.
+        lanes: run free-link scenes (under any terms, alone or mixed; any sign model; RK4)
+            four at a time in SIMD lanes, with AVX2 where the CPU has it (default). The
+            results are the same bit for bit as with ``lanes=False``, which runs every
+            scene alone on the scalar path (for comparisons and benchmarks). Other scenes
+            always run alone.
         outputs: the output fields every run computes and returns, from
             :data:`granrs.OUTPUTS` (``status`` always): the result's columns. None (default)
             keeps the scenes' own ``outputs`` (by default every field; a list of scenes must

@@ -1,56 +1,113 @@
-//! The free link under the thesis's terms or a law of terms that read the contact's frame
-//! (`rft`, `poncelet`, `rft_inertial`), for one scene or several at once:
+//! The free link under any law it accepts, for one scene or several at once:
 //! [`Model::eval_rigid_rod`] written over [`Real`]. With `F = f64` it is the lean path of a
 //! lone run's RK4 steps (`integrate::solve::Run::step`: a stage computes only what the step
 //! reads, after inlining); with `F = F64x4` it evaluates four scenes, one per SIMD lane, in
 //! the same instructions (the sweep's lanes, `integrate::lanes`).
 //!
-//! The force law is not copied: the terms' own arithmetic ([`Drag::law`], [`StaticH::law`],
-//! [`StaticV::law`], what their `contact_force` runs) is called with one parameter per lane,
-//! and the frame terms' own arithmetic (`force_with`, what their `contact_force` runs) on
-//! the boundary the general path gives them, with one number per lane (the four lanes share
-//! the terms and element counts: `rft`'s sets its loop). The mechanics (the rod's
-//! frame, its immersed geometry, the closed-form sticking row and the sums of
-//! [`super::rigid_rod`]) are written again without branches: each branch of the scalar path
-//! becomes a blend ([`Real::select_pos`]) on a per-lane flag, and each operation is the
-//! scalar path's, in its order, so that the results are [`Model::eval`]'s bit for bit (tests
-//! hold them so over random states and modes, and whole runs to the general path). Two
-//! blocks are skipped when every lane blends them away (the law out of the sand, the
-//! sticking row when nothing sticks): the same bits, less work.
+//! The force law is not copied, nor listed here: each contact term the scene lists is
+//! evaluated by its own arithmetic, [`Term::force_with`] (what its `contact_force` runs),
+//! with its numbers from its parameter table, one per lane ([`RodParams::numbers`]; a lone
+//! run calls the term's `contact_force`, its own numbers). The lanes share the terms and
+//! their counts ([`RodLaw`], [`RodLaw::shares`]). The mechanics (the rod's frame, its
+//! immersed geometry, the closed-form sticking row and the sums of [`super::rigid_rod`])
+//! are written again without branches: each branch of the scalar path becomes a blend
+//! ([`Real::select_pos`]) on a per-lane flag, and each operation is the scalar path's, in
+//! its order (the terms' sums in the list's order, as `terms_on`), so that the results are
+//! [`Model::eval`]'s bit for bit (tests hold them so over random states, modes and laws,
+//! and whole runs to the general path). Two blocks are skipped when every lane blends them
+//! away (the law out of the sand, the sticking row when nothing sticks): the same bits,
+//! less work.
 //!
 //! What it covers: a free link ([`Model::rigid_rod`]), applied at the tip or at the centroid,
 //! under any sign model (`modes`, held through a step; the thesis's plain sign `raw` and
-//! `smooth`'s tanh, each evaluation's own, with no sticking), whose contact terms are
-//! ([`RodParams::of`], [`RodLayout::of`]):
-//! - the thesis's three or any of them (`drag`, `static_h`, `static_v`, in that order;
-//!   `gravity` on or off: an absent term is one with a zero coefficient, whose force is
-//!   exactly zero, so every sum has the general path's bits); or
-//! - a [`FrameLaw`]: `rft` or `poncelet`, `rft_inertial`, or one of the first two with the
-//!   third, in either order (their moments, the held sign's shift of the frame and the
-//!   bounded reaction in y, from depth 0 while in contact, as the general path reads a law
-//!   that reads the frame);
-//!
-//! and in modes with at most one sticking row ([`RodModes::of`]). A step in a mode that
-//! sticks in both x and y, or whose one sticking row has a zero pivot ([`RodEval::pivot`]),
-//! is taken on the general path.
+//! `smooth`'s tanh, each evaluation's own, with no sticking), under any contact terms the
+//! free link accepts ([`RodParams::of`]), in modes with at most one sticking row whose
+//! reaction stands in one term's place ([`RodModes::of`]). A step in a mode that sticks in
+//! both x and y, or in an axis whose switch several static terms share, or whose one
+//! sticking row has a zero pivot ([`RodEval::pivot`]), is taken on the general path.
 
 use nalgebra::{SVector, Vector2};
 
 use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, SignModel, Slip};
 use crate::body::rod::ApplyAt;
-use crate::forces::drag::Drag;
-use crate::forces::poncelet::Poncelet;
-use crate::forces::rft::{Rft, RftCoefficients, RftInertial};
-use crate::forces::static_h::StaticH;
-use crate::forces::static_v::StaticV;
+use crate::forces::registry::{TermList, LANE_NUMBERS, MAX_TERMS};
 use crate::forces::{
-    AnyTerm, Boundary, ContactState, Frame, Medium, Outline, Real, Term, TermForce,
+    AnyTerm, Boundary, ContactState, Frame, Medium, Outline, Real, Switch, Term, TermForce,
 };
 use crate::num::{F64x4, LANES};
 
-/// What the evaluation of one free link under the thesis's terms or a [`FrameLaw`] reads
-/// that is fixed through a run: its mass, geometry, medium and the terms' parameters (one
-/// lane per scene; a frame law's one for all four).
+/// The contact terms of a free link as the lanes run them, with what the general path
+/// derives from them (`ForceSet`): one for every lane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodLaw {
+    /// The contact terms, in the scene's order (their counts, `Param::integer`, are the
+    /// lanes'; their other numbers are each lane's own, [`RodParams::numbers`]).
+    pub terms: TermList,
+    /// Where term `k`'s numbers start in [`RodParams::numbers`].
+    pub at: [usize; MAX_TERMS],
+    /// Whether term `k` adds to F_d (its class).
+    pub dynamic: [bool; MAX_TERMS],
+    /// Whether a listed term owns the slip switch of x, of y.
+    pub owns: [bool; 2],
+    /// Per axis, the one static term whose component a sticking reaction replaces
+    /// (`ForceSet::sole_static_owner`; `usize::MAX`: none).
+    pub owner: [usize; 2],
+    /// Whether a listed term reads the contact's frame (then the law acts from depth 0).
+    pub reads_frame: bool,
+    /// Whether a listed term reads A_r |v_E|.
+    pub reads_area_speed: bool,
+    /// Whether the terms are the thesis's three in its order (`drag`, `static_h`,
+    /// `static_v`): the lanes compile them into a step of their own, with no dispatch
+    /// between the terms (the common case; the same arithmetic).
+    pub thesis: bool,
+}
+
+impl RodLaw {
+    /// The law of `model`'s one contact.
+    fn of<const N: usize>(model: &Model<N>) -> Self {
+        let forces = &model.forces;
+        let terms = forces.per_contact[0];
+        let mut at = [0; MAX_TERMS];
+        let mut next = 0;
+        for (k, t) in terms.iter().enumerate() {
+            at[k] = next;
+            next += t.info().params.len();
+        }
+        RodLaw {
+            terms,
+            at,
+            dynamic: forces.dynamic,
+            owns: [forces.owns(Switch::SlipX), forces.owns(Switch::SlipY)],
+            owner: forces.sole_static_owner.map(|o| o.unwrap_or(usize::MAX)),
+            reads_frame: forces.reads_frame,
+            reads_area_speed: forces.reads_area_speed,
+            thesis: matches!(
+                terms[..],
+                [AnyTerm::Drag(_), AnyTerm::StaticH(_), AnyTerm::StaticV(_)]
+            ),
+        }
+    }
+
+    /// Whether runs under `self` and `other` can share the lanes: the same terms in the same
+    /// order with the same counts (`Param::integer`: `rft`'s elements set its loop); their
+    /// other numbers are per lane.
+    pub fn shares(&self, other: &RodLaw) -> bool {
+        self.terms.len() == other.terms.len()
+            && self.terms.iter().zip(other.terms.iter()).all(|(a, b)| {
+                let info = a.info();
+                info.name == b.info().name
+                    && info
+                        .params
+                        .iter()
+                        .zip(a.params().into_iter().zip(b.params()))
+                        .all(|(p, (x, y))| !p.integer || x == y)
+            })
+    }
+}
+
+/// What the evaluation of one free link reads that is fixed through a run: its mass,
+/// geometry, medium and its terms' numbers (one lane per scene), and its law (one for all
+/// four).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RodParams<F> {
     /// m + m_root [kg].
@@ -73,14 +130,6 @@ pub struct RodParams<F> {
     pub at_centroid: F,
     /// The sand.
     pub medium: Medium<F>,
-    /// drag.eta_d.
-    pub eta_d: F,
-    /// static_h.eta_h.
-    pub eta_h: F,
-    /// static_v.eta_v.
-    pub eta_v: F,
-    /// static_v.lam.
-    pub lam: F,
     /// 1 where the signs of v_E and of e x v_E are each evaluation's own (`raw`, `smooth`),
     /// 0 under `modes` (held through a step).
     pub unheld: F,
@@ -88,224 +137,68 @@ pub struct RodParams<F> {
     pub smooth: F,
     /// `smooth`'s eps [m/s] (1 under the other sign models).
     pub eps: F,
-    /// The law when its terms read the contact's frame ([`FrameLaw`]; then the thesis's
-    /// coefficients are zero): its terms and element counts one for every lane (the lanes
-    /// take only runs with the same, [`same_law`], [`RodParams::set`]), its numbers in
-    /// `frame_numbers`.
-    pub frame: Option<FrameLaw>,
-    /// The frame law's numbers, one per lane (zero for a term it does not list).
-    pub frame_numbers: FrameNumbers<F>,
+    /// Each listed term's parameter values in its table's order (`Term::params`), the
+    /// terms one after the other ([`RodLaw::at`]); zero past them.
+    pub numbers: [F; LANE_NUMBERS],
+    /// The contact terms, one law for every lane.
+    pub law: RodLaw,
 }
 
-/// A [`FrameLaw`]'s numbers in `F`, one per lane.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrameNumbers<F> {
-    /// `rft`'s `zeta` and coefficients.
-    pub rft: RftCoefficients<F>,
-    /// `poncelet`'s `c` and `k`.
-    pub poncelet: [F; 2],
-    /// `rft_inertial`'s `lam`.
-    pub lam: F,
-}
-
-impl FrameNumbers<f64> {
-    /// The numbers of `law` (zeros without one).
-    fn of(law: Option<&FrameLaw>) -> Self {
-        let mut n = FrameNumbers {
-            rft: RftCoefficients {
-                zeta: 0.0,
-                k: [0.0; 9],
+impl<F: Copy> RodParams<F> {
+    /// The same parameters, each number through `f`.
+    fn map<G>(&self, f: impl Fn(F) -> G) -> RodParams<G> {
+        RodParams {
+            mass: f(self.mass),
+            g: f(self.g),
+            inv_m: f(self.inv_m),
+            inv_i: f(self.inv_i),
+            tip: self.tip.map(&f),
+            length: f(self.length),
+            diameter: f(self.diameter),
+            section: f(self.section),
+            at_centroid: f(self.at_centroid),
+            medium: Medium {
+                rho_g: f(self.medium.rho_g),
+                g: f(self.medium.g),
             },
-            poncelet: [0.0; 2],
-            lam: 0.0,
-        };
-        match law.and_then(|l| l.statics) {
-            Some(FrameStatic::Rft(r)) => n.rft = r.coefficients_in(),
-            Some(FrameStatic::Poncelet(t)) => n.poncelet = [t.c, t.k],
-            None => {}
-        }
-        if let Some(r) = law.and_then(|l| l.inertial) {
-            n.lam = r.lam;
-        }
-        n
-    }
-}
-
-impl FrameNumbers<F64x4> {
-    /// Every lane `n`.
-    fn splat(n: &FrameNumbers<f64>) -> Self {
-        let s = F64x4::splat;
-        FrameNumbers {
-            rft: RftCoefficients {
-                zeta: s(n.rft.zeta),
-                k: n.rft.k.map(s),
-            },
-            poncelet: n.poncelet.map(s),
-            lam: s(n.lam),
+            unheld: f(self.unheld),
+            smooth: f(self.smooth),
+            eps: f(self.eps),
+            numbers: self.numbers.map(&f),
+            law: self.law,
         }
     }
 
-    /// Each value.
-    pub fn each(&mut self, mut f: impl FnMut(&mut F64x4)) {
-        f(&mut self.rft.zeta);
-        self.rft.k.iter_mut().for_each(&mut f);
-        self.poncelet.iter_mut().for_each(&mut f);
-        f(&mut self.lam);
-    }
-
-    /// Lane `i` becomes `n`.
-    fn set(&mut self, i: usize, n: &FrameNumbers<f64>) {
-        self.rft.zeta.0[i] = n.rft.zeta;
-        for (x, v) in self.rft.k.iter_mut().zip(n.rft.k) {
-            x.0[i] = v;
+    /// Each number, in [`RodParams::map`]'s order.
+    fn each_mut(&mut self, mut f: impl FnMut(&mut F)) {
+        for x in [
+            &mut self.mass,
+            &mut self.g,
+            &mut self.inv_m,
+            &mut self.inv_i,
+        ] {
+            f(x);
         }
-        for (x, v) in self.poncelet.iter_mut().zip(n.poncelet) {
-            x.0[i] = v;
+        self.tip.iter_mut().for_each(&mut f);
+        for x in [
+            &mut self.length,
+            &mut self.diameter,
+            &mut self.section,
+            &mut self.at_centroid,
+            &mut self.medium.rho_g,
+            &mut self.medium.g,
+            &mut self.unheld,
+            &mut self.smooth,
+            &mut self.eps,
+        ] {
+            f(x);
         }
-        self.lam.0[i] = n.lam;
+        self.numbers.iter_mut().for_each(f);
     }
-}
-
-/// A law of terms that read the contact's frame, as the lean path runs it: at most one
-/// static term (`rft` or `poncelet`, the owner of y's slip switch, in `static_v`'s place)
-/// and at most one dynamic one (`rft_inertial`, in `drag`'s place), in either order (two
-/// terms' sums are the same in either).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrameLaw {
-    /// The static term.
-    pub statics: Option<FrameStatic>,
-    /// `rft_inertial`.
-    pub inertial: Option<RftInertial>,
-}
-
-/// The static term of a [`FrameLaw`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum FrameStatic {
-    /// Resistive force theory.
-    Rft(Rft),
-    /// The Poncelet / Katsuragi-Durian law.
-    Poncelet(Poncelet),
-}
-
-/// Whether two runs' frame laws can share the lanes: the same terms with the same element
-/// counts (their numbers are per lane, [`FrameNumbers`]).
-pub fn same_law(a: &Option<FrameLaw>, b: &Option<FrameLaw>) -> bool {
-    let shape = |law: &Option<FrameLaw>| {
-        law.map(|l| {
-            let statics = match l.statics {
-                Some(FrameStatic::Rft(r)) => (1, r.elements),
-                Some(FrameStatic::Poncelet(_)) => (2, 0),
-                None => (0, 0),
-            };
-            (statics, l.inertial.map(|r| r.elements))
-        })
-    };
-    shape(a) == shape(b)
-}
-
-impl FrameLaw {
-    /// The law `terms` make, with where each stands ([`RodLayout::slot`]), when they are
-    /// terms that read the frame as [`FrameLaw`] allows.
-    fn of(terms: &[AnyTerm]) -> Option<(Self, [usize; 3])> {
-        let mut law = FrameLaw {
-            statics: None,
-            inertial: None,
-        };
-        let mut slot = [usize::MAX; 3];
-        for (k, t) in terms.iter().enumerate() {
-            let statics = match t {
-                AnyTerm::Rft(r) => FrameStatic::Rft(*r),
-                AnyTerm::Poncelet(p) => FrameStatic::Poncelet(*p),
-                AnyTerm::RftInertial(r) if law.inertial.is_none() => {
-                    law.inertial = Some(*r);
-                    slot[0] = k;
-                    continue;
-                }
-                _ => return None,
-            };
-            if law.statics.is_some() {
-                return None;
-            }
-            law.statics = Some(statics);
-            slot[2] = k;
-        }
-        (!terms.is_empty()).then_some((law, slot))
-    }
-}
-
-/// Where a run's listed terms stand in the lean path's three places, read on the scalar
-/// side only (kept out of [`RodParams`], which the lanes' arithmetic reads).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct RodLayout {
-    /// Where the terms in `drag`'s, `static_h`'s and `static_v`'s places (a frame law's
-    /// `rft_inertial` in the first, its static term in the third) stand in the scene's list
-    /// of contact terms (`usize::MAX` for a place it leaves empty): [`RodEval::write`] puts
-    /// each term's force there.
-    pub slot: [usize; 3],
-    /// Whether the terms in the places of `static_h` and `static_v` are listed, so own the
-    /// slip switches of x and y (only then does that component stick, [`RodModes::of`]).
-    pub owns: [bool; 2],
-}
-
-impl Default for RodLayout {
-    /// No term placed and no axis owned: the layout of a run off the lean path (never read).
-    fn default() -> Self {
-        RodLayout {
-            slot: [usize::MAX; 3],
-            owns: [false; 2],
-        }
-    }
-}
-
-impl RodLayout {
-    /// The layout of `model`'s contact terms, where [`RodParams::of`] covers it.
-    #[inline(never)]
-    pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
-        // A free link (one contact) only: other bodies may list no contact at all.
-        model.rigid_rod()?;
-        let terms = model.forces.per_contact.first()?;
-        if let Some((law, slot)) = FrameLaw::of(terms) {
-            // The static term owns the slip switch of y, not of x.
-            return Some(RodLayout {
-                slot,
-                owns: [false, law.statics.is_some()],
-            });
-        }
-        let (slot, _) = thesis_slots(terms)?;
-        Some(RodLayout {
-            slot,
-            owns: [slot[1] != usize::MAX, slot[2] != usize::MAX],
-        })
-    }
-}
-
-/// Where each of the thesis's terms stands in `terms` ([`RodLayout::slot`]), when `terms`
-/// lists only those, each at most once and in the thesis's order.
-#[inline(never)]
-fn thesis_slots(terms: &[AnyTerm]) -> Option<([usize; 3], [Option<&AnyTerm>; 3])> {
-    let mut slot = [usize::MAX; 3];
-    let mut found = [None; 3];
-    let mut next = 0;
-    for (k, t) in terms.iter().enumerate() {
-        let c = match t {
-            AnyTerm::Drag(_) => 0,
-            AnyTerm::StaticH(_) => 1,
-            AnyTerm::StaticV(_) => 2,
-            _ => return None,
-        };
-        if c < next {
-            return None;
-        }
-        slot[c] = k;
-        found[c] = Some(t);
-        next = c + 1;
-    }
-    Some((slot, found))
 }
 
 impl RodParams<f64> {
-    /// The parameters of `model`, or `None` when the lanes do not cover it (another body,
-    /// another term set; see the module).
+    /// The parameters of `model`, or `None` when it is not a free link.
     #[inline(never)]
     pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
         let rod = model.rigid_rod()?;
@@ -314,31 +207,11 @@ impl RodParams<f64> {
             SignModel::Raw => (1.0, 0.0, 1.0),
             SignModel::Smooth { eps } => (1.0, 1.0, eps),
         };
-        let terms = &model.forces.per_contact[0];
-        let frame = FrameLaw::of(terms);
-        if model.forces.reads_frame && frame.is_none() {
-            return None;
-        }
-        // A law of frame terms: no thesis term, its static term owning the slip switch of
-        // y as the lanes place it ([`RodLayout::of`]).
-        let (slot, found) = match frame {
-            Some((_, slot)) => (slot, [None; 3]),
-            None => thesis_slots(terms)?,
-        };
-        let listed = |c: usize| (slot[c] != usize::MAX).then_some(slot[c]);
-        // The sticking reaction replaces its owner's component: the lanes' owners are the
-        // terms in `static_h`'s place (x) and `static_v`'s (y, or a frame law's static
-        // term), as the general path finds them.
-        if model.forces.sole_static_owner != [listed(1), listed(2)] {
-            return None;
-        }
-        let (mut eta_d, mut eta_h, mut eta_v, mut lam) = (0.0, 0.0, 0.0, 0.0);
-        for t in found.into_iter().flatten() {
-            match t {
-                AnyTerm::Drag(d) => eta_d = d.eta_d,
-                AnyTerm::StaticH(h) => eta_h = h.eta_h,
-                AnyTerm::StaticV(v) => (eta_v, lam) = (v.eta_v, v.lam),
-                _ => unreachable!("thesis_slots lists the thesis's terms only"),
+        let law = RodLaw::of(model);
+        let mut numbers = [0.0; LANE_NUMBERS];
+        for (k, t) in law.terms.iter().enumerate() {
+            for (j, v) in t.params().into_iter().enumerate() {
+                numbers[law.at[k] + j] = v;
             }
         }
         let link = &model.mechanism.links[0];
@@ -357,15 +230,11 @@ impl RodParams<f64> {
                 ApplyAt::Centroid => 1.0,
             },
             medium: model.medium,
-            eta_d,
-            eta_h,
-            eta_v,
-            lam,
             unheld,
             smooth,
             eps,
-            frame: frame.map(|(law, _)| law),
-            frame_numbers: FrameNumbers::of(frame.as_ref().map(|(law, _)| law)),
+            numbers,
+            law,
         })
     }
 }
@@ -373,60 +242,22 @@ impl RodParams<f64> {
 impl RodParams<F64x4> {
     /// Every lane `p`.
     pub fn splat(p: &RodParams<f64>) -> Self {
-        let s = F64x4::splat;
-        RodParams {
-            mass: s(p.mass),
-            g: s(p.g),
-            inv_m: s(p.inv_m),
-            inv_i: s(p.inv_i),
-            tip: [s(p.tip[0]), s(p.tip[1])],
-            length: s(p.length),
-            diameter: s(p.diameter),
-            section: s(p.section),
-            at_centroid: s(p.at_centroid),
-            medium: Medium {
-                rho_g: s(p.medium.rho_g),
-                g: s(p.medium.g),
-            },
-            eta_d: s(p.eta_d),
-            eta_h: s(p.eta_h),
-            eta_v: s(p.eta_v),
-            lam: s(p.lam),
-            unheld: s(p.unheld),
-            smooth: s(p.smooth),
-            eps: s(p.eps),
-            frame: p.frame,
-            frame_numbers: FrameNumbers::splat(&p.frame_numbers),
-        }
+        p.map(F64x4::splat)
     }
 
-    /// Lane `i` becomes `p`, whose [`FrameLaw`] must share the lanes' terms and element
-    /// counts ([`same_law`]; its numbers are the lane's own).
+    /// Lane `i` becomes `p`, whose law must share the lanes' ([`RodLaw::shares`]).
     pub fn set(&mut self, i: usize, p: &RodParams<f64>) {
-        debug_assert!(
-            same_law(&self.frame, &p.frame),
-            "the lanes run one frame law"
-        );
-        self.frame_numbers.set(i, &p.frame_numbers);
-        self.mass.0[i] = p.mass;
-        self.g.0[i] = p.g;
-        self.inv_m.0[i] = p.inv_m;
-        self.inv_i.0[i] = p.inv_i;
-        self.tip[0].0[i] = p.tip[0];
-        self.tip[1].0[i] = p.tip[1];
-        self.length.0[i] = p.length;
-        self.diameter.0[i] = p.diameter;
-        self.section.0[i] = p.section;
-        self.at_centroid.0[i] = p.at_centroid;
-        self.medium.rho_g.0[i] = p.medium.rho_g;
-        self.medium.g.0[i] = p.medium.g;
-        self.eta_d.0[i] = p.eta_d;
-        self.eta_h.0[i] = p.eta_h;
-        self.eta_v.0[i] = p.eta_v;
-        self.lam.0[i] = p.lam;
-        self.unheld.0[i] = p.unheld;
-        self.smooth.0[i] = p.smooth;
-        self.eps.0[i] = p.eps;
+        debug_assert!(self.law.shares(&p.law), "the lanes run one law");
+        let mut values = Vec::with_capacity(16 + LANE_NUMBERS);
+        let mut p = *p;
+        p.each_mut(|x| values.push(*x));
+        let mut values = values.into_iter();
+        self.each_mut(|x| x.0[i] = values.next().unwrap_or(0.0));
+    }
+
+    /// Lane `i` takes lane `j`'s parameters.
+    pub fn copy_lane(&mut self, i: usize, j: usize) {
+        self.each_mut(|x| x.0[i] = x.0[j]);
     }
 }
 
@@ -446,19 +277,19 @@ pub struct RodModes<F> {
 }
 
 impl RodModes<f64> {
-    /// `mode` for the lanes of a run with `params` and `layout` ([`RodParams::of`],
-    /// [`RodLayout::of`]), or `None` when it sticks in both x and y (two sticking rows: the
-    /// scalar path takes the step). Where the signs are not held nothing sticks, nor does a
+    /// `mode` for the lanes of a run with `params` ([`RodParams::of`]), or `None` when the
+    /// scalar path takes the step: in contact, it sticks in both x and y (two sticking
+    /// rows), or in an axis with no one term whose component the reaction replaces
+    /// (shared among several). Where the signs are not held nothing sticks, nor does a
     /// component no listed term owns (`Model::eval_rigid_rod` takes no reaction there).
     #[inline]
-    pub fn of(mode: &ContactMode, params: &RodParams<f64>, layout: &RodLayout) -> Option<Self> {
+    pub fn of(mode: &ContactMode, params: &RodParams<f64>) -> Option<Self> {
         let plain = params.unheld > 0.0;
+        let law = &params.law;
         let stick = |s: Slip, owned: bool| !plain && owned && s == Slip::Stick;
-        let (sx, sy) = (
-            stick(mode.sx, layout.owns[0]),
-            stick(mode.sy, layout.owns[1]),
-        );
-        if mode.in_contact && sx && sy {
+        let (sx, sy) = (stick(mode.sx, law.owns[0]), stick(mode.sy, law.owns[1]));
+        let shared = |s: bool, axis: usize| s && law.owner[axis] == usize::MAX;
+        if mode.in_contact && ((sx && sy) || shared(sx, 0) || shared(sy, 1)) {
             return None;
         }
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
@@ -544,14 +375,14 @@ pub struct RodEval<F> {
     pub cross: F,
     /// Margin to full immersion (0 out of contact).
     pub margin: F,
-    /// Each term's force in its place (drag or `rft_inertial`, static_h, static_v or the
-    /// frame law's static term), a reaction in place of a stuck one.
-    pub terms: [[F; 2]; 3],
+    /// Each listed term's force in its place (a reaction in place of a stuck component;
+    /// zero past the list).
+    pub terms: [[F; 2]; MAX_TERMS],
     /// F_d.
     pub dynamic: [F; 2],
     /// F_s (or its reaction).
     pub statics: [F; 2],
-    /// The terms' moment about P (a frame law's; zero under the thesis's terms).
+    /// The terms' moment about P.
     pub moment: F,
     /// The sticking bounds.
     pub bound: [F; 2],
@@ -567,30 +398,107 @@ fn plain_sign<F: Real>(v: F) -> F {
     v.select_pos(one, (-v).select_pos(-one, zero))
 }
 
-/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms or a [`FrameLaw`]
-/// (`p.frame`), in `F`: [`rod_eval_law`] for the law at hand.
+/// [`Model::eval_rigid_rod`] of the free link, in `F`: [`rod_eval_law`] for the law at hand.
 #[inline(always)]
 pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F; 3]) -> RodEval<F> {
-    if p.frame.is_some() {
+    if p.law.thesis {
         rod_eval_law::<F, true>(p, m, q, qd)
     } else {
         rod_eval_law::<F, false>(p, m, q, qd)
     }
 }
 
-/// [`Model::eval_rigid_rod`] of the free link under the thesis's terms (`FRAME` false) or
-/// a [`FrameLaw`] (`FRAME` true, `p.frame` set), in `F`: the same operations in the same
-/// order, with blends for branches (see the module). One compiled step per kind of law, so
-/// that the thesis's carries no code of the others (measured: 4 % slower lanes with `rft`
-/// in the same step).
+/// The sums of one evaluation's terms: F_d, F_s, the moment, the sticking bounds, and each
+/// term's force (zero past the list).
+#[derive(Clone, Copy)]
+struct Sums<F> {
+    dynamic: [F; 2],
+    statics: [F; 2],
+    moment: F,
+    bound: [F; 2],
+    forces: [[F; 2]; MAX_TERMS],
+}
+
+impl<F: Real> Sums<F> {
+    /// No term.
+    #[inline(always)]
+    fn zero() -> Self {
+        let zero = F::splat(0.0);
+        Sums {
+            dynamic: [zero; 2],
+            statics: [zero; 2],
+            moment: zero,
+            bound: [zero; 2],
+            forces: [[zero; 2]; MAX_TERMS],
+        }
+    }
+
+    /// Term `k`'s force `tf` (of class `dynamic`) added as `terms_on` adds it.
+    #[inline(always)]
+    fn add(&mut self, k: usize, dynamic: bool, tf: TermForce<F>) {
+        let f = tf.force;
+        self.forces[k] = f;
+        if dynamic {
+            self.dynamic = [self.dynamic[0] + f[0], self.dynamic[1] + f[1]];
+        } else {
+            self.statics = [self.statics[0] + f[0], self.statics[1] + f[1]];
+        }
+        self.moment = self.moment + tf.moment;
+        self.bound = [self.bound[0] + tf.bound[0], self.bound[1] + tf.bound[1]];
+    }
+}
+
+/// The terms of `law` on `state`, summed in the list's order (`terms_on`): each term's own
+/// arithmetic, with its numbers from `numbers` in the lanes and its own in one lane
+/// (`contact_force`: a term's fast path for one scene, the same bits). `THESIS`: the
+/// thesis's three, known when compiled (`law.thesis`).
 #[inline(always)]
-pub fn rod_eval_law<F: Real, const FRAME: bool>(
+fn term_sums<F: Real, const THESIS: bool>(
+    law: &RodLaw,
+    numbers: &[F; LANE_NUMBERS],
+    state: &ContactState<F>,
+    medium: &Medium<F>,
+    sums: &mut Sums<F>,
+) {
+    let lanes = F::LANES > 1;
+    if THESIS {
+        let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] = law.terms[..] else {
+            unreachable!("a law marked the thesis's lists its three terms");
+        };
+        if lanes {
+            sums.add(0, true, d.force_with(&numbers[0..1], state, medium));
+            sums.add(1, false, h.force_with(&numbers[1..2], state, medium));
+            sums.add(2, false, v.force_with(&numbers[2..4], state, medium));
+        } else {
+            sums.add(0, true, d.contact_force(state, medium));
+            sums.add(1, false, h.contact_force(state, medium));
+            sums.add(2, false, v.contact_force(state, medium));
+        }
+        return;
+    }
+    for (k, t) in law.terms.iter().enumerate() {
+        let tf = if lanes {
+            t.force_with(&numbers[law.at[k]..], state, medium)
+        } else {
+            t.contact_force(state, medium)
+        };
+        sums.add(k, law.dynamic[k], tf);
+    }
+}
+
+/// [`Model::eval_rigid_rod`] of the free link in `F`: the same operations in the same
+/// order, with blends for branches (see the module). `THESIS`: the law is the thesis's three
+/// terms (`p.law.thesis`), compiled into a step of their own, with no dispatch between them
+/// (measured: 4 % slower lanes with `rft` in the same step); else any terms.
+#[inline(always)]
+pub fn rod_eval_law<F: Real, const THESIS: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     q: &[F; 3],
     qd: &[F; 3],
 ) -> RodEval<F> {
     let zero = F::splat(0.0);
+    let law = &p.law;
     let sel = |flag: F, a: F, b: F| flag.select_pos(a, b);
     let sel2 = |flag: F, a: [F; 2], b: [F; 2]| [sel(flag, a[0], b[0]), sel(flag, a[1], b[1])];
     // RodFrame.
@@ -629,8 +537,9 @@ pub fn rod_eval_law<F: Real, const FRAME: bool>(
     let v_centroid = sel2(inside, v_in, v_tip);
     let cross = sel(inside, axis[0] * v_in[1] - axis[1] * v_in[0], zero);
     // Forced: in contact and below the surface; in contact for a law that reads the frame
-    // (`rft`: `Model::eval_rigid_rod`).
-    let forced = if FRAME { inside } else { depth_out };
+    // (`Model::eval_rigid_rod`).
+    let reads_frame = !THESIS && law.reads_frame;
+    let forced = if reads_frame { inside } else { depth_out };
     // |e x v_E| as the drag reads it and the signs of v_E: the held ones under `modes`,
     // each evaluation's own under `raw` and `smooth` (`Model::held_cross`, `Model::signs`).
     // What every lane blends away is skipped (the same bits, less work: `tanh` is libm's).
@@ -654,7 +563,11 @@ pub fn rod_eval_law<F: Real, const FRAME: bool>(
             sel(p.unheld, own(v_centroid[1]), m.sign[1]),
         ]
     };
-    let area_speed = p.diameter * immersed * held;
+    let area_speed = if THESIS || law.reads_area_speed {
+        p.diameter * immersed * held
+    } else {
+        zero
+    };
     let p_local = sel2(p.at_centroid, centroid, p.tip);
     let state = ContactState {
         depth,
@@ -666,90 +579,57 @@ pub fn rod_eval_law<F: Real, const FRAME: bool>(
         sign,
         boundary: None,
     };
+    let mut sums = Sums::zero();
     // Out of the sand in every lane, each use of the law below is blended away: skip it
     // (its `pow`). The results are the same bit for bit.
-    let none = TermForce {
-        force: [zero, zero],
-        bound: [zero, zero],
-        moment: zero,
-    };
-    let (fd, fh, fv, moment) = if forced.all_zero() {
-        (none, none, none, zero)
-    } else if let (true, Some(law)) = (FRAME, &p.frame) {
-        // The frame law's terms on the boundary `Model::eval_rigid_rod` gives them: T's and
-        // E's velocities held on the side of the held sign of v_Ey where the static term
-        // owns its slip switch (`held_shift`: +0 otherwise, and always in x), P and E in
-        // the world, y held while it sticks.
-        let shift = if law.statics.is_some() {
-            (-(sign[1] * v_centroid[1])).select_pos(F::splat(-2.0) * v_centroid[1], zero)
+    if !forced.all_zero() {
+        if reads_frame {
+            // The boundary `Model::eval_rigid_rod` gives the terms: T's and E's velocities
+            // held on the side of the held signs of v_E where a listed term owns the slip
+            // switch (`held_shift`: +0 otherwise), P and E in the world, the stuck axes held.
+            let shift = |a: usize| {
+                if law.owns[a] {
+                    (-(sign[a] * v_centroid[a])).select_pos(F::splat(-2.0) * v_centroid[a], zero)
+                } else {
+                    zero
+                }
+            };
+            let shift = [shift(0), shift(1)];
+            let b = Boundary {
+                frame: Frame {
+                    origin: tip,
+                    v: [v_tip[0] + shift[0], v_tip[1] + shift[1]],
+                    // q turns clockwise: the counter-clockwise rate is -dq/dt.
+                    omega: -omega,
+                    axis,
+                },
+                outline: Outline::Rod {
+                    diameter: p.diameter,
+                    immersed,
+                },
+                apply: at(p_local),
+                centroid: at(centroid),
+                v_centroid: [v_centroid[0] + shift[0], v_centroid[1] + shift[1]],
+                // Held only in contact: a lane out of the sand blends the law away, and its
+                // held flag would make every lane pay `Rft::held`'s integrations.
+                held: [sel(inside, m.stuck_x, zero), sel(inside, m.stuck_y, zero)],
+            };
+            let state = ContactState {
+                boundary: Some(&b),
+                ..state
+            };
+            term_sums::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut sums);
         } else {
-            zero
-        };
-        let b = Boundary {
-            frame: Frame {
-                origin: tip,
-                v: [v_tip[0] + zero, v_tip[1] + shift],
-                // q turns clockwise: the counter-clockwise rate is -dq/dt.
-                omega: -omega,
-                axis,
-            },
-            outline: Outline::Rod {
-                diameter: p.diameter,
-                immersed,
-            },
-            apply: at(p_local),
-            centroid: at(centroid),
-            v_centroid: [v_centroid[0] + zero, v_centroid[1] + shift],
-            // Held only in contact: a lane out of the sand blends the law away, and its
-            // held flag would make every lane pay `Rft::held`'s integrations.
-            held: [sel(inside, m.stuck_x, zero), sel(inside, m.stuck_y, zero)],
-        };
-        let state = ContactState {
-            area_speed: zero,
-            boundary: Some(&b),
-            ..state
-        };
-        // In the lanes the terms are inlined into their step (AVX2 where the CPU has it); a
-        // lone run calls the general path's own copies (inlined into its AVX2 step, `rft`'s
-        // group of eight elements was slower: measured).
-        // The lanes read each lane's numbers; a lone run's are its law's own.
-        let (lanes, n) = (F::LANES > 1, &p.frame_numbers);
-        let fs = match law.statics {
-            Some(FrameStatic::Rft(r)) if lanes => r.force_with(&n.rft, &state),
-            Some(FrameStatic::Rft(r)) => r.contact_force(&state, &p.medium),
-            Some(FrameStatic::Poncelet(_)) if lanes => {
-                Poncelet::force_with(n.poncelet, &state, &p.medium)
-            }
-            Some(FrameStatic::Poncelet(t)) => t.contact_force(&state, &p.medium),
-            None => none,
-        };
-        let fi = match law.inertial {
-            Some(t) if lanes => t.force_with(n.lam, &state, &p.medium),
-            Some(t) => t.contact_force(&state, &p.medium),
-            None => none,
-        };
-        // `terms_on` sums the moments in the list's order from +0: the same bits either
-        // way (IEEE addition commutes; only a -0 first becomes +0, in both).
-        let moment = (zero + fs.moment) + fi.moment;
-        (fi, none, fs, moment)
-    } else {
-        let fv = StaticV::law(p.eta_v, p.lam, &state, &p.medium);
-        (
-            Drag::law(p.eta_d, &state, &p.medium),
-            StaticH::law(p.eta_h, &state, &p.medium),
-            fv,
-            zero + fv.moment,
-        )
-    };
-    let dynamic = [zero + fd.force[0], zero + fd.force[1]];
-    let statics = [
-        (zero + fh.force[0]) + fv.force[0],
-        (zero + fh.force[1]) + fv.force[1],
-    ];
-    let bound = [
-        ((zero + fd.bound[0]) + fh.bound[0]) + fv.bound[0],
-        ((zero + fd.bound[1]) + fh.bound[1]) + fv.bound[1],
-    ];
+            term_sums::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut sums);
+        }
+    }
+    let Sums {
+        dynamic,
+        statics,
+        moment,
+        bound,
+        forces,
+    } = sums;
     let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
     let lever_p = lever(p_local);
     let torque = total[0] * lever_p[0] + total[1] * lever_p[1];
@@ -805,19 +685,30 @@ pub fn rod_eval_law<F: Real, const FRAME: bool>(
         ];
         (qdd, mult, a)
     };
-    let terms = [
-        sel2(forced, fd.force, [zero, zero]),
-        sel2(
-            forced,
-            [sel(row_x, mult, fh.force[0]), fh.force[1]],
-            [zero, zero],
-        ),
-        sel2(
-            forced,
-            [fv.force[0], sel(row_y, mult, fv.force[1])],
-            [zero, zero],
-        ),
-    ];
+    // Each listed term's force, the reaction in its owner's place
+    // (`ContactForce::set_reaction`); zero past the list (as the sums left them). A plain
+    // loop, inlined, so that a stage that does not read the forces drops them (measured:
+    // `std::array::from_fn` here stayed a call, which kept every stage's forces in memory,
+    // a tenth to a quarter of a free-link impact on one scene).
+    let (owner, listed) = if THESIS {
+        ([1, 2], 3)
+    } else {
+        (law.owner, law.terms.len())
+    };
+    let mut terms = [[zero; 2]; MAX_TERMS];
+    for (k, (term, f)) in terms.iter_mut().zip(forces).take(listed).enumerate() {
+        let fx = if k == owner[0] {
+            sel(row_x, mult, f[0])
+        } else {
+            f[0]
+        };
+        let fy = if k == owner[1] {
+            sel(row_y, mult, f[1])
+        } else {
+            f[1]
+        };
+        *term = sel2(forced, [fx, fy], [zero, zero]);
+    }
     let statics = sel2(
         forced,
         [sel(row_x, mult, statics[0]), sel(row_y, mult, statics[1])],
@@ -876,25 +767,10 @@ impl RodEval<f64> {
         }
     }
 
-    /// Write this evaluation of a run with `layout` into `out` as [`Model::eval_into`]
-    /// does (each listed term's force in its place, [`RodLayout::slot`]).
+    /// Write this evaluation into `out` as [`Model::eval_into`] does.
     #[inline]
-    pub fn write<const N: usize>(&self, layout: &RodLayout, out: &mut Eval<N>) {
+    pub fn write<const N: usize>(&self, out: &mut Eval<N>) {
         let v2 = |a: [f64; 2]| Vector2::new(a[0], a[1]);
-        let mut terms = [Vector2::zeros(); crate::forces::registry::MAX_TERMS];
-        if layout.slot == [0, 1, 2] {
-            // The whole thesis set, the common case: fixed places (measured: placing them by
-            // `slot` made a thesis impact 4-8 % slower).
-            for (k, t) in self.terms.iter().enumerate() {
-                terms[k] = v2(*t);
-            }
-        } else {
-            for (&k, t) in layout.slot.iter().zip(&self.terms) {
-                if k != usize::MAX {
-                    terms[k] = v2(*t);
-                }
-            }
-        }
         out.contacts[0] = ContactEval {
             tip: v2(self.tip),
             v_tip: v2(self.v_tip),
@@ -902,7 +778,7 @@ impl RodEval<f64> {
             lowest: self.lowest,
             v_centroid: v2(self.v_centroid),
             force: ContactForce {
-                terms,
+                terms: self.terms.map(v2),
                 dynamic: v2(self.dynamic),
                 statics: v2(self.statics),
                 moment: self.moment,
@@ -935,7 +811,7 @@ impl RodEval<F64x4> {
             v_centroid: l2(self.v_centroid),
             cross: l(self.cross),
             margin: l(self.margin),
-            terms: [l2(self.terms[0]), l2(self.terms[1]), l2(self.terms[2])],
+            terms: self.terms.map(l2),
             dynamic: l2(self.dynamic),
             statics: l2(self.statics),
             moment: l(self.moment),
@@ -963,6 +839,53 @@ pub(crate) fn lean_equals_general(
     let general = run.finish(&model).unwrap();
     assert_eq!(format!("{lean:?}"), format!("{general:?}"), "{what}");
     lean
+}
+
+/// Every contact term of the registry that a free link accepts (defined on a rod), as a
+/// scene lists it: each number its default or, where it has none (or a zero one that
+/// would hide the term), a value given here, times `scale`, within its bounds; each count
+/// `count`, within its bounds. A new term with a required parameter fails here, naming it,
+/// until it has a value. For the tests here and in `integrate::lanes`.
+#[cfg(test)]
+pub(crate) fn rod_terms(scale: f64, count: usize) -> Vec<crate::forces::TermSpec> {
+    use crate::forces::{Acts, ContactKind, TermSpec, TERMS};
+    TERMS
+        .iter()
+        .filter(|t| t.acts == Acts::Contact && t.shapes.contains(&ContactKind::Rod))
+        .map(|t| {
+            let params: Vec<(&str, f64)> = t
+                .params
+                .iter()
+                .map(|p| {
+                    let base = match (t.name, p.name) {
+                        _ if p.integer => count as f64,
+                        ("rft", "zeta") => 1e6,
+                        ("poncelet", "c") => 0.8,
+                        ("poncelet", "k") => 150.0,
+                        ("axial_drag", "eta_a") => 0.5,
+                        ("constant", "fx") => 0.05,
+                        ("constant", "fy") => 0.3,
+                        _ if p.required() => panic!("give {}.{} a value here", t.name, p.name),
+                        _ => p.default,
+                    };
+                    let v = if p.integer { base } else { base * scale };
+                    (p.name, v.clamp(p.min, p.max))
+                })
+                .collect();
+            TermSpec::new(t.name, &params)
+        })
+        .collect()
+}
+
+/// The terms of [`rod_terms`] that the bits of `mask` pick (bit k: the k-th).
+#[cfg(test)]
+pub(crate) fn rod_law(mask: u32, scale: f64, count: usize) -> Vec<crate::forces::TermSpec> {
+    rod_terms(scale, count)
+        .into_iter()
+        .enumerate()
+        .filter(|(k, _)| mask & (1 << k) != 0)
+        .map(|(_, t)| t)
+        .collect()
 }
 
 #[cfg(test)]
@@ -1123,35 +1046,26 @@ mod tests {
         /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
         /// the accelerations, the power and every finding of the contact (what the events
         /// and the observer read), in every mode the lanes cover, under every sign model and
-        /// with any of the thesis's terms, mixed across the lanes, or under one frame law's
-        /// terms and element count with each lane's own numbers.
+        /// any law the free link accepts (any of the registry's terms a rod takes, alone or
+        /// mixed), its terms and counts shared by the lanes, each lane's own numbers.
         #[test]
         fn lanes_are_the_scalar_evaluation_bitwise(
             scenes in proptest::array::uniform4(scene()),
             states in proptest::array::uniform4(state()),
-            terms in proptest::array::uniform4(0u8..8),
-            frame in prop_oneof![
-                Just(None),
-                (0u8..6, 1e4f64..3e6, 1usize..14).prop_map(Some),
-            ],
+            mask in 1u32..(1 << rod_terms(1.0, 1).len()),
+            count in 1usize..14,
         ) {
             let models: Vec<Model<3>> = scenes
                 .iter()
-                .zip(terms)
-                .map(|(s, t)| match frame {
-                    // One law's terms and element count, each lane's own numbers.
-                    Some((kind, a, n)) => {
-                        let a = a * (1.0 + s.2 / 40.0);
-                        model_frame((s.0, s.1, s.6, s.7, s.8), &frame_law(kind, a, n))
-                    }
-                    None => model_signed(s.0, s.1, [s.2, s.3, s.4, s.5], s.6, s.7, s.8, t),
+                .map(|s| {
+                    let law = rod_law(mask, 0.5 + s.2 / 40.0, count);
+                    model_frame((s.0, s.1, s.6, s.7, s.8), &law)
                 })
                 .collect();
             let params_of = |i: usize| RodParams::of(&models[i]).unwrap();
-            let layout_of = |i: usize| RodLayout::of(&models[i]).unwrap();
             let mut params = RodParams::splat(&params_of(0));
             let default = ContactMode::default();
-            let mut modes = [RodModes::of(&default, &params_of(0), &layout_of(0)).unwrap(); LANES];
+            let mut modes = [RodModes::of(&default, &params_of(0)).unwrap(); LANES];
             let mut all_modes = [[ContactMode::default(); MAX_CONTACTS]; LANES];
             let (mut q, mut qd) = ([F64x4::splat(0.0); 3], [F64x4::splat(0.0); 3]);
             let mut covered = [true; LANES];
@@ -1172,7 +1086,7 @@ mod tests {
                     cross: if cross { Slip::Neg } else { Slip::Pos },
                     ..ContactMode::default()
                 };
-                match RodModes::of(&all_modes[i][0], &params_of(i), &layout_of(i)) {
+                match RodModes::of(&all_modes[i][0], &params_of(i)) {
                     Some(m) => modes[i] = m,
                     None => covered[i] = false,
                 }
@@ -1191,7 +1105,7 @@ mod tests {
                     continue;
                 }
                 let mut mine = scalar;
-                lane.write(&layout_of(i), &mut mine);
+                lane.write(&mut mine);
                 prop_assert_eq!(bits(mine.qdd.as_slice()), bits(scalar.qdd.as_slice()), "lane {}", i);
                 prop_assert_eq!(mine.power.to_bits(), scalar.power.to_bits());
                 let (a, b) = (mine.contacts[0], scalar.contacts[0]);
@@ -1286,11 +1200,8 @@ mod tests {
         for kind in [0u8, 1, 3] {
             let base = (0.05, 0.05, false, false, SignModel::Modes);
             let model = model_frame(base, &frame_law(kind, 1e4, 1));
-            let (p, l) = (
-                RodParams::of(&model).unwrap(),
-                RodLayout::of(&model).unwrap(),
-            );
-            let m = RodModes::of(&mode, &p, &l).unwrap();
+            let p = RodParams::of(&model).unwrap();
+            let m = RodModes::of(&mode, &p).unwrap();
             assert_eq!(m.stuck_y, 1.0);
             let th: f64 = 0.34151223113018786;
             let q = [0.025 * th.sin(), 0.025 * th.cos(), th];
@@ -1299,7 +1210,7 @@ mod tests {
             let mut lean = general;
             let one = rod_eval(&p, &m, &q, &qd);
             assert!(one.pivot_ok());
-            one.write(&l, &mut lean);
+            one.write(&mut lean);
             assert_eq!(
                 bits(lean.qdd.as_slice()),
                 bits(general.qdd.as_slice()),
@@ -1315,7 +1226,7 @@ mod tests {
             );
             for i in 0..LANES {
                 let mut lane = general;
-                lanes.lane(i).write(&l, &mut lane);
+                lanes.lane(i).write(&mut lane);
                 assert_eq!(
                     bits(lane.qdd.as_slice()),
                     bits(general.qdd.as_slice()),
@@ -1388,43 +1299,48 @@ mod tests {
         );
     }
 
-    /// A body the lean path does not cover has no layout, even one with no contact at all
-    /// (a linkage with none: `Run::new` asks every model).
+    /// Only a free link runs in the lanes: not a body with no contact at all (a linkage
+    /// with none: `Run::new` asks every model).
     #[test]
-    fn only_a_free_link_has_a_layout() {
+    fn only_a_free_link_runs_in_the_lanes() {
         let mut pendulum = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
         pendulum.forces.per_contact.clear();
         pendulum.contacts.clear();
-        assert!(RodLayout::of(&pendulum).is_none());
         assert!(RodParams::of(&pendulum).is_none());
     }
 
-    /// Runs share the lanes when their frame laws list the same terms with the same element
-    /// counts, whatever their numbers (each lane has its own).
+    /// Runs share the lanes when their laws list the same terms in the same order with the
+    /// same counts, whatever their numbers (each lane has its own).
     #[test]
-    fn frame_laws_share_the_lanes_by_their_terms_and_element_counts() {
+    fn laws_share_the_lanes_by_their_terms_and_counts() {
+        let base = (0.184, 0.19, false, true, SignModel::Modes);
         let law = |kind: u8, a: f64, n: usize| {
-            let m = model_frame(
-                (0.184, 0.19, false, true, SignModel::Modes),
-                &frame_law(kind, a, n),
-            );
-            RodParams::of(&m).unwrap().frame
+            RodParams::of(&model_frame(base, &frame_law(kind, a, n)))
+                .unwrap()
+                .law
         };
-        assert!(same_law(&law(0, 1e6, 8), &law(0, 3e5, 8)));
-        assert!(same_law(&law(1, 1e6, 8), &law(1, 2e5, 3)));
-        assert!(same_law(&law(3, 1e6, 8), &law(4, 5e5, 8)));
-        assert!(!same_law(&law(0, 1e6, 8), &law(0, 1e6, 7)));
-        assert!(!same_law(&law(0, 1e6, 8), &law(1, 1e6, 8)));
-        assert!(!same_law(&law(0, 1e6, 8), &law(3, 1e6, 8)));
-        assert!(!same_law(&law(2, 1e6, 8), &law(2, 1e6, 5)));
-        assert!(!same_law(&law(0, 1e6, 8), &None));
-        assert!(same_law(&None, &None));
+        assert!(law(0, 1e6, 8).shares(&law(0, 3e5, 8)));
+        assert!(law(1, 1e6, 8).shares(&law(1, 2e5, 3)));
+        assert!(!law(0, 1e6, 8).shares(&law(0, 1e6, 7)));
+        assert!(!law(0, 1e6, 8).shares(&law(1, 1e6, 8)));
+        assert!(!law(0, 1e6, 8).shares(&law(3, 1e6, 8)));
+        // The same terms in another order: another law (the sums' order is the list's).
+        assert!(!law(3, 1e6, 8).shares(&law(4, 1e6, 8)));
+        assert!(!law(2, 1e6, 8).shares(&law(2, 1e6, 5)));
+        let thesis = |eta: [f64; 4], terms: u8| {
+            let m = model_signed(0.184, 0.19, eta, false, true, SignModel::Modes, terms);
+            RodParams::of(&m).unwrap().law
+        };
+        let table = [15.2, 6.5, 248.0, 0.106];
+        assert!(thesis(table, 0b111).shares(&thesis([9.0, 1.0, 100.0, 0.3], 0b111)));
+        assert!(!thesis(table, 0b111).shares(&thesis(table, 0b101)));
+        assert!(!thesis(table, 0b111).shares(&law(0, 1e6, 8)));
     }
 
-    /// The lanes cover the thesis's set under every sign model and the frame laws, and
-    /// nothing else.
+    /// The lanes cover every law, and hand the scalar path the steps they do not: two
+    /// sticking rows, or a row whose reaction several static terms share.
     #[test]
-    fn lanes_cover_the_thesis_set_and_the_frame_laws() {
+    fn lanes_cover_every_law_and_hand_over_the_rows_they_do_not() {
         let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
         let flags = |m: &Model<3>| RodParams::of(m).map(|p| (p.unheld, p.smooth, p.eps));
         assert_eq!(flags(&thesis), Some((0.0, 0.0, 1.0)));
@@ -1434,24 +1350,11 @@ mod tests {
         let mut smooth = thesis.clone();
         smooth.sign_model = SignModel::Smooth { eps: 1e-3 };
         assert_eq!(flags(&smooth), Some((1.0, 1.0, 1e-3)));
-        // Any of the thesis's terms, in its order (gravity on or off).
-        let subset = model_signed(
-            0.184,
-            0.19,
-            [15.2, 6.5, 248.0, 0.106],
-            false,
-            false,
-            SignModel::Modes,
-            0b101,
-        );
-        let (p, l) = (
-            RodParams::of(&subset).unwrap(),
-            RodLayout::of(&subset).unwrap(),
-        );
-        assert_eq!(
-            (l.slot, l.owns, p.eta_h),
-            ([0, usize::MAX, 1], [false, true], 0.0)
-        );
+        let p = RodParams::of(&thesis).unwrap();
+        assert!(p.law.thesis);
+        assert_eq!((p.law.owns, p.law.owner), ([true, true], [1, 2]));
+        assert_eq!(p.numbers[..4], [15.2, 6.5, 248.0, 0.106]);
+        // Any of the thesis's terms in any order: covered, on the step for any law.
         let mut reordered = thesis.clone();
         reordered.forces = ForceSet::build(
             &[
@@ -1462,66 +1365,46 @@ mod tests {
             1,
         )
         .unwrap();
-        assert!(RodParams::of(&reordered).is_none());
+        let p = RodParams::of(&reordered).unwrap();
+        assert!(!p.law.thesis);
+        assert_eq!(
+            (p.law.at[..3].to_vec(), p.law.owner),
+            (vec![0, 1, 2], [0, 2])
+        );
+        assert_eq!(p.numbers[..4], [6.5, 15.2, 248.0, 0.106]);
         let both = ContactMode {
             in_contact: true,
             ..ContactMode::default()
         };
-        let layout = RodLayout::of(&thesis).unwrap();
-        assert!(RodModes::of(&both, &RodParams::of(&thesis).unwrap(), &layout).is_none());
+        assert!(RodModes::of(&both, &RodParams::of(&thesis).unwrap()).is_none());
         // Under the plain sign nothing sticks: the same mode is covered, with no row.
-        let plain = RodModes::of(&both, &RodParams::of(&raw).unwrap(), &layout).unwrap();
+        let plain = RodModes::of(&both, &RodParams::of(&raw).unwrap()).unwrap();
         assert_eq!((plain.stuck_x, plain.stuck_y), (0.0, 0.0));
-        // `rft` alone: in static_v's place, owning y; x never sticks, so the mode that
-        // sticks in both is covered with y's row alone.
+        // `rft` alone owns y, not x: the mode that sticks in both is covered with y's row.
         let base = (0.184, 0.19, false, true, SignModel::Modes);
-        let rft = model_frame(base, &frame_law(0, 1e6, 8));
-        let (p, l) = (RodParams::of(&rft).unwrap(), RodLayout::of(&rft).unwrap());
+        let rft = RodParams::of(&model_frame(base, &frame_law(0, 1e6, 8))).unwrap();
         assert_eq!(
-            (l.slot, l.owns),
-            ([usize::MAX, usize::MAX, 0], [false, true])
+            (rft.law.owns, rft.law.owner),
+            ([false, true], [usize::MAX, 0])
         );
-        assert_eq!((p.eta_d, p.eta_h, p.eta_v), (0.0, 0.0, 0.0));
-        let law = p.frame.unwrap();
-        assert!(matches!(law.statics, Some(FrameStatic::Rft(r)) if r.zeta == 1e6));
-        assert!(law.inertial.is_none());
-        let m = RodModes::of(&both, &p, &l).unwrap();
+        let m = RodModes::of(&both, &rft).unwrap();
         assert_eq!((m.stuck_x, m.stuck_y), (0.0, 1.0));
-        // `rft_inertial` in drag's place, before or after the static term; alone it owns
-        // nothing, so nothing sticks.
-        let slots = |kind: u8| {
-            let m = model_frame(base, &frame_law(kind, 1e6, 8));
-            let (p, l) = (RodParams::of(&m).unwrap(), RodLayout::of(&m).unwrap());
-            (l.slot, l.owns, p.frame.unwrap().inertial.is_some())
-        };
-        let none = usize::MAX;
-        assert_eq!(slots(1), ([none, none, 0], [false, true], false));
-        assert_eq!(slots(2), ([0, none, none], [false, false], true));
-        assert_eq!(slots(3), ([1, none, 0], [false, true], true));
-        assert_eq!(slots(4), ([0, none, 1], [false, true], true));
-        assert_eq!(slots(5), ([1, none, 0], [false, true], true));
-        let alone = model_frame(base, &frame_law(2, 1e6, 8));
-        let m = RodModes::of(
-            &both,
-            &RodParams::of(&alone).unwrap(),
-            &RodLayout::of(&alone).unwrap(),
+        // `poncelet` and `static_v` share y's reaction: a step sticking in y is the scalar
+        // path's, one sliding is the lanes'.
+        let shared = model_frame(
+            base,
+            &[
+                TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]),
+                TermSpec::new("static_v", &[("eta_v", 248.0), ("lam", 0.106)]),
+            ],
         );
-        assert_eq!(m.map(|m| (m.stuck_x, m.stuck_y)), Some((0.0, 0.0)));
-        // Not two static frame terms (both own y), nor a frame term with a thesis term (a
-        // term listed twice is refused before: `ForceSet::build`).
-        let other = |specs: &[TermSpec]| {
-            let mut m = thesis.clone();
-            m.forces = ForceSet::build(specs, 1).unwrap();
-            RodParams::of(&m).is_none() && RodLayout::of(&m).is_none()
+        let p = RodParams::of(&shared).unwrap();
+        assert_eq!((p.law.owns, p.law.owner), ([false, true], [usize::MAX; 2]));
+        assert!(RodModes::of(&both, &p).is_none());
+        let sliding = ContactMode {
+            sy: Slip::Neg,
+            ..both
         };
-        let rft_spec = TermSpec::new("rft", &[("zeta", 1e6)]);
-        let poncelet = TermSpec::new("poncelet", &[("c", 0.8), ("k", 150.0)]);
-        let static_v = TermSpec::new("static_v", &[("eta_v", 248.0), ("lam", 0.106)]);
-        assert!(other(&[rft_spec.clone(), static_v]));
-        assert!(other(&[rft_spec.clone(), poncelet]));
-        assert!(other(&[
-            rft_spec,
-            TermSpec::new("drag", &[("eta_d", 15.2)])
-        ]));
+        assert!(RodModes::of(&sliding, &p).is_some());
     }
 }

@@ -117,13 +117,17 @@ impl Term for AxialDrag {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        self.force_with(&[F::splat(self.eta_a)], c, m)
+    }
+
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
         };
         let one = F::splat(1.0);
         let (_, v_a) = Self::axial(b);
-        let k = -(F::splat(self.eta_a) * m.rho_g * Self::face(b) * v_a.abs() * v_a);
+        let k = -(p[0] * m.rho_g * Self::face(b) * v_a.abs() * v_a);
         let e = b.frame.axis;
         // No force along an axis held at zero: the sticking reaction stands in.
         let [hx, hy] = b.held;

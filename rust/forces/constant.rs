@@ -68,8 +68,12 @@ impl Term for Constant {
         vec![self.fx, self.fy]
     }
 
-    fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
-        TermForce::force([F::splat(self.fx), F::splat(self.fy)])
+    fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        self.force_with(&[F::splat(self.fx), F::splat(self.fy)], c, m)
+    }
+
+    fn force_with<F: Real>(&self, p: &[F], _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([p[0], p[1]])
     }
 
     /// None: the force is the same at every velocity and depth.

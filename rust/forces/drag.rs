@@ -67,7 +67,13 @@ impl Term for Drag {
 
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        Drag::law(F::splat(self.eta_d), c, m)
+        self.force_with(&[F::splat(self.eta_d)], c, m)
+    }
+
+    #[inline(always)]
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        let k = -(p[0] * m.rho_g * c.area_speed);
+        TermForce::force([k * c.v[0], k * c.v[1]])
     }
 
     /// With `k = eta_d rho_g A_r |v_E|` (so `|F| = k |v_E|`): `dF/dv = -k (I + v^ v^T)` for
@@ -84,16 +90,5 @@ impl Term for Drag {
                 0.0
             },
         }
-    }
-}
-
-impl Drag {
-    /// The term's arithmetic with its parameter as a number of type `F`: one scene's
-    /// ([`Term::contact_force`] splats it) or one per SIMD lane (the sweep's lanes,
-    /// `dynamics::rod_lanes`, whose scenes differ in their parameters).
-    #[inline(always)]
-    pub fn law<F: Real>(eta_d: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        let k = -(eta_d * m.rho_g * c.area_speed);
-        TermForce::force([k * c.v[0], k * c.v[1]])
     }
 }

@@ -12,7 +12,7 @@
 //! - **Energy:** with this term the potential energy is gravity's, m g y; without it the
 //!   body has none from gravity (a free link with nothing acting keeps E = KE).
 
-use super::{Acts, Class, ContactState, Medium, Rates, Term, TermInfo};
+use super::{Acts, Class, ContactState, Medium, Rates, Real, Term, TermForce, TermInfo};
 
 /// Gravity on the body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,6 +42,11 @@ impl Term for Gravity {
 
     fn params(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    /// None: a body term has no contact force.
+    fn force_with<F: Real>(&self, _p: &[F], _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
     }
 
     /// None at a contact: a constant force on each link.

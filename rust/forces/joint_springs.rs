@@ -17,7 +17,7 @@
 
 use nalgebra::SVector;
 
-use super::{Acts, Class, ContactState, Medium, Rates, Term, TermInfo};
+use super::{Acts, Class, ContactState, Medium, Rates, Real, Term, TermForce, TermInfo};
 use crate::body::{Joint, Link, Mechanism};
 
 /// The joints' spring-dampers.
@@ -48,6 +48,11 @@ impl Term for JointSprings {
 
     fn params(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    /// None: a body term has no contact force.
+    fn force_with<F: Real>(&self, _p: &[F], _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
     }
 
     /// None at a contact: it acts at the joints (a body term; [`Term::joint_rates`]).

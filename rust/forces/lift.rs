@@ -10,7 +10,7 @@
 //! - **Parameters:** `f` [1], the fraction of the weight, default 0.
 //! - **Energy:** its potential energy, -f m g y, is part of the body's (the field's).
 
-use super::{Acts, Class, ContactState, Medium, Param, Rates, Term, TermInfo};
+use super::{Acts, Class, ContactState, Medium, Param, Rates, Real, Term, TermForce, TermInfo};
 
 /// An upward pull of `f` times the weight on every mass.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,6 +52,11 @@ impl Term for Lift {
 
     fn params(&self) -> Vec<f64> {
         vec![self.f]
+    }
+
+    /// None: a body term has no contact force.
+    fn force_with<F: Real>(&self, _p: &[F], _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
     }
 
     /// None at a contact: a constant force on each link.

@@ -446,6 +446,14 @@ pub trait Term: Copy + Debug + PartialEq {
     fn contact_force<F: Real>(&self, _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
         TermForce::force([F::splat(0.0); 2])
     }
+    /// [`Term::contact_force`] with the term's parameters as numbers of type `F`, in the
+    /// order of `INFO.params` (`p`: one scene's, or one per SIMD lane in the sweep's lanes,
+    /// `dynamics::rod_lanes`, whose scenes differ in their numbers); a count
+    /// ([`Param::integer`]) is `self`'s, shared by the lanes. The term's one copy of its
+    /// arithmetic: `contact_force` is this with its own numbers. No default, as for
+    /// [`Term::rates`]: a contact term that left it out would be blind in the lanes (a
+    /// body term has no contact force: zero).
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F>;
     /// Its stiffness at one contact in the sand (`c` as [`Term::contact_force`] reads it),
     /// for the step-size check. No default: each term says how its force changes with the
     /// contact's velocity and position, or why it does not ([`Rates::NONE`]), so that a new

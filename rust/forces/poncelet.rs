@@ -133,7 +133,36 @@ impl Term for Poncelet {
 
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        Self::force_with([F::splat(self.c), F::splat(self.k)], c, m)
+        self.force_with(&[F::splat(self.c), F::splat(self.k)], c, m)
+    }
+
+    /// With `p = [c, k]`; inlined where it is called: the SIMD lanes
+    /// ([`crate::dynamics::rod_lanes`]) compile it into their AVX2 step.
+    #[inline(always)]
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        let (c_d, k_d) = (p[0], p[1]);
+        let zero = F::splat(0.0);
+        let Some(b) = c.boundary else {
+            return TermForce::force([zero; 2]);
+        };
+        let friction = k_d * c.depth;
+        let one = F::splat(1.0);
+        let v = b.v_centroid;
+        let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
+        let inv = speed.select_pos(speed.recip(), zero);
+        let drag = -(c_d * m.rho_g * Self::area_speed(b, v));
+        let k = drag - friction * inv;
+        // Along an axis held at zero the reaction stands in, up to k d.
+        let [held_x, held_y] = b.held;
+        let force = [(one - held_x) * k * v[0], (one - held_y) * k * v[1]];
+        let bound = [held_x * friction, held_y * friction];
+        // It acts at E: its moment about P.
+        let r = [b.centroid[0] - b.apply[0], b.centroid[1] - b.apply[1]];
+        TermForce {
+            force,
+            bound,
+            moment: r[0] * force[1] - r[1] * force[0],
+        }
     }
 
     /// The drag `c rho_g A |v| v` as a quadratic drag (`2 c rho_g A |v|`); in depth, the
@@ -158,41 +187,6 @@ impl Term for Poncelet {
         Rates {
             damping: 2.0 * drag,
             spring: self.k,
-        }
-    }
-}
-
-impl Poncelet {
-    /// [`Poncelet::contact_force`] with the coefficients `[c, k]` (this law's, or one per
-    /// lane), inlined where it is called: the SIMD lanes ([`crate::dynamics::rod_lanes`])
-    /// compile it into their AVX2 step.
-    #[inline(always)]
-    pub fn force_with<F: Real>(
-        [c_d, k_d]: [F; 2],
-        c: &ContactState<F>,
-        m: &Medium<F>,
-    ) -> TermForce<F> {
-        let zero = F::splat(0.0);
-        let Some(b) = c.boundary else {
-            return TermForce::force([zero; 2]);
-        };
-        let friction = k_d * c.depth;
-        let one = F::splat(1.0);
-        let v = b.v_centroid;
-        let speed = (v[0] * v[0] + v[1] * v[1]).sqrt();
-        let inv = speed.select_pos(speed.recip(), zero);
-        let drag = -(c_d * m.rho_g * Self::area_speed(b, v));
-        let k = drag - friction * inv;
-        // Along an axis held at zero the reaction stands in, up to k d.
-        let [held_x, held_y] = b.held;
-        let force = [(one - held_x) * k * v[0], (one - held_y) * k * v[1]];
-        let bound = [held_x * friction, held_y * friction];
-        // It acts at E: its moment about P.
-        let r = [b.centroid[0] - b.apply[0], b.centroid[1] - b.apply[1]];
-        TermForce {
-            force,
-            bound,
-            moment: r[0] * force[1] - r[1] * force[0],
         }
     }
 }

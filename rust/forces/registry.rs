@@ -20,6 +20,29 @@ pub const MAX_TERMS: usize = contact_terms(ALL_TERMS);
 /// Most body terms a scene may list: every body term of the registry (each at most once).
 pub const MAX_BODY_TERMS: usize = ALL_TERMS.len() - MAX_TERMS;
 
+/// Most parameter values the contact terms of one free link list together (each term at
+/// most once, every contact term defined on a rod): the length of the lanes' numbers
+/// (`dynamics::rod_lanes::RodParams::numbers`).
+pub const LANE_NUMBERS: usize = rod_numbers(ALL_TERMS);
+
+/// The sum of the parameter counts of `terms`' contact terms defined on a rod.
+const fn rod_numbers(terms: &[&TermInfo]) -> usize {
+    let (mut n, mut i) = (0, 0);
+    while i < terms.len() {
+        let t = terms[i];
+        let mut j = 0;
+        while j < t.shapes.len() {
+            if matches!(t.acts, Acts::Contact) && matches!(t.shapes[j], super::ContactKind::Rod) {
+                n += t.params.len();
+                break;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    n
+}
+
 /// How many of `terms` act at a contact.
 const fn contact_terms(terms: &[&TermInfo]) -> usize {
     let (mut n, mut i) = (0, 0);
@@ -74,6 +97,14 @@ macro_rules! registry {
             pub fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
                 match self {
                     $($(#[$m])* AnyTerm::$variant(t) => t.contact_force(c, m),)*
+                }
+            }
+
+            /// The force on one contact with the parameters `p` ([`Term::force_with`]).
+            #[inline(always)]
+            pub fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+                match self {
+                    $($(#[$m])* AnyTerm::$variant(t) => t.force_with(p, c, m),)*
                 }
             }
 

@@ -456,6 +456,17 @@ impl Term for Rft {
         self.force_base(&co, c)
     }
 
+    /// [`Rft::law`] with `p` its parameters in the table's order (`zeta`, `elements`, the
+    /// nine coefficients; the count `self`'s).
+    #[inline(always)]
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        let co = RftCoefficients {
+            zeta: p[0],
+            k: std::array::from_fn(|i| p[2 + i]),
+        };
+        self.law(&co, c)
+    }
+
     /// Per element, `zeta |z| dA (g0 + G v^)`: in depth, `zeta |alpha| dA`, summed over the
     /// immersed elements. Rate-independent: it does not grow with speed. Its direction
     /// turns with each element's velocity (`|G| zeta |z| dA / |v_k|` across it), which is
@@ -488,17 +499,17 @@ impl Term for Rft {
 const ROD_FAST_ELEMENTS: usize = 8;
 
 impl Rft {
-    /// [`Rft::force_with`], out of line, with the numbers behind a reference (seen through,
+    /// [`Rft::law`], out of line, with the numbers behind a reference (seen through,
     /// they were ten more values held in registers in the AVX2 path: 13 % slower there).
     #[inline(never)]
     fn force_base<F: Real>(&self, co: &RftCoefficients<F>, c: &ContactState<F>) -> TermForce<F> {
-        self.force_with(co, c)
+        self.law(co, c)
     }
 
     /// A lone rod's contact, held nowhere, at up to [`ROD_FAST_ELEMENTS`] elements per plate:
     /// the count known when compiled (one instance per count) and the whole compiled with
     /// AVX2 (its three-operand encodings; the same IEEE operations in the same order, so the
-    /// same bits as [`Rft::force_with`]). A quarter less time than the plain loop at eight
+    /// same bits as [`Rft::law`]). A quarter less time than the plain loop at eight
     /// elements, half at two (docs/laws.md, "Cost"). Measured on the way: LLVM packs two
     /// elements to a 128-bit register here; compiled one count per function it packed four
     /// to a 256-bit one, and the shuffles of the x, y pairs made that a quarter slower. A
@@ -544,11 +555,7 @@ impl Rft {
     /// inlined where it is called: the SIMD lanes ([`crate::dynamics::rod_lanes`]) compile
     /// it into their AVX2 step. Only the element count is `self`'s.
     #[inline(always)]
-    pub fn force_with<F: Real>(
-        &self,
-        co: &RftCoefficients<F>,
-        c: &ContactState<F>,
-    ) -> TermForce<F> {
+    pub fn law<F: Real>(&self, co: &RftCoefficients<F>, c: &ContactState<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
@@ -662,7 +669,13 @@ impl Term for RftInertial {
                 }
             }
         }
-        self.force_with(F::splat(self.lam), c, m)
+        self.law(F::splat(self.lam), c, m)
+    }
+
+    /// [`RftInertial::law`] with `p = [lam, elements]` (the count `self`'s).
+    #[inline(always)]
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        self.law(p[0], c, m)
     }
 
     /// Per element a quadratic drag along its normal: `dF/dv = -2 lam rho_g |v_n| n n^T dA`.
@@ -695,7 +708,7 @@ impl RftInertial {
     /// inlined where it is called: the SIMD lanes ([`crate::dynamics::rod_lanes`]) compile
     /// it into their AVX2 step. Only the element count is `self`'s.
     #[inline(always)]
-    pub fn force_with<F: Real>(&self, lam: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+    pub fn law<F: Real>(&self, lam: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         let zero = F::splat(0.0);
         let Some(b) = c.boundary else {
             return TermForce::force([zero; 2]);
@@ -749,7 +762,7 @@ impl RftInertial {
         *moment = *moment + cross(lever, n);
     }
 
-    /// [`RftInertial::force_with`] on a lone rod at up to [`ROD_FAST_ELEMENTS`] elements per
+    /// [`RftInertial::law`] on a lone rod at up to [`ROD_FAST_ELEMENTS`] elements per
     /// plate, the count known when compiled, compiled with AVX2 (the same operations in
     /// the same order: the same bits), as [`Rft`]'s (docs/laws.md, "Cost").
     ///
@@ -988,11 +1001,11 @@ mod tests {
             let pairs = [
                 (
                     t.contact_force(&state, &medium),
-                    t.force_with(&t.coefficients_in(), &state),
+                    t.law(&t.coefficients_in(), &state),
                 ),
                 (
                     inertial.contact_force(&state, &medium),
-                    inertial.force_with(1.7, &state, &medium),
+                    inertial.law(1.7, &state, &medium),
                 ),
             ];
             // The fast paths are what ran (where this CPU has them).

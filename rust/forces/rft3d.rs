@@ -53,7 +53,9 @@
 //! planar `rft_inertial`; Agarwal, Karsai, Goldman & Kamrin, Science Advances 7 (2021)
 //! eabe0631).
 
-use super::{Acts, Class, ContactState, Medium, Param, Rates, Real, Term, TermInfo, SPACE_SHAPES};
+use super::{
+    Acts, Class, ContactState, Medium, Param, Rates, Real, Term, TermForce, TermInfo, SPACE_SHAPES,
+};
 
 /// The fitted coefficients c_ik of the three functions f_1, f_2, f_3 (rows), in the order of
 /// the monomials T_k (columns; see the module's doc). Where public transcriptions of the SI
@@ -687,6 +689,11 @@ impl Term for Rft3d {
         vec![self.zeta, self.mu_surf, f64::from(u8::from(self.grazing))]
     }
 
+    /// None: never evaluated on a planar contact (refused before any work).
+    fn force_with<F: Real>(&self, _p: &[F], _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
+    }
+
     /// Never evaluated on a planar contact (refused before any work; the trait's
     /// `contact_force` gives it zero there); a body in space estimates its own stiffness
     /// (`crate::space::solve`).
@@ -738,6 +745,11 @@ impl Term for Rft3dInertial {
 
     fn params(&self) -> Vec<f64> {
         vec![self.lam]
+    }
+
+    /// None: never evaluated on a planar contact (refused before any work).
+    fn force_with<F: Real>(&self, _p: &[F], _c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
+        TermForce::force([F::splat(0.0); 2])
     }
 
     /// Never evaluated on a planar contact (as `Rft3d::rates`).

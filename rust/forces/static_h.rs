@@ -65,7 +65,19 @@ impl Term for StaticH {
 
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        StaticH::law(F::splat(self.eta_h), c, m)
+        self.force_with(&[F::splat(self.eta_h)], c, m)
+    }
+
+    #[inline(always)]
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        let zero = F::splat(0.0);
+        let rg = m.g * m.rho_g;
+        let bound = p[0] * rg * c.width * c.depth * c.depth;
+        TermForce {
+            force: [-c.sign[0] * bound, zero],
+            bound: [bound, zero],
+            moment: F::splat(0.0),
+        }
     }
 
     /// None that a step meets: its velocity enters only through a sign that the `modes`
@@ -74,20 +86,5 @@ impl Term for StaticH {
     /// the entry while the energy it stores is not (the thesis's runs are resolved there).
     fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
         Rates::NONE
-    }
-}
-
-impl StaticH {
-    /// The term's arithmetic with its parameter as a number of type `F` (see `Drag::law`).
-    #[inline(always)]
-    pub fn law<F: Real>(eta_h: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        let zero = F::splat(0.0);
-        let rg = m.g * m.rho_g;
-        let bound = eta_h * rg * c.width * c.depth * c.depth;
-        TermForce {
-            force: [-c.sign[0] * bound, zero],
-            bound: [bound, zero],
-            moment: F::splat(0.0),
-        }
     }
 }

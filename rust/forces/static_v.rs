@@ -82,22 +82,12 @@ impl Term for StaticV {
 
     #[inline(always)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
-        StaticV::law(F::splat(self.eta_v), F::splat(self.lam), c, m)
+        self.force_with(&[F::splat(self.eta_v), F::splat(self.lam)], c, m)
     }
 
-    /// None that a step meets: its velocity enters only through a sign that the `modes`
-    /// sign model holds through a step (the switch is a located event), and its depth law
-    /// is located where it is not smooth (the entry). A secant F / d would be unbounded at
-    /// the entry while the energy it stores is not (the thesis's runs are resolved there).
-    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
-        Rates::NONE
-    }
-}
-
-impl StaticV {
-    /// The term's arithmetic with its parameters as numbers of type `F` (see `Drag::law`).
     #[inline(always)]
-    pub fn law<F: Real>(eta_v: F, lam: F, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+    fn force_with<F: Real>(&self, p: &[F], c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
+        let (eta_v, lam) = (p[0], p[1]);
         let zero = F::splat(0.0);
         let rg = m.g * m.rho_g;
         // d * (1 / L_ref): the division waits for L_ref alone, not for the depth.
@@ -108,5 +98,13 @@ impl StaticV {
             bound: [zero, bound],
             moment: F::splat(0.0),
         }
+    }
+
+    /// None that a step meets: its velocity enters only through a sign that the `modes`
+    /// sign model holds through a step (the switch is a located event), and its depth law
+    /// is located where it is not smooth (the entry). A secant F / d would be unbounded at
+    /// the entry while the energy it stores is not (the thesis's runs are resolved there).
+    fn rates(&self, _c: &ContactState<f64>, _m: &Medium<f64>) -> Rates {
+        Rates::NONE
     }
 }

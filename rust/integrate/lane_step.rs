@@ -172,12 +172,12 @@ impl<F: Real> LaneStage<F> {
 /// One RK4 step ([`super::stepper::step_sampling`] and the end evaluation of
 /// [`super::stepper::full_step`]) in `F`, in the scalar path's order of operations.
 #[inline(always)]
-pub fn lane_step<F: Real, const FRAME: bool>(
+pub fn lane_step<F: Real, const THESIS: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    let rod_eval = rod_eval_law::<F, FRAME>;
+    let rod_eval = rod_eval_law::<F, THESIS>;
     let h = s.h;
     let half = F::splat(0.5) * h;
     let zero = F::splat(0.0);
@@ -411,12 +411,12 @@ impl LaneEnd<f64> {
 
 /// [`lane_step`] compiled for the baseline target.
 #[inline(never)]
-pub(super) fn lane_step_base<F: Real, const FRAME: bool>(
+pub(super) fn lane_step_base<F: Real, const THESIS: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    lane_step::<F, FRAME>(p, m, s)
+    lane_step::<F, THESIS>(p, m, s)
 }
 
 /// [`lane_step`] compiled with AVX2 (256-bit registers for the lanes; for one lane, the
@@ -427,12 +427,12 @@ pub(super) fn lane_step_base<F: Real, const FRAME: bool>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-unsafe fn lane_step_avx2<F: Real, const FRAME: bool>(
+unsafe fn lane_step_avx2<F: Real, const THESIS: bool>(
     p: &RodParams<F>,
     m: &RodModes<F>,
     s: &LaneStart<F>,
 ) -> LaneEnd<F> {
-    lane_step::<F, FRAME>(p, m, s)
+    lane_step::<F, THESIS>(p, m, s)
 }
 
 /// How the lanes run: with AVX2 where the CPU has it, else the baseline.
@@ -467,11 +467,11 @@ impl LaneIsa {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `Avx2` comes from `detect`, which found AVX2 on this CPU (this method
             // is the crate's own, so no caller outside it picks the variant).
-            LaneIsa::Avx2 if p.frame.is_some() => unsafe { lane_step_avx2::<F, true>(p, m, s) },
+            LaneIsa::Avx2 if p.law.thesis => unsafe { lane_step_avx2::<F, true>(p, m, s) },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
             LaneIsa::Avx2 => unsafe { lane_step_avx2::<F, false>(p, m, s) },
-            _ if p.frame.is_some() => lane_step_base::<F, true>(p, m, s),
+            _ if p.law.thesis => lane_step_base::<F, true>(p, m, s),
             _ => lane_step_base::<F, false>(p, m, s),
         }
     }

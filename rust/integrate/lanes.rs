@@ -1,8 +1,7 @@
 //! Several runs of the free link stepped at once, one per SIMD lane: the sweep's fast path.
-//! The lanes run one law's arithmetic at a time: the thesis's terms (any of them, with any
-//! coefficients per lane) or one law of terms that read the frame (`rft`, `poncelet`,
-//! `rft_inertial`: `dynamics::rod_lanes::FrameLaw`), its terms and element counts shared by
-//! the four, its numbers per lane.
+//! The lanes run one law at a time: any contact terms the free link accepts, their terms
+//! and counts shared by the four, their numbers per lane
+//! (`dynamics::rod_lanes::RodLaw::shares`).
 //!
 //! Layout (structure of arrays): each lane holds one scene; the state (q, q', work), the
 //! first stage, the step size, the held modes and the scene's parameters are each one
@@ -32,7 +31,7 @@ use super::options::SolveOptions;
 use super::outcome::Outcome;
 use super::solve::{solve, Run};
 use super::stepper::{Deriv, Method};
-use crate::dynamics::rod_lanes::{same_law, RodEval, RodModes, RodParams};
+use crate::dynamics::rod_lanes::{RodEval, RodModes, RodParams};
 use crate::dynamics::Model;
 use crate::error::Result;
 use crate::num::{F64x4, LANES};
@@ -76,9 +75,8 @@ pub struct LaneCounts {
 /// to `done` with its tag as the run ends (not in input order). A scene the lanes do not
 /// cover ([`covered`]) runs alone, on the scalar path, as [`solve`] runs it.
 ///
-/// The lanes run one law's arithmetic at a time (the thesis's terms with any coefficients
-/// per lane, or one [`crate::dynamics::rod_lanes::FrameLaw`]'s terms and element counts,
-/// with any numbers per lane: [`crate::dynamics::rod_lanes::same_law`]). A scene under
+/// The lanes run one law at a time (its terms and counts, with any numbers per lane:
+/// [`crate::dynamics::rod_lanes::RodLaw::shares`]). A scene under
 /// another law waits (up to [`WAITING`] of them; its lane stays empty) until the lanes have
 /// drained, and then they take its law.
 ///
@@ -202,7 +200,7 @@ pub fn run_lanes<T>(
         } else {
             let mut lane_params = *params;
             for i in (0..LANES).filter(|&i| !stepped[i]) {
-                copy_lane(&mut lane_params, i, first);
+                lane_params.copy_lane(i, first);
                 start.copy_lane(i, first);
                 lane_modes.copy_lane(i, first);
             }
@@ -262,12 +260,12 @@ impl<T> Feed<T> {
     ) -> Option<Slot<T>> {
         let idle = slots.iter().all(Option::is_none);
         loop {
-            let waited = match params.as_ref().map(|p| p.frame) {
+            let waited = match params.as_ref() {
                 _ if idle && !self.waiting.is_empty() => self.waiting.pop_front(),
-                Some(f) => self
+                Some(lanes) => self
                     .waiting
                     .iter()
-                    .position(|(_, p)| same_law(&p.frame, &f))
+                    .position(|(_, p)| lanes.law.shares(&p.law))
                     .and_then(|k| self.waiting.remove(k)),
                 None => None,
             };
@@ -293,7 +291,7 @@ impl<T> Feed<T> {
                 }
             };
             match params {
-                Some(lanes) if same_law(&lanes.frame, &p.frame) => lanes.set(i, &p),
+                Some(lanes) if lanes.law.shares(&p.law) => lanes.set(i, &p),
                 Some(lanes) if idle => {
                     *lanes = RodParams::splat(&p);
                     self.counts.law_changes += 1;
@@ -316,31 +314,6 @@ impl<T> Feed<T> {
             });
         }
     }
-}
-
-/// Lane `i` of `p` takes lane `j`'s parameters.
-fn copy_lane(p: &mut RodParams<F64x4>, i: usize, j: usize) {
-    let one = |x: &mut F64x4| x.0[i] = x.0[j];
-    one(&mut p.mass);
-    one(&mut p.g);
-    one(&mut p.inv_m);
-    one(&mut p.inv_i);
-    one(&mut p.tip[0]);
-    one(&mut p.tip[1]);
-    one(&mut p.length);
-    one(&mut p.diameter);
-    one(&mut p.section);
-    one(&mut p.at_centroid);
-    one(&mut p.medium.rho_g);
-    one(&mut p.medium.g);
-    one(&mut p.eta_d);
-    one(&mut p.eta_h);
-    one(&mut p.eta_v);
-    one(&mut p.lam);
-    one(&mut p.unheld);
-    one(&mut p.smooth);
-    one(&mut p.eps);
-    p.frame_numbers.each(one);
 }
 
 /// A run that failed leaves its lane with its error.
@@ -440,6 +413,52 @@ mod tests {
         assert_eq!(got, expected);
         assert_eq!((counts.alone, counts.in_lanes), (0, 40), "{counts:?}");
         assert!(counts.law_changes >= 2, "{counts:?}");
+    }
+
+    /// Every law the free link accepts runs in the lanes, each outcome the general path's
+    /// bit for bit (every field): each of the registry's terms that a rod takes alone, and
+    /// mixed (the thesis's three, each pair, all of them), with `gravity`, four scenes of
+    /// each law in one sweep, each with its own numbers, through entry, sticking and stops.
+    #[test]
+    fn every_law_runs_in_the_lanes_as_on_the_general_path() {
+        use crate::dynamics::rod_lanes::{rod_law, rod_terms};
+        let n = rod_terms(1.0, 1).len() as u32;
+        let mut masks: Vec<u32> = (0..n).map(|k| 1 << k).collect();
+        masks.push(0b111);
+        masks.push((1 << n) - 1);
+        for a in 0..n {
+            for b in a + 1..n {
+                masks.push((1 << a) | (1 << b));
+            }
+        }
+        let mut scenes = Vec::new();
+        let mut expected = Vec::new();
+        for (k, &mask) in masks.iter().enumerate() {
+            for j in 0..LANES {
+                let mut law = vec![TermSpec::new("gravity", &[])];
+                law.extend(rod_law(mask, 0.6 + 0.3 * j as f64, 3 + k % 5));
+                let s = scene(-40.0 + 27.0 * j as f64, 0.4 + 0.5 * j as f64, Some(&law));
+                let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
+                let mut run = Run::new(&model, q0, qd0, &s.options).general();
+                while let Some(h) = run.next_step(&model) {
+                    run.step(&model, h).unwrap();
+                }
+                expected.push(format!("{:?}", run.finish(&model)));
+                scenes.push((scenes.len(), model, q0, qd0, s.options));
+            }
+        }
+        let mut queue = scenes.into_iter();
+        let mut got = vec![String::new(); expected.len()];
+        let counts = run_lanes(
+            LaneIsa::detect(),
+            || queue.next(),
+            |k, out| got[k] = format!("{out:?}"),
+        );
+        for (k, (a, b)) in got.iter().zip(&expected).enumerate() {
+            assert_eq!(a, b, "law {:b}, scene {}", masks[k / LANES], k % LANES);
+        }
+        assert_eq!(counts.alone, 0, "{counts:?}");
+        assert!(counts.law_changes + 1 >= masks.len(), "{counts:?}");
     }
 
     /// A step gives the same bits compiled for the baseline target as with AVX2 (the CPU's

@@ -234,8 +234,8 @@ pub(super) fn validate_sweep<'py>(
 /// `outputs` (a list of output field names, or None for the scenes' own) are the fields
 /// every run computes and returns: the table's columns.
 ///
-/// `lanes` (default true) runs the free-link scenes under the thesis's terms or a frame law
-/// (`rft`, `poncelet`, `rft_inertial`) four at a time in SIMD lanes (`batch::Path::Lanes`;
+/// `lanes` (default true) runs the free-link scenes (under any terms) four at a time in
+/// SIMD lanes (`batch::Path::Lanes`;
 /// the same results bit for bit); false runs every scene alone on the scalar path.
 #[pyfunction]
 #[pyo3(signature = (base=None, axes=None, scenes=None, start=0, stop=None, threads=0, progress=None, lanes=true, outputs=None))]
