@@ -4,7 +4,8 @@
 //! - **A rod** is two plates (Li, Zhang & Goldman 2013 lump a plate's two faces into one
 //!   set of coefficients, so a thin body counts once):
 //!   - the shaft, on the rod's axis from the tip T along the immersed length l;
-//!   - the tip end, of length d_c across the axis at T.
+//!   - the tip end, of length d_c across the axis at T, from its deeper corner (mirror
+//!     images walk their elements alike).
 //!
 //!   Both are d_c wide out of the plane; the top end never counts.
 //! - **A box** (a sole) is three plates: its bottom (heel to toe) and its back and front
@@ -132,15 +133,22 @@ impl<F: Real> Outline<F> {
 }
 
 /// A rod's two plates at the pose `frame`: its shaft from the tip T along the axis over the
-/// immersed length, and its tip end across the axis at T, both `diameter` wide.
+/// immersed length, and its tip end across the axis at T from its deeper corner, both
+/// `diameter` wide.
 #[inline(always)]
 pub fn rod_plates<F: Real>(diameter: F, immersed: F, frame: &Frame<F>) -> [Plate<F>; 2] {
     let t = frame.origin;
     let e = frame.axis;
     let half = F::splat(0.5) * diameter;
-    // The normal to the axis, (-e_y, e_x).
-    let n = [-e[1], e[0]];
-    // Directions and lengths from the frame: no square root, no division.
+    // The tip end runs from its deeper corner: the normal to the axis, (-e_y, e_x), turned
+    // to point up the slope with the sign of e_x (the sign of 1 / e_x, so that a level
+    // end takes the sign of a zero e_x too). A rod and its mirror image (x -> -x) then walk
+    // their elements in the same order and their forces are each other's mirror image bit
+    // for bit; a normal fixed to the axis's left would walk the mirror's from the other end.
+    let one = F::splat(1.0);
+    let side = e[0].recip().select_pos(one, -one);
+    let n = [-(side * e[1]), side * e[0]];
+    // Directions and lengths from the frame: no square root (the one division is the side's).
     [
         Plate {
             a: t,
@@ -257,6 +265,42 @@ mod tests {
         let out = plate([0.0, 0.1], [1.0, 0.2]);
         assert_eq!(out.elements(3).length, 0.0);
         assert_eq!(depth_area(&out, 3), 0.0);
+    }
+
+    /// A rod's plates and its mirror image's (x -> -x) are each other's mirror image bit for
+    /// bit, ends and direction, so that the terms walk their elements in the same order:
+    /// the tip end runs from its deeper corner, the axis's x a zero of either sign too.
+    #[test]
+    fn a_rods_plates_mirror_its_mirror_images() {
+        let m = |p: [f64; 2]| [-p[0], p[1]];
+        for (ex, ey) in [
+            (0.6, 0.8),
+            (-0.6, 0.8),
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.3, -0.9),
+        ] {
+            let frame = Frame {
+                origin: [0.25, -0.05],
+                v: [0.0; 2],
+                omega: 0.0,
+                axis: [ex, ey],
+            };
+            let image = Frame {
+                origin: m(frame.origin),
+                axis: m(frame.axis),
+                ..frame
+            };
+            let plates = rod_plates(0.0127, 0.1, &frame);
+            let mirrored = rod_plates(0.0127, 0.1, &image);
+            for (p, q) in plates.iter().zip(&mirrored) {
+                for (a, b) in [(p.a, q.a), (p.b, q.b), (p.u, q.u)] {
+                    assert_eq!(m(a).map(f64::to_bits), b.map(f64::to_bits), "{ex} {ey}");
+                }
+            }
+            // The tip end from its deeper corner (level: either end, as the mirror's).
+            assert!(plates[1].a[1] <= plates[1].b[1], "{ex} {ey}");
+        }
     }
 
     #[test]
