@@ -22,7 +22,7 @@
 use std::f64::consts::PI;
 use std::mem::MaybeUninit;
 
-use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 use super::quad::{arc_below, around, clip_linear, intersect, pieces, trig_roots, Gauss};
 use crate::error::{GranrsError, Result};
@@ -727,88 +727,55 @@ impl Shape {
                 }
             }
             Shape::Mesh(m) => {
+                // Each vertex moved to the world frame and its velocity once (a vertex is
+                // shared by about six triangles), the same operations as per triangle.
                 let r = q.to_rotation_matrix();
-                #[cfg(target_arch = "x86_64")]
-                if crate::num::avx2() {
-                    // SAFETY: this CPU has AVX2 (checked).
-                    return unsafe { mesh_elements_avx2(m, &motion, &r, rule, out) };
+                let mut world = std::mem::take(&mut out.scratch);
+                let mut vel = std::mem::take(&mut out.scratch_v);
+                world.clear();
+                vel.clear();
+                world.extend(m.vertices.iter().map(|p| c + r * p));
+                vel.extend(world.iter().map(|p| motion.velocity_at(p)));
+                let (k, tris) = (rule.subdivisions(), &m.triangles);
+                let per = 3 * k * k;
+                let mut next = 0;
+                while next < tris.len() {
+                    // Every triangle's elements written straight into the arrays' room (for up
+                    // to 1024 triangles at a time, and two more for a cut's up to three
+                    // triangles: a big mesh grows the arrays as it needs), in mesh order.
+                    out.reserve(per * ((tris.len() - next).min(1024) + 2));
+                    out.fill(|room| {
+                        while next < tris.len() {
+                            let i = next;
+                            let t = tris[i];
+                            let pts = [world[t[0]], world[t[1]], world[t[2]]];
+                            if pts.iter().all(|p| p.z > surface) {
+                                next += 1;
+                                continue;
+                            }
+                            let u = [vel[t[0]], vel[t[1]], vel[t[2]]];
+                            let n = r * m.normals[i];
+                            match facet(&motion, &pts, &u, &n) {
+                                Facet::Whole if room.left() < per => return,
+                                Facet::Whole => {
+                                    let [a, b, c] = &pts;
+                                    triangle_with(a, b, c, &n, m.areas[i], k, surface, room);
+                                }
+                                Facet::Trailing => {}
+                                // A triangle cut by two lines has at most five corners: three
+                                // triangles.
+                                Facet::Cut if room.left() < 3 * per => return,
+                                Facet::Cut => polygon_with(&motion, &pts, &n, rule, room),
+                            }
+                            next += 1;
+                        }
+                    });
                 }
-                mesh_elements(m, &motion, &r, rule, out);
+                out.scratch = world;
+                out.scratch_v = vel;
             }
         }
     }
-}
-
-/// A mesh's elements, compiled for AVX2 (without FMA: the same IEEE operations, so the same
-/// bits as [`mesh_elements`]).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn mesh_elements_avx2(
-    m: &Mesh,
-    motion: &Motion,
-    r: &Rotation3<f64>,
-    rule: &Quadrature,
-    out: &mut Elements,
-) {
-    mesh_elements(m, motion, r, rule, out)
-}
-
-/// A mesh's elements at the pose (`motion.c`, `r`): each triangle below the surface kept
-/// whole, dropped (trailing) or cut ([`facet`]), in mesh order.
-#[inline(always)]
-fn mesh_elements(
-    m: &Mesh,
-    motion: &Motion,
-    r: &Rotation3<f64>,
-    rule: &Quadrature,
-    out: &mut Elements,
-) {
-    let (c, surface) = (&motion.c, motion.surface);
-    // Each vertex moved to the world frame and its velocity once (a vertex is
-    // shared by about six triangles), the same operations as per triangle.
-    let mut world = std::mem::take(&mut out.scratch);
-    let mut vel = std::mem::take(&mut out.scratch_v);
-    world.clear();
-    vel.clear();
-    world.extend(m.vertices.iter().map(|p| c + r * p));
-    vel.extend(world.iter().map(|p| motion.velocity_at(p)));
-    let (k, tris) = (rule.subdivisions(), &m.triangles);
-    let per = 3 * k * k;
-    let mut next = 0;
-    while next < tris.len() {
-        // Every triangle's elements written straight into the arrays' room (for up
-        // to 1024 triangles at a time, and two more for a cut's up to three
-        // triangles: a big mesh grows the arrays as it needs), in mesh order.
-        out.reserve(per * ((tris.len() - next).min(1024) + 2));
-        out.fill(|room| {
-            while next < tris.len() {
-                let i = next;
-                let t = tris[i];
-                let pts = [world[t[0]], world[t[1]], world[t[2]]];
-                if pts.iter().all(|p| p.z > surface) {
-                    next += 1;
-                    continue;
-                }
-                let u = [vel[t[0]], vel[t[1]], vel[t[2]]];
-                let n = r * m.normals[i];
-                match facet(motion, &pts, &u, &n) {
-                    Facet::Whole if room.left() < per => return,
-                    Facet::Whole => {
-                        let [a, b, c] = &pts;
-                        triangle_with(a, b, c, &n, m.areas[i], k, surface, room);
-                    }
-                    Facet::Trailing => {}
-                    // A triangle cut by two lines has at most five corners: three
-                    // triangles.
-                    Facet::Cut if room.left() < 3 * per => return,
-                    Facet::Cut => polygon_with(motion, &pts, &n, rule, room),
-                }
-                next += 1;
-            }
-        });
-    }
-    out.scratch = world;
-    out.scratch_v = vel;
 }
 
 /// The lower of the two ends `c +- h a` of an axis.
