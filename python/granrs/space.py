@@ -329,6 +329,9 @@ class Scene:
     record: bool = False
     quadrature: int = DEFAULT_QUADRATURE
     _compiled: Any = field(default=None, init=False, repr=False, compare=False)
+    #: The listed terms of :data:`_SAND_TERMS`, in its order (worked out once: ``load``
+    #: reads them at every call).
+    _sand_terms: tuple[str, ...] = field(default=(), init=False, repr=False, compare=False)
 
     def _dict(self, position: Any) -> dict[str, Any]:
         if not isinstance(self.body, Body):
@@ -362,6 +365,8 @@ class Scene:
             surface = float(self.surface)
             object.__setattr__(self, "position", (0.0, 0.0, surface - low[2]))
         object.__setattr__(self, "_compiled", _granrs.space_scene(self._dict(self.position)))
+        listed = {t.name for t in self.forces}
+        object.__setattr__(self, "_sand_terms", tuple(k for k in _SAND_TERMS if k in listed))
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with ``changes`` (checked as a new scene). A new ``medium`` applies as to
@@ -445,6 +450,10 @@ def run(scene: Scene) -> Result:
     )
 
 
+#: The sand terms whose shares :class:`Load` gives, in its order.
+_SAND_TERMS = ("rft3d", "rft3d_inertial", "poncelet")
+
+
 @dataclass(frozen=True)
 class Load:
     """The sand's load on a body at one pose and motion.
@@ -508,11 +517,10 @@ def load(
         scene.omega if omega is None else omega,
         bool(error),
     )
-    listed = {t.name for t in scene.forces}
     return Load(
-        force=tuple(d["force"]),
-        moment=tuple(d["moment"]),
-        terms={k: tuple(d[k]) for k in ("rft3d", "rft3d_inertial", "poncelet") if k in listed},
+        force=d["force"],
+        moment=d["moment"],
+        terms={k: d[k] for k in scene._sand_terms},
         wetted_area=d["wetted_area"],
         projected_area=d["projected_area"],
         elements=d["elements"],

@@ -4,7 +4,7 @@
 
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyList, PyTuple};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyTuple};
 
 use super::errors::to_pyerr;
 use super::run::watched;
@@ -51,21 +51,43 @@ fn item<'py>(d: &Bound<'py, PyDict>, key: &str, field: &str) -> Res<Bound<'py, P
 }
 
 fn numbers<const N: usize>(v: &Bound<'_, PyAny>, field: &str) -> Res<[f64; N]> {
-    let what = format!("a sequence of {N} numbers");
+    // The common case first: a tuple of N floats (NumPy's float64 is one: a subclass of
+    // float, never a bool), as `space.load`'s state at every call, without the general
+    // path's per-item checks.
+    if let Ok(t) = v.cast::<PyTuple>() {
+        if t.len() == N {
+            let mut out = [0.0; N];
+            let mut floats = true;
+            for (o, x) in out.iter_mut().zip(t.iter()) {
+                match x.cast::<PyFloat>() {
+                    Ok(f) => *o = f.value(),
+                    Err(_) => {
+                        floats = false;
+                        break;
+                    }
+                }
+            }
+            if floats {
+                return Ok(out);
+            }
+        }
+    }
+    let what = || format!("a sequence of {N} numbers");
     if v.is_instance_of::<pyo3::types::PyString>() {
-        return Err(wrong(field, &what, v));
+        return Err(wrong(field, &what(), v));
     }
     let items: Vec<Bound<'_, PyAny>> = v
         .try_iter()
-        .map_err(|_| wrong(field, &what, v))?
+        .map_err(|_| wrong(field, &what(), v))?
         .take(N + 1)
         .collect::<PyResult<_>>()
-        .map_err(|_| wrong(field, &what, v))?;
+        .map_err(|_| wrong(field, &what(), v))?;
     if items.len() != N {
         return Err(GranrsError::InvalidScene {
             field: field.into(),
             message: format!(
-                "{what}, got {}{}",
+                "{}, got {}{}",
+                what(),
                 items.len().min(N),
                 if items.len() > N { " or more" } else { "" }
             ),

@@ -71,8 +71,14 @@ pub struct Scene3 {
     pub nodes: usize,
 }
 
+/// Whether `v` is finite and in `[lo, hi]`.
+#[inline]
+fn within(v: f64, lo: f64, hi: f64) -> bool {
+    v.is_finite() && v >= lo && v <= hi
+}
+
 fn finite(field: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
-    if v.is_finite() && v >= lo && v <= hi {
+    if within(v, lo, hi) {
         Ok(v)
     } else {
         Err(GranrsError::InvalidParameter {
@@ -83,11 +89,25 @@ fn finite(field: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
     }
 }
 
-fn vector(field: &str, v: [f64; 3], bound: f64, what: &str) -> Result<Vector3<f64>> {
+/// [`finite`] on each entry `field[k]` of `v` (an entry's name is written out only for its
+/// error: a state is checked at every call of `space.load`).
+fn each_finite<const N: usize>(
+    field: &str,
+    v: [f64; N],
+    lo: f64,
+    hi: f64,
+    what: &str,
+) -> Result<[f64; N]> {
     for (k, x) in v.iter().enumerate() {
-        finite(&format!("{field}[{k}]"), *x, -bound, bound, what)?;
+        if !within(*x, lo, hi) {
+            finite(&format!("{field}[{k}]"), *x, lo, hi, what)?;
+        }
     }
-    Ok(Vector3::from(v))
+    Ok(v)
+}
+
+fn vector(field: &str, v: [f64; 3], bound: f64, what: &str) -> Result<Vector3<f64>> {
+    Ok(Vector3::from(each_finite(field, v, -bound, bound, what)?))
 }
 
 impl Scene3 {
@@ -201,16 +221,13 @@ pub fn state_of(
 ) -> Result<State> {
     // Wide enough for the default placement (the surface plus a size) of any shape.
     let c = vector("position", position, 1e7, "[m]")?;
-    let mut q = [0.0; 4];
-    for (k, x) in orientation.iter().enumerate() {
-        q[k] = finite(
-            &format!("orientation[{k}]"),
-            *x,
-            -2.0,
-            2.0,
-            "a unit quaternion (w, x, y, z)",
-        )?;
-    }
+    let q = each_finite(
+        "orientation",
+        orientation,
+        -2.0,
+        2.0,
+        "a unit quaternion (w, x, y, z)",
+    )?;
     let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
     if (norm - 1.0).abs() > 1e-6 {
         return Err(GranrsError::InvalidScene {

@@ -92,8 +92,8 @@ impl Elements {
     }
 
     /// Run `f` with the arrays' spare room ([`Elements::reserve`]d before) to write
-    /// elements into by index, then count what it wrote (a mesh's whole triangles: no
-    /// array's length or capacity is read or written per element).
+    /// elements into by index, then count what it wrote (a mesh's triangles, whole and cut:
+    /// no array's length or capacity is read or written per element).
     fn fill<R>(&mut self, f: impl FnOnce(&mut Room<'_>) -> R) -> R {
         let [x0, x1, x2] = &mut self.x;
         let [n0, n1, n2] = &mut self.n;
@@ -740,11 +740,11 @@ impl Shape {
                 let per = 3 * k * k;
                 let mut next = 0;
                 while next < tris.len() {
-                    // The whole triangles (most) written straight into the arrays' room (for
-                    // up to 1024 of them at a time: a big mesh's cut grows them as it needs),
-                    // up to the first one that needs the general cut.
-                    out.reserve(per * (tris.len() - next).min(1024));
-                    let stop = out.fill(|room| {
+                    // Every triangle's elements written straight into the arrays' room (for up
+                    // to 1024 triangles at a time, and two more for a cut's up to three
+                    // triangles: a big mesh grows the arrays as it needs), in mesh order.
+                    out.reserve(per * ((tris.len() - next).min(1024) + 2));
+                    out.fill(|room| {
                         while next < tris.len() {
                             let i = next;
                             let t = tris[i];
@@ -756,24 +756,20 @@ impl Shape {
                             let u = [vel[t[0]], vel[t[1]], vel[t[2]]];
                             let n = r * m.normals[i];
                             match facet(&motion, &pts, &u, &n) {
-                                Facet::Whole if room.left() < per => return None,
+                                Facet::Whole if room.left() < per => return,
                                 Facet::Whole => {
                                     let [a, b, c] = &pts;
                                     triangle_with(a, b, c, &n, m.areas[i], k, surface, room);
                                 }
                                 Facet::Trailing => {}
-                                Facet::Cut => {
-                                    next += 1;
-                                    return Some((pts, n));
-                                }
+                                // A triangle cut by two lines has at most five corners: three
+                                // triangles.
+                                Facet::Cut if room.left() < 3 * per => return,
+                                Facet::Cut => polygon_with(&motion, &pts, &n, rule, room),
                             }
                             next += 1;
                         }
-                        None
                     });
-                    if let Some((pts, n)) = stop {
-                        polygon_with(&motion, &pts, &n, rule, out);
-                    }
                 }
                 out.scratch = world;
                 out.scratch_v = vel;
@@ -1099,7 +1095,7 @@ fn polygon(m: &Motion, pts: &[V3], rule: &Quadrature, out: &mut Elements) {
 }
 
 /// [`polygon`] with its normal `n` given.
-fn polygon_with(m: &Motion, pts: &[V3], n: &V3, rule: &Quadrature, out: &mut Elements) {
+fn polygon_with(m: &Motion, pts: &[V3], n: &V3, rule: &Quadrature, out: &mut impl Sink) {
     let n = *n;
     let face = Poly::of(pts);
     let mut f = [0.0; 8];
@@ -1147,7 +1143,7 @@ fn triangle_area(a: &V3, b: &V3, c: &V3) -> f64 {
 }
 
 /// The 3-point rule (degree 2) on each of the `k^2` triangles a triangle is cut into.
-fn triangle(a: &V3, b: &V3, c: &V3, n: &V3, k: usize, surface: f64, out: &mut Elements) {
+fn triangle(a: &V3, b: &V3, c: &V3, n: &V3, k: usize, surface: f64, out: &mut impl Sink) {
     triangle_with(a, b, c, n, triangle_area(a, b, c), k, surface, out);
 }
 
