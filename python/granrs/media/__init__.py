@@ -704,13 +704,25 @@ def _same(value: Any, other: Any) -> bool:
         return False
 
 
+def _scene_card(medium: Any) -> MediumCard:
+    """:func:`load` for a scene's ``medium`` field: an error about an entry of the card
+    keeps the entry as its ``field`` (``name``, ``rft.zeta``) and says in its message that
+    it comes from the scene's ``medium``."""
+    try:
+        return load(medium)
+    except MediumError as e:
+        if str(e).startswith("medium") or getattr(e, "field", None) == "medium":
+            raise
+        raise MediumError(f"medium: {e}", field=e.field) from None
+
+
 def apply(scene: Any) -> None:
     """Apply the scene's medium (a name, a path or a card: :func:`granrs.media.load`): its
     ``rho_g`` and ``g`` where the scene's are their defaults, and its values of the listed
     terms' parameters the caller did not give; the terms' source then names the medium
     (unless it names something else). A term still missing a required parameter is refused
     naming it. Shared by :class:`granrs.Scene` and :class:`granrs.space.Scene`."""
-    card = None if scene.medium is None else load(scene.medium)
+    card = None if scene.medium is None else _scene_card(scene.medium)
     object.__setattr__(scene, "medium", card)
     if card is not None:
         defaults = {f.name: f.default for f in dataclasses.fields(scene)}
