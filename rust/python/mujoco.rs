@@ -565,6 +565,7 @@ impl MujocoCoupling {
                 previous: vec![0.0; nv],
                 held: vec![None; n],
                 solved: vec![None; n],
+                rates: vec![None; n],
                 cut: vec![0; n],
             }),
             bound: None,
