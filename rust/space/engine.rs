@@ -380,6 +380,9 @@ impl SpaceCoupling {
             let mut iterations = 0;
             // The residual before the last full Newton step, if the last step was full.
             let mut before: Option<f64> = None;
+            // The Newton matrix's LU factors, kept while they are the chord's (the same
+            // matrix at every chord step).
+            let mut factored: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
             while !converged && iterations < 40 {
                 iterations += 1;
                 if !rated && !use_chord {
@@ -397,16 +400,22 @@ impl SpaceCoupling {
                 // converge after all, the next iteration evaluates them or keeps the chord).
                 let now = r.amax();
                 let last_step = chording || before.is_some_and(|b| now * (now / b).powi(2) <= tol);
-                let mut kk = DMatrix::zeros(rows, rows);
-                for (a, k) in ks.iter().enumerate() {
-                    for p in 0..6 {
-                        for q in 0..6 {
-                            kk[(6 * a + p, 6 * a + q)] = k[p][q];
+                if !chording {
+                    factored = None;
+                }
+                if factored.is_none() {
+                    let mut kk = DMatrix::zeros(rows, rows);
+                    for (a, k) in ks.iter().enumerate() {
+                        for p in 0..6 {
+                            for q in 0..6 {
+                                kk[(6 * a + p, 6 * a + q)] = k[p][q];
+                            }
                         }
                     }
+                    let newton = DMatrix::identity(rows, rows) - h * (&resp * kk);
+                    factored = Some(newton.lu());
                 }
-                let newton = DMatrix::identity(rows, rows) - h * (&resp * kk);
-                let Some(step) = newton.lu().solve(&(-&r)) else {
+                let Some(step) = factored.as_ref().expect("factored").solve(&(-&r)) else {
                     break;
                 };
                 let mut t = 1.0;
