@@ -383,7 +383,7 @@ impl Views<'_> {
 /// shapes in space ([`space_engine::SpaceCoupling`]).
 enum Engine {
     Planar(Box<Coupling>),
-    Space(space_engine::SpaceCoupling),
+    Space(Box<space_engine::SpaceCoupling>),
 }
 
 /// The sand placed on the bodies of a MuJoCo model (`granrs.mujoco.Sand`): one call per
@@ -556,7 +556,7 @@ impl MujocoCoupling {
             });
         }
         Ok(MujocoCoupling {
-            engine: Engine::Space(space_engine::SpaceCoupling {
+            engine: Engine::Space(Box::new(space_engine::SpaceCoupling {
                 geoms,
                 nv,
                 patch,
@@ -565,8 +565,9 @@ impl MujocoCoupling {
                 previous: vec![0.0; nv],
                 held: vec![None; n],
                 solved: vec![None; n],
+                rates: vec![None; n],
                 cut: vec![0; n],
-            }),
+            })),
             bound: None,
         })
     }
