@@ -872,6 +872,13 @@ impl LinkageScene {
     /// Validate and run.
     pub fn run(&self) -> Result<Outcome> {
         self.validate()?;
+        self.run_validated()
+    }
+
+    /// [`LinkageScene::run`] of a scene already validated ([`LinkageScene::validate`], as
+    /// [`crate::spec::SceneSpec::build`] does): a compiled scene run many times is not
+    /// validated again on every run.
+    pub fn run_validated(&self) -> Result<Outcome> {
         with_size!(self.size(), N => {
             let (q0, qd0) = self.initial_state::<N>();
             solve_driven(&self.model::<N>(), q0, qd0, &self.options, self.drives())
