@@ -942,6 +942,19 @@ mod tests {
     }
 
     #[test]
+    fn a_validated_scene_runs_as_run_does() {
+        // `run_validated` (a compiled scene's run) is `run` without the validation: the same
+        // outcome, and an invalid scene is refused by `run` (and by `SceneSpec::build`).
+        let free = FreeLink::default().scene(Setting::default());
+        assert_eq!(free.run_validated().unwrap(), free.run().unwrap());
+        let s = pendulum(Joint::Free);
+        assert_eq!(s.run_validated().unwrap(), s.run().unwrap());
+        let mut bad = pendulum(Joint::Free);
+        bad.joints[0].parent = "c".into();
+        assert!(bad.run().is_err());
+    }
+
+    #[test]
     fn structure_errors_name_the_element() {
         let mut s = pendulum(Joint::Free);
         s.joints[0].parent = "c".into();
