@@ -121,11 +121,15 @@ def loud(
     energy; a step too large for the contact gains it."""
     stiff_or_stop = (h_lambda > RK4_STABILITY_LIMIT) | (unresolved_stops > 0)
     chatter = unresolved > 0
-    if isinstance(chatter, bool | np.bool_):
+    if isinstance(chatter, _ONE_RUN):
         # One run: the energies only where it chattered (a run's check costs no numpy call).
         return bool(stiff_or_stop) or (bool(chatter) and bool(_rose(energy_start, energy_end)))
     with np.errstate(invalid="ignore"):
         return stiff_or_stop | (chatter & _rose(energy_start, energy_end))
+
+
+#: What a comparison of one run's numbers gives (not a numpy array of runs).
+_ONE_RUN = (bool, np.bool_)
 
 
 def _rose(start: Any, end: Any) -> Any:
@@ -272,15 +276,18 @@ def _checked(scene: Scene, outcome: Any, result: Result) -> Result:
     if unresolved:
         raw = result._raw_dict()
         e0, e1 = raw["energy_start"], raw["energy_end"]
-    if scene.step_check and suspects(
-        h_lambda,
-        outcome.step_error,
-        unresolved_stops,
-        unresolved,
-        e0,
-        e1,
-        scene.sign_model != "raw",
-    ):
+    if scene.step_check:
+        if not suspects(
+            h_lambda,
+            outcome.step_error,
+            unresolved_stops,
+            unresolved,
+            e0,
+            e1,
+            scene.sign_model != "raw",
+        ):
+            # Not a suspect, so not loud either (a suspect is every loud run and more).
+            return result
         check = check_step(scene, outcome, result._raw_dict())
         if check is not None:
             result.step_check = check

@@ -872,6 +872,13 @@ impl LinkageScene {
     /// Validate and run.
     pub fn run(&self) -> Result<Outcome> {
         self.validate()?;
+        self.run_validated()
+    }
+
+    /// [`LinkageScene::run`] of a scene already validated ([`LinkageScene::validate`], as
+    /// [`crate::spec::SceneSpec::build`] does): a compiled scene run many times is not
+    /// validated again on every run.
+    pub fn run_validated(&self) -> Result<Outcome> {
         with_size!(self.size(), N => {
             let (q0, qd0) = self.initial_state::<N>();
             solve_driven(&self.model::<N>(), q0, qd0, &self.options, self.drives())
@@ -932,6 +939,19 @@ mod tests {
             },
             ..base
         }
+    }
+
+    #[test]
+    fn a_validated_scene_runs_as_run_does() {
+        // `run_validated` (a compiled scene's run) is `run` without the validation: the same
+        // outcome, and an invalid scene is refused by `run` (and by `SceneSpec::build`).
+        let free = FreeLink::default().scene(Setting::default());
+        assert_eq!(free.run_validated().unwrap(), free.run().unwrap());
+        let s = pendulum(Joint::Free);
+        assert_eq!(s.run_validated().unwrap(), s.run().unwrap());
+        let mut bad = pendulum(Joint::Free);
+        bad.joints[0].parent = "c".into();
+        assert!(bad.run().is_err());
     }
 
     #[test]

@@ -98,7 +98,7 @@ impl SwitchInputs for ContactEval {
 
 /// The value of a switching function: non-negative while the mode holds; the event is
 /// where it turns negative (the stop: where -v_Ty reaches zero).
-#[inline]
+#[inline(always)]
 fn switching<const N: usize>(kind: Kind, ci: usize, e: &Eval<N>, modes: &Modes) -> f64 {
     switching_of(kind, &e.contacts[ci], &modes[ci])
 }
@@ -207,7 +207,7 @@ fn corners_in<const N: usize>(e: &Eval<N>, ci: usize) -> u8 {
 }
 
 /// Whether the function has crossed (the event happened by the end of the step).
-#[inline]
+#[inline(always)]
 fn crossed(kind: Kind, g1: f64) -> bool {
     if kind == Kind::Stop {
         g1 <= 0.0

@@ -328,8 +328,9 @@ pub(super) fn watched<T: Send>(
 /// stops it and raises `KeyboardInterrupt` (or what a signal handler raised).
 #[pyfunction]
 pub(super) fn run(py: Python<'_>, compiled: &Bound<'_, Compiled>) -> PyResult<RunOutcome> {
+    // Validated when it was compiled (`SceneSpec::build`); the scene is immutable.
     let scene = &compiled.get().scene;
-    let (out, seconds) = watched(py, || scene.run())?;
+    let (out, seconds) = watched(py, || scene.run_validated())?;
     let out = out.map_err(|e| to_pyerr(py, e))?;
     let first = out.contacts.first();
     Ok(RunOutcome {
