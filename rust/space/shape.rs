@@ -1212,9 +1212,10 @@ fn triangle(a: &V3, b: &V3, c: &V3, n: &V3, k: usize, surface: f64, out: &mut im
     triangle_with(a, b, c, n, triangle_area(a, b, c), k, surface, out);
 }
 
-/// [`triangle`] with its area given.
+/// [`triangle`] with its area given (always inlined: its corners kept in registers, as
+/// [`emit`]'s).
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 fn triangle_with(
     a: &V3,
     b: &V3,
@@ -1252,21 +1253,41 @@ fn triangle_cut(
     let weight = area / (k * k) as f64 / 3.0;
     let (ab, ac) = ((b - a) / k as f64, (c - a) / k as f64);
     let at = |i: usize, j: usize| a + i as f64 * ab + j as f64 * ac;
-    // Each point (4 p + q + r) / 6, times the sixth rather than divided by 6 (a product
-    // is several times cheaper than a division; the same point to round-off).
-    const SIXTH: f64 = 1.0 / 6.0;
-    let mut emit = |p: V3, q: V3, r: V3| {
-        let x = [4.0 * p + q + r, p + 4.0 * q + r, p + q + 4.0 * r].map(|x| x * SIXTH);
-        out.put3(x, n, weight, surface);
-    };
     for i in 0..k {
         for j in 0..k - i {
-            emit(at(i, j), at(i + 1, j), at(i, j + 1));
+            emit(
+                at(i, j),
+                at(i + 1, j),
+                at(i, j + 1),
+                n,
+                weight,
+                surface,
+                out,
+            );
             if i + j + 2 <= k {
-                emit(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                emit(
+                    at(i + 1, j),
+                    at(i + 1, j + 1),
+                    at(i, j + 1),
+                    n,
+                    weight,
+                    surface,
+                    out,
+                );
             }
         }
     }
+}
+
+/// A small triangle's 3-point rule: each point (4 p + q + r) / 6, times the sixth rather
+/// than divided by 6 (a product is several times cheaper than a division; the same point
+/// to round-off). Always inlined: its corners stay in registers (passed through memory,
+/// each load of a corner stalled on the stores that had just written it).
+#[inline(always)]
+fn emit(p: V3, q: V3, r: V3, n: &V3, weight: f64, surface: f64, out: &mut impl Sink) {
+    const SIXTH: f64 = 1.0 / 6.0;
+    let x = [4.0 * p + q + r, p + 4.0 * q + r, p + q + 4.0 * r].map(|x| x * SIXTH);
+    out.put3(x, n, weight, surface);
 }
 
 #[cfg(test)]
