@@ -3,6 +3,7 @@ through the Python surface. Expected values are derived here, not read from the 
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import warnings
@@ -188,6 +189,42 @@ def test_a_sphere_straight_down_feels_no_sideways_force_and_a_dragged_one_lifts(
     side = space.load(s, position=(0, 0, -0.05), velocity=(1.0, 0, 0))
     assert side.force[0] < 0 < side.force[2], side.force
     assert side.force_error < 1e-6 * abs(side.force[0])
+
+
+def test_a_load_is_its_dataclass_with_each_listed_sand_term_in_order() -> None:
+    """space.load's result is a granrs.space.Load like one built from its fields: frozen,
+    equal, each field set, the listed sand terms' shares in the order rft3d,
+    rft3d_inertial, poncelet (whatever the scene's order), summing to the force."""
+    body = space.Body(space.Cuboid((0.1, 0.05, 0.03)), density=1000.0)
+    state = {"position": (0.01, 0.0, -0.01), "velocity": (0.3, -0.4, -1.0)}
+    cases = [
+        ([forces.poncelet(c=0.5, k=10.0), forces.gravity(), forces.rft3d(zeta=1e6)],
+         ["rft3d", "poncelet"]),
+        ([forces.rft3d_inertial(), forces.rft3d(zeta=1e6)], ["rft3d", "rft3d_inertial"]),
+        ([forces.gravity()], []),
+    ]  # fmt: skip
+    names = [f.name for f in dataclasses.fields(space.Load)]
+    for terms, listed in cases:
+        s = space.Scene(body=body, forces=terms)
+        got = space.load(s, **state)
+        assert type(got) is space.Load
+        assert sorted(vars(got)) == sorted(names)
+        assert list(got.terms) == listed
+        built = space.Load(**{k: getattr(got, k) for k in names})
+        assert built == got and repr(built) == repr(got)
+        assert dataclasses.asdict(got) == dataclasses.asdict(built)
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            got.force = (0.0, 0.0, 0.0)  # type: ignore[misc]
+        assert isinstance(got.elements, int)
+        total = np.sum([got.terms[k] for k in listed], axis=0) if listed else np.zeros(3)
+        assert np.allclose(total, got.force, rtol=1e-12, atol=0.0)
+        if listed:
+            assert got.elements > 0 and got.wetted_area > 0
+        else:
+            assert got.elements == 0 and got.terms == {}
+        assert math.isfinite(got.force_error) and math.isnan(
+            space.load(s, **state, error=False).force_error
+        )
 
 
 def test_turning_everything_about_the_vertical_turns_the_load() -> None:

@@ -329,9 +329,6 @@ class Scene:
     record: bool = False
     quadrature: int = DEFAULT_QUADRATURE
     _compiled: Any = field(default=None, init=False, repr=False, compare=False)
-    #: The listed terms of :data:`_SAND_TERMS`, in its order (worked out once: ``load``
-    #: reads them at every call).
-    _sand_terms: tuple[str, ...] = field(default=(), init=False, repr=False, compare=False)
 
     def _dict(self, position: Any) -> dict[str, Any]:
         if not isinstance(self.body, Body):
@@ -365,8 +362,6 @@ class Scene:
             surface = float(self.surface)
             object.__setattr__(self, "position", (0.0, 0.0, surface - low[2]))
         object.__setattr__(self, "_compiled", _granrs.space_scene(self._dict(self.position)))
-        listed = {t.name for t in self.forces}
-        object.__setattr__(self, "_sand_terms", tuple(k for k in _SAND_TERMS if k in listed))
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with ``changes`` (checked as a new scene). A new ``medium`` applies as to
@@ -450,10 +445,6 @@ def run(scene: Scene) -> Result:
     )
 
 
-#: The sand terms whose shares :class:`Load` gives, in its order.
-_SAND_TERMS = ("rft3d", "rft3d_inertial", "poncelet")
-
-
 @dataclass(frozen=True)
 class Load:
     """The sand's load on a body at one pose and motion.
@@ -509,24 +500,26 @@ def load(
         raise InvalidParameterError(
             f"load() takes a granrs.space.Scene, got {type(scene).__name__}", field="scene"
         )
-    d = _granrs.space_load(
-        scene._compiled,
-        scene.position if position is None else position,
-        scene.orientation if orientation is None else orientation,
-        scene.velocity if velocity is None else velocity,
-        scene.omega if omega is None else omega,
-        bool(error),
+    # The core gives Load's fields as a dict, which becomes the instance's own: the frozen
+    # dataclass built without its __init__'s assignment per field.
+    out = _new(Load)
+    _setattr(
+        out,
+        "__dict__",
+        _granrs.space_load(
+            scene._compiled,
+            scene.position if position is None else position,
+            scene.orientation if orientation is None else orientation,
+            scene.velocity if velocity is None else velocity,
+            scene.omega if omega is None else omega,
+            bool(error),
+        ),
     )
-    return Load(
-        force=d["force"],
-        moment=d["moment"],
-        terms={k: d[k] for k in scene._sand_terms},
-        wetted_area=d["wetted_area"],
-        projected_area=d["projected_area"],
-        elements=d["elements"],
-        force_error=d["force_error"],
-        moment_error=d["moment_error"],
-    )
+    return out
+
+
+_new = object.__new__
+_setattr = object.__setattr__
 
 
 def xi_n(rho_c: float, mu: float) -> float:

@@ -3,6 +3,7 @@
 //! outcome returned as a dict whose names come from `space::outputs`.
 
 use numpy::IntoPyArray;
+use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyTuple};
 
@@ -404,10 +405,13 @@ pub(super) fn space_run<'py>(
     }))
 }
 
-/// The sand's load on the scene's body at a pose and motion: a dict with `force` and
-/// `moment` (about the centre of mass) [N, N m], each term's share, the wetted and projected
-/// areas, the element count and, with `error`, the quadrature's error estimate (the change
-/// when its nodes are doubled) of the force and the moment (NaN without).
+/// The sand's load on the scene's body at a pose and motion, as the fields of
+/// `granrs.space.Load` (a dict that becomes its instance's own): `force` and `moment`
+/// (about the centre of mass) [N, N m], `terms` (each listed sand term's share, in the
+/// order rft3d, rft3d_inertial, poncelet), the wetted and projected areas, the element
+/// count and, with `error`, the quadrature's error estimate (the change when its nodes are
+/// doubled) of the force and the moment (NaN without). Its keys are interned: built at
+/// every call without a new string.
 #[pyfunction]
 #[pyo3(signature = (scene, position, orientation, velocity, omega, error=true))]
 pub(super) fn space_load<'py>(
@@ -431,9 +435,15 @@ pub(super) fn space_load<'py>(
     .map_err(|e| to_pyerr(py, e))?;
     let r = state.rotation();
     let w = r * state.w;
-    let (load, ef, em) = py.detach(|| {
+    let (load, ef, em, listed) = py.detach(|| {
         let mut body = scene.body.lock().unwrap_or_else(|p| p.into_inner());
-        if error {
+        let t = &body.sand.terms;
+        let listed = [
+            t.rft3d.is_some(),
+            t.inertial.is_some(),
+            t.poncelet.is_some(),
+        ];
+        let (load, ef, em) = if error {
             load_with_error(&mut body.sand, &state.c, &r, &state.v, &w)
         } else {
             (
@@ -441,21 +451,31 @@ pub(super) fn space_load<'py>(
                 f64::NAN,
                 f64::NAN,
             )
-        }
+        };
+        (load, ef, em, listed)
     });
     let v3 = |v: nalgebra::Vector3<f64>| (v.x, v.y, v.z);
-    Ok(py_dict!(py, {
-        "force": v3(load.force),
-        "moment": v3(load.moment),
-        "rft3d": v3(load.rft3d),
-        "rft3d_inertial": v3(load.inertial),
-        "poncelet": v3(load.poncelet),
-        "wetted_area": load.wetted_area,
-        "projected_area": load.projected_area,
-        "elements": load.elements,
-        "force_error": ef,
-        "moment_error": em,
-    }))
+    let terms = PyDict::new(py);
+    let shares = [
+        (intern!(py, "rft3d"), load.rft3d),
+        (intern!(py, "rft3d_inertial"), load.inertial),
+        (intern!(py, "poncelet"), load.poncelet),
+    ];
+    for ((name, share), on) in shares.into_iter().zip(listed) {
+        if on {
+            terms.set_item(name, v3(share))?;
+        }
+    }
+    let d = PyDict::new(py);
+    d.set_item(intern!(py, "force"), v3(load.force))?;
+    d.set_item(intern!(py, "moment"), v3(load.moment))?;
+    d.set_item(intern!(py, "terms"), terms)?;
+    d.set_item(intern!(py, "wetted_area"), load.wetted_area)?;
+    d.set_item(intern!(py, "projected_area"), load.projected_area)?;
+    d.set_item(intern!(py, "elements"), load.elements)?;
+    d.set_item(intern!(py, "force_error"), ef)?;
+    d.set_item(intern!(py, "moment_error"), em)?;
+    Ok(d)
 }
 
 /// Each summary field of a run in space: (name, unit, description).

@@ -200,7 +200,13 @@ impl Sand {
     /// [`Sand::load`] over the cut elements (the general path).
     fn load_cut(&mut self, c: &V3, q: &UnitQuaternion<f64>, v: &V3, omega: &V3) -> Load {
         let mut out = Load::default();
+        let areas = self.report_areas || self.terms.poncelet.is_some();
+        let speed = v.norm();
         self.elements.clear();
+        if areas && speed > 0.0 {
+            // The areas summed as the elements are cut (no second pass over them).
+            self.elements.sum_areas(v / speed);
+        }
         self.shape
             .elements(c, q, v, omega, self.surface, &self.rule, &mut self.elements);
         let e = &self.elements;
@@ -228,27 +234,16 @@ impl Sand {
             }
             out.inertial = f;
         }
-        let speed = v.norm();
-        if !(self.report_areas || self.terms.poncelet.is_some()) {
+        if !areas {
             out.force = out.rft3d + out.inertial;
             out.moment = moment;
             return out;
         }
-        if speed > 0.0 {
-            let vh = v / speed;
-            // The wetted area and the projected one in one pass (each sum in element order:
-            // two chains of additions that overlap).
-            let (mut wet, mut a, mut centre) = (0.0, 0.0, V3::zeros());
-            for i in 0..e.len() {
-                let area = e.area[i];
-                wet += area;
-                let p = (e.normal(i).dot(&vh)).max(0.0) * area;
-                a += p;
-                centre += p * e.point(i);
-            }
-            out.wetted_area = wet;
+        if let Some(sums) = e.sums {
+            let a = sums.projected;
+            out.wetted_area = sums.wetted;
             out.projected_area = a;
-            let at = (a > 0.0).then(|| centre / a);
+            let at = (a > 0.0).then(|| sums.moment / a);
             self.poncelet(&mut out, &mut moment, c, q, v, omega, a, at);
         } else {
             out.wetted_area = e.area.iter().sum();

@@ -42,10 +42,51 @@ pub struct Elements {
     pub area: Vec<f64>,
     /// Depths below the surface [m] (>= 0).
     pub depth: Vec<f64>,
+    /// The area sums taken as the elements are written, where asked for
+    /// ([`Elements::sum_areas`]; none after [`Elements::clear`]).
+    pub sums: Option<AreaSums>,
     /// A mesh's vertices in the world frame and their velocities (buffers kept between
     /// evaluations).
     scratch: Vec<V3>,
     scratch_v: Vec<V3>,
+}
+
+/// The immersed surface's areas summed over the elements in their order as they are
+/// written (the same bits as a pass over them after; the sums' additions, each a chain
+/// that waits on the one before, overlap with the cutting's work): the wetted area, the
+/// leading area projected normal to the unit direction `toward`, and that projection's
+/// first moment (its centre times it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AreaSums {
+    /// The unit direction the projected area is taken normal to (the centre's velocity's).
+    pub toward: V3,
+    /// The wetted area [m^2].
+    pub wetted: f64,
+    /// The projected leading area [m^2]: each element's `max(n . toward, 0) area`.
+    pub projected: f64,
+    /// The sum of each element's projected area times its position [m^3].
+    pub moment: V3,
+}
+
+impl AreaSums {
+    /// No elements yet, the projection normal to the unit `toward`.
+    pub fn toward(toward: V3) -> AreaSums {
+        AreaSums {
+            toward,
+            wetted: 0.0,
+            projected: 0.0,
+            moment: V3::zeros(),
+        }
+    }
+
+    /// Add an element at `x` of normal `n` and area weight `area`.
+    #[inline(always)]
+    pub fn add(&mut self, x: &V3, n: &V3, area: f64) {
+        self.wetted += area;
+        let p = n.dot(&self.toward).max(0.0) * area;
+        self.projected += p;
+        self.moment += p * x;
+    }
 }
 
 impl Elements {
@@ -57,6 +98,13 @@ impl Elements {
         }
         self.area.clear();
         self.depth.clear();
+        self.sums = None;
+    }
+
+    /// Sum the areas of the elements written from now on ([`AreaSums`], projected normal
+    /// to the unit `toward`), until [`Elements::clear`].
+    pub fn sum_areas(&mut self, toward: V3) {
+        self.sums = Some(AreaSums::toward(toward));
     }
 
     /// Element `i`'s position [m].
@@ -110,6 +158,7 @@ impl Elements {
             ],
             area: self.area.spare_capacity_mut(),
             depth: self.depth.spare_capacity_mut(),
+            sums: self.sums,
             len: 0,
             cap: 0,
         };
@@ -123,6 +172,7 @@ impl Elements {
             .unwrap_or(0);
         let out = f(&mut room);
         let more = room.len;
+        self.sums = room.sums;
         for v in self
             .x
             .iter_mut()
@@ -145,6 +195,9 @@ impl Elements {
         }
         self.area.push(area);
         self.depth.push(depth_below(surface, &x));
+        if let Some(s) = &mut self.sums {
+            s.add(&x, &n, area);
+        }
     }
 }
 
@@ -171,6 +224,11 @@ impl Sink for Elements {
         self.area.extend_from_slice(&[area; 3]);
         self.depth
             .extend_from_slice(&x.map(|p| depth_below(surface, &p)));
+        if let Some(s) = &mut self.sums {
+            for p in &x {
+                s.add(p, n, area);
+            }
+        }
     }
 }
 
@@ -180,6 +238,8 @@ struct Room<'a> {
     n: [&'a mut [MaybeUninit<f64>]; 3],
     area: &'a mut [MaybeUninit<f64>],
     depth: &'a mut [MaybeUninit<f64>],
+    /// [`Elements::sums`], taken on.
+    sums: Option<AreaSums>,
     /// How many elements are written.
     len: usize,
     /// How many fit.
@@ -208,6 +268,11 @@ impl Sink for Room<'_> {
         }
         put(self.area, [area; 3]);
         put(self.depth, x.map(|p| depth_below(surface, &p)));
+        if let Some(s) = &mut self.sums {
+            for p in &x {
+                s.add(p, n, area);
+            }
+        }
         self.len = i + 3;
     }
 }
@@ -1147,9 +1212,10 @@ fn triangle(a: &V3, b: &V3, c: &V3, n: &V3, k: usize, surface: f64, out: &mut im
     triangle_with(a, b, c, n, triangle_area(a, b, c), k, surface, out);
 }
 
-/// [`triangle`] with its area given.
+/// [`triangle`] with its area given (always inlined: its corners kept in registers, as
+/// [`emit`]'s).
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 fn triangle_with(
     a: &V3,
     b: &V3,
@@ -1187,21 +1253,41 @@ fn triangle_cut(
     let weight = area / (k * k) as f64 / 3.0;
     let (ab, ac) = ((b - a) / k as f64, (c - a) / k as f64);
     let at = |i: usize, j: usize| a + i as f64 * ab + j as f64 * ac;
-    // Each point (4 p + q + r) / 6, times the sixth rather than divided by 6 (a product
-    // is several times cheaper than a division; the same point to round-off).
-    const SIXTH: f64 = 1.0 / 6.0;
-    let mut emit = |p: V3, q: V3, r: V3| {
-        let x = [4.0 * p + q + r, p + 4.0 * q + r, p + q + 4.0 * r].map(|x| x * SIXTH);
-        out.put3(x, n, weight, surface);
-    };
     for i in 0..k {
         for j in 0..k - i {
-            emit(at(i, j), at(i + 1, j), at(i, j + 1));
+            emit(
+                at(i, j),
+                at(i + 1, j),
+                at(i, j + 1),
+                n,
+                weight,
+                surface,
+                out,
+            );
             if i + j + 2 <= k {
-                emit(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                emit(
+                    at(i + 1, j),
+                    at(i + 1, j + 1),
+                    at(i, j + 1),
+                    n,
+                    weight,
+                    surface,
+                    out,
+                );
             }
         }
     }
+}
+
+/// A small triangle's 3-point rule: each point (4 p + q + r) / 6, times the sixth rather
+/// than divided by 6 (a product is several times cheaper than a division; the same point
+/// to round-off). Always inlined: its corners stay in registers (passed through memory,
+/// each load of a corner stalled on the stores that had just written it).
+#[inline(always)]
+fn emit(p: V3, q: V3, r: V3, n: &V3, weight: f64, surface: f64, out: &mut impl Sink) {
+    const SIXTH: f64 = 1.0 / 6.0;
+    let x = [4.0 * p + q + r, p + 4.0 * q + r, p + q + 4.0 * r].map(|x| x * SIXTH);
+    out.put3(x, n, weight, surface);
 }
 
 #[cfg(test)]
@@ -1425,6 +1511,158 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The areas summed as the elements are written are a pass over the elements after,
+    /// bit for bit: on every shape, a mesh across the surface (an octahedron with vertices
+    /// exactly on it, a box with a face lying on it, a mesh of more triangles than one run
+    /// of the cut), leading, trailing, spinning and at rest, at two rules.
+    #[test]
+    fn the_areas_summed_while_cutting_are_a_pass_over_the_elements() {
+        fn pass(e: &Elements, toward: &V3) -> [u64; 5] {
+            let (mut wet, mut a, mut m) = (0.0, 0.0, V3::zeros());
+            for i in 0..e.len() {
+                wet += e.area[i];
+                let p = (e.normal(i).dot(toward)).max(0.0) * e.area[i];
+                a += p;
+                m += p * e.point(i);
+            }
+            [wet, a, m.x, m.y, m.z].map(f64::to_bits)
+        }
+        let octahedron = Shape::mesh(
+            "m",
+            &[
+                [0.1, 0.0, 0.0],
+                [-0.1, 0.0, 0.0],
+                [0.0, 0.06, 0.0],
+                [0.0, -0.06, 0.0],
+                [0.0, 0.0, 0.04],
+                [0.0, 0.0, -0.04],
+            ],
+            &[
+                [0, 2, 4],
+                [2, 1, 4],
+                [1, 3, 4],
+                [3, 0, 4],
+                [2, 0, 5],
+                [1, 2, 5],
+                [3, 1, 5],
+                [0, 3, 5],
+            ],
+        )
+        .unwrap();
+        let corners: Vec<[f64; 3]> = (0..8)
+            .map(|i| {
+                [
+                    if i & 1 != 0 { 0.1 } else { -0.1 },
+                    if i & 2 != 0 { 0.05 } else { -0.05 },
+                    if i & 4 != 0 { 0.15 } else { -0.15 },
+                ]
+            })
+            .collect();
+        let boxed = Shape::mesh(
+            "b",
+            &corners,
+            &[
+                [0, 2, 1],
+                [1, 2, 3],
+                [4, 5, 6],
+                [5, 7, 6],
+                [0, 1, 4],
+                [1, 5, 4],
+                [2, 6, 3],
+                [3, 6, 7],
+                [0, 4, 2],
+                [2, 4, 6],
+                [1, 3, 5],
+                [3, 7, 5],
+            ],
+        )
+        .unwrap();
+        // A UV sphere of 2208 triangles (more than one run of the cut).
+        let (rings, around) = (24usize, 48usize);
+        let mut v = vec![[0.0, 0.0, 0.05]];
+        for i in 1..rings {
+            let th = PI * i as f64 / rings as f64;
+            for j in 0..around {
+                let ph = 2.0 * PI * j as f64 / around as f64;
+                v.push([
+                    0.05 * th.sin() * ph.cos(),
+                    0.05 * th.sin() * ph.sin(),
+                    0.05 * th.cos(),
+                ]);
+            }
+        }
+        v.push([0.0, 0.0, -0.05]);
+        let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as i64;
+        let bottom = v.len() as i64 - 1;
+        let mut t = Vec::new();
+        for j in 0..around {
+            t.push([0, ring(1, j), ring(1, j + 1)]);
+            for i in 1..rings - 1 {
+                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+            }
+            t.push([bottom, ring(rings - 1, j + 1), ring(rings - 1, j)]);
+        }
+        let uv = Shape::mesh("u", &v, &t).unwrap();
+        let shapes = [
+            (octahedron, vec![-0.2, -0.03, 0.0, 0.02, 0.04]),
+            (boxed, vec![-0.2, 0.0, 0.15, 0.1]),
+            (uv, vec![-0.2, 0.0, 0.01]),
+            (Shape::sphere("s", 0.05).unwrap(), vec![-0.1, 0.0, 0.03]),
+            (
+                Shape::capsule("c", 0.02, 0.1).unwrap(),
+                vec![-0.1, 0.0, 0.03],
+            ),
+            (
+                Shape::cylinder("y", 0.02, 0.1).unwrap(),
+                vec![-0.1, 0.0, 0.03],
+            ),
+            (
+                Shape::cuboid("k", [0.1, 0.06, 0.04]).unwrap(),
+                vec![-0.1, 0.0, 0.02],
+            ),
+        ];
+        let motions = [
+            (V3::new(0.4, -0.2, -1.0), V3::new(1.0, 2.0, -0.5)),
+            (V3::new(0.0, 0.0, -1.0), V3::zeros()),
+            (V3::new(0.3, 0.1, 0.2), V3::new(0.0, 0.0, 3.0)),
+            (V3::new(1.0, 0.0, 0.0), V3::zeros()),
+        ];
+        let turns = [
+            UnitQuaternion::identity(),
+            UnitQuaternion::from_euler_angles(0.3, 0.5, -0.2),
+        ];
+        let mut cases = 0;
+        for rule in [Quadrature::new(6), Quadrature::new(12)] {
+            for (shape, heights) in &shapes {
+                for &z in heights {
+                    for (v, w) in motions {
+                        for q in &turns {
+                            let c = V3::new(0.01, 0.0, z);
+                            let toward = v / v.norm();
+                            let mut e = Elements::default();
+                            e.sum_areas(toward);
+                            shape.elements(&c, q, &v, &w, 0.0, &rule, &mut e);
+                            let s = e.sums.expect("asked for");
+                            assert_eq!(
+                                [s.wetted, s.projected, s.moment.x, s.moment.y, s.moment.z]
+                                    .map(f64::to_bits),
+                                pass(&e, &toward),
+                                "{shape:?} z {z} v {v:?} w {w:?}"
+                            );
+                            cases += usize::from(!e.is_empty());
+                            // Cleared, no sums (a caller that does not ask pays nothing).
+                            e.clear();
+                            shape.elements(&c, q, &v, &w, 0.0, &rule, &mut e);
+                            assert!(e.sums.is_none());
+                        }
+                    }
+                }
+            }
+        }
+        assert!(cases > 300, "{cases}");
     }
 
     #[test]
