@@ -30,7 +30,10 @@ use nalgebra::{SVector, Vector2};
 
 use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, SignModel, Slip};
 use crate::body::rod::ApplyAt;
+use crate::forces::drag::Drag;
 use crate::forces::registry::{TermList, LANE_NUMBERS, MAX_TERMS};
+use crate::forces::static_h::StaticH;
+use crate::forces::static_v::StaticV;
 use crate::forces::{
     AnyTerm, Boundary, ContactState, Frame, Medium, Outline, Real, Switch, Term, TermForce,
 };
@@ -451,7 +454,9 @@ impl<F: Real> Sums<F> {
 /// The terms of `law` on `state`, summed in the list's order (`terms_on`): each term's own
 /// arithmetic, with its numbers from `numbers` in the lanes and its own in one lane
 /// (`contact_force`: a term's fast path for one scene, the same bits). `THESIS`: the
-/// thesis's three, known when compiled (`law.thesis`).
+/// thesis's three, known when compiled (`law.thesis`): their `force_with` reads nothing of
+/// the term but the numbers given it (their `contact_force` is it with their own), so the
+/// step reads their numbers from `numbers` in one lane too and never looks at the list.
 #[inline(always)]
 fn term_sums<F: Real, const THESIS: bool>(
     law: &RodLaw,
@@ -462,18 +467,19 @@ fn term_sums<F: Real, const THESIS: bool>(
 ) {
     let lanes = F::LANES > 1;
     if THESIS {
-        let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] = law.terms[..] else {
-            unreachable!("a law marked the thesis's lists its three terms");
-        };
-        if lanes {
-            sums.add(0, true, d.force_with(&numbers[0..1], state, medium));
-            sums.add(1, false, h.force_with(&numbers[1..2], state, medium));
-            sums.add(2, false, v.force_with(&numbers[2..4], state, medium));
-        } else {
-            sums.add(0, true, d.contact_force(state, medium));
-            sums.add(1, false, h.contact_force(state, medium));
-            sums.add(2, false, v.contact_force(state, medium));
-        }
+        // Their numbers stand in `numbers` (`RodParams::of`): these terms' own are not read
+        // (NaN, so that a term that came to read them would show at once in the tests).
+        let (d, h, v) = (
+            Drag { eta_d: f64::NAN },
+            StaticH { eta_h: f64::NAN },
+            StaticV {
+                eta_v: f64::NAN,
+                lam: f64::NAN,
+            },
+        );
+        sums.add(0, true, d.force_with(&numbers[0..1], state, medium));
+        sums.add(1, false, h.force_with(&numbers[1..2], state, medium));
+        sums.add(2, false, v.force_with(&numbers[2..4], state, medium));
         return;
     }
     for (k, t) in law.terms.iter().enumerate() {
@@ -799,24 +805,30 @@ impl RodEval<F64x4> {
     /// Lane `i`.
     #[inline]
     pub fn lane(&self, i: usize) -> RodEval<f64> {
-        let l = |x: F64x4| x.0[i];
-        let l2 = |x: [F64x4; 2]| [x[0].0[i], x[1].0[i]];
+        // Each number read in place (by reference: a lane picked at run time from a value
+        // copied into registers went through a copy on the stack, four numbers for one).
+        let l = |x: &F64x4| x.0[i];
+        let l2 = |x: &[F64x4; 2]| [x[0].0[i], x[1].0[i]];
+        let mut terms = [[0.0; 2]; MAX_TERMS];
+        for (t, x) in terms.iter_mut().zip(&self.terms) {
+            *t = l2(x);
+        }
         RodEval {
-            qdd: [l(self.qdd[0]), l(self.qdd[1]), l(self.qdd[2])],
-            power: l(self.power),
-            tip: l2(self.tip),
-            v_tip: l2(self.v_tip),
-            depth: l(self.depth),
-            lowest: l(self.lowest),
-            v_centroid: l2(self.v_centroid),
-            cross: l(self.cross),
-            margin: l(self.margin),
-            terms: self.terms.map(l2),
-            dynamic: l2(self.dynamic),
-            statics: l2(self.statics),
-            moment: l(self.moment),
-            bound: l2(self.bound),
-            pivot: l(self.pivot),
+            qdd: [l(&self.qdd[0]), l(&self.qdd[1]), l(&self.qdd[2])],
+            power: l(&self.power),
+            tip: l2(&self.tip),
+            v_tip: l2(&self.v_tip),
+            depth: l(&self.depth),
+            lowest: l(&self.lowest),
+            v_centroid: l2(&self.v_centroid),
+            cross: l(&self.cross),
+            margin: l(&self.margin),
+            terms,
+            dynamic: l2(&self.dynamic),
+            statics: l2(&self.statics),
+            moment: l(&self.moment),
+            bound: l2(&self.bound),
+            pivot: l(&self.pivot),
         }
     }
 }

@@ -242,13 +242,14 @@ impl LaneEnd<F64x4> {
     /// Lane `i`.
     #[inline]
     pub fn lane(&self, i: usize) -> LaneEnd<f64> {
-        let l = |x: F64x4| x.0[i];
-        let l3 = |x: [F64x4; 3]| [x[0].0[i], x[1].0[i], x[2].0[i]];
+        // By reference, as `RodEval::lane`.
+        let l = |x: &F64x4| x.0[i];
+        let l3 = |x: &[F64x4; 3]| [x[0].0[i], x[1].0[i], x[2].0[i]];
         LaneEnd {
-            q: l3(self.q),
-            qd: l3(self.qd),
-            work: l(self.work),
-            dissipated: l(self.dissipated),
+            q: l3(&self.q),
+            qd: l3(&self.qd),
+            work: l(&self.work),
+            dissipated: l(&self.dissipated),
             eval: self.eval.lane(i),
             stages: [
                 self.stages[0].lane(i),
@@ -256,8 +257,8 @@ impl LaneEnd<F64x4> {
                 self.stages[2].lane(i),
             ],
             last: self.last.lane(i),
-            qd4: l3(self.qd4),
-            qdd4: l3(self.qdd4),
+            qd4: l3(&self.qd4),
+            qdd4: l3(&self.qdd4),
         }
     }
 }
@@ -270,14 +271,14 @@ impl LaneStage<F64x4> {
         &self,
         i: usize,
     ) -> (impl FnOnce() -> SVector<f64, N> + '_, DragStiffness) {
-        let l = move |x: F64x4| x.0[i];
+        let l = move |x: &F64x4| x.0[i];
         (
-            move || SVector::from_fn(|k, _| l(self.q[k])),
+            move || SVector::from_fn(|k, _| l(&self.q[k])),
             DragStiffness {
-                drag2: l(self.drag2),
-                speed2: l(self.speed2),
+                drag2: l(&self.drag2),
+                speed2: l(&self.speed2),
                 contact: 0,
-                v: Vector2::new(l(self.v[0]), l(self.v[1])),
+                v: Vector2::new(l(&self.v[0]), l(&self.v[1])),
             },
         )
     }
@@ -285,13 +286,13 @@ impl LaneStage<F64x4> {
     /// Lane `i`.
     #[inline(always)]
     pub fn lane(&self, i: usize) -> LaneStage<f64> {
-        let l = |x: F64x4| x.0[i];
+        let l = |x: &F64x4| x.0[i];
         LaneStage {
-            q: [l(self.q[0]), l(self.q[1]), l(self.q[2])],
-            drag2: l(self.drag2),
-            speed2: l(self.speed2),
-            v: [l(self.v[0]), l(self.v[1])],
-            pivot: l(self.pivot),
+            q: [l(&self.q[0]), l(&self.q[1]), l(&self.q[2])],
+            drag2: l(&self.drag2),
+            speed2: l(&self.speed2),
+            v: [l(&self.v[0]), l(&self.v[1])],
+            pivot: l(&self.pivot),
         }
     }
 }
@@ -327,7 +328,7 @@ impl<'a> LaneContact<'a> {
     }
 
     #[inline(always)]
-    pub(super) fn at(&self, x: F64x4) -> f64 {
+    pub(super) fn at(&self, x: &F64x4) -> f64 {
         x.0[self.i]
     }
 }
@@ -335,34 +336,37 @@ impl<'a> LaneContact<'a> {
 impl SwitchInputs for LaneContact<'_> {
     #[inline(always)]
     fn lowest(&self) -> f64 {
-        self.at(self.eval.lowest)
+        self.at(&self.eval.lowest)
     }
     #[inline(always)]
     fn v_centroid(&self) -> [f64; 2] {
         [
-            self.at(self.eval.v_centroid[0]),
-            self.at(self.eval.v_centroid[1]),
+            self.at(&self.eval.v_centroid[0]),
+            self.at(&self.eval.v_centroid[1]),
         ]
     }
     #[inline(always)]
     fn bound(&self) -> [f64; 2] {
-        [self.at(self.eval.bound[0]), self.at(self.eval.bound[1])]
+        [self.at(&self.eval.bound[0]), self.at(&self.eval.bound[1])]
     }
     #[inline(always)]
     fn statics(&self) -> [f64; 2] {
-        [self.at(self.eval.statics[0]), self.at(self.eval.statics[1])]
+        [
+            self.at(&self.eval.statics[0]),
+            self.at(&self.eval.statics[1]),
+        ]
     }
     #[inline(always)]
     fn v_tip_y(&self) -> f64 {
-        self.at(self.eval.v_tip[1])
+        self.at(&self.eval.v_tip[1])
     }
     #[inline(always)]
     fn cross(&self) -> f64 {
-        self.at(self.eval.cross)
+        self.at(&self.eval.cross)
     }
     #[inline(always)]
     fn immersion_margin(&self) -> f64 {
-        self.at(self.eval.margin)
+        self.at(&self.eval.margin)
     }
     #[inline(always)]
     fn corner_y(&self, _k: usize) -> f64 {

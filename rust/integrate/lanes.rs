@@ -97,7 +97,9 @@ pub fn run_lanes<T>(
         counts: LaneCounts::default(),
     };
     // Each lane's step start and held modes; a run the lanes keep ([`Run::in_lanes`]) starts
-    // its next step from its lane here, and `kept` holds its last end's evaluation.
+    // its next step from its lane here, and `kept` holds its last end's evaluation (taken
+    // only from a step whose end the lanes kept for some run: an evaluation holds every
+    // term's force per lane, a kilobyte).
     let mut start = LaneStart::<F64x4>::splat(0.0);
     let mut lane_modes = RodModes::<F64x4>::splat(0.0);
     let mut kept: Option<RodEval<F64x4>> = None;
@@ -207,6 +209,7 @@ pub fn run_lanes<T>(
             isa.step(&lane_params, &lane_modes, &start)
         };
 
+        let mut keep = false;
         for i in 0..LANES {
             if !stepped[i] {
                 continue;
@@ -216,6 +219,7 @@ pub fn run_lanes<T>(
             };
             if slot.may_stay && slot.run.accept_plain(&slot.model, &end, i) {
                 start.take_end(i, &end);
+                keep = true;
                 continue;
             }
             resume(&mut slot.run, &kept, i);
@@ -228,7 +232,12 @@ pub fn run_lanes<T>(
                 fail(&mut slots[i], e, &mut done);
             }
         }
-        kept = Some(end.eval);
+        // Every run the lanes kept before this step was stepped in it (a run in the lanes
+        // steps there while it lives, and takes back its end as it ends), so only the runs
+        // this step kept read `kept`.
+        if keep {
+            kept = Some(end.eval);
+        }
     }
     feed.counts
 }

@@ -526,18 +526,20 @@ impl<const N: usize> Run<N> {
         i: usize,
     ) -> bool {
         debug_assert!(self.may_stay_in_lanes(model) && !self.clamped);
-        let lane = |x: crate::num::F64x4| x.0[i];
-        if !(end.stages.iter().all(|st| pivot_ok(lane(st.pivot))) && pivot_ok(lane(end.eval.pivot)))
+        // By reference, as `RodEval::lane`.
+        let lane = |x: &crate::num::F64x4| x.0[i];
+        if !(end.stages.iter().all(|st| pivot_ok(lane(&st.pivot)))
+            && pivot_ok(lane(&end.eval.pivot)))
         {
             return false;
         }
         let y1 = State {
-            q: SVector::from_fn(|k, _| lane(end.q[k])),
-            qd: SVector::from_fn(|k, _| lane(end.qd[k])),
-            work: lane(end.work),
-            dissipated: lane(end.dissipated),
+            q: SVector::from_fn(|k, _| lane(&end.q[k])),
+            qd: SVector::from_fn(|k, _| lane(&end.qd[k])),
+            work: lane(&end.work),
+            dissipated: lane(&end.dissipated),
         };
-        if !y1.is_finite() || !end.eval.qdd.iter().all(|&a| lane(a).is_finite()) {
+        if !y1.is_finite() || !end.eval.qdd.iter().all(|a| lane(a).is_finite()) {
             return false;
         }
         if !self
@@ -554,14 +556,14 @@ impl<const N: usize> Run<N> {
         }
         if self.obs.wants_step_error() {
             let k4 = Deriv {
-                q: SVector::from_fn(|k, _| lane(end.qd4[k])),
-                qd: SVector::from_fn(|k, _| lane(end.qdd4[k])),
+                q: SVector::from_fn(|k, _| lane(&end.qd4[k])),
+                qd: SVector::from_fn(|k, _| lane(&end.qdd4[k])),
                 work: 0.0,
                 dissipated: 0.0,
             };
             let k5 = Deriv {
                 q: y1.qd,
-                qd: SVector::from_fn(|k, _| lane(end.eval.qdd[k])),
+                qd: SVector::from_fn(|k, _| lane(&end.eval.qdd[k])),
                 work: 0.0,
                 dissipated: 0.0,
             };
