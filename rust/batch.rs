@@ -529,7 +529,8 @@ pub fn run(
                             let (q0, qd0) = scene.initial_state::<3>();
                             return Some((j, scene.model::<3>(), q0, qd0, scene.options));
                         }
-                        Ok(scene) => match scene.run() {
+                        // Built, so validated ([`Source::scene`]).
+                        Ok(scene) => match scene.run_validated() {
                             Ok(out) => summarize(start + j, &out, row),
                             Err(e) => fail(start + j, row, e),
                         },
@@ -562,7 +563,8 @@ pub fn run(
                 row[0] = STATUS_CANCELLED;
                 continue;
             }
-            match src.scene(start + j).and_then(|s| s.run()) {
+            // Built, so validated ([`Source::scene`]).
+            match src.scene(start + j).and_then(|s| s.run_validated()) {
                 Ok(out) => summarize(start + j, &out, row),
                 Err(e) => fail(start + j, row, e),
             }

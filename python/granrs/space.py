@@ -28,7 +28,7 @@ Example::
     ...                     forces=[granrs.forces.rft3d(zeta=2e5), granrs.forces.gravity()])
     >>> r = granrs.simulate(scene)
     >>> r.status, round(r.depth * 1e3, 1)
-    ('stopped', 45.8)
+    ('stopped', 76.0)
 """
 
 from __future__ import annotations
