@@ -1333,9 +1333,59 @@ mod tests {
         );
     }
 
-    #[test]
-    fn a_mesh_and_a_cuboid_agree_on_the_same_box() {
-        let cube = Shape::cuboid("b", [0.2, 0.1, 0.3]).unwrap();
+    /// An octahedron stretched to 0.2 x 0.12 x 0.08 m about the origin: its corners and its
+    /// 8 outward triangles.
+    fn octahedron_data() -> (Vec<[f64; 3]>, Vec<[i64; 3]>) {
+        let v = vec![
+            [0.1, 0.0, 0.0],
+            [-0.1, 0.0, 0.0],
+            [0.0, 0.06, 0.0],
+            [0.0, -0.06, 0.0],
+            [0.0, 0.0, 0.04],
+            [0.0, 0.0, -0.04],
+        ];
+        let t = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        (v, t)
+    }
+
+    /// A UV sphere of radius 50 mm about the origin: `rings` rings of `around` corners
+    /// between its poles, and its outward triangles.
+    fn uv_sphere_data(rings: usize, around: usize) -> (Vec<[f64; 3]>, Vec<[i64; 3]>) {
+        let mut v = vec![[0.0, 0.0, 0.05]];
+        for i in 1..rings {
+            let th = PI * i as f64 / rings as f64;
+            for j in 0..around {
+                let ph = 2.0 * PI * j as f64 / around as f64;
+                let (s, c) = (0.05 * th.sin(), 0.05 * th.cos());
+                v.push([s * ph.cos(), s * ph.sin(), c]);
+            }
+        }
+        v.push([0.0, 0.0, -0.05]);
+        let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as i64;
+        let bottom = v.len() as i64 - 1;
+        let mut t = Vec::new();
+        for j in 0..around {
+            t.push([0, ring(1, j), ring(1, j + 1)]);
+            for i in 1..rings - 1 {
+                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+            }
+            t.push([bottom, ring(rings - 1, j + 1), ring(rings - 1, j)]);
+        }
+        (v, t)
+    }
+
+    /// The 0.2 x 0.1 x 0.3 m box about the origin: its corners and 12 outward triangles.
+    fn box_mesh_data() -> (Vec<[f64; 3]>, Vec<[i64; 3]>) {
         let v: Vec<[f64; 3]> = (0..8)
             .map(|i| {
                 [
@@ -1359,6 +1409,13 @@ mod tests {
             [1, 3, 5],
             [3, 7, 5],
         ];
+        (v, t)
+    }
+
+    #[test]
+    fn a_mesh_and_a_cuboid_agree_on_the_same_box() {
+        let cube = Shape::cuboid("b", [0.2, 0.1, 0.3]).unwrap();
+        let (v, t) = box_mesh_data();
         let mesh = Shape::mesh("m", &v, &t).unwrap();
         assert!((mesh.volume() - cube.volume()).abs() < 1e-15);
         assert!((mesh.unit_inertia() - cube.unit_inertia()).norm() < 1e-15);
@@ -1380,24 +1437,7 @@ mod tests {
     fn a_mesh_cut_per_vertex_is_the_clip_of_each_face() {
         // An octahedron stretched and turned: faces in, out, across the surface, leading,
         // trailing and across their leading edge.
-        let v = [
-            [0.1, 0.0, 0.0],
-            [-0.1, 0.0, 0.0],
-            [0.0, 0.06, 0.0],
-            [0.0, -0.06, 0.0],
-            [0.0, 0.0, 0.04],
-            [0.0, 0.0, -0.04],
-        ];
-        let t: Vec<[i64; 3]> = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let (v, t) = octahedron_data();
         let shape = Shape::mesh("m", &v, &t).unwrap();
         let Shape::Mesh(m) = &shape else {
             unreachable!()
@@ -1447,28 +1487,7 @@ mod tests {
     /// UV sphere of 2208, all under and at rest: every one whole), at two rules.
     #[test]
     fn a_big_mesh_cut_in_runs_is_the_clip_of_each_face() {
-        let (rings, around) = (24, 48);
-        let mut v = vec![[0.0, 0.0, 0.05]];
-        for i in 1..rings {
-            let th = PI * i as f64 / rings as f64;
-            for j in 0..around {
-                let ph = 2.0 * PI * j as f64 / around as f64;
-                let (s, c) = (0.05 * th.sin(), 0.05 * th.cos());
-                v.push([s * ph.cos(), s * ph.sin(), c]);
-            }
-        }
-        v.push([0.0, 0.0, -0.05]);
-        let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as i64;
-        let bottom = v.len() as i64 - 1;
-        let mut t = Vec::new();
-        for j in 0..around {
-            t.push([0, ring(1, j), ring(1, j + 1)]);
-            for i in 1..rings - 1 {
-                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
-                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
-            }
-            t.push([bottom, ring(rings - 1, j + 1), ring(rings - 1, j)]);
-        }
+        let (v, t) = uv_sphere_data(24, 48);
         assert_eq!(t.len(), 2208);
         let shape = Shape::mesh("m", &v, &t).unwrap();
         let Shape::Mesh(m) = &shape else {
@@ -1529,82 +1548,12 @@ mod tests {
             }
             [wet, a, m.x, m.y, m.z].map(f64::to_bits)
         }
-        let octahedron = Shape::mesh(
-            "m",
-            &[
-                [0.1, 0.0, 0.0],
-                [-0.1, 0.0, 0.0],
-                [0.0, 0.06, 0.0],
-                [0.0, -0.06, 0.0],
-                [0.0, 0.0, 0.04],
-                [0.0, 0.0, -0.04],
-            ],
-            &[
-                [0, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ],
-        )
-        .unwrap();
-        let corners: Vec<[f64; 3]> = (0..8)
-            .map(|i| {
-                [
-                    if i & 1 != 0 { 0.1 } else { -0.1 },
-                    if i & 2 != 0 { 0.05 } else { -0.05 },
-                    if i & 4 != 0 { 0.15 } else { -0.15 },
-                ]
-            })
-            .collect();
-        let boxed = Shape::mesh(
-            "b",
-            &corners,
-            &[
-                [0, 2, 1],
-                [1, 2, 3],
-                [4, 5, 6],
-                [5, 7, 6],
-                [0, 1, 4],
-                [1, 5, 4],
-                [2, 6, 3],
-                [3, 6, 7],
-                [0, 4, 2],
-                [2, 4, 6],
-                [1, 3, 5],
-                [3, 7, 5],
-            ],
-        )
-        .unwrap();
+        let (v, t) = octahedron_data();
+        let octahedron = Shape::mesh("m", &v, &t).unwrap();
+        let (corners, faces) = box_mesh_data();
+        let boxed = Shape::mesh("b", &corners, &faces).unwrap();
         // A UV sphere of 2208 triangles (more than one run of the cut).
-        let (rings, around) = (24usize, 48usize);
-        let mut v = vec![[0.0, 0.0, 0.05]];
-        for i in 1..rings {
-            let th = PI * i as f64 / rings as f64;
-            for j in 0..around {
-                let ph = 2.0 * PI * j as f64 / around as f64;
-                v.push([
-                    0.05 * th.sin() * ph.cos(),
-                    0.05 * th.sin() * ph.sin(),
-                    0.05 * th.cos(),
-                ]);
-            }
-        }
-        v.push([0.0, 0.0, -0.05]);
-        let ring = |i: usize, j: usize| (1 + (i - 1) * around + j % around) as i64;
-        let bottom = v.len() as i64 - 1;
-        let mut t = Vec::new();
-        for j in 0..around {
-            t.push([0, ring(1, j), ring(1, j + 1)]);
-            for i in 1..rings - 1 {
-                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
-                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
-            }
-            t.push([bottom, ring(rings - 1, j + 1), ring(rings - 1, j)]);
-        }
+        let (v, t) = uv_sphere_data(24, 48);
         let uv = Shape::mesh("u", &v, &t).unwrap();
         let shapes = [
             (octahedron, vec![-0.2, -0.03, 0.0, 0.02, 0.04]),
