@@ -110,6 +110,10 @@ def suspects(
     )
 
 
+#: What a comparison of one run's numbers gives (not a numpy array of runs).
+_ONE_RUN = (bool, np.bool_)
+
+
 def loud(
     h_lambda: Any, unresolved_stops: Any, unresolved: Any, energy_start: Any, energy_end: Any
 ) -> Any:
@@ -126,10 +130,6 @@ def loud(
         return bool(stiff_or_stop) or (bool(chatter) and bool(_rose(energy_start, energy_end)))
     with np.errstate(invalid="ignore"):
         return stiff_or_stop | (chatter & _rose(energy_start, energy_end))
-
-
-#: What a comparison of one run's numbers gives (not a numpy array of runs).
-_ONE_RUN = (bool, np.bool_)
 
 
 def _rose(start: Any, end: Any) -> Any:
