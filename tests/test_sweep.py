@@ -218,6 +218,17 @@ def test_an_exception_in_progress_cancels() -> None:
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
 def test_ctrl_c_stops_a_long_sweep_cleanly() -> None:
     # 200,000 leg impacts would take many minutes; Ctrl-C after 0.3 s must stop it.
+    # A process started in a shell's background job inherits SIGINT ignored, and Python then
+    # installs no handler for it (CI runs so): give this one the handler a terminal's Python
+    # has, for this test only.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _interrupt_a_long_sweep()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _interrupt_a_long_sweep() -> None:
     base = cases.leg(v0=3.28)
     timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
     start = time.perf_counter()
