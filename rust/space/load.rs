@@ -13,10 +13,11 @@ use super::shape::{Elements, Quadrature, Shape};
 use crate::error::{GranrsError, Result};
 use crate::forces::poncelet::Poncelet;
 use crate::forces::rft3d::{
-    stress_as, stress_capped, stress_on_ramp, stress_with_ramp, stress_with_rate,
-    stress_with_rate_on_ramp, Rft3d, Rft3dInertial, Rft3dLanes,
+    direction, ramp_position, stress_as, stress_capped, stress_on_ramp, stress_with_ramp,
+    stress_with_rate, stress_with_rate_on_ramp, Rft3d, Rft3dInertial, Rft3dLanes,
 };
 use crate::forces::{Acts, AnyTerm, Medium, TermSpec, TERMS};
+use crate::num::Real;
 
 type V3 = Vector3<f64>;
 
@@ -693,8 +694,8 @@ fn rft3d_rated_blocks(
     }
 }
 
-/// Elements per block of [`rft3d_rated`] (its 48 terms per element live on the stack:
-/// 24 kB).
+/// Elements per block of [`rft3d_rated`] (its 48 terms per element and the elements it
+/// keeps live on the stack: 28 kB).
 const RATED_BLOCK: usize = 64;
 
 #[inline(always)]
@@ -708,29 +709,50 @@ fn rft3d_rated_with<const GRAZING: bool>(
     out: &mut Wrench,
 ) {
     let n = e.len();
-    // Per block: each element's terms (one row per element, so that the sums below run
-    // across the terms in SIMD lanes).
-    let mut buf = [[0.0; TERMS_PER_ELEMENT]; RATED_BLOCK];
+    // Per block: the elements whose stress is not zero (moving, on the leading ramp),
+    // copied side by side, then each one's terms (one row per element, so that the sums
+    // below run across the terms in SIMD lanes). The others add zeros in the element loop,
+    // and a sum that starts at +0 is never -0: leaving them out gives the same bits, and
+    // a moving body's trailing half costs nothing.
+    let mut on = [[0.0; RATED_BLOCK]; 8];
+    // (Written before they are read: not zeroed, 24 kB per call.)
+    let mut buf = [std::mem::MaybeUninit::<[f64; TERMS_PER_ELEMENT]>::uninit(); RATED_BLOCK];
     let mut acc = out.terms();
     let mut start = 0;
     while start < n {
         let len = RATED_BLOCK.min(n - start);
         let (xs, ns) = (&e.x, &e.n);
-        let (area, depth) = (&e.area[start..start + len], &e.depth[start..start + len]);
-        let x = [0, 1, 2].map(|k| &xs[k][start..start + len]);
-        let nn = [0, 1, 2].map(|k| &ns[k][start..start + len]);
-        for (j, row) in buf[..len].iter_mut().enumerate() {
-            let (r, u) = arm_and_velocity([x[0][j], x[1][j], x[2][j]], c, v, omega);
-            let n = [nn[0][j], nn[1][j], nn[2][j]];
+        let mut m = 0;
+        for i in start..start + len {
+            let (x, nn) = (
+                [xs[0][i], xs[1][i], xs[2][i]],
+                [ns[0][i], ns[1][i], ns[2][i]],
+            );
+            let (_, u) = arm_and_velocity(x, c, v, omega);
+            let (s2, _, _, nu) = direction(nn, u);
+            let keep = s2.select_pos(ramp_position(nu, eps, GRAZING), 0.0) > 0.0;
+            for (col, y) in on.iter_mut().zip([x[0], x[1], x[2], nn[0], nn[1], nn[2]]) {
+                col[m] = y;
+            }
+            on[6][m] = e.area[i];
+            on[7][m] = e.depth[i];
+            m += usize::from(keep);
+        }
+        let [x0, x1, x2, n0, n1, n2, area, depth] = &on;
+        for (j, row) in buf[..m].iter_mut().enumerate() {
+            let (r, u) = arm_and_velocity([x0[j], x1[j], x2[j]], c, v, omega);
+            let n = [n0[j], n1[j], n2[j]];
             let (s, jac) = stress_with_rate_on_ramp(zeta, n, u, eps, GRAZING);
             let a = area[j];
             let w = a * depth[j];
             let g = jac.map(|row| row.map(|x| x * w));
             let r = V3::new(r[0], r[1], r[2]);
-            *row = element_terms(&r, s.map(|x| x * w), &g, s.map(|x| -x * a));
+            row.write(element_terms(&r, s.map(|x| x * w), &g, s.map(|x| -x * a)));
         }
         // Each sum in the elements' order (48 running sums side by side).
-        for row in &buf[..len] {
+        for row in &buf[..m] {
+            // SAFETY: the loop above wrote the first `m` rows.
+            let row = unsafe { row.assume_init_ref() };
             for (a, x) in acc.iter_mut().zip(row) {
                 *a += x;
             }
