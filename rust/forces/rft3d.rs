@@ -442,6 +442,31 @@ pub fn stress_on_ramp(zeta: f64, n: [f64; 3], u: [f64; 3], eps: f64, grazing: bo
     sigma.map(|v| on.select_pos(v, 0.0))
 }
 
+/// [`stress_with_rate`] of a law without a friction cap (`zeta`, `grazing`) at `eps > 0`,
+/// without a branch (so that the element kernel's loop runs in SIMD lanes): every part
+/// computed, the stress and its rate selected where the element moves and is on its ramp,
+/// else zero. The same operations, so the same bits.
+#[inline(always)]
+pub fn stress_with_rate_on_ramp(
+    zeta: f64,
+    n: [f64; 3],
+    u: [f64; 3],
+    eps: f64,
+    grazing: bool,
+) -> ([f64; 3], [[f64; 3]; 3]) {
+    let (s2, s, vh, nu) = direction(n, u);
+    let x = ramp_position(nu, eps, grazing);
+    let (lead, dlead) = ramp(x, eps);
+    let (a, ja) = alpha_with_rate(n, vh);
+    let (sigma, jac) = sigma_with_rate(zeta, lead, dlead, s, s2, eps, n, vh, a, ja);
+    // x where it moves (s2 > 0), else 0: positive where the stress is not zero.
+    let on = s2.select_pos(x, 0.0);
+    (
+        sigma.map(|v| on.select_pos(v, 0.0)),
+        jac.map(|row| row.map(|v| on.select_pos(v, 0.0))),
+    )
+}
+
 /// The cap's parts of alpha on an element of normal `n`: its normal part `an`, its
 /// tangential part `at` and that one's norm, and the cap `mu |an|`.
 #[inline(always)]

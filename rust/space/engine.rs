@@ -546,7 +546,7 @@ mod timing {
             }),
             ..Terms3::default()
         };
-        for nodes in [3, 6] {
+        for nodes in [3, 5, 6] {
             let shape = Shape::capsule("c", 0.08, 0.4).unwrap();
             let mut s = Sand::new(shape, terms, Medium::default(), 0.0, Quadrature::new(nodes));
             let q = UnitQuaternion::from_euler_angles(0.0, 1.2, 0.3);
@@ -558,22 +558,35 @@ mod timing {
                 k += s.cut_at_rest(&c, &q);
             }
             let cut = t.elapsed().as_secs_f64() / n as f64;
-            let t = std::time::Instant::now();
-            let mut acc = 0.0;
-            for _ in 0..n {
-                acc += s
-                    .wrench(&c, &q, &V3::new(0.0, 0.0, -1e-6), &V3::zeros(), 1e-5)
-                    .w[2];
-            }
-            let wr = t.elapsed().as_secs_f64() / n as f64;
             let el = k / n;
-            eprintln!(
-                "nodes {nodes}: {el} elements, cut {:.1} us ({:.0} ns/el), wrench {:.1} us ({:.0} ns/el) {acc:e}",
+            let mut line = format!(
+                "nodes {nodes}: {el} elements, cut {:.1} us ({:.0} ns/el)",
                 cut * 1e6,
-                cut * 1e9 / el as f64,
-                wr * 1e6,
-                wr * 1e9 / el as f64
+                cut * 1e9 / el as f64
             );
+            // Creeping (every element on the ramp) and moving (the trailing half off it).
+            for (what, v) in [("creeping", -1e-6), ("moving", -0.1)] {
+                let v = V3::new(0.3 * v, 0.0, v);
+                let mut acc = 0.0;
+                let t = std::time::Instant::now();
+                for _ in 0..n {
+                    acc += s.wrench(&c, &q, &v, &V3::zeros(), 1e-5).w[2];
+                }
+                let rated = t.elapsed().as_secs_f64() / n as f64;
+                let t = std::time::Instant::now();
+                for _ in 0..n {
+                    acc += s.wrench_value(&c, &q, &v, &V3::zeros(), 1e-5).w[2];
+                }
+                let value = t.elapsed().as_secs_f64() / n as f64;
+                line += &format!(
+                    "; {what}: wrench {:.1} us ({:.0} ns/el), without rates {:.1} us ({:.0} ns/el) {acc:e}",
+                    rated * 1e6,
+                    rated * 1e9 / el as f64,
+                    value * 1e6,
+                    value * 1e9 / el as f64
+                );
+            }
+            eprintln!("{line}");
         }
     }
 }

@@ -13,10 +13,11 @@ use super::shape::{Elements, Quadrature, Shape};
 use crate::error::{GranrsError, Result};
 use crate::forces::poncelet::Poncelet;
 use crate::forces::rft3d::{
-    stress_as, stress_capped, stress_on_ramp, stress_with_ramp, stress_with_rate, Rft3d,
-    Rft3dInertial, Rft3dLanes,
+    direction, ramp_position, stress_as, stress_capped, stress_on_ramp, stress_with_ramp,
+    stress_with_rate, stress_with_rate_on_ramp, Rft3d, Rft3dInertial, Rft3dLanes,
 };
 use crate::forces::{Acts, AnyTerm, Medium, TermSpec, TERMS};
+use crate::num::Real;
 
 type V3 = Vector3<f64>;
 
@@ -379,7 +380,54 @@ impl Wrench {
     /// point's velocity, `v + omega x r`) and its height rate `fz`.
     #[inline]
     fn add(&mut self, r: &V3, f: [f64; 3], g: &[[f64; 3]; 3], fz: [f64; 3]) {
-        self.add_value(r, f, fz);
+        let t = element_terms(r, f, g, fz);
+        let mut acc = self.terms();
+        for (a, x) in acc.iter_mut().zip(t) {
+            *a += x;
+        }
+        self.set_terms(&acc);
+    }
+
+    /// Its numbers in the order of [`element_terms`]: `w`, `kz`, then `k` by rows.
+    #[inline(always)]
+    fn terms(&self) -> [f64; TERMS_PER_ELEMENT] {
+        let mut t = [0.0; TERMS_PER_ELEMENT];
+        t[..6].copy_from_slice(&self.w);
+        t[6..12].copy_from_slice(&self.kz);
+        for (i, row) in self.k.iter().enumerate() {
+            t[12 + 6 * i..18 + 6 * i].copy_from_slice(row);
+        }
+        t
+    }
+
+    /// [`Wrench::terms`] written back.
+    #[inline(always)]
+    fn set_terms(&mut self, t: &[f64; TERMS_PER_ELEMENT]) {
+        self.w.copy_from_slice(&t[..6]);
+        self.kz.copy_from_slice(&t[6..12]);
+        for (i, row) in self.k.iter_mut().enumerate() {
+            row.copy_from_slice(&t[12 + 6 * i..18 + 6 * i]);
+        }
+    }
+}
+
+/// How many numbers an element adds to a [`Wrench`] with its rates.
+const TERMS_PER_ELEMENT: usize = 48;
+
+/// What a force `f` at arm `r` from the centre with its rate `g = d f / d u` (u the point's
+/// velocity, `v + omega x r`) and its height rate `fz` adds to a [`Wrench`]: to `w` (the
+/// force, its moment), to `kz` (the height rate, its moment) and to `k` by rows, in this
+/// order ([`Wrench::terms`]).
+#[inline(always)]
+fn element_terms(r: &V3, f: [f64; 3], g: &[[f64; 3]; 3], fz: [f64; 3]) -> [f64; TERMS_PER_ELEMENT] {
+    let mut t = [0.0; TERMS_PER_ELEMENT];
+    let rf = cross(r, f);
+    let rzf = cross(r, fz);
+    t[..3].copy_from_slice(&f);
+    t[3..6].copy_from_slice(&rf);
+    t[6..9].copy_from_slice(&fz);
+    t[9..12].copy_from_slice(&rzf);
+    {
         let (rx, ry, rz) = (r.x, r.y, r.z);
         let cross = |a: [f64; 3]| cross(r, a);
         // u = v - R omega, R a = r x a: the force's rate in the twist is G [I, -R]; the
@@ -399,12 +447,13 @@ impl Wrench {
         for (c, ((a, b), d)) in g0.into_iter().zip(g1).zip(g2).enumerate() {
             let col = [a, b, d];
             let m = cross(col);
-            for (i, (x, y)) in col.iter().zip(m).enumerate() {
-                self.k[i][c] += x;
-                self.k[3 + i][c] += y;
+            for (i, (&x, y)) in col.iter().zip(m).enumerate() {
+                t[12 + 6 * i + c] = x;
+                t[12 + 6 * (3 + i) + c] = y;
             }
         }
     }
+    t
 }
 
 impl Wrench {
@@ -488,31 +537,13 @@ impl Sand {
     ) -> Wrench {
         let mut out = Wrench::default();
         let e = &self.elements;
-        if let Some(law) = self
-            .terms
-            .rft3d
-            .filter(|l| !rates && eps > 0.0 && l.mu_surf == f64::INFINITY)
-        {
-            rft3d_value(&law, e, c, v, omega, eps, &mut out);
-        } else if let Some(law) = self.terms.rft3d {
-            for i in 0..e.len() {
-                let r = e.point(i) - c;
-                let u = v + omega.cross(&r);
-                let n = e.normal(i);
-                let (a, d) = (e.area[i], e.depth[i]);
-                let w = a * d;
-                if !rates {
-                    // A zero stress adds nothing (a sum that starts at +0 is never -0).
-                    let s = stress_with_ramp(&law, [n.x, n.y, n.z], [u.x, u.y, u.z], eps);
-                    out.add_value(&r, s.map(|x| x * w), s.map(|x| -x * a));
-                    continue;
+        if let Some(law) = self.terms.rft3d {
+            match rates {
+                _ if eps <= 0.0 || law.mu_surf != f64::INFINITY => {
+                    rft3d_elements(&law, e, c, v, omega, eps, rates, &mut out)
                 }
-                let (s, j) = stress_with_rate(&law, [n.x, n.y, n.z], [u.x, u.y, u.z], eps);
-                if s == [0.0; 3] && j == [[0.0; 3]; 3] {
-                    continue;
-                }
-                let g = j.map(|row| row.map(|x| x * w));
-                out.add(&r, s.map(|x| x * w), &g, s.map(|x| -x * a));
+                true => rft3d_rated(&law, e, c, v, omega, eps, &mut out),
+                false => rft3d_value(&law, e, c, v, omega, eps, &mut out),
             }
         }
         if let Some(t) = self.terms.inertial {
@@ -580,6 +611,155 @@ impl Sand {
         }
         out
     }
+}
+
+/// `rft3d`'s wrench (its rates `k` where `rates`) over the elements into `out`, one element
+/// at a time: any law, any `eps` (the kernels [`rft3d_rated`] and [`rft3d_value`] take a
+/// law without a friction cap at `eps > 0`, to the same bits).
+#[allow(clippy::too_many_arguments)]
+fn rft3d_elements(
+    law: &Rft3d,
+    e: &Elements,
+    c: &V3,
+    v: &V3,
+    omega: &V3,
+    eps: f64,
+    rates: bool,
+    out: &mut Wrench,
+) {
+    for i in 0..e.len() {
+        let r = e.point(i) - c;
+        let u = v + omega.cross(&r);
+        let n = e.normal(i);
+        let (a, d) = (e.area[i], e.depth[i]);
+        let w = a * d;
+        if !rates {
+            // A zero stress adds nothing (a sum that starts at +0 is never -0).
+            let s = stress_with_ramp(law, [n.x, n.y, n.z], [u.x, u.y, u.z], eps);
+            out.add_value(&r, s.map(|x| x * w), s.map(|x| -x * a));
+            continue;
+        }
+        let (s, j) = stress_with_rate(law, [n.x, n.y, n.z], [u.x, u.y, u.z], eps);
+        if s == [0.0; 3] && j == [[0.0; 3]; 3] {
+            continue;
+        }
+        let g = j.map(|row| row.map(|x| x * w));
+        out.add(&r, s.map(|x| x * w), &g, s.map(|x| -x * a));
+    }
+}
+
+/// `rft3d`'s wrench with its rates over the elements into `out`, as [`rft3d_elements`] with
+/// `rates` (a law without a friction cap, `eps > 0`): per block, each element's
+/// [`element_terms`] in a loop without a branch ([`stress_with_rate_on_ramp`]; AVX2 where
+/// the CPU has it: the same IEEE operations), then added in the elements' order, so the
+/// same bits (an element left out there adds zeros here, and a sum that starts at +0 is
+/// never -0).
+fn rft3d_rated(law: &Rft3d, e: &Elements, c: &V3, v: &V3, omega: &V3, eps: f64, out: &mut Wrench) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::num::avx2() {
+        // SAFETY: this CPU has AVX2 (checked).
+        return unsafe { rft3d_rated_avx2(law, e, c, v, omega, eps, out) };
+    }
+    rft3d_rated_blocks(law, e, c, v, omega, eps, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn rft3d_rated_avx2(
+    law: &Rft3d,
+    e: &Elements,
+    c: &V3,
+    v: &V3,
+    omega: &V3,
+    eps: f64,
+    out: &mut Wrench,
+) {
+    rft3d_rated_blocks(law, e, c, v, omega, eps, out)
+}
+
+#[inline(always)]
+fn rft3d_rated_blocks(
+    law: &Rft3d,
+    e: &Elements,
+    c: &V3,
+    v: &V3,
+    omega: &V3,
+    eps: f64,
+    out: &mut Wrench,
+) {
+    if law.grazing {
+        rft3d_rated_with::<true>(law.zeta, e, c, v, omega, eps, out)
+    } else {
+        rft3d_rated_with::<false>(law.zeta, e, c, v, omega, eps, out)
+    }
+}
+
+/// Elements per block of [`rft3d_rated`] (its 48 terms per element and the elements it
+/// keeps live on the stack: 28 kB).
+const RATED_BLOCK: usize = 64;
+
+#[inline(always)]
+fn rft3d_rated_with<const GRAZING: bool>(
+    zeta: f64,
+    e: &Elements,
+    c: &V3,
+    v: &V3,
+    omega: &V3,
+    eps: f64,
+    out: &mut Wrench,
+) {
+    let n = e.len();
+    // Per block: the elements whose stress is not zero (moving, on the leading ramp),
+    // copied side by side, then each one's terms (one row per element, so that the sums
+    // below run across the terms in SIMD lanes). The others add zeros in the element loop,
+    // and a sum that starts at +0 is never -0: leaving them out gives the same bits, and
+    // a moving body's trailing half costs nothing.
+    let mut on = [[0.0; RATED_BLOCK]; 8];
+    // (Written before they are read: not zeroed, 24 kB per call.)
+    let mut buf = [std::mem::MaybeUninit::<[f64; TERMS_PER_ELEMENT]>::uninit(); RATED_BLOCK];
+    let mut acc = out.terms();
+    let mut start = 0;
+    while start < n {
+        let len = RATED_BLOCK.min(n - start);
+        let (xs, ns) = (&e.x, &e.n);
+        let mut m = 0;
+        for i in start..start + len {
+            let (x, nn) = (
+                [xs[0][i], xs[1][i], xs[2][i]],
+                [ns[0][i], ns[1][i], ns[2][i]],
+            );
+            let (_, u) = arm_and_velocity(x, c, v, omega);
+            let (s2, _, _, nu) = direction(nn, u);
+            let keep = s2.select_pos(ramp_position(nu, eps, GRAZING), 0.0) > 0.0;
+            for (col, y) in on.iter_mut().zip([x[0], x[1], x[2], nn[0], nn[1], nn[2]]) {
+                col[m] = y;
+            }
+            on[6][m] = e.area[i];
+            on[7][m] = e.depth[i];
+            m += usize::from(keep);
+        }
+        let [x0, x1, x2, n0, n1, n2, area, depth] = &on;
+        for (j, row) in buf[..m].iter_mut().enumerate() {
+            let (r, u) = arm_and_velocity([x0[j], x1[j], x2[j]], c, v, omega);
+            let n = [n0[j], n1[j], n2[j]];
+            let (s, jac) = stress_with_rate_on_ramp(zeta, n, u, eps, GRAZING);
+            let a = area[j];
+            let w = a * depth[j];
+            let g = jac.map(|row| row.map(|x| x * w));
+            let r = V3::new(r[0], r[1], r[2]);
+            row.write(element_terms(&r, s.map(|x| x * w), &g, s.map(|x| -x * a)));
+        }
+        // Each sum in the elements' order (48 running sums side by side).
+        for row in &buf[..m] {
+            // SAFETY: the loop above wrote the first `m` rows.
+            let row = unsafe { row.assume_init_ref() };
+            for (a, x) in acc.iter_mut().zip(row) {
+                *a += x;
+            }
+        }
+        start += len;
+    }
+    out.set_terms(&acc);
 }
 
 /// `rft3d`'s wrench and its height rates over the elements into `out` (no rates `k`), as
@@ -1033,6 +1213,45 @@ mod tests {
         assert!((m - m1).norm() <= 1e-13 * m1.norm(), "{m:?} {m1:?}");
         // And the same bits every time.
         assert_eq!(rft3d_sum(&law, &e, &c, &v, &w), (f, m));
+    }
+
+    /// The rated kernel is the element loop bit for bit (the wrench, its rates and its
+    /// height rates): over several blocks, grazing counted or not, moving, creeping within
+    /// the ramp and at rest.
+    #[test]
+    fn the_rated_kernel_is_the_element_loop_bit_for_bit() {
+        let bits = |w: &Wrench| {
+            let mut t = w.w.to_vec();
+            t.extend(w.kz);
+            t.extend(w.k.iter().flatten());
+            t.iter().map(|y| y.to_bits()).collect::<Vec<_>>()
+        };
+        let mut s = sand(Shape::capsule("c", 0.02, 0.1).unwrap(), 12);
+        let q = UnitQuaternion::from_euler_angles(0.3, 0.8, -0.4);
+        let c = V3::new(0.0, 0.0, 0.01);
+        let e = s.elements_at(&c, &q, &V3::zeros(), &V3::zeros()).clone();
+        assert!(e.len() > 2 * RATED_BLOCK + 1, "several blocks: {}", e.len());
+        let mut checked = 0;
+        for grazing in [true, false] {
+            let law = Rft3d {
+                zeta: 1e6,
+                mu_surf: f64::INFINITY,
+                grazing,
+            };
+            for scale in [1.0, 3e-6, 0.0] {
+                let xi = [0.3, -0.2, -1.0, 2.0, -1.5, 0.7].map(|x| x * scale);
+                let (v, w) = (V3::new(xi[0], xi[1], xi[2]), V3::new(xi[3], xi[4], xi[5]));
+                let (mut kernel, mut one) = (Wrench::default(), Wrench::default());
+                rft3d_rated(&law, &e, &c, &v, &w, 1e-5, &mut kernel);
+                rft3d_elements(&law, &e, &c, &v, &w, 1e-5, true, &mut one);
+                assert_eq!(bits(&kernel), bits(&one), "grazing {grazing} scale {scale}");
+                if scale > 0.0 {
+                    assert!(one.w[2] != 0.0 && one.k[2][2] != 0.0 && one.k[5][3] != 0.0);
+                }
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 6);
     }
 
     /// The wrench without its rates is the wrench's value and height rates bit for bit:
