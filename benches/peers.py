@@ -63,6 +63,15 @@ granrs itself is timed per impact, summary only (no time series):
   path (``lanes=False``), in the same loop; and with its lanes asking only for the depth and
   t_s (``outputs=("depth", "t_s")``: the columns the numba loop returns).
 
+* The free link under ``rft`` (gravity and ``rft(zeta=...)``, 8 elements) on the same scenes,
+  against the thesis's law: ``granrs.simulate`` per scene and a sweep's lanes on one thread,
+  at ``zeta = 1e6`` and at the ``zeta`` fitted to Table 3.1 (the ``thesis_sand`` medium
+  card's ``rft.zeta``), and the run alone as the core times it. Targets: a ``simulate`` at
+  most ``TARGET_RFT_SIMULATE`` times the thesis's, a sweep per core at most
+  ``TARGET_RFT_SWEEP`` times the thesis's sweep. ``simulate`` and a sweep include the step's
+  check (a run whose ``step_error`` is above 1e-5 runs again at ``dt / 10``: under ``rft``
+  the vertical drops do); the run alone does not.
+
 It prints a work-precision table and writes its figure (``--figure``, a PNG): every peer at
 several steps (solve_ivp at several rtols), the median over the scenes of the depth error
 against the reference, against the time per impact. solve_ivp is timed at matched accuracy
@@ -144,6 +153,10 @@ TARGET_SCALAR_LEAN = 1.2
 TARGET_SCALAR_DEFAULT = 1.6
 #: What the lean rows ask for: the depth and the stopping time (the peers' two results).
 LEAN_OUTPUTS = ("depth", "t_s")
+#: Targets of the free link under ``rft`` against the thesis's law on the same scenes: a
+#: ``simulate`` per scene, and a sweep's lanes on one thread.
+TARGET_RFT_SIMULATE = 3.0
+TARGET_RFT_SWEEP = 2.0
 #: Copies of the scenes in one timed sweep (so that a sweep's fixed cost is spread), and
 #: the sweeps' repeats per repeat of the per-scene timing: a sweep is timed as a whole, and
 #: on a shared machine only a best of many short batches escapes the other loads.
@@ -565,6 +578,17 @@ def build(quick: bool) -> list[SceneRun]:
     return runs
 
 
+def rft_laws() -> dict[str, list[granrs.forces.Term]]:
+    """The ``rft`` laws timed against the thesis's, by key suffix: ``zeta = 1e6`` and the
+    ``zeta`` fitted to Table 3.1 (the ``thesis_sand`` card's)."""
+    fitted = granrs.media.load("thesis_sand").value("rft.zeta").value
+    rft = granrs.forces.rft
+    return {
+        "rft": [granrs.forces.gravity(), rft(zeta=1e6)],
+        "rft_fitted": [granrs.forces.gravity(), rft(zeta=fitted)],
+    }
+
+
 def granrs_result(scene: granrs.Scene) -> granrs.Result:
     r = granrs.simulate(scene)
     if r.status != "stopped":
@@ -627,10 +651,19 @@ def methods(runs: list[SceneRun]) -> dict[str, Callable[[SceneRun], Any]]:
     """Name -> one impact of a scene (what is timed)."""
     raw = {id(r): r.scene.replace(sign_model="raw") for r in runs}
     lean = {id(r): r.scene.replace(outputs=LEAN_OUTPUTS) for r in runs}
-    for scene in [*raw.values(), *lean.values()]:
+    rft = {
+        key: {id(r): r.scene.replace(forces=law) for r in runs} for key, law in rft_laws().items()
+    }
+    for scene in [*raw.values(), *lean.values(), *(s for d in rft.values() for s in d.values())]:
         scene._compiled()  # compiled once here, as the default scenes are, not in the timing
     return {
         "granrs": lambda r: granrs.simulate(r.scene),
+        "granrs_rft": lambda r: granrs.simulate(rft["rft"][id(r)]),
+        "granrs_rft_fitted": lambda r: granrs.simulate(rft["rft_fitted"][id(r)]),
+        "granrs_rft_core": lambda r: _granrs.run(rft["rft"][id(r)]._compiled()).run_seconds,
+        "granrs_rft_fitted_core": lambda r: (
+            _granrs.run(rft["rft_fitted"][id(r)]._compiled()).run_seconds
+        ),
         "granrs_lean": lambda r: granrs.simulate(lean[id(r)]),
         "granrs_raw": lambda r: granrs.simulate(raw[id(r)]),
         # The run alone, as the core times it (no Python around it), in the same loop.
@@ -663,7 +696,7 @@ def time_all(runs: list[SceneRun], repeats: int, ivp_repeats: int) -> None:
                 if name == "solve_ivp" and r.ivp_failed:
                     r.seconds[name] = math.nan
                     continue
-                if name == "granrs_core":
+                if name.endswith("_core"):
                     dt = fn(r)
                 else:
                     t0 = time.perf_counter()
@@ -684,6 +717,10 @@ def time_sweeps(runs: list[SceneRun], repeats: int, copies: int) -> dict[str, fl
     batch_scalar(y0s[:1], ps[:1], DT, T_END, out[:1])  # compile
 
     lean = [s.replace(outputs=LEAN_OUTPUTS) for s in scenes[: len(runs)]] * copies
+    rft = {
+        key: [s.replace(forces=law) for s in scenes[: len(runs)]] * copies
+        for key, law in rft_laws().items()
+    }
 
     def sweep(threads: int, lanes: bool = True) -> None:
         granrs.sweep(scenes, threads=threads, progress=False, lanes=lanes)
@@ -702,6 +739,8 @@ def time_sweeps(runs: list[SceneRun], repeats: int, copies: int) -> dict[str, fl
         "sweep_scalar_2": lambda: sweep(2, lanes=False),
         "sweep_lean_1": lambda: sweep_lean(1),
         "sweep_lean_2": lambda: sweep_lean(2),
+        "sweep_rft_1": lambda: granrs.sweep(rft["rft"], threads=1, progress=False),
+        "sweep_rft_fitted_1": lambda: granrs.sweep(rft["rft_fitted"], threads=1, progress=False),
         "numba_parallel_1": lambda: in_prange(1),
         "numba_parallel_2": lambda: in_prange(2),
     }
@@ -898,6 +937,10 @@ def summarize(
     labels = {
         "granrs": 'granrs.simulate, sign_model="modes" (default)',
         "granrs_lean": 'granrs.simulate, outputs=("depth", "t_s")',
+        "granrs_rft": "granrs.simulate, rft (zeta 1e6)",
+        "granrs_rft_fitted": "granrs.simulate, rft (zeta fitted to Table 3.1)",
+        "granrs_rft_core": "granrs rft (zeta 1e6), the run alone (timed in the core)",
+        "granrs_rft_fitted_core": "granrs rft (zeta fitted), the run alone (timed in the core)",
         "granrs_raw": 'granrs.simulate, sign_model="raw"',
         "granrs_core": "granrs modes, the run alone (timed in the core, same loop)",
         "rust": "granrs modes, Rust only (criterion impact/table_3_5_all)",
@@ -913,6 +956,8 @@ def summarize(
         "sweep_scalar_2": "granrs.sweep, scalar path (lanes=False), 2 threads (per impact)",
         "sweep_lean_1": 'granrs.sweep, SIMD lanes, outputs=("depth", "t_s"), 1 thread',
         "sweep_lean_2": 'granrs.sweep, SIMD lanes, outputs=("depth", "t_s"), 2 threads',
+        "sweep_rft_1": "granrs.sweep, SIMD lanes, rft (zeta 1e6), 1 thread",
+        "sweep_rft_fitted_1": "granrs.sweep, SIMD lanes, rft (zeta fitted), 1 thread",
         "numba_parallel_1": "numba scalars in a prange, 1 thread (per impact)",
         "numba_parallel_2": "numba scalars in a prange, 2 threads (per impact)",
     }
@@ -964,6 +1009,13 @@ def summarize(
                 f"({theirs:.2f}x) | {ours / theirs:.3g} | >= {TARGET_SCALING:g} | "
                 f"{'yes' if ours / theirs >= TARGET_SCALING else 'NO'} |"
             )
+    for key, zeta in (("rft", "1e6"), ("rft_fitted", "fitted to Table 3.1")):
+        ratio(f"granrs (simulate) rft, zeta {zeta} / thesis", f"granrs_{key}", "granrs",
+              TARGET_RFT_SIMULATE, True)  # fmt: skip
+        ratio(f"granrs sweep (lanes) 1 thread, rft, zeta {zeta} / thesis", f"sweep_{key}_1",
+              "sweep_1", TARGET_RFT_SWEEP, True)  # fmt: skip
+        ratio(f"granrs run alone, rft, zeta {zeta} / thesis (no step check)",
+              f"granrs_{key}_core", "granrs_core", None, True)  # fmt: skip
     ratio("granrs Rust only / numba scalar", "rust", "numba_scalar", None, True)
     ratio("granrs raw Rust only / numba scalar", "rust_raw", "numba_scalar", None, True)
     ratio("solve_ivp / granrs (simulate), mean over the scenes it ran", "solve_ivp",

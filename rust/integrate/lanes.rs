@@ -425,12 +425,36 @@ mod tests {
     }
 
     /// Every law the free link accepts runs in the lanes, each outcome the general path's
-    /// bit for bit (every field): each of the registry's terms that a rod takes alone, and
-    /// mixed (the thesis's three, each pair, all of them), with `gravity`, four scenes of
-    /// each law in one sweep, each with its own numbers, through entry, sticking and stops.
+    /// bit for bit (every field): each of the registry's contact terms that a rod takes
+    /// alone, and mixed (the thesis's three, each pair, all of them), four scenes of each
+    /// law in one sweep, each with its own numbers, through entry, sticking and stops; and
+    /// with the registry's body terms that a rod takes (`gravity`, `joint_springs`), each
+    /// scene listing its own choice of them (none: no gravity), which the lanes share.
     #[test]
     fn every_law_runs_in_the_lanes_as_on_the_general_path() {
         use crate::dynamics::rod_lanes::{rod_law, rod_terms};
+        use crate::forces::{Acts, ContactKind, TERMS};
+        let body: Vec<TermSpec> = TERMS
+            .iter()
+            .filter(|t| t.acts == Acts::Body && t.shapes.contains(&ContactKind::Rod))
+            .map(|t| {
+                let params: Vec<(&str, f64)> = t
+                    .params
+                    .iter()
+                    .map(|p| match (t.name, p.name) {
+                        ("lift", "f") => (p.name, 0.3),
+                        _ if p.required() => panic!("give {}.{} a value here", t.name, p.name),
+                        _ => (p.name, p.default),
+                    })
+                    .collect();
+                TermSpec::new(t.name, &params)
+            })
+            .collect();
+        let names: Vec<&str> = body.iter().map(|t| t.name.as_str()).collect();
+        assert!(
+            names.contains(&"gravity") && names.contains(&"joint_springs"),
+            "{names:?}"
+        );
         let n = rod_terms(1.0, 1).len() as u32;
         let mut masks: Vec<u32> = (0..n).map(|k| 1 << k).collect();
         masks.push(0b111);
@@ -444,7 +468,13 @@ mod tests {
         let mut expected = Vec::new();
         for (k, &mask) in masks.iter().enumerate() {
             for j in 0..LANES {
-                let mut law = vec![TermSpec::new("gravity", &[])];
+                // Scene j of law k lists the body terms that the bits of k + j pick, so that
+                // every choice of them meets every law.
+                let pick = (k + j) % (1 << body.len());
+                let mut law: Vec<TermSpec> = (body.iter().enumerate())
+                    .filter(|(b, _)| pick & (1 << b) != 0)
+                    .map(|(_, t)| t.clone())
+                    .collect();
                 law.extend(rod_law(mask, 0.6 + 0.3 * j as f64, 3 + k % 5));
                 let s = scene(-40.0 + 27.0 * j as f64, 0.4 + 0.5 * j as f64, Some(&law));
                 let (model, (q0, qd0)) = (s.model::<3>(), s.initial_state::<3>());
