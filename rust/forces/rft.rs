@@ -47,9 +47,10 @@
 //! leading surfaces). `lam` = 1 is the momentum-flux value; the paper's own coefficient
 //! could not be checked here (see docs/laws.md). It is zero at rest, so it owns no switch.
 
-#[cfg(target_arch = "x86_64")]
-use super::outline::rod_plates;
 use super::outline::Plate;
+#[cfg(target_arch = "x86_64")]
+mod lone_rod;
+
 use super::{
     Acts, Boundary, Class, ContactState, Medium, Outline, Param, Rates, Real, Switch, Term,
     TermForce, TermInfo,
@@ -274,23 +275,6 @@ impl Rft {
         sum
     }
 
-    /// [`Rft::integrate`] over a rod's two plates at `N` elements each (`self.elements`), its
-    /// elements moving along their own velocities: the same arithmetic in the same order.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn integrate_rod<F: Real, const N: usize>(
-        &self,
-        co: &RftCoefficients<F>,
-        (diameter, immersed): (F, F),
-        b: &Boundary<F>,
-    ) -> ([F; 2], F) {
-        let plates = rod_plates(diameter, immersed, &b.frame);
-        let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
-        self.add_plate::<F, N>(co, &plates[0], b, None, &mut sum);
-        self.add_plate::<F, N>(co, &plates[1], b, None, &mut sum);
-        sum
-    }
-
     /// [`Rft::integrate`] over an arc's chords, kept out of the rod's and the box's path.
     #[inline(never)]
     fn integrate_chords<F: Real>(
@@ -437,21 +421,12 @@ impl Term for Rft {
     fn contact_force<F: Real>(&self, c: &ContactState<F>, _m: &Medium<F>) -> TermForce<F> {
         let co = self.coefficients_in();
         #[cfg(target_arch = "x86_64")]
-        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::num::avx2() {
-            if let Some(b) = c.boundary {
-                if let Outline::Rod { diameter, immersed } = b.outline {
-                    if (b.held[0] + b.held[1]).all_zero() {
-                        // SAFETY: this CPU has AVX2 (checked).
-                        let (force, moment) =
-                            unsafe { self.rod_avx2(&co, (diameter, immersed), b) };
-                        return TermForce {
-                            force,
-                            bound: [F::splat(0.0); 2],
-                            moment,
-                        };
-                    }
-                }
-            }
+        if let Some((force, moment)) = self.lone_rod(&co, c) {
+            return TermForce {
+                force,
+                bound: [F::splat(0.0); 2],
+                moment,
+            };
         }
         self.force_base(&co, c)
     }
@@ -493,51 +468,12 @@ impl Term for Rft {
     }
 }
 
-/// Most elements per plate of a lone rod's fast paths ([`Rft::rod_avx2`],
-/// [`RftInertial::rod_avx2`]); each count from 1 up has its own instance.
-#[cfg(target_arch = "x86_64")]
-const ROD_FAST_ELEMENTS: usize = 8;
-
 impl Rft {
     /// [`Rft::law`], out of line, with the numbers behind a reference (seen through,
     /// they were ten more values held in registers in the AVX2 path: 13 % slower there).
     #[inline(never)]
     fn force_base<F: Real>(&self, co: &RftCoefficients<F>, c: &ContactState<F>) -> TermForce<F> {
         self.law(co, c)
-    }
-
-    /// A lone rod's contact, held nowhere, at up to [`ROD_FAST_ELEMENTS`] elements per plate:
-    /// the count known when compiled (one instance per count) and the whole compiled with
-    /// AVX2 (its three-operand encodings; the same IEEE operations in the same order, so the
-    /// same bits as [`Rft::law`]). A quarter less time than the plain loop at eight
-    /// elements, half at two (docs/laws.md, "Cost"). Measured on the way: LLVM packs two
-    /// elements to a 128-bit register here; compiled one count per function it packed four
-    /// to a 256-bit one, and the shuffles of the x, y pairs made that a quarter slower. A
-    /// change here is to be measured (`benches/bench_laws.py`).
-    ///
-    /// # Safety
-    /// The CPU must have AVX2 ([`crate::num::avx2`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[inline(never)]
-    unsafe fn rod_avx2<F: Real>(
-        &self,
-        co: &RftCoefficients<F>,
-        rod: (F, F),
-        b: &Boundary<F>,
-    ) -> ([F; 2], F) {
-        match self.elements {
-            1 => self.integrate_rod::<F, 1>(co, rod, b),
-            2 => self.integrate_rod::<F, 2>(co, rod, b),
-            3 => self.integrate_rod::<F, 3>(co, rod, b),
-            4 => self.integrate_rod::<F, 4>(co, rod, b),
-            5 => self.integrate_rod::<F, 5>(co, rod, b),
-            6 => self.integrate_rod::<F, 6>(co, rod, b),
-            7 => self.integrate_rod::<F, 7>(co, rod, b),
-            // 8: `contact_force` sends only 1..=8 here. (A fallback arm to the plain loop, even
-            // out of line, made the 8-element force 25 % slower: measured.)
-            _ => self.integrate_rod::<F, 8>(co, rod, b),
-        }
     }
 }
 
@@ -655,19 +591,12 @@ impl Term for RftInertial {
     #[inline(never)]
     fn contact_force<F: Real>(&self, c: &ContactState<F>, m: &Medium<F>) -> TermForce<F> {
         #[cfg(target_arch = "x86_64")]
-        if F::LANES == 1 && (1..=ROD_FAST_ELEMENTS).contains(&self.elements) && crate::num::avx2() {
-            if let Some(b) = c.boundary {
-                if let Outline::Rod { diameter, immersed } = b.outline {
-                    let k = -(F::splat(self.lam) * m.rho_g);
-                    // SAFETY: this CPU has AVX2 (checked).
-                    let (force, moment) = unsafe { self.rod_avx2(k, (diameter, immersed), b) };
-                    return TermForce {
-                        force,
-                        bound: [F::splat(0.0); 2],
-                        moment,
-                    };
-                }
-            }
+        if let Some((force, moment)) = self.lone_rod(c, m) {
+            return TermForce {
+                force,
+                bound: [F::splat(0.0); 2],
+                moment,
+            };
         }
         self.law(F::splat(self.lam), c, m)
     }
@@ -760,47 +689,6 @@ impl RftInertial {
         let r0 = [el.start[0] - b.apply[0], el.start[1] - b.apply[1]];
         let lever = [sw * r0[0] + stw * el.step[0], sw * r0[1] + stw * el.step[1]];
         *moment = *moment + cross(lever, n);
-    }
-
-    /// [`RftInertial::law`] on a lone rod at up to [`ROD_FAST_ELEMENTS`] elements per
-    /// plate, the count known when compiled, compiled with AVX2 (the same operations in
-    /// the same order: the same bits), as [`Rft`]'s (docs/laws.md, "Cost").
-    ///
-    /// # Safety
-    /// The CPU must have AVX2 ([`crate::num::avx2`]).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    #[inline(never)]
-    unsafe fn rod_avx2<F: Real>(
-        &self,
-        k: F,
-        (diameter, immersed): (F, F),
-        b: &Boundary<F>,
-    ) -> ([F; 2], F) {
-        #[inline(always)]
-        fn rod<F: Real, const N: usize>(
-            t: &RftInertial,
-            k: F,
-            plates: &[Plate<F>; 2],
-            b: &Boundary<F>,
-        ) -> ([F; 2], F) {
-            let mut sum = ([F::splat(0.0); 2], F::splat(0.0));
-            t.add_plate::<F, N>(k, &plates[0], b, &mut sum);
-            t.add_plate::<F, N>(k, &plates[1], b, &mut sum);
-            sum
-        }
-        let plates = rod_plates(diameter, immersed, &b.frame);
-        match self.elements {
-            1 => rod::<F, 1>(self, k, &plates, b),
-            2 => rod::<F, 2>(self, k, &plates, b),
-            3 => rod::<F, 3>(self, k, &plates, b),
-            4 => rod::<F, 4>(self, k, &plates, b),
-            5 => rod::<F, 5>(self, k, &plates, b),
-            6 => rod::<F, 6>(self, k, &plates, b),
-            7 => rod::<F, 7>(self, k, &plates, b),
-            // 8: `contact_force` sends only 1..=8 here (as `Rft::rod_avx2`).
-            _ => rod::<F, 8>(self, k, &plates, b),
-        }
     }
 }
 
