@@ -344,7 +344,19 @@ impl<'a> RodTerms<'a, f64> {
     /// are listed in its order.
     #[inline(always)]
     pub fn of_forces(forces: &'a ForceSet, thesis_numbers: &'a mut [f64; 4]) -> Self {
-        let terms = &forces.per_contact[0][..];
+        Self::of_terms(forces, &forces.per_contact[0], thesis_numbers)
+    }
+
+    /// [`RodTerms::of_forces`] with the contact terms `terms` in place of the set's own:
+    /// the same terms, in the same order, with other numbers (`granrs.resistance_force`
+    /// gives each state its own).
+    #[inline(always)]
+    pub fn of_terms(
+        forces: &'a ForceSet,
+        terms: &'a [AnyTerm],
+        thesis_numbers: &'a mut [f64; 4],
+    ) -> Self {
+        debug_assert_eq!(terms.len(), forces.per_contact[0].len(), "the set's terms");
         let thesis = if let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] = terms {
             *thesis_numbers = [d.eta_d, h.eta_h, v.eta_v, v.lam];
             true
@@ -512,6 +524,8 @@ pub struct RodEval<F> {
     pub cross: F,
     /// Margin to full immersion (0 out of contact).
     pub margin: F,
+    /// The immersed length l = min(d / cos q, L) (in contact or not).
+    pub immersed: F,
     /// Each listed term's force in its place (a reaction in place of a stuck component;
     /// zero past the list).
     pub terms: [[F; 2]; MAX_TERMS],
@@ -935,6 +949,7 @@ pub fn rod_kernel<F: Real, const THESIS: bool>(
         v_centroid,
         cross,
         margin,
+        immersed,
         terms,
         dynamic,
         statics,
@@ -1076,6 +1091,7 @@ impl RodEval<F64x4> {
             v_centroid: l2(&self.v_centroid),
             cross: l(&self.cross),
             margin: l(&self.margin),
+            immersed: l(&self.immersed),
             terms,
             dynamic: l2(&self.dynamic),
             statics: l2(&self.statics),
