@@ -99,7 +99,7 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
     };
     let e = rod_eval_terms(&body, &law, &modes, &[0.0, -depth, q], &[vx, vy, omega]);
     let half = 0.5 * e.immersed;
-    let (s, c) = q.sin_cos();
+    let [s, c] = e.axis;
     let (dynamic, statics) = (e.dynamic, e.statics);
     let values = [
         dynamic[0] + statics[0],

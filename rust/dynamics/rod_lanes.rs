@@ -526,6 +526,8 @@ pub struct RodEval<F> {
     pub margin: F,
     /// The immersed length l = min(d / cos q, L) (in contact or not).
     pub immersed: F,
+    /// The rod's axis e = (sin q, cos q), from the tip.
+    pub axis: [F; 2],
     /// Each listed term's force in its place (a reaction in place of a stuck component;
     /// zero past the list).
     pub terms: [[F; 2]; MAX_TERMS],
@@ -952,6 +954,7 @@ pub fn rod_kernel<F: Real, const THESIS: bool>(
         cross,
         margin,
         immersed,
+        axis,
         terms,
         dynamic,
         statics,
@@ -1094,6 +1097,7 @@ impl RodEval<F64x4> {
             cross: l(&self.cross),
             margin: l(&self.margin),
             immersed: l(&self.immersed),
+            axis: l2(&self.axis),
             terms,
             dynamic: l2(&self.dynamic),
             statics: l2(&self.statics),
