@@ -11,11 +11,11 @@
 
 use nalgebra::Vector2;
 
-use crate::dynamics::{raw_sign, terms_on};
+use crate::dynamics::rod_lanes::{rod_eval_terms, RodBody, RodModes, RodTerms};
 use crate::forces::drag::Drag;
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
-use crate::forces::{AnyTerm, Boundary, ContactState, ForceSet, Frame, Medium, Outline};
+use crate::forces::{AnyTerm, ForceSet, Medium};
 
 /// Inputs per state, in this order.
 pub const INPUTS: [&str; 9] = [
@@ -51,20 +51,14 @@ pub struct RodSetup {
 }
 
 /// Evaluate one state: `input` in the order of [`INPUTS`] (angle in degrees), `out` in the
-/// order of [`OUTPUTS`]. The forces come from the same term evaluation as a run's
-/// ([`terms_on`]), with this state's coefficients.
+/// order of [`OUTPUTS`]. The state is the free link's with its root at the tip (unit mass
+/// and inertia, no gravity), evaluated by the free link's own kernel
+/// ([`rod_eval_terms`]: the same geometry, signs and terms as a run's), with this state's
+/// coefficients; in contact where the tip is below the surface.
 pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
     let [depth, q_deg, vx, vy, omega, eta_h, eta_d, eta_v, lam] = input;
     let q = q_deg.to_radians();
-    let (s, c) = q.sin_cos();
     let depth = depth.max(0.0);
-    let l = if depth >= setup.length * c {
-        setup.length
-    } else {
-        depth / c
-    };
-    let half = 0.5 * l;
-    let v_e = Vector2::new(vx + half * omega * c, vy - half * omega * s);
     let mut terms = setup.forces.per_contact[0];
     for t in terms.iter_mut() {
         *t = match *t {
@@ -74,62 +68,50 @@ pub fn evaluate(setup: &RodSetup, input: [f64; 9], out: &mut [f64]) {
             other => other,
         };
     }
-    let sign = match setup.sign {
-        Sign::Raw => [raw_sign(v_e.x), raw_sign(v_e.y)],
-        Sign::Smooth(eps) => [(v_e.x / eps).tanh(), (v_e.y / eps).tanh()],
+    let (smooth, eps) = match setup.sign {
+        Sign::Raw => (0.0, 1.0),
+        Sign::Smooth(eps) => (1.0, eps),
     };
-    // A_r |v_E| = d_c l |e x v_E|: smooth at v_E = 0, no division.
-    let cross = (s * v_e.y - c * v_e.x).abs();
-    // T at depth d; omega = dq/dt turns e clockwise.
-    let boundary = Boundary {
-        frame: Frame {
-            origin: [0.0, -depth],
-            v: [vx, vy],
-            omega: -omega,
-            axis: [s, c],
-        },
-        outline: Outline::Rod {
-            diameter: setup.diameter,
-            immersed: l,
-        },
-        apply: [0.0, -depth],
-        centroid: [half * s, -depth + half * c],
-        v_centroid: [v_e.x, v_e.y],
-        held: [0.0; 2],
+    let body = RodBody {
+        mass: 1.0,
+        g: 0.0,
+        inv_m: 1.0,
+        inv_i: 1.0,
+        tip: [0.0; 2],
+        length: setup.length,
+        diameter: setup.diameter,
+        section: std::f64::consts::FRAC_PI_4 * setup.diameter * setup.diameter,
+        at_centroid: 0.0,
+        medium: setup.medium,
+        unheld: 1.0,
+        smooth,
+        eps,
     };
-    let state = ContactState {
-        depth,
-        volume: std::f64::consts::FRAC_PI_4 * setup.diameter * setup.diameter * l,
-        width: setup.diameter,
-        l_ref: setup.length,
-        v: [v_e.x, v_e.y],
-        area_speed: setup.diameter * l * cross,
-        sign,
-        boundary: Some(&boundary),
+    let mut numbers = [0.0; 4];
+    let law = RodTerms::of_terms(&setup.forces, &terms, &mut numbers);
+    // The signs are each evaluation's own: nothing is held, nothing sticks.
+    let modes = RodModes {
+        in_contact: if depth > 0.0 { 1.0 } else { 0.0 },
+        sign: [0.0; 2],
+        cross: 1.0,
+        stuck_x: 0.0,
+        stuck_y: 0.0,
     };
-    let mut f = crate::dynamics::ContactForce::default();
-    if depth > 0.0 {
-        terms_on(
-            &setup.forces,
-            &terms,
-            &state,
-            &setup.medium,
-            &mut f,
-            &mut [0.0; 2],
-        );
-    }
-    let total = f.total();
+    let e = rod_eval_terms(&body, &law, &modes, &[0.0, -depth, q], &[vx, vy, omega]);
+    let half = 0.5 * e.immersed;
+    let [s, c] = e.axis;
+    let (dynamic, statics) = (e.dynamic, e.statics);
     let values = [
-        total.x,
-        total.y,
-        f.dynamic.x,
-        f.dynamic.y,
-        f.statics.x,
-        f.statics.y,
-        l,
+        dynamic[0] + statics[0],
+        dynamic[1] + statics[1],
+        dynamic[0],
+        dynamic[1],
+        statics[0],
+        statics[1],
+        e.immersed,
         half * s,
         half * c,
-        v_e.norm(),
+        Vector2::new(e.v_centroid[0], e.v_centroid[1]).norm(),
     ];
     out[..values.len()].copy_from_slice(&values);
 }

@@ -72,6 +72,8 @@ pub trait Real:
     fn sin_cos(self) -> (Self, Self);
     /// Hyperbolic tangent (libm's, in each lane).
     fn tanh(self) -> Self;
+    /// Lane `i`'s value (`f64`: itself).
+    fn lane(self, i: usize) -> f64;
 }
 
 impl Real for f64 {
@@ -127,6 +129,11 @@ impl Real for f64 {
     #[inline(always)]
     fn tanh(self) -> Self {
         f64::tanh(self)
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        debug_assert_eq!(i, 0, "one lane");
+        self
     }
 }
 
@@ -240,6 +247,10 @@ impl Real for F64x4 {
     #[inline(always)]
     fn tanh(self) -> Self {
         self.map(f64::tanh)
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        self.0[i]
     }
 }
 

@@ -16,8 +16,10 @@
 //! Here: the model, its modes and what an evaluation returns, and [`terms_on`], the one
 //! evaluation of the force law. Beside it: `rhs.rs` (geometry -> terms -> constraints, one
 //! pipeline for every body: [`Model::eval`], [`Model::eval_general`]), `constraints.rs` (the
-//! constraint rows, their multipliers and the projection onto them) and `rigid_rod.rs` (the
-//! free link's closed-form mass matrix and sticking, calling the same terms).
+//! constraint rows, their multipliers and the projection onto them), `rigid_rod.rs` (the
+//! free link: its closed-form evaluation and projection) and `rod_lanes.rs` (the free
+//! link's mechanics written once, for one scene and for four in SIMD lanes, calling the
+//! same terms).
 
 use nalgebra::{SVector, Vector2};
 

@@ -389,22 +389,21 @@ impl<const N: usize> Model<N> {
     /// Evaluate the accelerations and the per-contact forces at `(q, qd)` in `modes`.
     ///
     /// A single rigid rod whose root is its centre of mass (the free link) has a constant,
-    /// diagonal mass matrix and no velocity products: it takes [`Model::eval_rigid_rod`],
-    /// the same equations in closed form.
+    /// diagonal mass matrix and no velocity products: it takes the free link's kernel
+    /// ([`Model::eval_free_link`], the same equations in closed form).
     #[inline]
     pub fn eval(&self, q: &SVector<f64, N>, qd: &SVector<f64, N>, modes: &Modes) -> Eval<N> {
         match self.rigid_rod() {
             Some(rod) => {
-                let mut contacts = [ContactEval::default(); MAX_CONTACTS];
-                let (qdd, power, joint_torque) =
-                    self.eval_rigid_rod(rod, q, qd, modes, &mut contacts[0]);
-                Eval {
-                    qdd,
-                    power,
+                let mut e = Eval {
+                    qdd: SVector::zeros(),
+                    power: 0.0,
                     joint_power: 0.0,
-                    joint_torque,
-                    contacts,
-                }
+                    joint_torque: [0.0; N],
+                    contacts: [ContactEval::default(); MAX_CONTACTS],
+                };
+                self.eval_free_link(rod, q, qd, modes).write(&mut e);
+                e
             }
             None => self.eval_general(q, qd, modes),
         }
@@ -423,15 +422,7 @@ impl<const N: usize> Model<N> {
         out: &mut Eval<N>,
     ) {
         match self.rigid_rod() {
-            Some(rod) => {
-                out.contacts[0] = ContactEval::default();
-                let (qdd, power, joint_torque) =
-                    self.eval_rigid_rod(rod, q, qd, modes, &mut out.contacts[0]);
-                out.qdd = qdd;
-                out.power = power;
-                out.joint_power = 0.0;
-                out.joint_torque = joint_torque;
-            }
+            Some(rod) => self.eval_free_link(rod, q, qd, modes).write(out),
             None => self.eval_general_into(q, qd, modes, out),
         }
     }
@@ -460,9 +451,9 @@ impl<const N: usize> Model<N> {
     ) -> (SVector<f64, N>, f64, f64, DragStiffness) {
         match self.rigid_rod() {
             Some(rod) => {
-                let mut contact = ContactEval::default();
-                let (qdd, power, _) = self.eval_rigid_rod(rod, q, qd, modes, &mut contact);
-                (qdd, power, 0.0, DragStiffness::of(0, &contact))
+                let e = self.eval_free_link(rod, q, qd, modes);
+                let qdd = SVector::from_fn(|i, _| e.qdd[i]);
+                (qdd, e.power, 0.0, e.stiffness())
             }
             None => {
                 let e = self.eval_general(q, qd, modes);

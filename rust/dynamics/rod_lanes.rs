@@ -1,45 +1,52 @@
-//! The free link under any law it accepts, for one scene or several at once:
-//! [`Model::eval_rigid_rod`] written over [`Real`]. With `F = f64` it is the lean path of a
-//! lone run's RK4 steps (`integrate::solve::Run::step`: a stage computes only what the step
-//! reads, after inlining); with `F = F64x4` it evaluates four scenes, one per SIMD lane, in
-//! the same instructions (the sweep's lanes, `integrate::lanes`).
+//! The free link's mechanics, written once, over [`Real`]: [`rod_kernel`] evaluates a
+//! single rigid rod whose root is its centre of mass ([`Model::rigid_rod`]): its frame, its
+//! immersed geometry, its terms' sums, its accelerations under `M = diag(m + m_root,
+//! m + m_root, I)`, its sticking reactions and the power of the sand's force. It is what
+//! [`Model::eval`] runs for a free link (in `f64`, one scene: the events, stops, samples,
+//! the ledger, the forces and bounds, the MuJoCo coupling's geoms), what a lone run's RK4
+//! steps run (`integrate::solve::Run::step`, the same kernel in `f64` inside
+//! `integrate::lane_step`: a stage computes only what the step reads, after inlining), and
+//! what the sweep's lanes run with `F = F64x4` (four scenes, one per SIMD lane, in the same
+//! instructions, `integrate::lanes`).
 //!
 //! The force law is not copied, nor listed here: each contact term the scene lists is
 //! evaluated by its own arithmetic, [`Term::force_with`] (what its `contact_force` runs),
-//! with its numbers from its parameter table, one per lane ([`RodParams::numbers`]; a lone
-//! run calls the term's `contact_force`, its own numbers). The lanes share the terms and
-//! their counts ([`RodLaw`], [`RodLaw::shares`]). The mechanics (the rod's frame, its
-//! immersed geometry, the closed-form sticking row and the sums of [`super::rigid_rod`])
-//! are written again without branches: each branch of the scalar path becomes a blend
-//! ([`Real::select_pos`]) on a per-lane flag, and each operation is the scalar path's, in
-//! its order (the terms' sums in the list's order, as `terms_on`), so that the results are
-//! [`Model::eval`]'s bit for bit (tests hold them so over random states, modes and laws,
-//! and whole runs to the general path). Two blocks are skipped when every lane blends them
-//! away (the law out of the sand, the sticking row when nothing sticks): the same bits,
-//! less work.
+//! with its numbers from its parameter table, one per lane ([`RodParams::numbers`]; one
+//! scene calls the term's `contact_force`, its own numbers). The lanes share the terms and
+//! their counts ([`RodLaw`], [`RodLaw::shares`]). Branches are blends
+//! ([`Real::select_pos`]) on per-lane flags, so that a lane's result is the one-scene
+//! result bit for bit (tests hold them so over random states, modes and laws); two blocks
+//! are skipped when every lane blends them away (the law out of the sand, the sticking row
+//! when nothing sticks): the same bits, less work.
 //!
-//! What it covers: a free link ([`Model::rigid_rod`]), applied at the tip or at the centroid,
-//! under any sign model (`modes`, held through a step; the thesis's plain sign `raw` and
-//! `smooth`'s tanh, each evaluation's own, with no sticking), under any contact terms the
-//! free link accepts ([`RodParams::of`]), in modes with at most one sticking row whose
-//! reaction stands in one term's place ([`RodModes::of`]). A step in a mode that sticks in
-//! both x and y, or in an axis whose switch several static terms share, or whose one
-//! sticking row has a zero pivot ([`RodEval::pivot`]), is taken on the general path.
+//! What it reads: the body ([`RodBody`], built from the model at every evaluation without
+//! allocating), the terms ([`RodTerms`], borrowed: from the model's force set for one
+//! scene, from a run's [`RodParams`] in the lanes) and the modes ([`RodModes`]). It covers
+//! any sign model (`modes`, held through a step; the thesis's plain sign `raw` and
+//! `smooth`'s tanh, each evaluation's own, with no sticking), a force at the tip or at the
+//! centroid, and any contact terms the free link accepts. A sticking row is solved in
+//! closed form; for one scene the kernel also solves the rows the closed form leaves
+//! ([`one_scene_rows`]): x and y stuck together, a reaction shared by several static terms,
+//! a pivot that is not clearly nonzero. The lanes hand such steps to the one-scene
+//! evaluation ([`RodModes::of`], [`pivot_ok`]).
 
 use nalgebra::{SVector, Vector2};
 
+use super::constraints::solve_upto2;
 use super::{ContactEval, ContactForce, ContactMode, DragStiffness, Eval, Model, SignModel, Slip};
 use crate::body::rod::ApplyAt;
+use crate::body::RodContact;
 use crate::forces::drag::Drag;
 use crate::forces::registry::{TermList, LANE_NUMBERS, MAX_TERMS};
 use crate::forces::static_h::StaticH;
 use crate::forces::static_v::StaticV;
 use crate::forces::{
-    AnyTerm, Boundary, ContactState, Frame, Medium, Outline, Real, Switch, Term, TermForce,
+    AnyTerm, Boundary, ContactState, ForceSet, Frame, Medium, Outline, Real, Switch, Term,
+    TermForce,
 };
 use crate::num::{F64x4, LANES};
 
-/// The contact terms of a free link as the lanes run them, with what the general path
+/// The contact terms of a free link as the lanes run them, with what the force set
 /// derives from them (`ForceSet`): one for every lane.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RodLaw {
@@ -108,11 +115,13 @@ impl RodLaw {
     }
 }
 
-/// What the evaluation of one free link reads that is fixed through a run: its mass,
-/// geometry, medium and its terms' numbers (one lane per scene), and its law (one for all
-/// four).
+/// What the evaluation of one free link reads of its body, its contact, the sand and the
+/// sign model (one lane per scene): built from the model in a few loads and two divisions,
+/// without allocating, so that [`Model::eval`] builds it at every call and nothing derived
+/// from the model is kept beside it (a test that changes a model's terms or sign model
+/// after building it evaluates what it changed).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RodParams<F> {
+pub struct RodBody<F> {
     /// m + m_root [kg].
     pub mass: F,
     /// The acceleration of gravity on the body ([`Model::gravity`]) [m/s^2].
@@ -140,17 +149,44 @@ pub struct RodParams<F> {
     pub smooth: F,
     /// `smooth`'s eps [m/s] (1 under the other sign models).
     pub eps: F,
-    /// Each listed term's parameter values in its table's order (`Term::params`), the
-    /// terms one after the other ([`RodLaw::at`]); zero past them.
-    pub numbers: [F; LANE_NUMBERS],
-    /// The contact terms, one law for every lane.
-    pub law: RodLaw,
 }
 
-impl<F: Copy> RodParams<F> {
-    /// The same parameters, each number through `f`.
-    fn map<G>(&self, f: impl Fn(F) -> G) -> RodParams<G> {
-        RodParams {
+impl RodBody<f64> {
+    /// The body of `model`, whose free link's contact is `rod` ([`Model::rigid_rod`]).
+    #[inline(always)]
+    pub fn of<const N: usize>(model: &Model<N>, rod: &RodContact) -> Self {
+        let (unheld, smooth, eps) = match model.sign_model {
+            SignModel::Modes => (0.0, 0.0, 1.0),
+            SignModel::Raw => (1.0, 0.0, 1.0),
+            SignModel::Smooth { eps } => (1.0, 1.0, eps),
+        };
+        let link = &model.mechanism.links[0];
+        let mass = link.mass + model.mechanism.root_mass;
+        RodBody {
+            mass,
+            g: model.gravity(),
+            inv_m: 1.0 / mass,
+            inv_i: 1.0 / link.inertia,
+            tip: [rod.tip.x, rod.tip.y],
+            length: rod.length,
+            diameter: rod.diameter,
+            section: std::f64::consts::FRAC_PI_4 * rod.diameter * rod.diameter,
+            at_centroid: match model.apply_at {
+                ApplyAt::Tip => 0.0,
+                ApplyAt::Centroid => 1.0,
+            },
+            medium: model.medium,
+            unheld,
+            smooth,
+            eps,
+        }
+    }
+}
+
+impl<F: Copy> RodBody<F> {
+    /// The same body, each number through `f`.
+    fn map<G>(&self, f: impl Fn(F) -> G) -> RodBody<G> {
+        RodBody {
             mass: f(self.mass),
             g: f(self.g),
             inv_m: f(self.inv_m),
@@ -167,12 +203,10 @@ impl<F: Copy> RodParams<F> {
             unheld: f(self.unheld),
             smooth: f(self.smooth),
             eps: f(self.eps),
-            numbers: self.numbers.map(&f),
-            law: self.law,
         }
     }
 
-    /// Each number, in [`RodParams::map`]'s order.
+    /// Each number, in [`RodBody::map`]'s order.
     fn each_mut(&mut self, mut f: impl FnMut(&mut F)) {
         for x in [
             &mut self.mass,
@@ -196,7 +230,56 @@ impl<F: Copy> RodParams<F> {
         ] {
             f(x);
         }
+    }
+}
+
+/// What a run in the lanes keeps of its free link: its body ([`RodBody`]) and its terms'
+/// numbers (one lane per scene), and its law (one for all four). Built once per run (it
+/// copies the term list and allocates); a lone evaluation ([`Model::eval`]) reads the
+/// model's own terms instead ([`RodTerms::of_forces`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodParams<F> {
+    /// The body, its contact, the sand and the sign model.
+    pub body: RodBody<F>,
+    /// Each listed term's parameter values in its table's order (`Term::params`), the
+    /// terms one after the other ([`RodLaw::at`]); zero past them.
+    pub numbers: [F; LANE_NUMBERS],
+    /// The contact terms, one law for every lane.
+    pub law: RodLaw,
+}
+
+impl<F: Copy> RodParams<F> {
+    /// The same parameters, each number through `f`.
+    fn map<G>(&self, f: impl Fn(F) -> G) -> RodParams<G> {
+        RodParams {
+            body: self.body.map(&f),
+            numbers: self.numbers.map(&f),
+            law: self.law,
+        }
+    }
+
+    /// Each number, in [`RodParams::map`]'s order.
+    fn each_mut(&mut self, mut f: impl FnMut(&mut F)) {
+        self.body.each_mut(&mut f);
         self.numbers.iter_mut().for_each(f);
+    }
+
+    /// The terms as the kernel reads them: this law with these numbers.
+    #[inline(always)]
+    pub fn terms(&self) -> RodTerms<'_, F> {
+        let law = &self.law;
+        RodTerms {
+            terms: &law.terms,
+            numbers: &self.numbers,
+            at: &law.at,
+            dynamic: &law.dynamic,
+            owns: law.owns,
+            owner: law.owner,
+            reads_frame: law.reads_frame,
+            reads_area_speed: law.reads_area_speed,
+            thesis: law.thesis,
+            forces: None,
+        }
     }
 }
 
@@ -205,11 +288,6 @@ impl RodParams<f64> {
     #[inline(never)]
     pub fn of<const N: usize>(model: &Model<N>) -> Option<Self> {
         let rod = model.rigid_rod()?;
-        let (unheld, smooth, eps) = match model.sign_model {
-            SignModel::Modes => (0.0, 0.0, 1.0),
-            SignModel::Raw => (1.0, 0.0, 1.0),
-            SignModel::Smooth { eps } => (1.0, 1.0, eps),
-        };
         let law = RodLaw::of(model);
         let mut numbers = [0.0; LANE_NUMBERS];
         for (k, t) in law.terms.iter().enumerate() {
@@ -217,28 +295,87 @@ impl RodParams<f64> {
                 numbers[law.at[k] + j] = v;
             }
         }
-        let link = &model.mechanism.links[0];
-        let mass = link.mass + model.mechanism.root_mass;
         Some(RodParams {
-            mass,
-            g: model.gravity(),
-            inv_m: 1.0 / (link.mass + model.mechanism.root_mass),
-            inv_i: 1.0 / link.inertia,
-            tip: [rod.tip.x, rod.tip.y],
-            length: rod.length,
-            diameter: rod.diameter,
-            section: std::f64::consts::FRAC_PI_4 * rod.diameter * rod.diameter,
-            at_centroid: match model.apply_at {
-                ApplyAt::Tip => 0.0,
-                ApplyAt::Centroid => 1.0,
-            },
-            medium: model.medium,
-            unheld,
-            smooth,
-            eps,
+            body: RodBody::of(model, rod),
             numbers,
             law,
         })
+    }
+}
+
+/// The contact terms of a free link as one evaluation reads them, borrowed: from a run's
+/// [`RodParams`] in the lanes (each lane's numbers), or from the model's [`ForceSet`] for
+/// one scene ([`RodTerms::of_forces`]: each term's own numbers).
+#[derive(Debug, Clone, Copy)]
+pub struct RodTerms<'a, F> {
+    /// The contact terms, in the scene's order.
+    pub terms: &'a [AnyTerm],
+    /// The lanes' numbers of the terms ([`RodParams::numbers`]); for one scene, the
+    /// thesis's four (`eta_d`, `eta_h`, `eta_v`, `lam`) when `thesis`, else none (each term
+    /// reads its own).
+    pub numbers: &'a [F],
+    /// Where term `k`'s numbers start in `numbers` (read in the lanes only).
+    pub at: &'a [usize; MAX_TERMS],
+    /// Whether term `k` adds to F_d (its class).
+    pub dynamic: &'a [bool; MAX_TERMS],
+    /// Whether a listed term owns the slip switch of x, of y.
+    pub owns: [bool; 2],
+    /// Per axis, the one static term whose component a sticking reaction replaces
+    /// (`usize::MAX`: none, the reaction is shared).
+    pub owner: [usize; 2],
+    /// Whether a listed term reads the contact's frame (then the law acts from depth 0).
+    pub reads_frame: bool,
+    /// Whether a listed term reads A_r |v_E|.
+    pub reads_area_speed: bool,
+    /// Whether the terms are the thesis's three in its order ([`RodLaw::thesis`]).
+    pub thesis: bool,
+    /// For one scene, its force set: the kernel then solves every sticking row itself (two
+    /// rows, a reaction shared by several static terms, a pivot that is not clear).
+    /// `None` in the lanes, which hand such steps to the one-scene evaluation.
+    pub forces: Option<&'a ForceSet>,
+}
+
+/// Where the numbers of terms read by no one start (one scene: each term reads its own).
+const NO_AT: [usize; MAX_TERMS] = [0; MAX_TERMS];
+
+impl<'a> RodTerms<'a, f64> {
+    /// The terms of one scene's force set `forces`, read in place (nothing copied but
+    /// their flags): the thesis's four numbers go to `thesis_numbers` when its three terms
+    /// are listed in its order.
+    #[inline(always)]
+    pub fn of_forces(forces: &'a ForceSet, thesis_numbers: &'a mut [f64; 4]) -> Self {
+        Self::of_terms(forces, &forces.per_contact[0], thesis_numbers)
+    }
+
+    /// [`RodTerms::of_forces`] with the contact terms `terms` in place of the set's own:
+    /// the same terms, in the same order, with other numbers (`granrs.resistance_force`
+    /// gives each state its own).
+    #[inline(always)]
+    pub fn of_terms(
+        forces: &'a ForceSet,
+        terms: &'a [AnyTerm],
+        thesis_numbers: &'a mut [f64; 4],
+    ) -> Self {
+        debug_assert_eq!(terms.len(), forces.per_contact[0].len(), "the set's terms");
+        let thesis = if let [AnyTerm::Drag(d), AnyTerm::StaticH(h), AnyTerm::StaticV(v)] = terms {
+            *thesis_numbers = [d.eta_d, h.eta_h, v.eta_v, v.lam];
+            true
+        } else {
+            false
+        };
+        let numbers: &'a [f64; 4] = thesis_numbers;
+        RodTerms {
+            terms,
+            numbers,
+            at: &NO_AT,
+            dynamic: &forces.dynamic,
+            owns: [forces.owns(Switch::SlipX), forces.owns(Switch::SlipY)],
+            owner: forces.sole_static_owner.map(|o| o.unwrap_or(usize::MAX)),
+            reads_frame: forces.reads_frame,
+            reads_area_speed: forces.reads_area_speed,
+            thesis,
+            forces: Some(forces),
+        }
     }
 }
 
@@ -280,29 +417,38 @@ pub struct RodModes<F> {
 }
 
 impl RodModes<f64> {
+    /// `mode` as the kernel reads it, for a body whose signs are each evaluation's own
+    /// where `unheld` ([`RodBody::unheld`]) and whose terms own the slip switches `owns`:
+    /// where the signs are not held nothing sticks, nor does a component no listed term owns
+    /// (no reaction there). It may stick in both x and y.
+    #[inline(always)]
+    pub fn held(mode: &ContactMode, unheld: f64, owns: [bool; 2]) -> Self {
+        let plain = unheld > 0.0;
+        let stick = |s: Slip, owned: bool| !plain && owned && s == Slip::Stick;
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        RodModes {
+            in_contact: flag(mode.in_contact),
+            sign: [mode.sx.sign(), mode.sy.sign()],
+            cross: if mode.cross == Slip::Neg { -1.0 } else { 1.0 },
+            stuck_x: flag(stick(mode.sx, owns[0])),
+            stuck_y: flag(stick(mode.sy, owns[1])),
+        }
+    }
+
     /// `mode` for the lanes of a run with `params` ([`RodParams::of`]), or `None` when the
-    /// scalar path takes the step: in contact, it sticks in both x and y (two sticking
-    /// rows), or in an axis with no one term whose component the reaction replaces
-    /// (shared among several). Where the signs are not held nothing sticks, nor does a
-    /// component no listed term owns (`Model::eval_rigid_rod` takes no reaction there).
+    /// lanes hand the step to the one-scene evaluation: in contact, it sticks in both x and
+    /// y (two sticking rows), or in an axis with no one term whose component the reaction
+    /// replaces (shared among several).
     #[inline]
     pub fn of(mode: &ContactMode, params: &RodParams<f64>) -> Option<Self> {
-        let plain = params.unheld > 0.0;
         let law = &params.law;
-        let stick = |s: Slip, owned: bool| !plain && owned && s == Slip::Stick;
-        let (sx, sy) = (stick(mode.sx, law.owns[0]), stick(mode.sy, law.owns[1]));
+        let m = Self::held(mode, params.body.unheld, law.owns);
+        let (sx, sy) = (m.stuck_x > 0.0, m.stuck_y > 0.0);
         let shared = |s: bool, axis: usize| s && law.owner[axis] == usize::MAX;
         if mode.in_contact && ((sx && sy) || shared(sx, 0) || shared(sy, 1)) {
             return None;
         }
-        let flag = |b: bool| if b { 1.0 } else { 0.0 };
-        Some(RodModes {
-            in_contact: flag(mode.in_contact),
-            sign: [mode.sx.sign(), mode.sy.sign()],
-            cross: if mode.cross == Slip::Neg { -1.0 } else { 1.0 },
-            stuck_x: flag(sx),
-            stuck_y: flag(sy),
-        })
+        Some(m)
     }
 }
 
@@ -378,6 +524,10 @@ pub struct RodEval<F> {
     pub cross: F,
     /// Margin to full immersion (0 out of contact).
     pub margin: F,
+    /// The immersed length l = min(d / cos q, L) (in contact or not).
+    pub immersed: F,
+    /// The rod's axis e = (sin q, cos q), from the tip.
+    pub axis: [F; 2],
     /// Each listed term's force in its place (a reaction in place of a stuck component;
     /// zero past the list).
     pub terms: [[F; 2]; MAX_TERMS],
@@ -390,7 +540,7 @@ pub struct RodEval<F> {
     /// The sticking bounds.
     pub bound: [F; 2],
     /// Where a sticking row acts: its pivot `1/m + lever_E lever_P / I`; 1 elsewhere. A
-    /// lane whose pivot is not clearly nonzero takes the step on the scalar path.
+    /// lane whose pivot is not clearly nonzero hands the step to the one-scene evaluation.
     pub pivot: F,
 }
 
@@ -401,14 +551,39 @@ fn plain_sign<F: Real>(v: F) -> F {
     v.select_pos(one, (-v).select_pos(-one, zero))
 }
 
-/// [`Model::eval_rigid_rod`] of the free link, in `F`: [`rod_eval_law`] for the law at hand.
+/// The free link's evaluation of a run in the lanes, in `F`: [`rod_kernel`] for its law.
 #[inline(always)]
 pub fn rod_eval<F: Real>(p: &RodParams<F>, m: &RodModes<F>, q: &[F; 3], qd: &[F; 3]) -> RodEval<F> {
-    if p.law.thesis {
-        rod_eval_law::<F, true>(p, m, q, qd)
+    rod_eval_terms(&p.body, &p.terms(), m, q, qd)
+}
+
+/// [`rod_kernel`] for the law at hand: the thesis's three terms compiled into a kernel of
+/// their own where they are listed.
+#[inline(always)]
+pub fn rod_eval_terms<F: Real>(
+    p: &RodBody<F>,
+    law: &RodTerms<'_, F>,
+    m: &RodModes<F>,
+    q: &[F; 3],
+    qd: &[F; 3],
+) -> RodEval<F> {
+    if law.thesis {
+        rod_kernel::<F, true>(p, law, m, q, qd)
     } else {
-        rod_eval_law::<F, false>(p, m, q, qd)
+        rod_kernel::<F, false>(p, law, m, q, qd)
     }
+}
+
+/// [`rod_kernel`] of a run in the lanes whose law is known when compiled (`THESIS`:
+/// [`RodLaw::thesis`]).
+#[inline(always)]
+pub fn rod_eval_law<F: Real, const THESIS: bool>(
+    p: &RodParams<F>,
+    m: &RodModes<F>,
+    q: &[F; 3],
+    qd: &[F; 3],
+) -> RodEval<F> {
+    rod_kernel::<F, THESIS>(&p.body, &p.terms(), m, q, qd)
 }
 
 /// The sums of one evaluation's terms: F_d, F_s, the moment, the sticking bounds, and each
@@ -452,22 +627,22 @@ impl<F: Real> Sums<F> {
 }
 
 /// The terms of `law` on `state`, summed in the list's order (`terms_on`): each term's own
-/// arithmetic, with its numbers from `numbers` in the lanes and its own in one lane
+/// arithmetic, with its numbers from `law.numbers` in the lanes and its own in one lane
 /// (`contact_force`: a term's fast path for one scene, the same bits). `THESIS`: the
 /// thesis's three, known when compiled (`law.thesis`): their `force_with` reads nothing of
 /// the term but the numbers given it (their `contact_force` is it with their own), so the
-/// step reads their numbers from `numbers` in one lane too and never looks at the list.
+/// kernel reads their numbers from `law.numbers` in one lane too and never looks at the
+/// list.
 #[inline(always)]
 fn term_sums<F: Real, const THESIS: bool>(
-    law: &RodLaw,
-    numbers: &[F; LANE_NUMBERS],
+    law: &RodTerms<'_, F>,
     state: &ContactState<F>,
     medium: &Medium<F>,
     sums: &mut Sums<F>,
 ) {
-    let lanes = F::LANES > 1;
+    let (lanes, numbers) = (F::LANES > 1, law.numbers);
     if THESIS {
-        // Their numbers stand in `numbers` (`RodParams::of`): these terms' own are not read
+        // Their numbers stand in `numbers` (`RodParams::of`, `RodTerms::of_forces`): these terms' own are not read
         // (NaN, so that a term that came to read them would show at once in the tests).
         let (d, h, v) = (
             Drag { eta_d: f64::NAN },
@@ -492,19 +667,20 @@ fn term_sums<F: Real, const THESIS: bool>(
     }
 }
 
-/// [`Model::eval_rigid_rod`] of the free link in `F`: the same operations in the same
-/// order, with blends for branches (see the module). `THESIS`: the law is the thesis's three
-/// terms (`p.law.thesis`), compiled into a step of their own, with no dispatch between them
-/// (measured: 4 % slower lanes with `rft` in the same step); else any terms.
+/// The free link's evaluation, in `F` (one scene in `f64`, four in `F64x4`): body `p`,
+/// terms `law`, modes `m`, at `(q, qd)`; branches are blends (see the module). `THESIS`:
+/// the law is the thesis's three terms (`law.thesis`), compiled into a kernel of their own,
+/// with no dispatch between them (measured: 4 % slower lanes with `rft` in the same step);
+/// else any terms.
 #[inline(always)]
-pub fn rod_eval_law<F: Real, const THESIS: bool>(
-    p: &RodParams<F>,
+pub fn rod_kernel<F: Real, const THESIS: bool>(
+    p: &RodBody<F>,
+    law: &RodTerms<'_, F>,
     m: &RodModes<F>,
     q: &[F; 3],
     qd: &[F; 3],
 ) -> RodEval<F> {
     let zero = F::splat(0.0);
-    let law = &p.law;
     let sel = |flag: F, a: F, b: F| flag.select_pos(a, b);
     let sel2 = |flag: F, a: [F; 2], b: [F; 2]| [sel(flag, a[0], b[0]), sel(flag, a[1], b[1])];
     // RodFrame.
@@ -543,7 +719,8 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
     let v_centroid = sel2(inside, v_in, v_tip);
     let cross = sel(inside, axis[0] * v_in[1] - axis[1] * v_in[0], zero);
     // Forced: in contact and below the surface; in contact for a law that reads the frame
-    // (`Model::eval_rigid_rod`).
+    // (a `poncelet` drag or a plate's `rft_inertial` is finite at depth 0: the entry is a
+    // jump).
     let reads_frame = !THESIS && law.reads_frame;
     let forced = if reads_frame { inside } else { depth_out };
     // |e x v_E| as the drag reads it and the signs of v_E: the held ones under `modes`,
@@ -590,7 +767,7 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
     // (its `pow`). The results are the same bit for bit.
     if !forced.all_zero() {
         if reads_frame {
-            // The boundary `Model::eval_rigid_rod` gives the terms: T's and E's velocities
+            // The boundary the terms read: T's and E's velocities
             // held on the side of the held signs of v_E where a listed term owns the slip
             // switch (`held_shift`: +0 otherwise), P and E in the world, the stuck axes held.
             let shift = |a: usize| {
@@ -624,9 +801,9 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
                 boundary: Some(&b),
                 ..state
             };
-            term_sums::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut sums);
+            term_sums::<F, THESIS>(law, &state, &p.medium, &mut sums);
         } else {
-            term_sums::<F, THESIS>(law, &p.numbers, &state, &p.medium, &mut sums);
+            term_sums::<F, THESIS>(law, &state, &p.medium, &mut sums);
         }
     }
     let Sums {
@@ -634,7 +811,7 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         statics,
         moment,
         bound,
-        forces,
+        forces: each,
     } = sums;
     let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
     let lever_p = lever(p_local);
@@ -645,13 +822,13 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         sel(forced, zero + (torque - moment), zero),
     ];
     let qdd = [gen[0] * p.inv_m, gen[1] * p.inv_m, gen[2] * p.inv_i];
-    // The sticking row (rigid_rod_reactions with one row): x or y.
+    // The sticking row, in closed form: x or y (the lanes' modes have at most one).
     let row_x = sel(forced, m.stuck_x, zero);
     let row_y = sel(forced, m.stuck_y, zero);
     let row = row_x + row_y;
     // No lane sticks: each use of the row below is blended away; skip it (its divisions).
-    let (qdd, mult, a) = if row.all_zero() {
-        (qdd, zero, F::splat(1.0))
+    let (qdd, mult, a, solved) = if row.all_zero() {
+        (qdd, zero, F::splat(1.0), None)
     } else {
         let lever_e = lever(centroid);
         // Without spin in every lane (the vertical drop) the bias is blended to zero: skip
@@ -684,12 +861,42 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         let qdd_row = sel(row_x, qdd[0], qdd[1]);
         let a = p.inv_m + le * (lp * p.inv_i);
         let mult = -(bias + (qdd_row + le * qdd[2])) * a.recip();
-        let qdd = [
+        let closed = [
             sel(row_x, qdd[0] + mult * p.inv_m, qdd[0]),
             sel(row_y, qdd[1] + mult * p.inv_m, qdd[1]),
             sel(row, qdd[2] + mult * (lp * p.inv_i), qdd[2]),
         ];
-        (qdd, mult, a)
+        // One scene (its force set given): the rows the closed form leaves, solved here
+        // ([`one_scene_rows`]); the lanes hand such steps to it (`RodModes::of`,
+        // [`pivot_ok`]). Ruled out for the lanes when compiled: left to the optimizer, the
+        // lanes kept this block's inputs alive (measured: a sweep's lanes 6 % slower).
+        let one_scene = if F::LANES == 1 { law.forces } else { None };
+        let solved = one_scene.and_then(|set| {
+            let l = |x: F| x.lane(0);
+            let l2 = |x: [F; 2]| [l(x[0]), l(x[1])];
+            let stuck = [l(row_x) > 0.0, l(row_y) > 0.0];
+            let shared = |k: usize| stuck[k] && law.owner[k] == usize::MAX;
+            let single = !(stuck[0] && stuck[1]) && pivot_ok(l(a));
+            if single && !shared(0) && !shared(1) {
+                return None;
+            }
+            let found = ContactForce {
+                terms: each.map(|f| Vector2::new(l(f[0]), l(f[1]))),
+                dynamic: Vector2::new(l(dynamic[0]), l(dynamic[1])),
+                statics: Vector2::new(l(statics[0]), l(statics[1])),
+                moment: l(moment),
+            };
+            Some(one_scene_rows(
+                set,
+                stuck,
+                single.then(|| (closed.map(l), l(mult))),
+                (l2(lever_e), l2(lever_p), l2(a_bias)),
+                (l(p.inv_m), l(p.inv_i)),
+                qdd.map(l),
+                found,
+            ))
+        });
+        (closed, mult, a, solved)
     };
     // Each listed term's force, the reaction in its owner's place
     // (`ContactForce::set_reaction`); zero past the list (as the sums left them). A plain
@@ -702,7 +909,7 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         (law.owner, law.terms.len())
     };
     let mut terms = [[zero; 2]; MAX_TERMS];
-    for (k, (term, f)) in terms.iter_mut().zip(forces).take(listed).enumerate() {
+    for (k, (term, f)) in terms.iter_mut().zip(each).take(listed).enumerate() {
         let fx = if k == owner[0] {
             sel(row_x, mult, f[0])
         } else {
@@ -715,11 +922,19 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         };
         *term = sel2(forced, [fx, fy], [zero, zero]);
     }
-    let statics = sel2(
+    let mut statics = sel2(
         forced,
         [sel(row_x, mult, statics[0]), sel(row_y, mult, statics[1])],
         [zero, zero],
     );
+    let mut qdd = qdd;
+    if let Some((solved_qdd, force)) = solved {
+        // (In the sand: a row sticks.)
+        let v = |x: Vector2<f64>| [F::splat(x.x), F::splat(x.y)];
+        qdd = solved_qdd.map(F::splat);
+        terms = force.terms.map(v);
+        statics = v(force.statics);
+    }
     let dynamic = sel2(forced, dynamic, [zero, zero]);
     let total = [dynamic[0] + statics[0], dynamic[1] + statics[1]];
     let v_p = sel2(p.at_centroid, v_centroid, v_tip);
@@ -738,6 +953,8 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
         v_centroid,
         cross,
         margin,
+        immersed,
+        axis,
         terms,
         dynamic,
         statics,
@@ -747,11 +964,67 @@ pub fn rod_eval_law<F: Real, const THESIS: bool>(
     }
 }
 
-/// Whether a sticking row's pivot `a` ([`RodEval::pivot`]) is clearly nonzero, as the
-/// scalar path judges it (`rigid_rod_reactions`); else the scalar path takes the step.
+/// Whether a sticking row's pivot `a` ([`RodEval::pivot`]) is clearly nonzero: else the
+/// closed form's reaction would divide by (nearly) zero, and the row is solved with the
+/// shifted fallback of [`solve_upto2`] ([`one_scene_rows`]; the lanes hand the step to
+/// the one-scene evaluation).
 #[inline]
 pub fn pivot_ok(a: f64) -> bool {
     a.abs() > 1e-13 * a.abs().max(f64::MIN_POSITIVE)
+}
+
+/// The sticking rows of one scene that the kernel's closed form leaves: x and y stuck
+/// together (two rows, solved together), or one row whose pivot is not clearly nonzero
+/// (solved with [`solve_upto2`]'s shifted fallback; where that fails too, no reaction);
+/// `closed` holds the closed form's accelerations and reaction where it stands (one row,
+/// a clear pivot). Row `i` holds E's velocity along its axis `u` at zero: its Jacobian is
+/// `(u_x, u_y, lever_E . u)`, and its reaction at P gives `(u_x, u_y, lever_P . u)`;
+/// `M = diag(m, m, I)` and the bias `a_bias` (E slides over the rod as the immersed part
+/// grows) make the system `1/m [u_i = u_j] + lever_E,i lever_P,j / I`. Each reaction goes in
+/// place of the static terms that own its axis ([`ContactForce::set_reaction`]: shared by
+/// several in proportion to their magnitudes). Returns the accelerations and the forces.
+#[cold]
+#[inline(never)]
+fn one_scene_rows(
+    set: &ForceSet,
+    stuck: [bool; 2],
+    closed: Option<([f64; 3], f64)>,
+    (lever_e, lever_p, a_bias): ([f64; 2], [f64; 2], [f64; 2]),
+    (inv_m, inv_i): (f64, f64),
+    mut qdd: [f64; 3],
+    mut force: ContactForce,
+) -> ([f64; 3], ContactForce) {
+    let mut axes = [0usize; 2];
+    let mut k = 0;
+    for (axis, _) in stuck.iter().enumerate().filter(|(_, &on)| on) {
+        axes[k] = axis;
+        k += 1;
+    }
+    let mut mults = [0.0; 2];
+    if let Some((closed_qdd, mult)) = closed {
+        qdd = closed_qdd;
+        mults[0] = mult;
+    } else {
+        let mut a = [[0.0; 2]; 2];
+        let mut b = [0.0; 2];
+        for i in 0..k {
+            let ai = axes[i];
+            b[i] = -(a_bias[ai] + (qdd[ai] + lever_e[ai] * qdd[2]));
+            for j in 0..k {
+                let linear = if ai == axes[j] { inv_m } else { 0.0 };
+                a[i][j] = linear + lever_e[ai] * (lever_p[axes[j]] * inv_i);
+            }
+        }
+        mults = solve_upto2(k, a, b).unwrap_or([0.0; 2]);
+        for i in 0..k {
+            qdd[axes[i]] += mults[i] * inv_m;
+            qdd[2] += mults[i] * (lever_p[axes[i]] * inv_i);
+        }
+    }
+    for i in 0..k {
+        force.set_reaction(set, axes[i], mults[i]);
+    }
+    (qdd, force)
 }
 
 impl RodEval<f64> {
@@ -823,6 +1096,8 @@ impl RodEval<F64x4> {
             v_centroid: l2(&self.v_centroid),
             cross: l(&self.cross),
             margin: l(&self.margin),
+            immersed: l(&self.immersed),
+            axis: l2(&self.axis),
             terms,
             dynamic: l2(&self.dynamic),
             statics: l2(&self.statics),
@@ -833,9 +1108,12 @@ impl RodEval<F64x4> {
     }
 }
 
-/// Run scene `s` as [`crate::integrate::solve`] runs it (the lean path where it covers the
-/// scene) and on the general path alone, assert the outcomes are the same bit for bit
-/// (every field; `what` names the case) and return it. For tests here and in `batch.rs`.
+/// Run scene `s` as [`crate::integrate::solve`] runs it (its RK4 steps through the lane
+/// step in one lane, `integrate::lane_step`, where the lanes cover the step) and with every
+/// step on the stepper (`Run::general`: `full_step` over [`Model::eval`]), assert the
+/// outcomes are the same bit for bit (every field; `what` names the case) and return it:
+/// the lane step's stages, sums and hand-overs are the stepper's. For tests here and in
+/// `batch.rs`.
 #[cfg(test)]
 pub(crate) fn lean_equals_general(
     s: &crate::bodies::LinkageScene,
@@ -1055,7 +1333,9 @@ mod tests {
     }
 
     proptest! {
-        /// Four scenes in four lanes give, each, the scalar path's evaluation bit for bit:
+        /// Four scenes in four lanes give, each, the one-scene evaluation ([`Model::eval`],
+        /// the kernel in `f64` with the model's own terms) bit for bit (the blends are the
+        /// branches):
         /// the accelerations, the power and every finding of the contact (what the events
         /// and the observer read), in every mode the lanes cover, under every sign model and
         /// any law the free link accepts (any of the registry's terms a rod takes, alone or
@@ -1196,9 +1476,8 @@ mod tests {
     }
 
     /// A frame law's sticking row at depth 0 with spin (the tip at the surface, in contact,
-    /// y stuck): the general path's rate of the immersed length is zero out of the sand,
-    /// and the lean path's must be too (the proptest found it; pinned here). Alone and in
-    /// every lane of the lanes.
+    /// y stuck): the rate of the immersed length is zero out of the sand, in every lane of
+    /// the lanes as in one scene (the proptest found it; pinned here).
     #[test]
     fn a_frame_law_sticking_at_depth_zero_with_spin_is_the_general_path() {
         let mode = ContactMode {
@@ -1311,6 +1590,122 @@ mod tests {
         );
     }
 
+    proptest! {
+        /// One scene's term sums (`term_sums` over the model's own force set,
+        /// [`RodTerms::of_forces`]) are `terms_on`'s, bitwise: every term's force, the sums
+        /// by class, the moment and the bounds; the thesis's three in its order take the
+        /// compiled-in kernel (their numbers copied out of the terms), in any other order
+        /// each term's own `contact_force`.
+        #[test]
+        fn one_scenes_term_sums_are_terms_on(
+            depth in 1e-6f64..0.2, l in 1e-4f64..0.19, vx in -3.0f64..3.0,
+            vy in -3.0f64..3.0, area_speed in 0.0f64..0.01, sx in 0u8..3, sy in 0u8..3,
+            order in 0usize..6,
+        ) {
+            let state = ContactState {
+                depth,
+                volume: std::f64::consts::FRAC_PI_4 * 0.0127 * 0.0127 * l,
+                width: 0.0127,
+                l_ref: 0.19,
+                v: [vx, vy],
+                area_speed,
+                sign: [slip(sx).sign(), slip(sy).sign()],
+                boundary: None,
+            };
+            let terms = [
+                TermSpec::new("drag", &[("eta_d", 11.0)]),
+                TermSpec::new("static_h", &[("eta_h", 5.5)]),
+                TermSpec::new("static_v", &[("eta_v", 53.0), ("lam", 0.25)]),
+            ];
+            let perm = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]][order];
+            let specs: Vec<TermSpec> = perm.iter().map(|&i| terms[i].clone()).collect();
+            let forces = ForceSet::build(&specs, 1).unwrap();
+            let medium = Medium::default();
+            let mut numbers = [0.0; 4];
+            let law = RodTerms::of_forces(&forces, &mut numbers);
+            prop_assert_eq!(law.thesis, order == 0);
+            let mut sums = Sums::zero();
+            if law.thesis {
+                prop_assert_eq!(law.numbers, &[11.0, 5.5, 53.0, 0.25][..]);
+                term_sums::<f64, true>(&law, &state, &medium, &mut sums);
+            } else {
+                term_sums::<f64, false>(&law, &state, &medium, &mut sums);
+            }
+            let mut general = ContactForce::default();
+            let mut bound = [0.0; 2];
+            crate::dynamics::terms_on(
+                &forces,
+                &forces.per_contact[0],
+                &state,
+                &medium,
+                &mut general,
+                &mut bound,
+            );
+            let v2 = |a: [f64; 2]| Vector2::new(a[0], a[1]);
+            let mine = ContactForce {
+                terms: sums.forces.map(v2),
+                dynamic: v2(sums.dynamic),
+                statics: v2(sums.statics),
+                moment: sums.moment,
+            };
+            prop_assert_eq!(mine, general);
+            prop_assert_eq!(sums.bound, bound);
+        }
+    }
+
+    /// A sticking row whose pivot `1/m + lever_E lever_P / I` is exactly zero: one scene's
+    /// kernel solves it with the shifted system (`solve_upto2`), where the closed form
+    /// would divide by zero. A vertical rod at rest, stuck in x, pressed only downwards:
+    /// the row's right-hand side is zero, so the reaction is zero (not 0 / 0) and the
+    /// accelerations are those with nothing stuck. The lanes hand the step over.
+    #[test]
+    fn a_zero_pivot_is_solved_in_one_scene_and_handed_over_by_the_lanes() {
+        let model = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
+        let rod = *model.rigid_rod().unwrap();
+        let mut body = RodBody::of(&model, &rod);
+        let depth = 0.05;
+        // Vertical (e = (0, 1), n = (1, 0)): a point's lever along x is its local x.
+        let q = [0.0, -rod.tip.x - depth, 0.0];
+        let qd = [0.0; 3];
+        let (lever_p, lever_e) = (rod.tip.x, rod.tip.x + 0.5 * depth);
+        body.inv_m = -(lever_e * (lever_p * body.inv_i));
+        let mut numbers = [0.0; 4];
+        let law = RodTerms::of_forces(&model.forces, &mut numbers);
+        let stuck = ContactMode {
+            in_contact: true,
+            sx: Slip::Stick,
+            sy: Slip::Neg,
+            ..ContactMode::default()
+        };
+        let free = ContactMode {
+            sx: Slip::Pos,
+            ..stuck
+        };
+        let m = RodModes::held(&stuck, body.unheld, law.owns);
+        assert_eq!((m.stuck_x, m.stuck_y), (1.0, 0.0));
+        let one = rod_eval_terms(&body, &law, &m, &q, &qd);
+        assert_eq!(one.pivot, 0.0);
+        let m_free = RodModes::held(&free, body.unheld, law.owns);
+        let slides = rod_eval_terms(&body, &law, &m_free, &q, &qd);
+        // At rest and vertical, nothing pushes sideways nor turns the rod: stuck, the
+        // reaction in static_h's place is zero; the vertical acceleration is the same as
+        // sliding (y's terms are the same).
+        assert_eq!(one.terms[1][0], 0.0);
+        assert_eq!(one.statics[0], 0.0);
+        assert_eq!(one.qdd[0], 0.0);
+        assert_eq!(one.qdd[1], slides.qdd[1]);
+        assert!(one.qdd.iter().all(|x| x.is_finite()), "{:?}", one.qdd);
+        // Without the force set (as the lanes read their law) the closed form divides by
+        // the zero pivot, which `pivot_ok` flags for the hand-over.
+        let lanes_law = RodTerms {
+            forces: None,
+            ..law
+        };
+        let lanes = rod_eval_terms(&body, &lanes_law, &m, &q, &qd);
+        assert!(!lanes.pivot_ok());
+        assert!(lanes.qdd[0].is_nan(), "{:?}", lanes.qdd);
+    }
+
     /// Only a free link runs in the lanes: not a body with no contact at all (a linkage
     /// with none: `Run::new` asks every model).
     #[test]
@@ -1349,12 +1744,13 @@ mod tests {
         assert!(!thesis(table, 0b111).shares(&law(0, 1e6, 8)));
     }
 
-    /// The lanes cover every law, and hand the scalar path the steps they do not: two
+    /// The lanes cover every law, and hand the one-scene evaluation the steps they do not: two
     /// sticking rows, or a row whose reaction several static terms share.
     #[test]
     fn lanes_cover_every_law_and_hand_over_the_rows_they_do_not() {
         let thesis = model(0.184, 0.19, [15.2, 6.5, 248.0, 0.106], false, true);
-        let flags = |m: &Model<3>| RodParams::of(m).map(|p| (p.unheld, p.smooth, p.eps));
+        let flags =
+            |m: &Model<3>| RodParams::of(m).map(|p| (p.body.unheld, p.body.smooth, p.body.eps));
         assert_eq!(flags(&thesis), Some((0.0, 0.0, 1.0)));
         let mut raw = thesis.clone();
         raw.sign_model = SignModel::Raw;
