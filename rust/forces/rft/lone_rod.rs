@@ -14,6 +14,24 @@ use crate::forces::{Boundary, ContactState, Medium, Outline, Real};
 /// [`RftInertial::rod_avx2`]); each count from 1 up has its own instance.
 const ROD_FAST_ELEMENTS: usize = 8;
 
+/// The boundary of one scene's rod and its (diameter, immersed length), where a fast path
+/// applies: one scene, a rod outline, 1 to [`ROD_FAST_ELEMENTS`] elements per plate, and a
+/// CPU with AVX2.
+#[inline(always)]
+fn lone_rod_of<'a, F: Real>(
+    elements: usize,
+    c: &ContactState<'a, F>,
+) -> Option<(&'a Boundary<F>, (F, F))> {
+    if F::LANES != 1 || !(1..=ROD_FAST_ELEMENTS).contains(&elements) || !crate::num::avx2() {
+        return None;
+    }
+    let b = c.boundary?;
+    let Outline::Rod { diameter, immersed } = b.outline else {
+        return None;
+    };
+    Some((b, (diameter, immersed)))
+}
+
 impl Rft {
     /// A lone rod's force and moment by [`Rft::rod_avx2`], where it applies: one scene, a rod
     /// held nowhere, at most [`ROD_FAST_ELEMENTS`] elements per plate, a CPU with AVX2.
@@ -23,19 +41,12 @@ impl Rft {
         co: &RftCoefficients<F>,
         c: &ContactState<F>,
     ) -> Option<([F; 2], F)> {
-        if F::LANES != 1 || !(1..=ROD_FAST_ELEMENTS).contains(&self.elements) || !crate::num::avx2()
-        {
-            return None;
-        }
-        let b = c.boundary?;
-        let Outline::Rod { diameter, immersed } = b.outline else {
-            return None;
-        };
+        let (b, rod) = lone_rod_of(self.elements, c)?;
         if !(b.held[0] + b.held[1]).all_zero() {
             return None;
         }
-        // SAFETY: this CPU has AVX2 (checked).
-        Some(unsafe { self.rod_avx2(co, (diameter, immersed), b) })
+        // SAFETY: this CPU has AVX2 (`lone_rod_of` checked).
+        Some(unsafe { self.rod_avx2(co, rod, b) })
     }
 
     /// [`Rft::integrate`] over a rod's two plates at `N` elements each (`self.elements`), its
@@ -97,17 +108,10 @@ impl RftInertial {
         c: &ContactState<F>,
         m: &Medium<F>,
     ) -> Option<([F; 2], F)> {
-        if F::LANES != 1 || !(1..=ROD_FAST_ELEMENTS).contains(&self.elements) || !crate::num::avx2()
-        {
-            return None;
-        }
-        let b = c.boundary?;
-        let Outline::Rod { diameter, immersed } = b.outline else {
-            return None;
-        };
+        let (b, rod) = lone_rod_of(self.elements, c)?;
         let k = -(F::splat(self.lam) * m.rho_g);
-        // SAFETY: this CPU has AVX2 (checked).
-        Some(unsafe { self.rod_avx2(k, (diameter, immersed), b) })
+        // SAFETY: this CPU has AVX2 (`lone_rod_of` checked).
+        Some(unsafe { self.rod_avx2(k, rod, b) })
     }
 
     /// [`RftInertial::law`] on a lone rod at up to [`ROD_FAST_ELEMENTS`] elements per
