@@ -11,7 +11,9 @@ Parts:
 
 * ``sweep``: a sweep of free-link impacts (angles x speeds x coefficient scales), summary
   only, on 1 and 2 threads, each in a fresh child process that reports its own peak
-  resident memory (``ru_maxrss``). Targets: 2 threads >= 1.8x faster than 1; peak < 200 MB.
+  resident memory (``ru_maxrss``), and once more on 1 thread asking only for the depth and
+  t_s. Targets: 2 threads >= 1.8x faster than 1; peak < 200 MB; at a million impacts
+  (``--runs 1000000``) the sweep asking for the depth and t_s peaks < 300 MB.
 * ``overhead``: each ``granrs.simulate(scene)`` call timed whole, against the run inside
   it as the core times it. Target: overhead < 10 % of the call.
 * ``prune``: the vertical drop with every effect and every series recorded, against the
@@ -58,6 +60,9 @@ from granrs import _granrs, cases
 from granrs.forces import select, thesis
 
 PARTS = ("sweep", "overhead", "prune", "force", "fixed", "lanes", "axis")
+#: What the lean sweep asks for, and its peak memory's target for a million impacts.
+LEAN_OUTPUTS = ("depth", "t_s")
+LEAN_PEAK_MB = 300
 
 
 def _median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -82,13 +87,15 @@ def _sweep_axes(n: int) -> dict[str, list[float]]:
     }
 
 
-def _child(n: int, threads: int) -> None:
-    """Run one sweep and print its time and this process's peak memory (JSON)."""
+def _child(n: int, threads: int, lean: int = 0) -> None:
+    """Run one sweep and print its time and this process's peak memory (JSON); ``lean``:
+    the sweep asks only for the depth and t_s (``outputs=LEAN_OUTPUTS``)."""
     base = cases.free_link(q_deg=0.0, v0=2.0)
     axes = _sweep_axes(n)
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     t0 = time.perf_counter()
-    df = granrs.sweep(base, threads=threads, progress=False, **axes)
+    outputs = {"outputs": list(LEAN_OUTPUTS)} if lean else {}
+    df = granrs.sweep(base, threads=threads, progress=False, **outputs, **axes)
     elapsed = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
     ok = bool((df["status"] == "stopped").all() and np.isfinite(df["depth"]).all())
@@ -97,6 +104,7 @@ def _child(n: int, threads: int) -> None:
             {
                 "runs": len(df),
                 "threads": threads,
+                "lean": bool(lean),
                 "seconds": elapsed,
                 "peak_mb": peak / 1024,
                 "before_mb": rss_before / 1024,
@@ -109,26 +117,28 @@ def _child(n: int, threads: int) -> None:
 
 def part_sweep(n: int) -> list[str]:
     rows = {}
-    for threads in (1, 2):
+    for threads, lean in ((1, 0), (2, 0), (1, 1)):
         out = subprocess.run(
-            [sys.executable, __file__, "--child", str(n), str(threads)],
+            [sys.executable, __file__, "--child", str(n), str(threads), str(lean)],
             check=True,
             capture_output=True,
             text=True,
         )
-        rows[threads] = json.loads(out.stdout.strip().splitlines()[-1])
-    one, two = rows[1], rows[2]
+        rows[threads, lean] = json.loads(out.stdout.strip().splitlines()[-1])
+    one, two, lean_one = rows[1, 0], rows[2, 0], rows[1, 1]
     speedup = one["seconds"] / two["seconds"]
     lines = [
         f"### Sweep of {one['runs']:,} free-link impacts, summary only",
         "",
-        "| threads | time [s] | per impact [us] | peak RSS [MB] | RSS after import [MB] "
+        "| threads | columns | time [s] | per impact [us] | peak RSS [MB] | RSS after import [MB] "
         "| DataFrame [MB] | all stopped, finite |",
-        "|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|",
     ]
-    for r in (one, two):
+    for r in (one, two, lean_one):
+        columns = "depth, t_s" if r["lean"] else "default"
         lines.append(
-            f"| {r['threads']} | {r['seconds']:.2f} | {r['seconds'] / r['runs'] * 1e6:.1f} "
+            f"| {r['threads']} | {columns} | {r['seconds']:.2f} "
+            f"| {r['seconds'] / r['runs'] * 1e6:.1f} "
             f"| {r['peak_mb']:.0f} | {r['before_mb']:.0f} | {r['frame_mb']:.1f} "
             f"| {r['all_stopped_finite']} |"
         )
@@ -138,6 +148,9 @@ def part_sweep(n: int) -> list[str]:
         f"2 threads / 1 thread speed-up: **{speedup:.2f}x** (target >= 1.8x: "
         f"{'met' if speedup >= 1.8 else 'NOT met'}); peak memory **{peak:.0f} MB** "
         f"(target < 200 MB: {'met' if peak < 200 else 'NOT met'}).",
+        f"Asking only for the depth and t_s: peak **{lean_one['peak_mb']:.0f} MB** "
+        f"(a million-impact sweep's target < {LEAN_PEAK_MB} MB at --runs 1000000: "
+        f"{'met' if lean_one['peak_mb'] < LEAN_PEAK_MB else 'NOT met'}).",
         "",
     ]
     return lines
@@ -403,7 +416,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="10,000-impact sweep, fewer repeats")
     parser.add_argument("--runs", type=int, default=None, help="impacts in the sweep")
     parser.add_argument("--out", help="also write the Markdown report here")
-    parser.add_argument("--child", nargs=2, type=int, help=argparse.SUPPRESS)
+    parser.add_argument("--child", nargs="+", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
         _child(*args.child)
