@@ -462,7 +462,7 @@ def test_rust_graph_sees_the_crate() -> None:
     graph = rust_graph()
     assert "error.rs" in graph["spec/mod.rs"]  # use crate::error::{...}
     assert "num.rs" in graph["forces/mod.rs"]  # pub use crate::num::Real
-    assert "num.rs" in graph["forces/rft.rs"]  # crate::num::avx2()
+    assert "num.rs" in graph["forces/rft/lone_rod.rs"]  # crate::num::avx2(), a nested module
     assert "fields.rs" in graph["error.rs"]  # crate::fields::info
     assert "forces/rft.rs" not in graph["forces/rft.rs"]
 
