@@ -57,7 +57,7 @@ def _float(cell: str) -> float:
 
 
 #: The report's runs, without the step-size warning's one known false alarm among them: the
-#: chain (case 2) under ``poncelet`` to all stops at dt = 1e-4 reads step_error 0.19 (link 1's
+#: chain (case 2) under ``poncelet`` to all stops at dt = 1e-4 reads step_error 0.031 (link 1's
 #: stop is grazing, its tip's vertical acceleration 0.4 m/s^2, and the steps' summed velocity
 #: error counts there whole) while its t_s moves by 1e-4 at dt / 10 (docs/hard_cases.md).
 def _reproduce_quietly(out: Path) -> Path:

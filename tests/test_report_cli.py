@@ -28,7 +28,7 @@ def test_cli_reproduce_quiet_replaces_report(
     assert captured.out == ""
     # No progress, and no warning: the command's own warnings are part of its output (one
     # line each). Its one step-size warning was a false alarm (the chain, case 2, under
-    # `poncelet` to all stops: step_error 0.186 while t_s and depth move by 1e-4 at dt / 10);
+    # `poncelet` to all stops: step_error 0.031 while t_s and depth move by 1e-4 at dt / 10);
     # the step's check runs that chain again at dt / 10 and finds it resolved.
     assert captured.err == ""
     assert (out / "README.md").is_file()

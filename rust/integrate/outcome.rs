@@ -180,7 +180,8 @@ pub struct Outcome {
     pub h_lambda: f64,
     /// The largest relative error of a contact's t_s or depth that the run's steps estimate
     /// (RK4; NaN for Dopri5): each step's error estimate
-    /// ([`crate::integrate::stepper::companion`]), summed in magnitude over the run, carried
+    /// ([`crate::integrate::stepper::companion`]; a step cut at an event takes the whole
+    /// step's, scaled to its length), summed in magnitude over the run, carried
     /// to the tip's height and vertical velocity at the stop (or at the end without one);
     /// a stop's time error is that velocity's error and the residual left at the located
     /// stop over the tip's vertical acceleration. Above

@@ -443,24 +443,23 @@ impl<const N: usize> Run<N> {
             earliest = events.polish(model, modes, &span, earliest, stats);
         }
         let h_star = earliest * h;
-        // The step to the event, and its fourth stage (RK4).
-        let (y_star, k4_star) = if let Some(y_star) = y_to_event {
-            (y_star, None)
+        // The step to the event.
+        let y_star = if let Some(y_star) = y_to_event {
+            y_star
         } else if earliest >= 1.0 {
-            (y1, k4.copied())
+            y1
         } else if h_star > 0.0 {
             let sample = |q: &SVector<f64, N>, s: &_| obs.offer(|| *q, s);
-            let (y_star, _, k4) =
-                partial_step(model, options.method, modes, y, k1, h_star, stats, sample);
-            (y_star, k4)
+            partial_step(model, options.method, modes, y, k1, h_star, stats, sample).0
         } else {
-            (*y, None)
+            *y
         };
         let t_star = if earliest >= 1.0 { t_next } else { *t + h_star };
         let e_star = model.eval(&y_star.q, &y_star.qd, modes);
         stats.rhs_evals += 1;
-        if let (Some(k4), true) = (k4_star, h_star > 0.0) {
-            obs.step_error(h_star.min(h), &k4, &deriv_of(&y_star, &e_star));
+        if let (Some(k4), true) = (k4, h_star > 0.0) {
+            // The whole step's estimate, not one read at the event (see `cut_step_error`).
+            obs.cut_step_error(h, h_star.min(h), k4, &deriv_of(&y1, e1));
         }
         if h_star > 0.0 {
             stats.steps += 1;

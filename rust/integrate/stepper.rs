@@ -158,7 +158,9 @@ pub fn step_sampling<const N: usize>(
 /// right-hand side is smooth through the step (a bound on RK4's own error, of order h^5),
 /// and of order h times the jump where the force changes abruptly between the fourth stage
 /// and the end (an element's or E's velocity through zero, a speed a step does not
-/// resolve). No evaluation: both stages exist.
+/// resolve). No evaluation: both stages exist. A step cut at a located event takes the
+/// whole step's, scaled (`Observer::cut_step_error`): its own end lies on the event's
+/// switching function, where the held mode's force need not be a function of the state.
 #[inline(always)]
 pub fn companion<const N: usize>(
     h: f64,
@@ -311,9 +313,9 @@ pub fn full_step<const N: usize>(
 }
 
 /// A step of `method` of size `h` from `y` to a located event, without the evaluation at
-/// its end (RK4: three evaluations; Dopri5 spends its six), its error estimate's
-/// weighted RMS norm (0 for RK4) and RK4's fourth stage (`None` for Dopri5). RK4 shows
-/// `sample` its stages.
+/// its end (RK4: three evaluations; Dopri5 spends its six), and its error estimate's
+/// weighted RMS norm (0 for RK4: the run estimates such a step's error from the whole step
+/// it cuts, `Observer::cut_step_error`). RK4 shows `sample` its stages.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn partial_step<const N: usize>(
@@ -325,17 +327,16 @@ pub fn partial_step<const N: usize>(
     h: f64,
     stats: &mut Stats,
     sample: impl FnMut(&SVector<f64, N>, &DragStiffness),
-) -> (State<N>, f64, Option<Deriv<N>>) {
+) -> (State<N>, f64) {
     match method {
         Method::Rk4 => {
             stats.rhs_evals += 3;
-            let (y1, k4) = step_sampling(model, modes, y, k1, h, sample);
-            (y1, 0.0, Some(k4))
+            (step_sampling(model, modes, y, k1, h, sample).0, 0.0)
         }
         Method::Dopri5 { rtol, atol } => {
             stats.rhs_evals += 6;
             let (y1, _, err) = dopri5_step(model, modes, y, k1, h, rtol, atol);
-            (y1, err, None)
+            (y1, err)
         }
     }
 }
