@@ -21,10 +21,9 @@ import re
 import uuid
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from . import _granrs, space
 from .api import (
@@ -49,6 +48,9 @@ from .forces import Term
 from .result import JOINT_NAMES
 from .scene import OUTPUTS, Scene, axis_rows
 from .scene import _names as _listed
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["STATUSES", "sweep"]
 
@@ -163,6 +165,8 @@ def _names(columns: Sequence[str], body: str) -> list[str]:
 @functools.cache
 def _status_dtype() -> pd.CategoricalDtype:
     """The ``status`` column's dtype (:data:`STATUSES`), checked once, not per sweep."""
+    import pandas as pd
+
     return pd.CategoricalDtype(list(STATUSES))
 
 
@@ -256,6 +260,8 @@ class _Table:
         """The DataFrame, made without copying a column: the axis columns (taken from
         ``axis_columns``) first, then each column a row of its block (``status`` a
         categorical over its codes)."""
+        import pandas as pd
+
         columns: dict[str, Any] = {}
         for name in list(axis_columns or {}):
             columns[name] = axis_columns.pop(name)  # type: ignore[union-attr]
@@ -554,6 +560,8 @@ def _sweep_space(
     finally:
         if bar is not None:
             bar.close()
+    import pandas as pd
+
     frame = pd.DataFrame(columns)
     frame["status"] = pd.Categorical(
         [r[0] for r in rows], categories=["stopped", "not_stopped", "failed"]
