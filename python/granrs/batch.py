@@ -220,8 +220,9 @@ class _Table:
     columns`` floats) and then made a DataFrame without copying them: the floats are one
     ``columns x rows`` block (the frame's own), the counters and the flags one block each,
     ``status`` its own array. The counters are int32 (a run's stay far below 2^31; a block
-    that does not fit is widened to int64). So a sweep holds its result plus one chunk (a
-    summary-only sweep of 1e6 runs stays under 300 MB)."""
+    that does not fit is widened to int64). So a sweep holds its result plus one chunk, a
+    product over a thesis-row axis too (each part's chunks go to their rows in the whole:
+    :func:`_run_by_row`); the sweeps guide gives the peak memory of a million runs."""
 
     def __init__(self, columns: Sequence[str], body: str, n: int) -> None:
         self.layout = _layout(tuple(columns), body)
@@ -902,8 +903,63 @@ def _check_rows(
         return
     candidates = np.concatenate(found)
     loud_rows = dict(zip(candidates.tolist(), np.concatenate(loud_found).tolist(), strict=True))
-    checked, unchecked = [], []
-    for i in candidates.tolist():
+    moved: list[tuple[int, str]] = []
+    unchecked: list[int] = []
+    # CHECK_BATCH rows at a time: their scenes are built and run again a batch at a time.
+    for lo in range(0, len(candidates), CHECK_BATCH):
+        m, u = _recheck(
+            table, candidates[lo : lo + CHECK_BATCH], loud_rows, row_scene, threads, lanes
+        )
+        moved += m
+        unchecked += u
+    if not moved and not unchecked:
+        return
+    bad = sorted([i for i, _ in moved] + unchecked)
+    rows_text = f"{bad[:5]}{', ...' if len(bad) > 5 else ''}"
+    parts = []
+    if moved:
+        listed = "; ".join(f"row {i}: {what}" for i, what in moved[:10])
+        more = f"; and {len(moved) - 10} more" if len(moved) > 10 else ""
+        parts.append(
+            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than "
+            f"{100 * STEP_ERROR_LIMIT:g} % "
+            f"({listed}{more})"
+        )
+    if unchecked:
+        listed = f"{sorted(unchecked)[:5]}{', ...' if len(unchecked) > 5 else ''}"
+        parts.append(
+            f"{len(unchecked)} unchecked (rows {listed}: h_lambda above "
+            f"{RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or 'unresolved' "
+            "steps where the sign modes chattered and the energy rose)"
+        )
+    warnings.warn(
+        StepSizeWarning(
+            f"{len(bad)} of {n} runs (rows {rows_text}) did not resolve their contact: "
+            f"{'; '.join(parts)}. Use a "
+            f"smaller dt for those runs (dt / {STEP_CHECK_FACTOR} or less)"
+        ),
+        stacklevel=3,
+    )
+
+
+#: How many of a sweep's rows its step check builds and runs again at a time
+#: (:func:`_check_rows`): a batch's scenes are held together, not every suspect row's.
+CHECK_BATCH = 256
+
+
+def _recheck(
+    table: _Table,
+    rows_to_check: np.ndarray,
+    loud_rows: Mapping[int, bool],
+    row_scene: Any,
+    threads: int,
+    lanes: bool,
+) -> tuple[list[tuple[int, str]], list[int]]:
+    """The step's check of some of a sweep's suspect rows (:func:`_check_rows`): those that
+    moved at ``dt / STEP_CHECK_FACTOR`` (with their moves) and those that warn unchecked."""
+    checked: list[tuple[int, Scene]] = []
+    unchecked: list[int] = []
+    for i in rows_to_check.tolist():
         s = row_scene(i)
         if not s.step_check:
             if loud_rows[i]:
@@ -936,31 +992,4 @@ def _check_rows(
             check = step_move(coarse_values[j], fine_values[j], status, fine_dt[i])
             if check["moved"]:
                 moved.append((i, describe_move(check)))
-    if not moved and not unchecked:
-        return
-    bad = sorted([i for i, _ in moved] + unchecked)
-    rows_text = f"{bad[:5]}{', ...' if len(bad) > 5 else ''}"
-    parts = []
-    if moved:
-        listed = "; ".join(f"row {i}: {what}" for i, what in moved[:10])
-        more = f"; and {len(moved) - 10} more" if len(moved) > 10 else ""
-        parts.append(
-            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than "
-            f"{100 * STEP_ERROR_LIMIT:g} % "
-            f"({listed}{more})"
-        )
-    if unchecked:
-        listed = f"{sorted(unchecked)[:5]}{', ...' if len(unchecked) > 5 else ''}"
-        parts.append(
-            f"{len(unchecked)} unchecked (rows {listed}: h_lambda above "
-            f"{RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or 'unresolved' "
-            "steps where the sign modes chattered and the energy rose)"
-        )
-    warnings.warn(
-        StepSizeWarning(
-            f"{len(bad)} of {n} runs (rows {rows_text}) did not resolve their contact: "
-            f"{'; '.join(parts)}. Use a "
-            f"smaller dt for those runs (dt / {STEP_CHECK_FACTOR} or less)"
-        ),
-        stacklevel=3,
-    )
+    return moved, unchecked
