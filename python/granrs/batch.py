@@ -430,9 +430,9 @@ def _run_local(
             body, columns = raw["body"], list(raw["columns"])
             if table is None:
                 table = _Table(columns, body, size)
-            rows = slice(lo - start, hi - start)
+            rows: slice | np.ndarray = slice(lo - start, hi - start)
             if places is not None:  # a part of a sweep: its rows' places in the whole
-                rows = places.of(np.arange(rows.start, rows.stop))
+                rows = places.of(np.arange(lo - start, hi - start))
             table.put(np.asarray(raw["data"]), rows)
             failures += raw["failures"]
             unresolved += raw["unresolved"]
