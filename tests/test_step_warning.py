@@ -19,7 +19,7 @@ from types import ModuleType
 import pytest
 
 import granrs
-from granrs import cases
+from granrs import batch, cases
 from granrs import forces as f
 
 MASS, LENGTH, DIAMETER, RHO_G = 0.184, 0.190, 0.0127, 1650.0
@@ -536,6 +536,33 @@ def test_a_sweep_checks_its_flagged_rows_together_and_keeps_its_columns() -> Non
         plain = granrs.sweep([s.replace(step_check=False) for s in scenes], progress=False)
     assert table.equals(plain)
     assert list(table.columns) == list(plain.columns)
+
+
+@pytest.mark.parametrize("size", [1, 2])
+def test_a_sweeps_check_in_batches_warns_as_in_one(
+    monkeypatch: pytest.MonkeyPatch, size: int
+) -> None:
+    """A sweep's step check builds and runs its flagged rows again ``CHECK_BATCH`` at a
+    time: in batches of one or two rows, the warning is word for word the one of a single
+    batch (the rows that moved, with their moves, and the row that warns unchecked)."""
+    scenes = [
+        short_impact(1e-3),
+        short_impact(1e-4),
+        thesis_few_steps(1e-3),
+        thesis_few_steps(1e-4),
+        short_impact(1e-3).replace(step_check=False),
+    ]
+
+    def warned() -> list[str]:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            granrs.sweep(scenes, progress=False)
+        return [str(w.message) for w in caught if issubclass(w.category, granrs.StepSizeWarning)]
+
+    whole = warned()
+    assert len(whole) == 1 and whole[0].startswith("3 of 5 runs (rows [0, 2, 4])"), whole
+    monkeypatch.setattr(batch, "CHECK_BATCH", size)
+    assert warned() == whole
 
 
 def test_a_sweep_of_the_chain_is_checked_too() -> None:

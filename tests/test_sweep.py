@@ -19,7 +19,7 @@ import pandas as pd
 import pytest
 
 import granrs
-from granrs import _granrs, cases
+from granrs import _granrs, batch, cases
 from granrs.errors import InvalidParameterError, InvalidSceneError, UnknownNameError
 from granrs.forces import select, thesis
 
@@ -63,6 +63,52 @@ def test_product_rows_equal_single_runs_in_input_order() -> None:
         assert row.status == alone.status
         for key in SHARED:
             assert _same(getattr(row, key), alone.summary[key]), (q, v, key)
+
+
+def test_a_product_over_thesis_rows_fills_the_frame_a_list_of_its_scenes_does(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The free link's q_deg selects each run's thesis row, so a product over it runs one
+    part per row and puts each chunk's rows at their places in the whole table as it comes:
+    the frame is the one a list of the same scenes gives (one table, in order), value for
+    value, with the same dtypes, column order and index. Chunks of 5 runs, so that each part
+    takes several, and q_deg the last axis, so that the parts' rows interleave."""
+    monkeypatch.setattr(batch, "LOCAL_CHUNK", 5)
+    parts = []
+    by_row = batch._run_by_row
+
+    def spy(kwargs, field, terms, n, run):  # type: ignore[no-untyped-def]
+        parts.append(len({tuple(map(repr, t)) for t in terms}))
+        return by_row(kwargs, field, terms, n, run)
+
+    monkeypatch.setattr(batch, "_run_by_row", spy)
+    base = cases.free_link(q_deg=0, v0=2.0)
+    vs, qs = [0.5, 2.0, 4.0], [float(q) for q in np.linspace(-85, 85, 13)]
+    df = granrs.sweep(base, v0=vs, q_deg=qs, threads=2, progress=False)
+    assert len(parts) == 1 and parts[0] > 2
+    alone = granrs.sweep(
+        [base.replace(v0=v, q_deg=q) for v in vs for q in qs], threads=2, progress=False
+    )
+    assert list(df.columns[:2]) == ["v0", "q_deg"]
+    assert df[["v0", "q_deg"]].values.tolist() == [[v, q] for v in vs for q in qs]
+    pd.testing.assert_frame_equal(df.drop(columns=["v0", "q_deg"]), alone, check_exact=True)
+
+
+def test_a_sweeps_columns_keep_their_dtypes() -> None:
+    """The counters are int32, the ``stopped`` flags bool, ``status`` a categorical of
+    :data:`granrs.batch.STATUSES`, every other column (the axes' too) float64; the index a
+    RangeIndex."""
+    counters = {"steps", "rhs_evals", "root_evals", "events", "rejected", "unresolved"}
+    counters.add("unresolved_stops")
+    df = granrs.sweep(cases.free_link(q_deg=0, v0=2.0), q_deg=[0.0, 45.0], v0=[1.0, 3.0])
+    assert isinstance(df.index, pd.RangeIndex) and len(df) == 4
+    assert list(df["status"].cat.categories) == list(batch.STATUSES)
+    for name, dtype in df.dtypes.items():
+        if name == "status":
+            continue
+        want = "int32" if name in counters else "bool" if name == "stopped" else "float64"
+        assert str(dtype) == want, name
+    assert counters <= set(df.columns) and "stopped" in df.columns
 
 
 def test_list_of_scenes_chain_and_leg_equal_single_runs() -> None:

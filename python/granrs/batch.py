@@ -21,10 +21,9 @@ import re
 import uuid
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from . import _granrs, space
 from .api import (
@@ -49,6 +48,9 @@ from .forces import Term
 from .result import JOINT_NAMES
 from .scene import OUTPUTS, Scene, axis_rows
 from .scene import _names as _listed
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["STATUSES", "sweep"]
 
@@ -163,6 +165,8 @@ def _names(columns: Sequence[str], body: str) -> list[str]:
 @functools.cache
 def _status_dtype() -> pd.CategoricalDtype:
     """The ``status`` column's dtype (:data:`STATUSES`), checked once, not per sweep."""
+    import pandas as pd
+
     return pd.CategoricalDtype(list(STATUSES))
 
 
@@ -216,8 +220,9 @@ class _Table:
     columns`` floats) and then made a DataFrame without copying them: the floats are one
     ``columns x rows`` block (the frame's own), the counters and the flags one block each,
     ``status`` its own array. The counters are int32 (a run's stay far below 2^31; a block
-    that does not fit is widened to int64). So a sweep holds its result plus one chunk (a
-    summary-only sweep of 1e6 runs stays under 300 MB)."""
+    that does not fit is widened to int64). So a sweep holds its result plus one chunk, a
+    product over a thesis-row axis too (each part's chunks go to their rows in the whole:
+    :func:`_run_by_row`); the sweeps guide gives the peak memory of a million runs."""
 
     def __init__(self, columns: Sequence[str], body: str, n: int) -> None:
         self.layout = _layout(tuple(columns), body)
@@ -228,9 +233,9 @@ class _Table:
         self.status = np.empty(n, dtype=np.int8)
         self.n = n
 
-    def put(self, data: np.ndarray, offset: int) -> None:
-        """Rows ``offset .. offset + len(data)`` from a core table: one operation per kind."""
-        rows = slice(offset, offset + len(data))
+    def put(self, data: np.ndarray, rows: slice | np.ndarray) -> None:
+        """The rows ``rows`` (as many as ``data`` has: a slice, or their indices) from a core
+        table: one operation per kind."""
         index = self.layout.index
         self.blocks["float"][:, rows] = data[:, index["float"]].T
         self.blocks["bool"][:, rows] = data[:, index["bool"]].T == 1.0
@@ -256,6 +261,8 @@ class _Table:
         """The DataFrame, made without copying a column: the axis columns (taken from
         ``axis_columns``) first, then each column a row of its block (``status`` a
         categorical over its codes)."""
+        import pandas as pd
+
         columns: dict[str, Any] = {}
         for name in list(axis_columns or {}):
             columns[name] = axis_columns.pop(name)  # type: ignore[union-attr]
@@ -280,7 +287,7 @@ def _table(raw: dict[str, Any]) -> _Table:
     if table is None:
         data = np.asarray(raw.pop("data"))
         table = _Table(raw["columns"], raw["body"], len(data))
-        table.put(data, 0)
+        table.put(data, slice(0, len(data)))
     return table
 
 
@@ -358,15 +365,53 @@ def _progress_bar(total: int, progress: bool | None) -> Any:
 LOCAL_CHUNK = 1 << 13
 
 
+class _Places:
+    """Where the runs of a part of a product sweep go in the whole: the part is the product
+    ``shape`` (the last axis fastest) with its axis ``axis`` taking only the values
+    ``members`` (indices into that axis), and its runs ``runs`` are the whole's rows
+    ``self.of(runs)`` (taken a chunk at a time: no index of the sweep's length)."""
+
+    def __init__(self, shape: Sequence[int], axis: int, members: Sequence[int]) -> None:
+        self.shape = tuple(shape)
+        self.part = tuple(len(members) if k == axis else m for k, m in enumerate(shape))
+        self.axis = axis
+        self.members = np.asarray(members, dtype=np.intp)
+
+    def __len__(self) -> int:
+        return math.prod(self.part)
+
+    def of(self, runs: np.ndarray) -> np.ndarray:
+        at = list(np.unravel_index(runs, self.part))
+        at[self.axis] = self.members[at[self.axis]]
+        return np.ravel_multi_index(at, self.shape)
+
+
+#: Where a part of a sweep puts its runs (:func:`_run_local`): the whole sweep's table (None
+#: until its first chunk makes it), the whole's run count, and the part's :class:`_Places`.
+_Into = tuple[_Table | None, int, _Places]
+
+
 def _run_local(
-    kwargs: dict[str, Any], start: int, stop: int, threads: int, progress: bool | None
+    kwargs: dict[str, Any],
+    start: int,
+    stop: int,
+    threads: int,
+    progress: bool | None,
+    into: _Into | None = None,
 ) -> dict[str, Any]:
+    """Runs ``start..stop`` of a sweep on this machine, a chunk at a time, each chunk's
+    table copied into the result's columns as it comes: a table of ``stop - start`` rows,
+    or with ``into``, the whole sweep's table at the part's places (its failures and
+    ``unresolved`` are still the part's run indices)."""
     if stop - start > LOCAL_CHUNK:
         # Every run is validated before the first chunk runs.
         plain = {k: v for k, v in kwargs.items() if k != "lanes"}
         _granrs.validate_sweep(**plain, threads=threads)
     bar = _progress_bar(stop - start, progress)
     table: _Table | None = None
+    size, places = stop - start, None
+    if into is not None:
+        table, size, places = into
     failures: list[tuple[int, str]] = []
     unresolved: list[int] = []
     body = ""
@@ -384,8 +429,11 @@ def _run_local(
             raw = _granrs.sweep(**kwargs, start=lo, stop=hi, threads=threads, progress=callback)
             body, columns = raw["body"], list(raw["columns"])
             if table is None:
-                table = _Table(columns, body, stop - start)
-            table.put(np.asarray(raw["data"]), lo - start)
+                table = _Table(columns, body, size)
+            rows: slice | np.ndarray = slice(lo - start, hi - start)
+            if places is not None:  # a part of a sweep: its rows' places in the whole
+                rows = places.of(np.arange(lo - start, hi - start))
+            table.put(np.asarray(raw["data"]), rows)
             failures += raw["failures"]
             unresolved += raw["unresolved"]
             del raw
@@ -513,6 +561,8 @@ def _sweep_space(
     finally:
         if bar is not None:
             bar.close()
+    import pandas as pd
+
     frame = pd.DataFrame(columns)
     frame["status"] = pd.Categorical(
         [r[0] for r in rows], categories=["stopped", "not_stopped", "failed"]
@@ -676,9 +726,11 @@ def sweep(
                 f"chunk_size must be a whole number >= 1; got {chunk_size!r}", field="chunk_size"
             )
 
-    def run(kw: dict[str, Any], count: int, validated: bool = False) -> dict[str, Any]:
+    def run(
+        kw: dict[str, Any], count: int, validated: bool = False, into: _Into | None = None
+    ) -> dict[str, Any]:
         if client is None:
-            return _run_local(kw, 0, count, n_threads, progress)
+            return _run_local(kw, 0, count, n_threads, progress, into)
         if count == 0:
             return run_chunk(kw, 0, 0, 1)
         if not validated:
@@ -700,7 +752,9 @@ def sweep(
         _granrs.validate_sweep(
             **{k: v for k, v in kwargs.items() if k != "lanes"}, threads=n_threads
         )
-        table, failures, unresolved = _run_by_row(kwargs, *rows, n, lambda kw, c: run(kw, c, True))
+        table, failures, unresolved = _run_by_row(
+            kwargs, *rows, n, lambda kw, c, into: run(kw, c, True, into)
+        )
         start = 0
     if isinstance(scene, Scene):
         names, values = list(plain_axes), list(plain_axes.values())
@@ -726,7 +780,9 @@ def _run_by_row(
 ) -> tuple[_Table, list[tuple[int, str]], list[int]]:
     """A product sweep whose ``field`` axis selects each run's force terms (``terms``, one
     per value of that axis): one product per distinct set of terms, over the values that
-    select it, each row put at its place in the whole product (the last axis fastest)."""
+    select it, each row put at its place in the whole product (the last axis fastest):
+    locally as each chunk comes (``run(kwargs, count, into)``: :func:`_run_local`), from
+    Dask's table once it is back."""
     axes = kwargs["axes"]
     k = [name for name, _ in axes].index(field)
     shape = [len(values) for _, values in axes]
@@ -738,7 +794,6 @@ def _run_by_row(
                 break
         else:
             groups.append((t, [i]))
-    index = np.arange(n).reshape(shape)
     table: _Table | None = None
     failures: list[tuple[int, str]] = []
     unresolved: list[int] = []
@@ -746,20 +801,21 @@ def _run_by_row(
         sub_axes = list(axes)
         sub_axes[k] = (field, [axes[k][1][i] for i in members])
         sub = {**kwargs, "base": {**kwargs["base"], "forces": list(group_terms)}, "axes": sub_axes}
-        where = np.take(index, members, axis=k).ravel()
-        raw = run(sub, len(where))
-        part = _table(raw)
-        if table is None:
-            table = _Table(raw["columns"], raw["body"], n)
-        for kind, block in part.blocks.items():
-            if block.dtype != table.blocks[kind].dtype:
-                table.blocks[kind] = table.blocks[kind].astype(
-                    np.result_type(block, table.blocks[kind])
-                )
-            table.blocks[kind][:, where] = block
-        table.status[where] = part.status
-        failures += [(int(where[i - raw["start"]]), message) for i, message in raw["failures"]]
-        unresolved += [int(where[i - raw["start"]]) for i in raw["unresolved"]]
+        places = _Places(shape, k, members)
+        raw = run(sub, len(places), (table, n, places))
+        if raw.get("table") is not None:
+            table = raw["table"]
+        else:  # Dask's table, whole
+            data = np.asarray(raw.pop("data"))
+            if table is None:
+                table = _Table(raw["columns"], raw["body"], n)
+            table.put(data, places.of(np.arange(len(data))))
+            del data
+        start = raw["start"]
+        at = places.of(np.array([i - start for i, _ in raw["failures"]], dtype=np.intp))
+        failures += [(int(i), m) for i, (_, m) in zip(at, raw["failures"], strict=True)]
+        unresolved += places.of(np.array(raw["unresolved"], dtype=np.intp) - start).tolist()
+        del raw
     assert table is not None
     return table, failures, sorted(unresolved)
 
@@ -820,28 +876,90 @@ def _check_rows(
     table is left as it is."""
     n = table.n
     have = table.layout.rows_of
+    stopped_at = np.asarray(unresolved, dtype=np.intp)
+    # A chunk of rows at a time: no temporaries of the sweep's length.
+    found, loud_found = [], []
+    for lo in range(0, n, LOCAL_CHUNK):
+        hi = min(n, lo + LOCAL_CHUNK)
 
-    def column(name: str, fill: float) -> np.ndarray:
-        return table.column(name) if name in have else np.full(n, fill)
+        def column(name: str, fill: float, lo: int = lo, hi: int = hi) -> np.ndarray:
+            return table.column(name)[lo:hi] if name in have else np.full(hi - lo, fill)
 
-    stops = np.zeros(n, dtype=np.int64)
-    stops[np.asarray(unresolved, dtype=np.intp)] = 1
-    chatter = column("unresolved", 0)
-    numbers = (
-        column("h_lambda", math.nan),
-        stops,
-        chatter,
-        column("energy_start", math.nan),
-        column("energy_end", math.nan),
-    )
-    loud_rows = loud(*numbers)
-    candidates = np.flatnonzero(
-        suspects(numbers[0], column("step_error", math.nan), *numbers[1:], True)
-    )
-    if candidates.size == 0:
+        stops = np.zeros(hi - lo, dtype=np.int64)
+        stops[stopped_at[(lo <= stopped_at) & (stopped_at < hi)] - lo] = 1
+        numbers = (
+            column("h_lambda", math.nan),
+            stops,
+            column("unresolved", 0),
+            column("energy_start", math.nan),
+            column("energy_end", math.nan),
+        )
+        here = np.flatnonzero(
+            suspects(numbers[0], column("step_error", math.nan), *numbers[1:], True)
+        )
+        found.append(lo + here)
+        loud_found.append(loud(*numbers)[here])
+    if not any(c.size for c in found):
         return
-    checked, unchecked = [], []
-    for i in candidates.tolist():
+    candidates = np.concatenate(found)
+    loud_rows = dict(zip(candidates.tolist(), np.concatenate(loud_found).tolist(), strict=True))
+    moved: list[tuple[int, str]] = []
+    unchecked: list[int] = []
+    # CHECK_BATCH rows at a time: their scenes are built and run again a batch at a time.
+    for lo in range(0, len(candidates), CHECK_BATCH):
+        m, u = _recheck(
+            table, candidates[lo : lo + CHECK_BATCH], loud_rows, row_scene, threads, lanes
+        )
+        moved += m
+        unchecked += u
+    if not moved and not unchecked:
+        return
+    bad = sorted([i for i, _ in moved] + unchecked)
+    rows_text = f"{bad[:5]}{', ...' if len(bad) > 5 else ''}"
+    parts = []
+    if moved:
+        listed = "; ".join(f"row {i}: {what}" for i, what in moved[:10])
+        more = f"; and {len(moved) - 10} more" if len(moved) > 10 else ""
+        parts.append(
+            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than "
+            f"{100 * STEP_ERROR_LIMIT:g} % "
+            f"({listed}{more})"
+        )
+    if unchecked:
+        listed = f"{sorted(unchecked)[:5]}{', ...' if len(unchecked) > 5 else ''}"
+        parts.append(
+            f"{len(unchecked)} unchecked (rows {listed}: h_lambda above "
+            f"{RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or 'unresolved' "
+            "steps where the sign modes chattered and the energy rose)"
+        )
+    warnings.warn(
+        StepSizeWarning(
+            f"{len(bad)} of {n} runs (rows {rows_text}) did not resolve their contact: "
+            f"{'; '.join(parts)}. Use a "
+            f"smaller dt for those runs (dt / {STEP_CHECK_FACTOR} or less)"
+        ),
+        stacklevel=3,
+    )
+
+
+#: How many of a sweep's rows its step check builds and runs again at a time
+#: (:func:`_check_rows`): a batch's scenes are held together, not every suspect row's.
+CHECK_BATCH = 256
+
+
+def _recheck(
+    table: _Table,
+    rows_to_check: np.ndarray,
+    loud_rows: Mapping[int, bool],
+    row_scene: Any,
+    threads: int,
+    lanes: bool,
+) -> tuple[list[tuple[int, str]], list[int]]:
+    """The step's check of some of a sweep's suspect rows (:func:`_check_rows`): those that
+    moved at ``dt / STEP_CHECK_FACTOR`` (with their moves) and those that warn unchecked."""
+    checked: list[tuple[int, Scene]] = []
+    unchecked: list[int] = []
+    for i in rows_to_check.tolist():
         s = row_scene(i)
         if not s.step_check:
             if loud_rows[i]:
@@ -874,31 +992,4 @@ def _check_rows(
             check = step_move(coarse_values[j], fine_values[j], status, fine_dt[i])
             if check["moved"]:
                 moved.append((i, describe_move(check)))
-    if not moved and not unchecked:
-        return
-    bad = sorted([i for i, _ in moved] + unchecked)
-    rows_text = f"{bad[:5]}{', ...' if len(bad) > 5 else ''}"
-    parts = []
-    if moved:
-        listed = "; ".join(f"row {i}: {what}" for i, what in moved[:10])
-        more = f"; and {len(moved) - 10} more" if len(moved) > 10 else ""
-        parts.append(
-            f"checked at dt / {STEP_CHECK_FACTOR}, {len(moved)} moved by more than "
-            f"{100 * STEP_ERROR_LIMIT:g} % "
-            f"({listed}{more})"
-        )
-    if unchecked:
-        listed = f"{sorted(unchecked)[:5]}{', ...' if len(unchecked) > 5 else ''}"
-        parts.append(
-            f"{len(unchecked)} unchecked (rows {listed}: h_lambda above "
-            f"{RK4_STABILITY_LIMIT}, 'unresolved_stops' the step missed, or 'unresolved' "
-            "steps where the sign modes chattered and the energy rose)"
-        )
-    warnings.warn(
-        StepSizeWarning(
-            f"{len(bad)} of {n} runs (rows {rows_text}) did not resolve their contact: "
-            f"{'; '.join(parts)}. Use a "
-            f"smaller dt for those runs (dt / {STEP_CHECK_FACTOR} or less)"
-        ),
-        stacklevel=3,
-    )
+    return moved, unchecked

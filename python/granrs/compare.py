@@ -61,10 +61,9 @@ import math
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from . import forces as _forces
 from .batch import _threads as _check_threads
@@ -74,6 +73,9 @@ from .calibrate.fit import _residual_frame
 from .calibrate.model import _parse_param, base_coefficients
 from .errors import GranrsError, InvalidParameterError, SimulationError, UnknownNameError
 from .scene import Scene
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = [
     "BODY_UNKNOWNS",
@@ -679,6 +681,8 @@ def _entry(
     tick: Callable[[str], None],
 ) -> dict[str, Any]:
     """Fit, cross-validate and summarise one law on one dataset."""
+    import pandas as pd
+
     t0 = time.perf_counter()
     k = len(job.params)
     n_res = 2 * len(m)
@@ -806,6 +810,8 @@ def compare(
             (``field="laws"``), an invalid ``dt`` (the scene's rule, ``field="dt"``),
             ``threads`` (the sweep's rule) or ``starts``; all before any run.
     """
+    import pandas as pd
+
     law_list = _law_list(laws)
     data = _datasets(measurements)
     if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
@@ -897,6 +903,8 @@ def _rank(frame: pd.DataFrame) -> pd.Series:
     """Per dataset: the available laws whose rows all ran out of sample by ``oos_chi2``
     (1 the best), then those with failed rows, by how many failed (ties share a rank);
     NA for a law that did not run."""
+    import pandas as pd
+
     rank = pd.array([pd.NA] * len(frame), dtype="Int64")
     for _, sub in frame[frame["available"]].groupby("dataset", sort=False):
         at = frame.index.get_indexer(sub.index)
@@ -970,6 +978,8 @@ JSON_KEYS: tuple[str, ...] = (
 
 
 def _json_value(value: Any) -> Any:
+    import pandas as pd
+
     if isinstance(value, Mapping):
         return {str(k): _json_value(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

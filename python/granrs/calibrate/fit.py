@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from .._progress import progress_bar
 from ..coefficients import Coefficients
@@ -29,6 +28,8 @@ from .model import _JOINT_START, _JOINTS, LawSpec, _Model, _Param, _parse_param
 from .posterior import Posterior
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from ..media import MediumCard
 
 __all__ = ["CalibrationResult", "calibrate", "evaluate", "within"]

@@ -11,10 +11,9 @@ import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from .. import data
 from ..errors import (
@@ -22,6 +21,9 @@ from ..errors import (
     MeasurementError,
     UnknownNameError,
 )
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["BODIES", "QUANTITIES", "THESIS_MEASUREMENTS", "THESIS_RESOLUTION", "Measurements"]
 
@@ -114,6 +116,8 @@ class Measurements:
         (chain), ``"table_5_1"`` (the leg, per subject and height) or ``"table_5_1_means"``
         (the leg: per height, the mean and sd across the subjects' means). The means are
         printed to 1 mm and 1 ms: ``resolution`` is set to that."""
+        import pandas as pd
+
         if name not in THESIS_MEASUREMENTS:
             hint = difflib.get_close_matches(str(name), list(THESIS_MEASUREMENTS), n=1)
             more = f"; did you mean {hint[0]!r}?" if hint else ""
@@ -229,6 +233,8 @@ def _check_frame(rows: pd.DataFrame, body: str, name: str) -> None:
 
 
 def _read_csv(handle: IO[str], filename: str, body: str) -> pd.DataFrame:
+    import pandas as pd
+
     required = (*_KEY_COLUMNS[body], *_VALUE_COLUMNS)
     try:
         reader = csv.DictReader(handle, strict=True)

@@ -13,10 +13,9 @@ import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from .. import cases as _cases
 from .. import data
@@ -28,6 +27,9 @@ from ..errors import (
     UnknownNameError,
 )
 from ..scene import Scene
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 try:  # the core's step-resolution check (newer builds)
     from ..api import RK4_STABILITY_LIMIT as _RK4_LIMIT

@@ -14,12 +14,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from ..errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["Posterior"]
 
@@ -78,6 +80,7 @@ def sample(
     """Run the ensemble from a ball about ``x_opt`` (fitted space) for ``steps`` steps;
     ``evaluate`` gives the weighted residuals of a list of points in one sweep."""
     import emcee
+    import pandas as pd
 
     lo_x, hi_x = box
     ndim = len(x_opt)
