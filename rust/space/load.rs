@@ -714,8 +714,8 @@ fn rft3d_rated_with<const GRAZING: bool>(
     // below run across the terms in SIMD lanes). The others add zeros in the element loop,
     // and a sum that starts at +0 is never -0: leaving them out gives the same bits, and
     // a moving body's trailing half costs nothing.
-    let mut on = [[0.0; RATED_BLOCK]; 8];
-    // (Written before they are read: not zeroed, 24 kB per call.)
+    // (Both written before they are read: not zeroed, 4 kB and 24 kB per call.)
+    let mut on = [[std::mem::MaybeUninit::<f64>::uninit(); RATED_BLOCK]; 8];
     let mut buf = [std::mem::MaybeUninit::<[f64; TERMS_PER_ELEMENT]>::uninit(); RATED_BLOCK];
     let mut acc = out.terms();
     let mut start = 0;
@@ -731,14 +731,16 @@ fn rft3d_rated_with<const GRAZING: bool>(
             let (_, u) = arm_and_velocity(x, c, v, omega);
             let (s2, _, _, nu) = direction(nn, u);
             let keep = s2.select_pos(ramp_position(nu, eps, GRAZING), 0.0) > 0.0;
-            for (col, y) in on.iter_mut().zip([x[0], x[1], x[2], nn[0], nn[1], nn[2]]) {
-                col[m] = y;
+            let values = [x[0], x[1], x[2], nn[0], nn[1], nn[2], e.area[i], e.depth[i]];
+            for (col, y) in on.iter_mut().zip(values) {
+                col[m].write(y);
             }
-            on[6][m] = e.area[i];
-            on[7][m] = e.depth[i];
             m += usize::from(keep);
         }
-        let [x0, x1, x2, n0, n1, n2, area, depth] = &on;
+        // SAFETY: the loop above wrote each column's first `m` (and more).
+        let [x0, x1, x2, n0, n1, n2, area, depth]: [&[f64]; 8] = std::array::from_fn(|k| unsafe {
+            std::slice::from_raw_parts(on[k].as_ptr().cast::<f64>(), m)
+        });
         for (j, row) in buf[..m].iter_mut().enumerate() {
             let (r, u) = arm_and_velocity([x0[j], x1[j], x2[j]], c, v, omega);
             let n = [n0[j], n1[j], n2[j]];

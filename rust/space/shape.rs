@@ -186,18 +186,70 @@ impl Elements {
         }
         out
     }
+}
 
-    #[inline]
-    fn push(&mut self, x: V3, n: V3, area: f64, surface: f64) {
-        for k in 0..3 {
-            self.x[k].push(x[k]);
-            self.n[k].push(n[k]);
+/// Elements per [`Batch`].
+const BATCH: usize = 64;
+
+/// A curved surface's elements as they are cut, one at a time: written to arrays on the
+/// stack and appended to [`Elements`] a batch at a time (in their order: the same
+/// elements), where a push onto each of its eight arrays would check and grow each one per
+/// element. The last batch goes in when it is dropped.
+struct Batch<'a> {
+    out: &'a mut Elements,
+    /// The batch's positions, normals, area weights and depths, each by coordinate (its
+    /// first `len` of each written; not zeroed, 4 kB).
+    cols: [[MaybeUninit<f64>; BATCH]; 8],
+    len: usize,
+}
+
+impl<'a> Batch<'a> {
+    fn new(out: &'a mut Elements) -> Self {
+        Batch {
+            out,
+            // SAFETY: an array of `MaybeUninit` needs no initialization (a repeat of
+            // `MaybeUninit::uninit()` here was compiled as a 4 kB memset).
+            cols: unsafe { MaybeUninit::uninit().assume_init() },
+            len: 0,
         }
-        self.area.push(area);
-        self.depth.push(depth_below(surface, &x));
-        if let Some(s) = &mut self.sums {
+    }
+
+    /// An element at `x` of normal `n` and area weight `area`, below `surface`.
+    #[inline(always)]
+    fn push(&mut self, x: V3, n: V3, area: f64, surface: f64) {
+        if self.len == BATCH {
+            self.flush();
+        }
+        let i = self.len;
+        let values = [x.x, x.y, x.z, n.x, n.y, n.z, area, depth_below(surface, &x)];
+        for (col, v) in self.cols.iter_mut().zip(values) {
+            col[i].write(v);
+        }
+        if let Some(s) = &mut self.out.sums {
             s.add(&x, &n, area);
         }
+        self.len = i + 1;
+    }
+
+    /// Append the batch to the elements.
+    fn flush(&mut self) {
+        let (len, out) = (self.len, &mut *self.out);
+        let [x0, x1, x2] = &mut out.x;
+        let [n0, n1, n2] = &mut out.n;
+        let to = [x0, x1, x2, n0, n1, n2, &mut out.area, &mut out.depth];
+        for (v, col) in to.into_iter().zip(&self.cols) {
+            // SAFETY: `push`, the only way `len` grows, wrote entries `..len` of each column.
+            v.extend_from_slice(unsafe {
+                std::slice::from_raw_parts(col.as_ptr().cast::<f64>(), len)
+            });
+        }
+        self.len = 0;
+    }
+}
+
+impl Drop for Batch<'_> {
+    fn drop(&mut self) {
+        self.flush();
     }
 }
 
@@ -949,6 +1001,7 @@ fn sphere_patch(
         trig_roots(p.dot(&a), -ra, 0.0, 0.0, theta_max, &mut breaks);
     }
     let g = &rule.gauss;
+    let mut out = Batch::new(out);
     // The horizon's angles on each circle (one buffer for all of them).
     let mut flips = Vec::with_capacity(4);
     pieces(0.0, theta_max, &mut breaks, PANEL, |t0, t1| {
@@ -1010,6 +1063,7 @@ fn cylinder_side(m: &Motion, a: &V3, r: f64, h: f64, rule: &Quadrature, out: &mu
     // Where the side's normal is horizontal (the law's m flips there).
     trig_roots(u1.z, u2.z, 0.0, 0.0, 2.0 * PI, &mut breaks);
     let g = &rule.gauss;
+    let mut out = Batch::new(out);
     let speed = m.v.norm() + m.omega.norm() * (r + h);
     around(0.0, 2.0 * PI, &mut breaks, PANEL, g, |phi, wf| {
         {
@@ -1050,6 +1104,7 @@ fn disk(m: &Motion, e: &V3, nu: &V3, r: f64, rule: &Quadrature, out: &mut Elemen
     let rim = [e + r * u1, e - r * u1, e + r * u2, e - r * u2, *e];
     let grazing = m.grazing(nu, &rim);
     let g = &rule.gauss;
+    let mut out = Batch::new(out);
     around(0.0, 2.0 * PI, &mut breaks, PANEL, g, |phi, wf| {
         let (sp, cp) = phi.sin_cos();
         let d = cp * u1 + sp * u2;
