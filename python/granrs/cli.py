@@ -1036,11 +1036,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns the exit code instead of exiting (also for ``--help``, ``--version`` and usage
     errors), so that it can be called from Python and tests.
     """
-    parser = build_parser()
     try:
+        # Building the parser imports the report's chapters (and pandas): a Ctrl-C there
+        # stops the command as one during its work does.
+        parser = build_parser()
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, usage errors
         return exc.code if isinstance(exc.code, int) else EXIT_INVALID
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     try:
         with warnings.catch_warnings():
             # granrs's own warnings are part of the command's output: one line each.
