@@ -79,7 +79,7 @@ def test_what_the_targets_leave_is_the_time_above_the_floor():
     """The report's budget lines from made-up times: a loop of 800 evaluations taking 40 us
     of which its calls take 32 (40 ns per evaluation), and granrs taking 80 us over 1000
     evaluations: granrs's own work is 80 - 40 = 40 us against the loop's 8 (5x); the sweep
-    line leaves 40 / 3 us over 1000 evaluations, 13.3 ns each. A located loop of 42 us and
+    line leaves 40 / 2 us over 1000 evaluations, 20 ns each. A located loop of 42 us and
     granrs raw of 80: 40 against 10 us (4x)."""
     peers = _peers()
     runs = peers.build(quick=True)[:2]
@@ -92,7 +92,14 @@ def test_what_the_targets_leave_is_the_time_above_the_floor():
     assert "| the calls, ns per evaluation | 40.0 |" in lines
     assert "| the loop's own, us per impact (ns per evaluation) | 8.0 (10.0) |" in lines
     assert "| granrs.simulate's own, us per impact (ns per evaluation) | 40.0 (40.0) |" in lines
-    assert "granrs's own must shrink by | 5x |" in lines
+    assert "| granrs.simulate's own / the loop's own | 5x |" in lines
+    # The lean line: 1.2 x 40 us less granrs's calls (1000 x 40 ns) leaves 8 us of its own;
+    # a lean run of 70 us takes 30.
+    assert "granrs's own may take" not in lines
+    times["granrs_lean"] = 70.0
+    lean = "\n".join(peers.targets_left(runs, times))
+    assert "granrs's own may take, us per impact (it takes) | 8.0 (30.0) |" in lean
     assert "granrs raw's own / the located loop's own | 4x |" in lines
-    assert "all included | 13.3 |" in lines
+    # The sweep line (1/2 x the loop) leaves 40 / 2 us over 1000 evaluations: 20 ns each.
+    assert "all included | 20.0 |" in lines
     assert peers.targets_left(runs, {"numba_scalar": 40.0, "granrs": 80.0}) == []
