@@ -103,6 +103,8 @@ def test_a_product_over_axes(monkeypatch: pytest.MonkeyPatch) -> None:
     # The strings compare and group as the frame's do.
     np.testing.assert_array_equal(columns["status"] == "stopped", frame["status"] == "stopped")
     assert list(np.unique(columns["status"])) == sorted(set(frame["status"]))
+    # Each row refers to one of the five shared strings (8 bytes a row, no string per row).
+    assert all(any(s is t for t in batch.STATUSES) for s in columns["status"])
 
 
 def test_a_product_asking_for_the_depth_and_t_s(monkeypatch: pytest.MonkeyPatch) -> None:
