@@ -12,8 +12,10 @@ Parts:
 * ``sweep``: a sweep of free-link impacts (angles x speeds x coefficient scales), summary
   only, on 1 and 2 threads, each in a fresh child process that reports its own peak
   resident memory (``ru_maxrss``), and once more on 1 thread asking only for the depth and
-  t_s. Targets: 2 threads >= 1.8x faster than 1; peak < 200 MB; at a million impacts
-  (``--runs 1000000``) the sweep asking for the depth and t_s peaks < 300 MB.
+  t_s, and on 1 and 2 threads returning every column as numpy arrays (``as_frame=False``:
+  no pandas). Targets: 2 threads >= 1.8x faster than 1; peak < 200 MB; at a million impacts
+  (``--runs 1000000``) the sweep asking for the depth and t_s, and the sweep returning
+  numpy arrays, each peak < 300 MB.
 * ``overhead``: each ``granrs.simulate(scene)`` call timed whole, against the run inside
   it as the core times it. Target: overhead < 10 % of the call.
 * ``prune``: the vertical drop with every effect and every series recorded, against the
@@ -63,6 +65,8 @@ PARTS = ("sweep", "overhead", "prune", "force", "fixed", "lanes", "axis")
 #: What the lean sweep asks for, and its peak memory's target for a million impacts.
 LEAN_OUTPUTS = ("depth", "t_s")
 LEAN_PEAK_MB = 300
+#: The peak memory's target for a million impacts with every column as numpy arrays.
+ARRAYS_PEAK_MB = 300
 
 
 def _median_time(fn: Callable[[], object], repeat: int) -> float:
@@ -87,60 +91,80 @@ def _sweep_axes(n: int) -> dict[str, list[float]]:
     }
 
 
-def _child(n: int, threads: int, lean: int = 0) -> None:
+def _child(n: int, threads: int, lean: int = 0, arrays: int = 0) -> None:
     """Run one sweep and print its time and this process's peak memory (JSON); ``lean``:
-    the sweep asks only for the depth and t_s (``outputs=LEAN_OUTPUTS``)."""
+    the sweep asks only for the depth and t_s (``outputs=LEAN_OUTPUTS``); ``arrays``: it
+    returns numpy arrays (``as_frame=False``), and the child reports whether pandas was
+    loaded."""
     base = cases.free_link(q_deg=0.0, v0=2.0)
     axes = _sweep_axes(n)
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     t0 = time.perf_counter()
     outputs = {"outputs": list(LEAN_OUTPUTS)} if lean else {}
-    df = granrs.sweep(base, threads=threads, progress=False, **outputs, **axes)
+    result = granrs.sweep(
+        base, threads=threads, progress=False, as_frame=not arrays, **outputs, **axes
+    )
     elapsed = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
-    ok = bool((df["status"] == "stopped").all() and np.isfinite(df["depth"]).all())
+    pandas_loaded = "pandas" in sys.modules
+    if arrays:
+        assert isinstance(result, dict)
+        # The object column's strings are the five shared ones: 8 bytes a row each.
+        result_mb = sum(column.nbytes for column in result.values()) / 2**20
+    else:
+        result_mb = result.memory_usage(deep=True).sum() / 2**20
+    ok = bool((result["status"] == "stopped").all() and np.isfinite(result["depth"]).all())
     print(
         json.dumps(
             {
-                "runs": len(df),
+                "runs": len(result["status"]),
                 "threads": threads,
                 "lean": bool(lean),
+                "arrays": bool(arrays),
                 "seconds": elapsed,
                 "peak_mb": peak / 1024,
                 "before_mb": rss_before / 1024,
-                "frame_mb": df.memory_usage(deep=True).sum() / 2**20,
+                "result_mb": result_mb,
+                "pandas_loaded": pandas_loaded,
                 "all_stopped_finite": ok,
             }
         )
     )
 
 
+#: The sweep part's children: (threads, lean, arrays).
+SWEEP_RUNS = ((1, 0, 0), (2, 0, 0), (1, 1, 0), (1, 0, 1), (2, 0, 1))
+
+
 def part_sweep(n: int) -> list[str]:
     rows = {}
-    for threads, lean in ((1, 0), (2, 0), (1, 1)):
+    for threads, lean, arrays in SWEEP_RUNS:
         out = subprocess.run(
-            [sys.executable, __file__, "--child", str(n), str(threads), str(lean)],
+            [sys.executable, __file__, "--child", str(n), str(threads), str(lean), str(arrays)],
             check=True,
             capture_output=True,
             text=True,
         )
-        rows[threads, lean] = json.loads(out.stdout.strip().splitlines()[-1])
-    one, two, lean_one = rows[1, 0], rows[2, 0], rows[1, 1]
+        rows[threads, lean, arrays] = json.loads(out.stdout.strip().splitlines()[-1])
+    one, two, lean_one = rows[1, 0, 0], rows[2, 0, 0], rows[1, 1, 0]
+    arrays_peak = max(rows[1, 0, 1]["peak_mb"], rows[2, 0, 1]["peak_mb"])
     speedup = one["seconds"] / two["seconds"]
     lines = [
         f"### Sweep of {one['runs']:,} free-link impacts, summary only",
         "",
-        "| threads | columns | time [s] | per impact [us] | peak RSS [MB] | RSS after import [MB] "
-        "| DataFrame [MB] | all stopped, finite |",
-        "|---|---|---|---|---|---|---|---|",
+        "| threads | columns | returns | time [s] | per impact [us] | peak RSS [MB] "
+        "| RSS after import [MB] | result [MB] | pandas loaded | all stopped, finite |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for r in (one, two, lean_one):
+    for key in SWEEP_RUNS:
+        r = rows[key]
         columns = "depth, t_s" if r["lean"] else "default"
+        returns = "numpy arrays" if r["arrays"] else "DataFrame"
         lines.append(
-            f"| {r['threads']} | {columns} | {r['seconds']:.2f} "
+            f"| {r['threads']} | {columns} | {returns} | {r['seconds']:.2f} "
             f"| {r['seconds'] / r['runs'] * 1e6:.1f} "
-            f"| {r['peak_mb']:.0f} | {r['before_mb']:.0f} | {r['frame_mb']:.1f} "
-            f"| {r['all_stopped_finite']} |"
+            f"| {r['peak_mb']:.0f} | {r['before_mb']:.0f} | {r['result_mb']:.1f} "
+            f"| {r['pandas_loaded']} | {r['all_stopped_finite']} |"
         )
     peak = max(one["peak_mb"], two["peak_mb"])
     lines += [
@@ -151,6 +175,9 @@ def part_sweep(n: int) -> list[str]:
         f"Asking only for the depth and t_s: peak **{lean_one['peak_mb']:.0f} MB** "
         f"(a million-impact sweep's target < {LEAN_PEAK_MB} MB at --runs 1000000: "
         f"{'met' if lean_one['peak_mb'] < LEAN_PEAK_MB else 'NOT met'}).",
+        f"Every column as numpy arrays (``as_frame=False``): peak **{arrays_peak:.0f} MB** "
+        f"on 1 and 2 threads (a million-impact sweep's target < {ARRAYS_PEAK_MB} MB at "
+        f"--runs 1000000: {'met' if arrays_peak < ARRAYS_PEAK_MB else 'NOT met'}).",
         "",
     ]
     return lines

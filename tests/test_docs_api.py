@@ -45,7 +45,7 @@ gen = _generator()
 
 #: Python blocks of the pages that are not run, by (page, index among its python blocks).
 NOT_RUN = {
-    ("sweeps.md", 4): "needs a Dask scheduler",
+    ("sweeps.md", 5): "needs a Dask scheduler",
     ("compare.md", 4): "a search of four sums on Table 3.1, about a minute of fits (sums are "
     "tested on a cheap set in test_compare.py)",
 }

@@ -2,7 +2,8 @@
 
 :func:`sweep` runs the Cartesian product of field values over a base scene (or a list of
 scenes) in the Rust core, on a rayon pool with the GIL released, and returns a pandas
-DataFrame of summaries in input order. Every run is validated before the first starts; a
+DataFrame of summaries in input order (or, with ``as_frame=False``, its columns as numpy
+arrays, without pandas). Every run is validated before the first starts; a
 bad value raises the typed error naming the field and the run. A progress bar (tqdm) shows
 on long sweeps; Ctrl-C cancels the sweep (its validation and the runs in flight included)
 within a fraction of a second and raises ``KeyboardInterrupt``.
@@ -252,33 +253,73 @@ class _Table:
         kind, row = self.layout.rows_of[name]
         return self.status if kind == "status" else self.blocks[kind][row]
 
-    def frame(
+    def _columns(
         self,
         failures: Sequence[tuple[int, str]],
         start: int,
         axis_columns: dict[str, np.ndarray] | None,
-    ) -> pd.DataFrame:
-        """The DataFrame, made without copying a column: the axis columns (taken from
-        ``axis_columns``) first, then each column a row of its block (``status`` a
-        categorical over its codes)."""
-        import pandas as pd
-
+        status: Any,
+    ) -> dict[str, Any]:
+        """The result's columns in order, none copied: the axis columns (taken from
+        ``axis_columns``) first, then each of :attr:`layout`'s names, a row of its block
+        (``status``: ``status(codes)`` of its codes, :data:`STATUSES` indices), then
+        ``error`` where a run failed (an object array, None where the run did not fail)."""
         columns: dict[str, Any] = {}
         for name in list(axis_columns or {}):
             columns[name] = axis_columns.pop(name)  # type: ignore[union-attr]
         for name, (kind, row) in zip(self.layout.names, self.layout.places, strict=True):
             if name in columns:
                 raise ValueError(f"a sweep's axis and its output are both named {name!r}")
-            if kind == "status":
-                columns[name] = pd.Categorical.from_codes(self.status, dtype=_status_dtype())
-            else:
-                columns[name] = self.blocks[kind][row]
+            columns[name] = status(self.status) if kind == "status" else self.blocks[kind][row]
         if failures:
-            errors = np.full(self.n, None, dtype=object)
-            for i, message in failures:
-                errors[i - start] = message
-            columns["error"] = errors
-        return pd.DataFrame(columns, copy=False)
+            columns["error"] = _errors(failures, start, self.n)
+        return columns
+
+    def frame(
+        self,
+        failures: Sequence[tuple[int, str]],
+        start: int,
+        axis_columns: dict[str, np.ndarray] | None,
+    ) -> pd.DataFrame:
+        """The DataFrame, made without copying a column (:meth:`_columns`; ``status`` a
+        categorical over its codes)."""
+        import pandas as pd
+
+        def status(codes: np.ndarray) -> pd.Categorical:
+            return pd.Categorical.from_codes(codes, dtype=_status_dtype())
+
+        return pd.DataFrame(self._columns(failures, start, axis_columns, status), copy=False)
+
+    def columns(
+        self,
+        failures: Sequence[tuple[int, str]],
+        start: int,
+        axis_columns: dict[str, np.ndarray] | None,
+    ) -> dict[str, np.ndarray]:
+        """The frame's columns as numpy arrays, without pandas (``sweep(...,
+        as_frame=False)``): the same names in the same order (:meth:`_columns`), each
+        numeric or flag column a view of its block; ``status`` an object array of the
+        :data:`STATUSES` strings (:func:`_status_strings`)."""
+        return self._columns(failures, start, axis_columns, _status_strings)
+
+
+#: The ``status`` strings by code, as an object array: indexing it by a sweep's codes gives
+#: its ``status`` column without pandas (each row a reference to one of these five strings).
+_STATUS_OBJECTS = np.array(STATUSES, dtype=object)
+
+
+def _status_strings(codes: np.ndarray) -> np.ndarray:
+    """A ``status`` column of :data:`STATUSES` strings (an object array) from its codes."""
+    return _STATUS_OBJECTS[codes]
+
+
+def _errors(failures: Sequence[tuple[int, str]], start: int, n: int) -> np.ndarray:
+    """The ``error`` column of ``n`` runs from ``start``: each failed run's message (``failures``
+    holds (run index, message)), None elsewhere."""
+    errors = np.full(n, None, dtype=object)
+    for i, message in failures:
+        errors[i - start] = message
+    return errors
 
 
 def _table(raw: dict[str, Any]) -> _Table:
@@ -503,9 +544,11 @@ def _sweep_space(
     progress: bool | None,
     client: Any,
     axes: dict[str, Any],
-) -> pd.DataFrame:
+    as_frame: bool,
+) -> pd.DataFrame | dict[str, np.ndarray]:
     """``sweep`` of bodies in space (see :func:`sweep`): each run on a worker thread, the
-    GIL released; one row per run of its status and :data:`granrs.space.SUMMARY_FIELDS`."""
+    GIL released; one row per run of its status and :data:`granrs.space.SUMMARY_FIELDS`: a
+    DataFrame, or with ``as_frame=False`` its columns (numpy arrays; ``status`` strings)."""
     if client is not None:
         raise InvalidParameterError(
             "a sweep of bodies in space runs on this machine's threads; Dask takes planar "
@@ -527,7 +570,7 @@ def _sweep_space(
                 scenes.append(scene.replace(**dict(zip(names, combo, strict=True))))
             except GranrsError as e:
                 raise type(e)(f"run {i}: {e}", field=getattr(e, "field", None)) from e
-        columns: dict[str, list[Any]] = {
+        axis_values: dict[str, list[Any]] = {
             name: [c[k] for c in combos] for k, name in enumerate(names)
         }
     else:
@@ -539,7 +582,7 @@ def _sweep_space(
                     f"{type(s).__name__}",
                     field="scene",
                 )
-        columns = {}
+        axis_values = {}
 
     def one(s: space.Scene) -> tuple[str, dict[str, float], str]:
         try:
@@ -561,17 +604,13 @@ def _sweep_space(
     finally:
         if bar is not None:
             bar.close()
-    import pandas as pd
-
-    frame = pd.DataFrame(columns)
-    frame["status"] = pd.Categorical(
-        [r[0] for r in rows], categories=["stopped", "not_stopped", "failed"]
-    )
+    columns: dict[str, Any] = {name: _space_axis(values) for name, values in axis_values.items()}
+    columns["status"] = _STATUS_OBJECTS[[STATUSES.index(r[0]) for r in rows]]
     for name in space.SUMMARY_FIELDS:
-        frame[name] = np.array([r[1].get(name, np.nan) for r in rows], dtype=float)
+        columns[name] = np.array([r[1].get(name, np.nan) for r in rows], dtype=float)
     if any(r[0] == "failed" for r in rows):
-        frame["error"] = [r[2] or None for r in rows]
-    stiff = int((frame["h_lambda"] > RK4_STABILITY_LIMIT).sum()) if n else 0
+        columns["error"] = _errors([(i, r[2]) for i, r in enumerate(rows) if r[2]], 0, n)
+    stiff = int((columns["h_lambda"] > RK4_STABILITY_LIMIT).sum()) if n else 0
     if stiff:
         warnings.warn(
             StepSizeWarning(
@@ -581,7 +620,37 @@ def _sweep_space(
             ),
             stacklevel=3,
         )
+    if not as_frame:
+        return columns
+    import pandas as pd
+
+    frame = pd.DataFrame(axis_values)
+    for name, column in columns.items():
+        if name == "status":
+            column = pd.Categorical(column, categories=list(_SPACE_STATUSES))
+        if name not in axis_values:
+            frame[name] = column
     return frame
+
+
+#: Values of a sweep in space's ``status`` column (its DataFrame's categories).
+_SPACE_STATUSES: tuple[str, ...] = ("stopped", "not_stopped", "failed")
+
+
+def _space_axis(values: list[Any]) -> np.ndarray:
+    """A sweep in space's axis column as a numpy array: numbers and flags as numpy makes them
+    (as pandas does: int64, float64, bool), anything else (a velocity's tuple, text) an
+    object array of the values themselves."""
+    try:
+        array = np.asarray(values)
+    except ValueError:  # ragged sequences
+        array = np.empty(0)
+    if array.ndim == 1 and len(array) == len(values) and array.dtype.kind in "biuf":
+        return array
+    out = np.empty(len(values), dtype=object)
+    for i, v in enumerate(values):
+        out[i] = v
+    return out
 
 
 def fast_lanes() -> bool:
@@ -609,8 +678,9 @@ def sweep(
     chunk_size: int | None = None,
     lanes: bool = True,
     outputs: Sequence[str] | None = None,
+    as_frame: bool = True,
     **axes: Any,
-) -> pd.DataFrame:
+) -> pd.DataFrame | dict[str, np.ndarray]:
     """Run many scenes in parallel and return one row of summaries per run.
 
     Args:
@@ -625,7 +695,7 @@ def sweep(
             sweeps of at least 2000 runs; True always; False never.
         client: a ``dask.distributed.Client``: cut the sweep into chunks of ``chunk_size``
             runs (default: about four chunks per worker thread), each run by the Rust batch
-            on a worker with one thread. The result is the same DataFrame.
+            on a worker with one thread. The result is the same.
         chunk_size: runs per Dask task.
         lanes: run free-link scenes (under any terms, alone or mixed; any sign model; RK4)
             four at a time in SIMD lanes, with AVX2 where the CPU has it (default). The
@@ -637,6 +707,12 @@ def sweep(
             keeps the scenes' own ``outputs`` (by default every field; a list of scenes must
             then agree on them). A field left out is not computed: ``outputs=("depth",
             "t_s")`` runs only what those need (see the sweeps guide, "Outputs").
+        as_frame: True (default): return a pandas DataFrame. False: return its columns as a
+            dict of numpy arrays instead, without importing pandas (for numpy, JAX or torch
+            code, or where pandas is not installed): the same names in the same order,
+            with the same values; the numeric and flag columns with the frame's dtypes,
+            not copied; ``status`` an object array of its strings (``d["status"] ==
+            "stopped"`` and ``np.unique(d["status"])`` work), ``error`` as in the frame.
         **axes: field name = values (any Scene field but ``body`` and ``outputs``; a single
             value is an axis of one). The sweep runs their Cartesian product, the last axis varying
             fastest, as ``itertools.product``.
@@ -649,7 +725,11 @@ def sweep(
         chain's prefixed ``c0.`` and ``c1.``), and per joint ``<joint>.F_max``,
         ``<joint>.torque_max`` and ``<joint>.impulse_work``: those of ``outputs`` only, when
         given, in that same order. A run that failed has status ``"failed"`` and its message
-        in an ``error`` column (present only then).
+        in an ``error`` column (present only then). With ``as_frame=False``, a dict of
+        those columns, name -> numpy array of one value per run: float64 for the floats
+        (and numeric axes), int32 for the counters (int64 if one does not fit), bool for
+        the ``stopped`` flags, and object arrays for ``status`` (its strings), ``error``
+        (the message, None where the run did not fail) and non-numeric axes.
 
     Warns:
         StepSizeWarning: once, listing the rows whose t_s, depth or status moves by more
@@ -670,7 +750,16 @@ def sweep(
         >>> df = granrs.sweep(base, q_deg=[0, 30, 60], v0=[1.0, 2.0])
         >>> len(df), list(df.columns[:3])
         (6, ['q_deg', 'v0', 'status'])
+        >>> cols = granrs.sweep(base, q_deg=[0, 30, 60], v0=[1.0, 2.0], as_frame=False)
+        >>> list(cols)[:3], cols["depth"].dtype, bool((cols["status"] == "stopped").all())
+        (['q_deg', 'v0', 'status'], dtype('float64'), True)
     """
+    if not isinstance(as_frame, bool):
+        raise InvalidParameterError(
+            "as_frame must be True (a pandas DataFrame) or False (a dict of numpy arrays); "
+            f"got {as_frame!r}",
+            field="as_frame",
+        )
     n_threads = _threads(threads)
     if outputs is not None:
         outputs = list(_listed(outputs, "outputs", OUTPUTS))
@@ -691,7 +780,7 @@ def sweep(
                 "outputs",
                 field="outputs",
             )
-        return _sweep_space(scene, n_threads, progress, client, axes)
+        return _sweep_space(scene, n_threads, progress, client, axes, as_frame)
     if isinstance(scene, Scene):
         kwargs, plain_axes = _axis_sweep(scene, axes)
         # A thesis-row scene swept over the field that selects its row (the free link's
@@ -766,9 +855,10 @@ def sweep(
     else:
         row_scene = scenes.__getitem__
     _check_rows(table, unresolved, row_scene, n_threads, lanes)
-    frame = table.frame(failures, start, axis_columns)
+    make = table.frame if as_frame else table.columns
+    result = make(failures, start, axis_columns)
     del axis_columns, table
-    return frame
+    return result
 
 
 def _run_by_row(
