@@ -43,12 +43,13 @@ torso leaves 0.2 to 1 m), and a seed whose Ant lies with its feet out of the san
 nearly at the rigid floor's speed. So each seed's row also says, from a few more runs of
 each (the same seeded paths, their calls timed on their own), on what share of the MuJoCo
 steps some foot had elements below the surface (at any RK4 stage), the Sand's time per such
-step (its four passive-force calls), MuJoCo's own time per step with the sand (the Sand's
-calls taken out, the Python callback's dispatch left in) and on the rigid floor, and how
-many resets per 1000 env steps each had (an episode ends when the Ant is unhealthy or at
-its 1000th step). The headline is the median over the seeds of the sand / rigid ratio,
-against the line of 0.5. With the defaults (15 repeats of 1000 env steps) ``python
-benches/bench_mujoco.py --part rollout`` takes about 2.5 minutes on a release build.
+step (its four passive-force calls) and per step out of the sand, MuJoCo's own time per step
+with the sand (the Sand's calls taken out, the Python callback's dispatch left in) and on the
+rigid floor, and how many resets per 1000 env steps each had (an episode ends when the Ant
+is unhealthy or at its 1000th step). The headline is the median over the seeds of the sand
+/ rigid ratio, against the line of 0.5. With the defaults (15 repeats of 1000 env steps)
+``python benches/bench_mujoco.py --part rollout`` takes about 2.5 minutes on a release
+build.
 
 **At rest (``--part rest``).** Gymnasium's own hopper (``hopper.xml``, RK4 at 2 ms, no
 floor) held upright by a PD controller on its motors, its whole weight on its foot in the
@@ -372,14 +373,13 @@ def space_cost(repeats: int, steps: int) -> None:
 _ELEMENTS = SPACE_GEOM_OUTPUTS.index("elements")
 
 
-def sand_steps(calls: list[tuple[int, bool, float]]) -> tuple[int, int, float]:
+def sand_steps(calls: list[tuple[int, bool, float]]) -> tuple[int, int, float, float]:
     """MuJoCo steps from the Sand's passive-force calls, in order, each ``(stage, in_sand,
     seconds)``: the call's RK4 stage (1 to 4; each step starts with a stage 1), whether some
     geom had elements below the surface after it, and the call's time.
 
-    Returns the number of steps, how many had a geom in the sand at any of their stages,
-    and the Sand's time summed over those steps' calls (a step out of the sand, whose calls
-    have nothing to solve, is left out)."""
+    Returns the number of steps, how many had a geom in the sand at any of their stages, and
+    the Sand's time summed over those steps' calls and over the other steps' calls."""
     steps: list[list] = []  # [in the sand, seconds] of each MuJoCo step
     for stage, inside, seconds in calls:
         if stage == 1:
@@ -389,7 +389,8 @@ def sand_steps(calls: list[tuple[int, bool, float]]) -> tuple[int, int, float]:
         steps[-1][0] = steps[-1][0] or inside
         steps[-1][1] += seconds
     sand = [seconds for inside, seconds in steps if inside]
-    return len(steps), len(sand), float(sum(sand))
+    out = [seconds for inside, seconds in steps if not inside]
+    return len(steps), len(sand), float(sum(sand)), float(sum(out))
 
 
 def rollout_medians(rows: list[dict[str, float]]) -> dict[str, float]:
@@ -404,6 +405,7 @@ ROLLOUT_COLUMNS = (
     ("rigid", "rigid floor [env steps/s, median]", "{:.0f}"),
     ("share", "MuJoCo steps with a foot in the sand", "{:.0%}"),
     ("sand_us", "Sand per such step [us]", "{:.0f}"),
+    ("out_us", "Sand per step out of the sand [us]", "{:.1f}"),
     ("mj_us", "mj_step, sand env [us]", "{:.1f}"),
     ("rigid_us", "mj_step, rigid floor [us]", "{:.1f}"),
     ("resets", "resets per 1000 env steps, sand (rigid)", "{:.1f}"),
@@ -440,7 +442,7 @@ def rollout(repeats: int, steps: int, seeds: int) -> dict[str, float]:
                 resets += 1
         return steps / (time.perf_counter() - t), resets
 
-    def trace(env: gymnasium.Env, seed: int) -> tuple[float, int, int, float, int]:
+    def trace(env: gymnasium.Env, seed: int) -> tuple[float, int, int, float, float, int]:
         """MuJoCo's time per step [s], and sand_steps() of the run (zeros on the rigid
         floor), and the resets."""
         clock = time.perf_counter
@@ -505,12 +507,12 @@ def rollout(repeats: int, steps: int, seeds: int) -> dict[str, float]:
                 resets.add((r_resets, s_resets))
             assert len(resets) == 1, "a seed's path is the same in every repeat"
             # The traces' times: the median of a few (one run's move with the machine's load).
-            rigid_us = float(np.median([trace(rigid, seed)[0] for _ in range(traces)]))
-            *_, rigid_resets = trace(rigid, seed)
+            rigids = [trace(rigid, seed) for _ in range(traces)]
+            rigid_us, rigid_resets = float(np.median([t[0] for t in rigids])), rigids[0][-1]
             sands = [trace(sand, seed) for _ in range(traces)]
-            mj_us, sand_s = (float(np.median([t[k] for t in sands])) for k in (0, 3))
-            _, n, in_sand, _, sand_resets = sands[0]
-            assert all(t[1:3] == (n, in_sand) and t[4] == sand_resets for t in sands)
+            mj_us, sand_s, out_s = (float(np.median([t[k] for t in sands])) for k in (0, 3, 4))
+            _, n, in_sand, _, _, sand_resets = sands[0]
+            assert all(t[1:3] == (n, in_sand) and t[5] == sand_resets for t in sands)
             assert (rigid_resets, sand_resets) in resets, "the traced runs follow the timed paths"
             assert n == steps * sand.unwrapped.frame_skip, "every MuJoCo step's calls traced"
             rows.append(
@@ -519,6 +521,7 @@ def rollout(repeats: int, steps: int, seeds: int) -> dict[str, float]:
                     "rigid": float(np.median(speeds)),
                     "share": in_sand / n,
                     "sand_us": sand_s / in_sand * 1e6 if in_sand else float("nan"),
+                    "out_us": out_s / (n - in_sand) * 1e6 if n > in_sand else float("nan"),
                     "mj_us": mj_us * 1e6,
                     "rigid_us": rigid_us * 1e6,
                     "resets": sand_resets * 1000 / steps,

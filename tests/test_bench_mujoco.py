@@ -25,8 +25,8 @@ def _bench():
 
 def test_sand_steps_groups_rk4_stages_into_steps():
     """Three RK4 steps: the first in the sand at its third stage only (its four calls' time
-    counts, 1 + 1 + 2 + 1), the second out of the sand (left out), the third in the sand
-    throughout (4 x 3): 3 steps, 2 in the sand, 5 + 12 = 17 s."""
+    counts, 1 + 1 + 2 + 1), the second out of the sand (4 x 0.5), the third in the sand
+    throughout (4 x 3): 3 steps, 2 in the sand, 5 + 12 = 17 s in the sand, 2 s out."""
     calls = [
         (1, False, 1.0),
         (2, False, 1.0),
@@ -41,15 +41,15 @@ def test_sand_steps_groups_rk4_stages_into_steps():
         (3, True, 3.0),
         (4, True, 3.0),
     ]
-    assert _bench().sand_steps(calls) == (3, 2, 17.0)
+    assert _bench().sand_steps(calls) == (3, 2, 17.0, 2.0)
 
 
 def test_sand_steps_one_call_per_step_and_edges():
     """Euler's one call per step (every call a stage 1); no calls; a trace that starts
     inside a step is an error."""
     bench = _bench()
-    assert bench.sand_steps([(1, True, 1.0), (1, False, 2.0), (1, True, 4.0)]) == (3, 2, 5.0)
-    assert bench.sand_steps([]) == (0, 0, 0.0)
+    assert bench.sand_steps([(1, True, 1.0), (1, False, 2.0), (1, True, 4.0)]) == (3, 2, 5.0, 2.0)
+    assert bench.sand_steps([]) == (0, 0, 0.0, 0.0)
     with pytest.raises(ValueError, match="stage 2"):
         bench.sand_steps([(2, True, 1.0)])
 
