@@ -48,7 +48,7 @@ def test_sand_steps_one_call_per_step_and_edges():
     """Euler's one call per step (every call a stage 1); no calls; a trace that starts
     inside a step is an error."""
     bench = _bench()
-    assert bench.sand_steps([(1, True, 1.0), (1, False, 2.0), (1, True, 4.0)]) == (3, 2, 5.0, 2.0)
+    assert bench.sand_steps([(1, True, 1.0), (1, True, 4.0), (1, False, 2.0)]) == (3, 2, 5.0, 2.0)
     assert bench.sand_steps([]) == (0, 0, 0.0, 0.0)
     with pytest.raises(ValueError, match="stage 2"):
         bench.sand_steps([(2, True, 1.0)])
