@@ -37,7 +37,19 @@ sand, nor ``Sand.step`` repeated on one state, whose solve then starts converged
 
 **A Gymnasium rollout (``--part rollout``).** ``Ant-v5`` with seeded random actions, with
 :class:`granrs.gym.SandWrapper` and on its rigid floor, timed in turn within each repeat: env
-steps per second and their ratio.
+steps per second and their ratio, for each of ``--seeds`` seeds (6). The ratio measures the
+Ant's path as much as the sand: random actions throw the Ant about (an episode ends when its
+torso leaves 0.2 to 1 m), and a seed whose Ant lies with its feet out of the sand runs
+nearly at the rigid floor's speed. So each seed's row also says, from a few more runs of
+each (the same seeded paths, their calls timed on their own), on what share of the MuJoCo
+steps some foot had elements below the surface (at any RK4 stage), the Sand's time per such
+step (its four passive-force calls) and per step out of the sand, MuJoCo's own time per step
+with the sand (the Sand's calls taken out, the Python callback's dispatch left in) and on the
+rigid floor, and how many resets per 1000 env steps each had (an episode ends when the Ant
+is unhealthy or at its 1000th step). The headline is the median over the seeds of the sand
+/ rigid ratio, against the line of 0.5. With the defaults (15 repeats of 1000 env steps)
+``python benches/bench_mujoco.py --part rollout`` takes about 2.5 minutes on a release
+build.
 
 **At rest (``--part rest``).** Gymnasium's own hopper (``hopper.xml``, RK4 at 2 ms, no
 floor) held upright by a PD controller on its motors, its whole weight on its foot in the
@@ -57,7 +69,7 @@ the load and a rise of 1e-6 J/s.
 Usage::
 
     python benches/bench_mujoco.py [--part all|table|cost|space-table|space-cost|rollout|rest]
-                                   [--repeats 15] [--steps 1000]
+                                   [--repeats 15] [--steps 1000] [--seeds 6]
 """
 
 from __future__ import annotations
@@ -71,7 +83,14 @@ import numpy as np
 
 import granrs
 from granrs import forces, space
-from granrs.mujoco import WALKER_SAND_GEOMS, Sand, body_drop, rod_drop, walker_mjcf
+from granrs.mujoco import (
+    SPACE_GEOM_OUTPUTS,
+    WALKER_SAND_GEOMS,
+    Sand,
+    body_drop,
+    rod_drop,
+    walker_mjcf,
+)
 
 TIMESTEPS = (1e-4, 1e-3, 2e-3)
 RUNS = (("Euler", "step"), ("RK4", "step"), ("RK4", "callback"), ("implicitfast", "step"))
@@ -350,42 +369,176 @@ def space_cost(repeats: int, steps: int) -> None:
         )
 
 
-def rollout(repeats: int, steps: int) -> None:
-    """Gymnasium's Ant-v5 with random actions (seeded), with :class:`granrs.gym.SandWrapper`
-    and on its rigid floor: env steps per second over ``steps`` steps, the two timed in turn
-    within each repeat (reset at the start and whenever an episode ends)."""
+#: The column of ``Sand.output`` that counts a geom's surface elements below the sand.
+_ELEMENTS = SPACE_GEOM_OUTPUTS.index("elements")
+
+
+def sand_steps(calls: list[tuple[int, bool, float]]) -> tuple[int, int, float, float]:
+    """MuJoCo steps from the Sand's passive-force calls, in order, each ``(stage, in_sand,
+    seconds)``: the call's RK4 stage (1 to 4; each step starts with a stage 1), whether some
+    geom had elements below the surface after it, and the call's time.
+
+    Returns the number of steps, how many had a geom in the sand at any of their stages, and
+    the Sand's time summed over those steps' calls and over the other steps' calls."""
+    steps: list[list] = []  # [in the sand, seconds] of each MuJoCo step
+    for stage, inside, seconds in calls:
+        if stage == 1:
+            steps.append([False, 0.0])
+        elif not steps:
+            raise ValueError(f"the first call is at RK4 stage {stage}, not a step's first")
+        steps[-1][0] = steps[-1][0] or inside
+        steps[-1][1] += seconds
+    sand = [seconds for inside, seconds in steps if inside]
+    out = [seconds for inside, seconds in steps if not inside]
+    return len(steps), len(sand), float(sum(sand)), float(sum(out))
+
+
+def rollout_medians(rows: list[dict[str, float]]) -> dict[str, float]:
+    """The median over seeds of each column of the per-seed rows (each seed's sand / rigid
+    ratio is itself the median of its repeats)."""
+    return {k: float(np.median([row[k] for row in rows])) for k in rows[0]}
+
+
+#: The columns of ``--part rollout``'s table: (key, header, format).
+ROLLOUT_COLUMNS = (
+    ("ratio", "sand / rigid (median of repeats)", "{:.2f}"),
+    ("rigid", "rigid floor [env steps/s, median]", "{:.0f}"),
+    ("share", "MuJoCo steps with a foot in the sand", "{:.0%}"),
+    ("sand_us", "Sand per such step [us]", "{:.0f}"),
+    ("out_us", "Sand per step out of the sand [us]", "{:.1f}"),
+    ("mj_us", "mj_step, sand env [us]", "{:.1f}"),
+    ("rigid_us", "mj_step, rigid floor [us]", "{:.1f}"),
+    ("resets", "resets per 1000 env steps, sand (rigid)", "{:.1f}"),
+    ("rigid_resets", "", "{:.1f}"),
+)
+
+
+def rollout(repeats: int, steps: int, seeds: int) -> dict[str, float]:
+    """Gymnasium's Ant-v5 with random actions, with :class:`granrs.gym.SandWrapper` and on
+    its rigid floor, for seeds 0 to ``seeds - 1`` (the environment's reset and its action
+    space seeded alike): env steps per second over ``steps`` steps, the two timed in turn
+    within each repeat (reset at the start and whenever an episode ends). Then ``repeats //
+    5`` more runs of each (at least one; the medians of their times), the same seeded paths
+    with the calls timed on their own (the timed runs are bare): the Sand's passive-force
+    callback (its RK4 stage, and whether a foot has elements below the surface after it) and
+    MuJoCo's step (``_step_mujoco_simulation`` less the Sand's calls in it, per step of
+    ``frame_skip``). Prints a row per seed and the medians over seeds; returns the medians."""
     import gymnasium
 
     from granrs.gym import SandWrapper
 
-    def run(env: gymnasium.Env) -> float:
-        env.reset(seed=0)
-        env.action_space.seed(0)
-        actions = [env.action_space.sample() for _ in range(steps)]
+    def actions(env: gymnasium.Env, seed: int) -> list:
+        env.reset(seed=seed)
+        env.action_space.seed(seed)
+        return [env.action_space.sample() for _ in range(steps)]
+
+    def run(env: gymnasium.Env, seed: int) -> tuple[float, int]:
+        todo, resets = actions(env, seed), 0
         t = time.perf_counter()
-        for a in actions:
+        for a in todo:
             _, _, terminated, truncated, _ = env.step(a)
             if terminated or truncated:
                 env.reset()
-        return steps / (time.perf_counter() - t)
+                resets += 1
+        return steps / (time.perf_counter() - t), resets
+
+    def trace(env: gymnasium.Env, seed: int) -> tuple[float, int, int, float, float, int]:
+        """MuJoCo's time per step [s], and sand_steps() of the run (zeros on the rigid
+        floor), and the resets."""
+        clock = time.perf_counter
+        inner = env.unwrapped
+        calls: list[tuple[int, bool, float]] = []
+        sand = env.sand if isinstance(env, SandWrapper) else None
+        simulate = inner._step_mujoco_simulation
+        mujoco_time, tracing = [0.0], [0.0]
+
+        def timed_simulation(ctrl: object, n_frames: int) -> None:
+            before, traced = len(calls), tracing[0]
+            t = clock()
+            simulate(ctrl, n_frames)
+            dt = clock() - t - (tracing[0] - traced)
+            mujoco_time[0] += dt - sum(c[2] for c in calls[before:])
+
+        todo, resets = actions(env, seed), 0
+        inner._step_mujoco_simulation = timed_simulation
+        if sand is not None:
+            callback = sand._callback
+
+            def timed_callback(m: mujoco.MjModel, d: mujoco.MjData) -> None:
+                t0 = clock()
+                callback(m, d)
+                t1 = clock()
+                stage = sand._stage[0] if sand._rk4 else 1
+                calls.append((stage, bool(np.any(sand.output[:, _ELEMENTS] > 0)), t1 - t0))
+                tracing[0] += clock() - t1  # this trace's own time, neither MuJoCo's nor sand's
+
+            calls.clear()
+            sand._callback = timed_callback
+        try:
+            for a in todo:
+                _, _, terminated, truncated, _ = env.step(a)
+                if terminated or truncated:
+                    during_step = len(calls)
+                    env.reset()  # its mj_forward calls the Sand once: not a step's
+                    del calls[during_step:]
+                    resets += 1
+        finally:
+            del inner._step_mujoco_simulation
+            if sand is not None:
+                del sand._callback
+        n_mj = steps * inner.frame_skip
+        return (mujoco_time[0] / n_mj, *sand_steps(calls), resets)
 
     rigid = gymnasium.make("Ant-v5")
     sand = SandWrapper(gymnasium.make("Ant-v5"))
-    ratios, best = [], {"rigid": 0.0, "sand": 0.0}
+    traces = max(1, repeats // 5)
+    print(f"Ant-v5, random actions, {steps} env steps, {repeats} repeats, seeds 0 to {seeds - 1}:")
+    print("| seed | " + " | ".join(h for _, h, _ in ROLLOUT_COLUMNS if h) + " |")
+    print("|---" * sum(1 for _, h, _ in (("", "seed", ""), *ROLLOUT_COLUMNS) if h) + "|")
+    rows = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", granrs.StepSizeWarning)
-        for _ in range(repeats):
-            r, s = run(rigid), run(sand)
-            best["rigid"], best["sand"] = max(best["rigid"], r), max(best["sand"], s)
-            ratios.append(s / r)
-    q = np.array(ratios)
-    print(f"Ant-v5, random actions, {steps} env steps, {repeats} repeats:")
-    print("| rigid floor [steps/s, max] | sand [steps/s, max] | sand / rigid (median, range) |")
-    print("|---|---|---|")
-    print(
-        f"| {best['rigid']:.0f} | {best['sand']:.0f} | {np.median(q):.2f} "
-        f"({q.min():.2f} to {q.max():.2f}) |"
-    )
+        for seed in range(seeds):
+            ratios, speeds, resets = [], [], set()
+            for _ in range(repeats):
+                (r, r_resets), (s, s_resets) = run(rigid, seed), run(sand, seed)
+                ratios.append(s / r)
+                speeds.append(r)
+                resets.add((r_resets, s_resets))
+            assert len(resets) == 1, "a seed's path is the same in every repeat"
+            # The traces' times: the median of a few (one run's move with the machine's load).
+            rigids = [trace(rigid, seed) for _ in range(traces)]
+            rigid_us, rigid_resets = float(np.median([t[0] for t in rigids])), rigids[0][-1]
+            sands = [trace(sand, seed) for _ in range(traces)]
+            mj_us, sand_s, out_s = (float(np.median([t[k] for t in sands])) for k in (0, 3, 4))
+            _, n, in_sand, _, _, sand_resets = sands[0]
+            assert all(t[1:3] == (n, in_sand) and t[5] == sand_resets for t in sands)
+            assert (rigid_resets, sand_resets) in resets, "the traced runs follow the timed paths"
+            assert n == steps * sand.unwrapped.frame_skip, "every MuJoCo step's calls traced"
+            rows.append(
+                {
+                    "ratio": float(np.median(ratios)),
+                    "rigid": float(np.median(speeds)),
+                    "share": in_sand / n,
+                    "sand_us": sand_s / in_sand * 1e6 if in_sand else float("nan"),
+                    "out_us": out_s / (n - in_sand) * 1e6 if n > in_sand else float("nan"),
+                    "mj_us": mj_us * 1e6,
+                    "rigid_us": rigid_us * 1e6,
+                    "resets": sand_resets * 1000 / steps,
+                    "rigid_resets": rigid_resets * 1000 / steps,
+                }
+            )
+            print(_rollout_row(str(seed), rows[-1]), flush=True)
+    medians = rollout_medians(rows)
+    print(_rollout_row("median", medians))
+    print(f"sand / rigid, the median over seeds: {medians['ratio']:.2f} (the line: >= 0.5)")
+    return medians
+
+
+def _rollout_row(label: str, row: dict[str, float]) -> str:
+    cells = {k: f.format(row[k]) for k, _, f in ROLLOUT_COLUMNS}
+    cells["resets"] += f" ({cells.pop('rigid_resets')})"
+    return f"| {label} | " + " | ".join(cells.values()) + " |"
 
 
 #: The laws of ``--part rest``: the Sand's arguments (zeta as the docs' Ant and hopper).
@@ -500,6 +653,7 @@ def main() -> None:
     )
     parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--steps", type=int, default=1000)
+    parser.add_argument("--seeds", type=int, default=6, help="--part rollout's seeds")
     args = parser.parse_args()
     if args.part in ("all", "cost"):
         cost(args.repeats, args.steps)
@@ -510,7 +664,7 @@ def main() -> None:
     if args.part in ("all", "space-cost"):
         space_cost(args.repeats, args.steps)
     if args.part in ("all", "rollout"):
-        rollout(args.repeats, args.steps)
+        rollout(args.repeats, args.steps, args.seeds)
     if args.part in ("all", "rest"):
         rest()
 
