@@ -22,7 +22,7 @@ import re
 import uuid
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
 
@@ -667,6 +667,53 @@ def fast_lanes() -> bool:
         True where the lanes call the four-lane functions.
     """
     return bool(_granrs.fast_lanes())
+
+
+# The result's type follows ``as_frame`` for type checkers: a DataFrame by default, a dict
+# of numpy arrays with ``as_frame=False`` (the signature is the implementation's below).
+@overload
+def sweep(
+    scene: Scene | Sequence[Scene],
+    *,
+    threads: int | None = ...,
+    progress: bool | None = ...,
+    client: Any = ...,
+    chunk_size: int | None = ...,
+    lanes: bool = ...,
+    outputs: Sequence[str] | None = ...,
+    as_frame: Literal[True] = ...,
+    **axes: Any,
+) -> pd.DataFrame: ...
+
+
+@overload
+def sweep(
+    scene: Scene | Sequence[Scene],
+    *,
+    threads: int | None = ...,
+    progress: bool | None = ...,
+    client: Any = ...,
+    chunk_size: int | None = ...,
+    lanes: bool = ...,
+    outputs: Sequence[str] | None = ...,
+    as_frame: Literal[False],
+    **axes: Any,
+) -> dict[str, np.ndarray]: ...
+
+
+@overload
+def sweep(
+    scene: Scene | Sequence[Scene],
+    *,
+    threads: int | None = ...,
+    progress: bool | None = ...,
+    client: Any = ...,
+    chunk_size: int | None = ...,
+    lanes: bool = ...,
+    outputs: Sequence[str] | None = ...,
+    as_frame: bool = ...,
+    **axes: Any,
+) -> pd.DataFrame | dict[str, np.ndarray]: ...
 
 
 def sweep(
