@@ -10,17 +10,16 @@ prints its figures.
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import os
 import re
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from _modules import load_module
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -33,12 +32,7 @@ BENCHES = Path(__file__).resolve().parent.parent / "benches"
 
 
 def _load_bench() -> Any:
-    spec = importlib.util.spec_from_file_location("adversarial", BENCHES / "adversarial.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["adversarial"] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_module("adversarial", BENCHES / "adversarial.py")
 
 
 adversarial = _load_bench()

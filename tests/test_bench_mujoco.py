@@ -4,23 +4,14 @@ the expected values computed by hand)."""
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import pytest
+from _modules import REPO, load_module
 
 pytest.importorskip("mujoco")
 
 
 def _bench():
-    path = Path(__file__).resolve().parents[1] / "benches" / "bench_mujoco.py"
-    spec = importlib.util.spec_from_file_location("granrs_bench_mujoco", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_module("granrs_bench_mujoco", REPO / "benches" / "bench_mujoco.py")
 
 
 def test_sand_steps_groups_rk4_stages_into_steps():

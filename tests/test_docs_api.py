@@ -12,15 +12,14 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import importlib.util
 import io
 import os
 import re
-import sys
 from pathlib import Path
 from types import ModuleType
 
 import pytest
+from _modules import load_module
 
 import granrs
 from granrs import forces
@@ -29,15 +28,7 @@ DOCS = Path(__file__).resolve().parents[1] / "docs"
 
 
 def _generator() -> ModuleType:
-    name = "granrs_docs"
-    if name in sys.modules:
-        return sys.modules[name]
-    spec = importlib.util.spec_from_file_location(name, DOCS / "_ext" / "granrs_docs.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_module("granrs_docs", DOCS / "_ext" / "granrs_docs.py", reuse=True)
 
 
 gen = _generator()

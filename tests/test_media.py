@@ -4,13 +4,12 @@ one's own, and bad cards refused naming the entry."""
 from __future__ import annotations
 
 import doctest
-import importlib.util
 import math
 import pickle
-import sys
 from pathlib import Path
 
 import pytest
+from _modules import load_module
 
 import granrs
 from granrs import forces as f
@@ -263,12 +262,7 @@ def test_the_module_s_examples_run() -> None:
 
 def test_the_docs_table_lists_every_card_s_every_value() -> None:
     docs = Path(__file__).resolve().parents[1] / "docs"
-    spec = importlib.util.spec_from_file_location("granrs_docs", docs / "_ext" / "granrs_docs.py")
-    assert spec is not None and spec.loader is not None
-    gen = sys.modules.get("granrs_docs") or importlib.util.module_from_spec(spec)
-    if "granrs_docs" not in sys.modules:
-        sys.modules["granrs_docs"] = gen
-        spec.loader.exec_module(gen)
+    gen = load_module("granrs_docs", docs / "_ext" / "granrs_docs.py", reuse=True)
     page = (docs / "media.md").read_text(encoding="utf-8")
     assert ".. granrs-media-table::" in page
     rows = gen.media_table_rows()

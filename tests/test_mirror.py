@@ -13,14 +13,12 @@ now runs from its deeper corner in both.
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 import warnings
-from pathlib import Path
 from types import ModuleType
 
 import pytest
+from _modules import REPO, load_module
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -34,13 +32,7 @@ NEGATED = ("x_tip_end", "dq", "omega_end")
 
 
 def _bench() -> ModuleType:
-    path = Path(__file__).resolve().parents[1] / "benches" / "step_warning.py"
-    spec = importlib.util.spec_from_file_location("granrs_bench_step_warning_mirror", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_module("granrs_bench_step_warning_mirror", REPO / "benches" / "step_warning.py")
 
 
 def simulate_quiet(scene: granrs.Scene) -> tuple[granrs.Result, bool]:

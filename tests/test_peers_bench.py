@@ -8,10 +8,9 @@ the stop is located), and solve_ivp must converge to granrs's reference depth.
 from __future__ import annotations
 
 import importlib.util
-import sys
-from pathlib import Path
 
 import pytest
+from _modules import REPO, load_module
 
 # Benchmarks: deselected by default (pyproject's addopts), run with -m bench after
 # pip install -e '.[bench]'. A mark, not a module-level importorskip, so that a default run
@@ -26,13 +25,7 @@ pytestmark = [
 
 
 def _peers():
-    path = Path(__file__).resolve().parents[1] / "benches" / "peers.py"
-    spec = importlib.util.spec_from_file_location("granrs_bench_peers", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_module("granrs_bench_peers", REPO / "benches" / "peers.py")
 
 
 def test_peers_agree_with_granrs_raw_and_solve_ivp_converges():

@@ -9,14 +9,12 @@ to 1144.0 J, without a warning. Each test below says how it failed on that code.
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
 import warnings
-from pathlib import Path
 from types import ModuleType
 
 import pytest
+from _modules import REPO, load_module
 
 import granrs
 from granrs import batch, cases
@@ -26,13 +24,7 @@ MASS, LENGTH, DIAMETER, RHO_G = 0.184, 0.190, 0.0127, 1650.0
 
 
 def _bench() -> ModuleType:
-    path = Path(__file__).resolve().parents[1] / "benches" / "step_warning.py"
-    spec = importlib.util.spec_from_file_location("granrs_bench_step_warning", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_module("granrs_bench_step_warning", REPO / "benches" / "step_warning.py")
 
 
 def simulate_caught(scene: granrs.Scene) -> tuple[granrs.Result, list[str]]:

@@ -4,7 +4,6 @@ progress, stops on Ctrl-C, and gives the same table on Dask."""
 
 from __future__ import annotations
 
-import importlib.util
 import itertools
 import math
 import multiprocessing
@@ -12,11 +11,11 @@ import os
 import signal
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from _modules import REPO, load_module
 
 import granrs
 from granrs import _granrs, batch, cases
@@ -323,12 +322,7 @@ def test_a_sweep_of_linkages_with_several_links_names_their_joint_columns() -> N
 
     import numpy as np
 
-    spec = importlib.util.spec_from_file_location(
-        "soak", Path(__file__).parent.parent / "benches" / "soak.py"
-    )
-    assert spec is not None and spec.loader is not None
-    soak = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(soak)
+    soak = load_module("soak", REPO / "benches" / "soak.py")
     scenes = soak.random_table_scenes(np.random.default_rng(1), 3, False, 500)
     df = granrs.sweep(scenes, progress=False)
     assert len(df) == 3
